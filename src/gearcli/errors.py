@@ -1,0 +1,71 @@
+"""Input problems: collected with their source location, reported once.
+
+Every check appends an :class:`Issue` (file, YAML path or element, line, message) to a
+list; :class:`MechanismError` carries the whole list.  The CLI prints one line per issue
+(``file:line: path: message``) and exits with status 2.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Issue:
+    """One problem in an input file."""
+
+    file: str
+    path: str
+    line: int | None
+    message: str
+
+    def __str__(self) -> str:
+        where = self.file if self.line is None else f"{self.file}:{self.line}"
+        return f"{where}: {self.path}: {self.message}" if self.path else f"{where}: {self.message}"
+
+
+class GearcliError(Exception):
+    """Base class of the errors gearcli reports as bad input (exit status 2)."""
+
+    def lines(self) -> list[str]:
+        return [str(self)]
+
+
+class MechanismError(GearcliError):
+    """A mechanism file is invalid; ``issues`` lists every problem found."""
+
+    def __init__(self, issues: list[Issue]):
+        self.issues = list(issues)
+        super().__init__("\n".join(str(i) for i in self.issues))
+
+    def lines(self) -> list[str]:
+        return [str(i) for i in self.issues]
+
+
+class TrajectoryError(GearcliError):
+    """A trajectory file or array is invalid."""
+
+
+class Collector:
+    """Collects issues of one file, locating YAML paths through a path -> line map."""
+
+    def __init__(self, file: str, lines: dict[str, int] | None = None):
+        self.file = file
+        self.lines = lines or {}
+        self.issues: list[Issue] = []
+
+    def line_of(self, path: str) -> int | None:
+        """Line of ``path`` or of its nearest enclosing node."""
+        p = path
+        while p:
+            if p in self.lines:
+                return self.lines[p]
+            cut = max(p.rfind("."), p.rfind("["))
+            p = p[:cut] if cut > 0 else ""
+        return self.lines.get("", None)
+
+    def add(self, path: str, message: str) -> None:
+        self.issues.append(Issue(self.file, path, self.line_of(path), message))
+
+    def raise_if_any(self) -> None:
+        if self.issues:
+            raise MechanismError(self.issues)

@@ -1,0 +1,278 @@
+"""Mechanism files (YAML) -> :class:`~gearcli.model.Mechanism`.
+
+Parsing keeps each node's line (``yaml.compose``) under its YAML path, e.g.
+``gears[2].mesh_point``, so that every later check can say where a problem is.  The file is
+validated against ``schemas/mechanism.schema.json`` (jsonschema), then checked for names,
+masses and inertias.  Problems are collected and raised together as a
+:class:`~gearcli.errors.MechanismError`.  Degrees (``*_deg`` fields) are converted here;
+nothing below this module knows about them.
+"""
+from __future__ import annotations
+
+import json
+from functools import lru_cache
+from importlib import resources
+from pathlib import Path
+
+import jsonschema
+import numpy as np
+import yaml
+
+from .errors import Collector, Issue, MechanismError
+from .model import GearPair, Joint, Link, Mechanism, Motor
+from .spatial import align_z, rot_x, rot_z, rpy_matrix
+
+
+@lru_cache(maxsize=1)
+def mechanism_schema() -> dict:
+    """The JSON Schema of mechanism files (``schemas/mechanism.schema.json``)."""
+    try:
+        text = resources.files("gearcli").joinpath("schemas/mechanism.schema.json").read_text()
+    except (FileNotFoundError, ModuleNotFoundError, OSError):
+        text = (Path(__file__).resolve().parents[2] / "schemas" / "mechanism.schema.json").read_text()
+    return json.loads(text)
+
+
+def load_mechanism(path: str | Path) -> Mechanism:
+    """Read a mechanism from a YAML file or a URDF (``.urdf``) file.
+
+    Raises :class:`~gearcli.errors.MechanismError` listing every problem found.
+    """
+    path = Path(path)
+    if path.suffix.lower() in (".urdf", ".xml"):
+        from .urdf import load_urdf  # noqa: PLC0415  (optional stage)
+
+        return load_urdf(path)
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise MechanismError([Issue(str(path), "", None, f"cannot read file: {exc.strerror}")]) from None
+    return parse_mechanism(text, str(path))
+
+
+def yaml_lines(text: str, file: str) -> tuple[object, dict[str, int]]:
+    """Parse YAML ``text``; return the data and a map YAML path -> 1-based line.
+
+    Duplicate mapping keys and syntax errors raise :class:`MechanismError`.
+    """
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        line = mark.line + 1 if mark is not None else None
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise MechanismError([Issue(file, "", line, f"YAML syntax error: {problem}")]) from None
+    lines: dict[str, int] = {}
+    col = Collector(file, lines)
+
+    def walk(node, path: str) -> None:
+        lines[path] = node.start_mark.line + 1
+        if isinstance(node, yaml.MappingNode):
+            seen = set()
+            for key, value in node.value:
+                k = key.value
+                sub = f"{path}.{k}" if path else str(k)
+                if k in seen:
+                    lines[sub] = key.start_mark.line + 1
+                    col.add(sub, f"duplicate key '{k}'")
+                seen.add(k)
+                walk(value, sub)
+                lines[sub] = key.start_mark.line + 1
+        elif isinstance(node, yaml.SequenceNode):
+            for i, item in enumerate(node.value):
+                walk(item, f"{path}[{i}]")
+
+    if root is not None:
+        walk(root, "")
+    col.raise_if_any()
+    return data, lines
+
+
+def _json_path(parts) -> str:
+    out = ""
+    for p in parts:
+        out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))
+    return out
+
+
+def _schema_issues(data, col: Collector) -> None:
+    validator = jsonschema.Draft202012Validator(mechanism_schema())
+    for err in sorted(validator.iter_errors(data), key=lambda e: list(map(str, e.absolute_path))):
+        if err.validator == "oneOf" and err.context:
+            # report the branch that got furthest, not the whole oneOf blurb
+            best = max(err.context, key=lambda e: len(e.absolute_path))
+            message = best.message
+        else:
+            message = err.message
+        col.add(_json_path(err.absolute_path), message)
+
+
+def parse_mechanism(text: str, file: str = "<string>") -> Mechanism:
+    """Parse the YAML text of a mechanism file (see the README for the format)."""
+    data, lines = yaml_lines(text, file)
+    col = Collector(file, lines)
+    if not isinstance(data, dict):
+        col.add("", "a mechanism file must be a YAML mapping")
+        col.raise_if_any()
+    _schema_issues(data, col)
+    col.raise_if_any()
+    mech = _build(data, col, file, lines)
+    col.raise_if_any()
+    return mech
+
+
+def inertia_matrix(spec) -> np.ndarray:
+    """Inertia tensor from ``[Ixx, Iyy, Izz]`` or ``{ixx, iyy, izz, ixy, ixz, iyz}``."""
+    if isinstance(spec, dict):
+        ixx, iyy, izz = spec["ixx"], spec["iyy"], spec["izz"]
+        ixy, ixz, iyz = spec.get("ixy", 0.0), spec.get("ixz", 0.0), spec.get("iyz", 0.0)
+        return np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]], float)
+    return np.diag(np.asarray(spec, float))
+
+
+def check_inertia(I: np.ndarray, mass: float) -> str | None:
+    """Why ``I`` is not a physical inertia tensor about the centre of mass, or None."""
+    w = np.linalg.eigvalsh(I)
+    scale = max(float(np.max(np.abs(w))), 1e-300)
+    if mass > 0 and np.all(w == 0):
+        return None  # point mass
+    if w[0] < -1e-12 * scale:
+        return f"inertia tensor is not positive semi-definite (eigenvalues {np.array2string(w, precision=4)})"
+    a, b, c = w
+    if a + b < c * (1 - 1e-9) - 1e-15:
+        return (f"principal moments {np.array2string(w, precision=4)} violate the triangle "
+                "inequality (I1 + I2 >= I3)")
+    return None
+
+
+def _angle(spec: dict, key: str, col: Collector, path: str) -> float:
+    if key in spec and f"{key}_deg" in spec:
+        col.add(f"{path}.{key}_deg", f"give either {key} (rad) or {key}_deg, not both")
+    if f"{key}_deg" in spec:
+        return float(np.deg2rad(spec[f"{key}_deg"]))
+    return float(spec.get(key, 0.0))
+
+
+def joint_geometry(spec: dict, col: Collector, path: str):
+    """(R_pj, p_pj, R_jc, p_jc) of a joint spec with ``dh`` or ``origin``/``axis``."""
+    if "dh" in spec:
+        if "origin" in spec or "axis" in spec:
+            col.add(path, "give the joint geometry either as dh or as origin/axis, not both")
+        dh = spec["dh"]
+        theta = _angle(dh, "theta", col, f"{path}.dh")
+        alpha = _angle(dh, "alpha", col, f"{path}.dh")
+        d, a = float(dh.get("d", 0.0)), float(dh.get("a", 0.0))
+        return rot_z(theta), np.array([0.0, 0.0, d]), rot_x(alpha), np.array([a, 0.0, 0.0])
+    origin = spec.get("origin", {})
+    xyz = np.asarray(origin.get("xyz", [0.0, 0.0, 0.0]), float)
+    if "rpy" in origin and "rpy_deg" in origin:
+        col.add(f"{path}.origin.rpy_deg", "give either rpy (rad) or rpy_deg, not both")
+    rpy = np.deg2rad(origin["rpy_deg"]) if "rpy_deg" in origin else np.asarray(origin.get("rpy", [0, 0, 0]), float)
+    axis = np.asarray(spec.get("axis", [0.0, 0.0, 1.0]), float)
+    if np.linalg.norm(axis) < 1e-12:
+        col.add(f"{path}.axis", "joint axis must not be the zero vector")
+        axis = np.array([0.0, 0.0, 1.0])
+    A = align_z(axis)
+    return rpy_matrix(rpy) @ A, xyz, A.T, np.zeros(3)
+
+
+def _build(data: dict, col: Collector, file: str, lines: dict) -> Mechanism:
+    base = data["base"]
+    links: list[Link] = []
+    names: dict[str, str] = {}
+    for i, spec in enumerate(data["links"]):
+        path = f"links[{i}]"
+        name = spec["name"]
+        if name in names:
+            col.add(f"{path}.name", f"duplicate link name '{name}' (first at {names[name]})")
+        names[name] = path
+        mass = float(spec.get("mass", 0.0))
+        I = inertia_matrix(spec["inertia"]) if "inertia" in spec else np.zeros((3, 3))
+        if name != base:
+            if "mass" not in spec:
+                col.add(path, f"link '{name}' has no mass")
+            elif mass <= 0:
+                col.add(f"{path}.mass", f"mass must be positive, got {mass:g} kg")
+            why = check_inertia(I, mass)
+            if why:
+                col.add(f"{path}.inertia", why)
+        links.append(Link(name, mass, np.asarray(spec.get("com", [0, 0, 0]), float), I, path))
+
+    def ref(value: str, path: str, what: str = "link") -> None:
+        if value not in names:
+            col.add(path, f"unknown {what} '{value}'")
+
+    for key in ("base", "end_effector"):
+        ref(data[key], key)
+
+    joints: list[Joint] = []
+    jnames: dict[str, str] = {}
+    for i, spec in enumerate(data["joints"]):
+        path = f"joints[{i}]"
+        if spec["name"] in jnames:
+            col.add(f"{path}.name", f"duplicate joint name '{spec['name']}' (first at {jnames[spec['name']]})")
+        jnames[spec["name"]] = path
+        ref(spec["parent"], f"{path}.parent")
+        ref(spec["child"], f"{path}.child")
+        if spec["parent"] == spec["child"]:
+            col.add(f"{path}.child", "a joint cannot connect a link to itself")
+        R_pj, p_pj, R_jc, p_jc = joint_geometry(spec, col, path)
+        source = {k: spec[k] for k in ("dh", "origin", "axis") if k in spec}
+        joints.append(Joint(spec["name"], spec["parent"], spec["child"], R_pj, p_pj, R_jc, p_jc,
+                            spec.get("type", "revolute"), spec.get("label"), source, path))
+
+    gears: list[GearPair] = []
+    gnames: dict[str, str] = {}
+    for i, spec in enumerate(data.get("gears", [])):
+        path = f"gears[{i}]"
+        j, k = spec["links"]
+        ref(j, f"{path}.links[0]")
+        ref(k, f"{path}.links[1]")
+        if j == k:
+            col.add(f"{path}.links", "a gear pair needs two different links")
+        name = spec.get("name", f"{j}-{k}")
+        if name in gnames:
+            col.add(f"{path}.name", f"duplicate gear pair name '{name}' (first at {gnames[name]})")
+        gnames[name] = path
+        if "carrier" in spec:
+            ref(spec["carrier"], f"{path}.carrier")
+        if "ratio" not in spec and "teeth" not in spec:
+            col.add(path, "a gear pair needs a ratio or tooth counts (teeth)")
+        if spec.get("ratio", 1.0) == 0:
+            col.add(f"{path}.ratio", "gear ratio must not be zero")
+        if "mesh_point" not in spec and "ratio" not in spec:
+            col.add(path, "a gear pair without mesh_point needs an explicit signed ratio")
+        kind = spec.get("kind", "external")
+        cones = spec.get("cone_angles_deg")
+        if cones is not None and kind != "bevel":
+            col.add(f"{path}.cone_angles_deg", f"cone angles are only for bevel gears, this pair is {kind}")
+        gears.append(GearPair(
+            name, j, k, kind,
+            float(spec["ratio"]) if "ratio" in spec else None,
+            tuple(spec["teeth"]) if "teeth" in spec else None,
+            np.asarray(spec["mesh_point"], float) if "mesh_point" in spec else None,
+            spec.get("carrier"),
+            float(np.deg2rad(spec.get("pressure_angle_deg", 20.0))),
+            tuple(np.deg2rad(cones)) if cones is not None else None,
+            path,
+        ))
+
+    motors: list[Motor] = []
+    mnames: dict[str, str] = {}
+    for i, spec in enumerate(data.get("motors", [])):
+        path = f"motors[{i}]"
+        if spec["name"] in mnames:
+            col.add(f"{path}.name", f"duplicate motor name '{spec['name']}' (first at {mnames[spec['name']]})")
+        mnames[spec["name"]] = path
+        ref(spec["link"], f"{path}.link")
+        if "stator" in spec:
+            ref(spec["stator"], f"{path}.stator")
+        motors.append(Motor(spec["name"], spec["link"], spec.get("stator"), path))
+
+    return Mechanism(
+        name=data["name"], base=base, end_effector=data["end_effector"],
+        links=tuple(links), joints=tuple(joints), gears=tuple(gears), motors=tuple(motors),
+        gravity=np.asarray(data.get("gravity", [0.0, 0.0, -9.81]), float),
+        source=file, lines=dict(lines),
+    )

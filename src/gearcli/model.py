@@ -1,0 +1,118 @@
+"""The mechanism model: frozen dataclasses that no algorithm mutates.
+
+Frames and units
+----------------
+Every link has a frame.  Lengths in m, masses in kg, inertias in kg*m^2 about the centre of
+mass with axes parallel to the link frame, angles in rad.  A revolute joint connects a
+*parent* link to a *child* link.  Its geometry is normalised, whatever the file said, to
+
+    child frame = parent frame * X_pj * Rz(q) * X_jc
+
+where ``X_pj = (R_pj, p_pj)`` places the **joint frame** in the parent frame at q = 0 (its
+z axis is the rotation axis) and ``X_jc = (R_jc, p_jc)`` places the child frame in the
+rotated joint frame.  The joint frame after rotation, parent * X_pj * Rz(q), is fixed in
+the child: its z is the joint axis and its x turns with the child.  For a D-H joint it is
+Rz(theta)*Tz(d) of the parent frame.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True, eq=False)
+class Link:
+    """A rigid body.  ``inertia`` is about the centre of mass, in link-frame axes."""
+
+    name: str
+    mass: float = 0.0
+    com: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+    path: str = ""
+
+
+@dataclass(frozen=True, eq=False)
+class Joint:
+    """A one-degree-of-freedom joint (a real bearing) between ``parent`` and ``child``.
+
+    ``type`` is ``"revolute"`` (q is an angle about the joint z axis) or ``"prismatic"``
+    (q is a displacement along it).  ``source`` keeps the geometry as written in the file
+    (``{"dh": {...}}`` or ``{"origin": {...}, "axis": [...]}``) for export.
+    """
+
+    name: str
+    parent: str
+    child: str
+    R_pj: np.ndarray
+    p_pj: np.ndarray
+    R_jc: np.ndarray
+    p_jc: np.ndarray
+    type: str = "revolute"
+    label: str | None = None
+    source: dict = field(default_factory=dict)
+    path: str = ""
+
+
+GEAR_KINDS = ("external", "internal", "bevel")
+
+
+@dataclass(frozen=True, eq=False)
+class GearPair:
+    """A gear pair between links ``j`` and ``k``.
+
+    Fundamental circuit equation (paper Eq. 8): theta_{j,c} = ratio * theta_{k,c}, with c
+    the carrier and the angles measured about each joint's positive axis.  ``mesh_point``
+    is the pitch point in the carrier frame (m); ``None`` means an ideal coupling with no
+    tooth geometry.
+    """
+
+    name: str
+    j: str
+    k: str
+    kind: str = "external"
+    ratio: float | None = None
+    teeth: tuple[int, int] | None = None
+    mesh_point: np.ndarray | None = None
+    carrier: str | None = None
+    pressure_angle: float = np.deg2rad(20.0)
+    cone_angles: tuple[float, float] | None = None
+    path: str = ""
+
+
+@dataclass(frozen=True, eq=False)
+class Motor:
+    """A motor driving input link ``link``; its stator is fixed in ``stator`` (default the
+    input link's carrier in the canonical graph).  Its torque acts on ``link`` about the
+    link's positive joint axis and, reversed, on the stator."""
+
+    name: str
+    link: str
+    stator: str | None = None
+    path: str = ""
+
+
+@dataclass(frozen=True, eq=False)
+class Mechanism:
+    """A whole mechanism as read from a file.  ``lines`` maps source paths to lines."""
+
+    name: str
+    base: str
+    end_effector: str
+    links: tuple[Link, ...]
+    joints: tuple[Joint, ...]
+    gears: tuple[GearPair, ...] = ()
+    motors: tuple[Motor, ...] = ()
+    gravity: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, -9.81]))
+    source: str = "<memory>"
+    lines: dict = field(default_factory=dict)
+
+    def link(self, name: str) -> Link:
+        for link in self.links:
+            if link.name == name:
+                return link
+        raise KeyError(name)
+
+    @property
+    def link_names(self) -> list[str]:
+        return [link.name for link in self.links]

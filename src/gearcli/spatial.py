@@ -1,0 +1,96 @@
+"""Rotations, homogeneous transforms and batched vector helpers.
+
+Batched arrays carry the sample axis first: vectors ``(N, 3)``, rotations ``(N, 3, 3)``.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def rot_x(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def rot_y(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def rot_z(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def rpy_matrix(rpy) -> np.ndarray:
+    """URDF roll-pitch-yaw (fixed axes x, y, z): R = Rz(yaw) Ry(pitch) Rx(roll)."""
+    r, p, y = rpy
+    return rot_z(y) @ rot_y(p) @ rot_x(r)
+
+
+def matrix_rpy(R: np.ndarray) -> np.ndarray:
+    """Inverse of :func:`rpy_matrix` (roll, pitch, yaw)."""
+    pitch = np.arctan2(-R[2, 0], np.hypot(R[0, 0], R[1, 0]))
+    if np.hypot(R[0, 0], R[1, 0]) < 1e-12:
+        return np.array([np.arctan2(-R[1, 2], R[1, 1]), pitch, 0.0])
+    return np.array([np.arctan2(R[2, 1], R[2, 2]), pitch, np.arctan2(R[1, 0], R[0, 0])])
+
+
+def align_z(axis) -> np.ndarray:
+    """A rotation whose third column is the unit vector ``axis`` (minimal rotation from z)."""
+    a = np.asarray(axis, float)
+    a = a / np.linalg.norm(a)
+    z = np.array([0.0, 0.0, 1.0])
+    v = np.cross(z, a)
+    c = float(a @ z)
+    if np.linalg.norm(v) < 1e-15:
+        return np.eye(3) if c > 0 else rot_x(np.pi)
+    K = skew(v)
+    return np.eye(3) + K + K @ K / (1.0 + c)
+
+
+def skew(v) -> np.ndarray:
+    x, y, z = v
+    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+
+
+def rot_z_batch(q: np.ndarray) -> np.ndarray:
+    """Rotations about z by angles ``q`` (N,) -> (N, 3, 3)."""
+    c, s = np.cos(q), np.sin(q)
+    R = np.zeros(q.shape + (3, 3))
+    R[..., 0, 0] = c
+    R[..., 0, 1] = -s
+    R[..., 1, 0] = s
+    R[..., 1, 1] = c
+    R[..., 2, 2] = 1.0
+    return R
+
+
+def mv(R: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Batched matrix-vector product: (N,3,3) or (3,3) times (N,3) or (3,)."""
+    return np.einsum("...ij,...j->...i", R, x)
+
+
+def mm(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """Batched matrix product."""
+    return np.matmul(A, B)
+
+
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product of (N,3) arrays (broadcasting), faster than np.cross for small rows."""
+    return np.stack(
+        (
+            a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+            a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+            a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0],
+        ),
+        axis=-1,
+    )
+
+
+def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.einsum("...i,...i->...", a, b)
+
+
+def unit(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
