@@ -1,0 +1,66 @@
+"""File to file: mechanism + trajectory CSV -> loads CSV and summary (``gearcli solve``).
+
+Data flow: :func:`~gearcli.loader.load_mechanism` -> :func:`~gearcli.graph.analyse` ->
+:class:`~gearcli.trajectory.TrajectoryReader` (chunks) -> :func:`~gearcli.dynamics.solve` ->
+:mod:`~gearcli.report`.  Memory is bounded by the chunk size, whatever the file length.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from .dynamics import solve
+from .graph import Analysis, analyse
+from .loader import load_mechanism
+from .report import AtomicWriter, Summary, column_names, format_rows, table
+from .trajectory import TrajectoryReader
+
+
+@dataclass
+class SolveReport:
+    analysis: Analysis
+    samples: int
+    summary: Summary
+    residual: float | None
+    output: Path | None
+
+
+def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, method: str = "block",
+               verify: bool = False, chunk: int = 50_000, progress=None, analysis: Analysis | None = None) -> SolveReport:
+    """Solve a trajectory file and write the loads CSV (see :mod:`gearcli.report`).
+
+    ``progress(total=None, advance=None)`` is called with ``total`` once (number of
+    samples) and with ``advance`` after each chunk.  The output is written to a temporary
+    file and renamed only when everything succeeded.
+    """
+    an = analysis or analyse(load_mechanism(mech_path))
+    reader = TrajectoryReader(traj_path, an.independent_names, degrees=degrees, chunk=chunk)
+    if progress is not None:
+        progress(total=reader.count())
+    summary = Summary.for_mechanism(an)
+    worst = 0.0
+    n = 0
+
+    def run(f):
+        nonlocal worst, n
+        if f is not None:
+            f.write(",".join(column_names(an)) + "\n")
+        for part in reader:
+            res = solve(an, part.q, part.qd, part.qdd, method=method, chunk=chunk, verify=verify)
+            tab = table(an, part.t, res)
+            summary.add(tab)
+            if f is not None:
+                f.write(format_rows(tab))
+            if verify:
+                worst = max(worst, res.residual)
+            n += len(part.t)
+            if progress is not None:
+                progress(advance=len(part.t))
+
+    out = None if out_path is None else Path(out_path)
+    if out is None:
+        run(None)
+    else:
+        with AtomicWriter(out) as f:
+            run(f)
+    return SolveReport(an, n, summary, worst if verify else None, out)

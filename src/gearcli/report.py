@@ -1,0 +1,142 @@
+"""Result tables: the output CSV columns (a stable contract) and the summary statistics.
+
+Columns, in order (units SI):
+
+* ``t`` (s);
+* ``motor:<motor>`` (N*m): torque the motor applies to its input link about that link's
+  positive joint axis (N for a prismatic input);
+* ``tau:<joint>`` (N*m): equivalent torques on the independent joints (paper Eq. 25);
+* per gear pair with geometry ``gear:<pair>:t`` (N, tangential force on gear j by gear k,
+  positive when it turns j in j's positive sense), ``gear:<pair>:sep`` (N, separating
+  force magnitude), ``gear:<pair>:<link>:radial`` and ``gear:<pair>:<link>:axial`` (N,
+  the tooth force on that gear along its outward radial direction at the pitch point and
+  along its positive axis), for j then k; per ideal pair (no geometry)
+  ``gear:<pair>:torque`` (N*m, mesh torque on j about its axis);
+* per real joint ``joint:<joint>:fx, fy, fz, mx, my, mz`` (N, N*m): reaction wrench the
+  parent exerts on the child, in the joint frame, about its origin; then
+  ``joint:<joint>:radial`` = hypot(fx, fy), ``axial`` = |fz|, ``bending`` = hypot(mx, my).
+"""
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .dynamics import Result
+
+
+def column_names(an) -> list[str]:
+    mech = an.mech
+    cols = ["t"]
+    cols += [f"motor:{m.name}" for m in mech.motors]
+    cols += [f"tau:{n}" for n in an.independent_names]
+    for c in an.circuits:
+        gp = mech.gears[c.gear]
+        if c.geometry is None:
+            cols.append(f"gear:{gp.name}:torque")
+            continue
+        cols += [f"gear:{gp.name}:t", f"gear:{gp.name}:sep"]
+        for link in (gp.j, gp.k):
+            cols += [f"gear:{gp.name}:{link}:radial", f"gear:{gp.name}:{link}:axial"]
+    for jt in mech.joints:
+        cols += [f"joint:{jt.name}:{c}" for c in ("fx", "fy", "fz", "mx", "my", "mz", "radial", "axial", "bending")]
+    return cols
+
+
+def table(an, t: np.ndarray, res: Result) -> np.ndarray:
+    """The output columns of :func:`column_names` as one (N, ncol) array."""
+    parts = [t[:, None], res.motor, res.tau]
+    for ci, c in enumerate(an.circuits):
+        if c.geometry is None:
+            parts.append(res.gear_t[:, ci:ci + 1])
+            continue
+        parts += [res.gear_t[:, ci:ci + 1], res.gear_sep[:, ci:ci + 1],
+                  np.stack([res.gear_radial[:, ci, 0], res.gear_axial[:, ci, 0],
+                            res.gear_radial[:, ci, 1], res.gear_axial[:, ci, 1]], axis=1)]
+    W = res.joint
+    for ji in range(W.shape[1]):
+        w = W[:, ji]
+        parts += [w, np.stack([np.hypot(w[:, 0], w[:, 1]), np.abs(w[:, 2]), np.hypot(w[:, 3], w[:, 4])], axis=1)]
+    return np.hstack(parts)
+
+
+@dataclass
+class Stat:
+    name: str
+    unit: str
+    peak: float = 0.0
+    t_peak: float = float("nan")
+    sumsq: float = 0.0
+    n: int = 0
+
+    @property
+    def rms(self) -> float:
+        return float(np.sqrt(self.sumsq / self.n)) if self.n else float("nan")
+
+
+@dataclass
+class Summary:
+    """Peak magnitude, RMS and time of the peak of the main loads, accumulated by chunks."""
+
+    columns: list[int]
+    stats: list[Stat] = field(default_factory=list)
+
+    @classmethod
+    def for_mechanism(cls, an) -> "Summary":
+        names = column_names(an)
+        pick = []
+        for i, n in enumerate(names):
+            kind = n.split(":")[0]
+            last = n.rsplit(":", 1)[-1]
+            if kind == "motor":
+                pick.append((i, f"motor {n[6:]}", "N·m"))
+            elif kind == "gear" and last in ("t", "torque"):
+                pick.append((i, f"gear {n[5:-len(last) - 1]} {'tangential' if last == 't' else 'torque'}",
+                             "N" if last == "t" else "N·m"))
+            elif kind == "joint" and last in ("radial", "axial", "bending"):
+                pick.append((i, f"bearing {n[6:-len(last) - 1]} {last}", "N·m" if last == "bending" else "N"))
+        return cls([p[0] for p in pick], [Stat(p[1], p[2]) for p in pick])
+
+    def add(self, tab: np.ndarray) -> None:
+        t = tab[:, 0]
+        X = np.abs(tab[:, self.columns])
+        imax = np.argmax(X, axis=0)
+        for k, st in enumerate(self.stats):
+            v = X[imax[k], k]
+            if v > st.peak or st.n == 0:
+                st.peak, st.t_peak = float(v), float(t[imax[k]])
+            st.sumsq += float(np.dot(X[:, k], X[:, k]))
+            st.n += X.shape[0]
+
+
+def format_rows(tab: np.ndarray, fmt: str = "%.9g") -> str:
+    """CSV text of the rows of ``tab``."""
+    n, m = tab.shape
+    line = ",".join([fmt] * m) + "\n"
+    return (line * n) % tuple(tab.ravel().tolist())
+
+
+class AtomicWriter:
+    """A text file written to a temporary file beside the target and renamed on success,
+    so that a failure never leaves a partial output."""
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+        self.tmp = None
+
+    def __enter__(self):
+        d = self.path.parent if str(self.path.parent) else Path(".")
+        fd, self.tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".tmp", dir=d)
+        self.f = os.fdopen(fd, "w")
+        return self.f
+
+    def __exit__(self, exc_type, exc, tb):
+        self.f.close()
+        if exc_type is None:
+            os.replace(self.tmp, self.path)
+        else:
+            os.unlink(self.tmp)
+        return False
