@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .kinematics import forward
+from .blocks import solve_blocks
 from .loads import Columns, inertia_load
 from .schedule import unknown_groups
 
@@ -127,16 +128,30 @@ def _solve_chunk(an, q_ind, qd_ind, qdd_ind, method, verify) -> Result:
     q, qd, qdd = joint_space(an, q_ind, qd_ind, qdd_ind)
     kin = forward(an.mech, an.tree, q, qd, qdd)
     b = inertia_load(an, kin)
-    cols = Columns(an, kin)
+    cols = Columns(an, kin) if (method == "full" or verify) else _LazyColumns(an, kin)
     groups = unknown_groups(an)
     if method == "block":
-        x, sig = _block_solve(an, groups, cols, b)
+        def general(gs, links, rhs):
+            return _solve_signed(an, gs, cols, links, rhs)
+        x, sig = solve_blocks(an, kin, b, q, general)
     else:
         x, sig = _full_solve(an, groups, cols, b)
     res = _result(an, groups, x)
     if verify:
         res.residual = residual(an, groups, cols, b, x, sig)
     return res
+
+
+class _LazyColumns:
+    """Columns built on first use (the fast block path rarely needs them)."""
+
+    def __init__(self, an, kin):
+        self.an, self.kin, self._c = an, kin, None
+
+    def __getattr__(self, name):
+        if self._c is None:
+            self._c = Columns(self.an, self.kin)
+        return getattr(self._c, name)
 
 
 def _key(g):
@@ -217,32 +232,6 @@ class _SubCols:
 class _SubKin:
     def __init__(self, kin, idx):
         self.n = len(idx)
-
-
-def _block_solve(an, groups, cols, b):
-    tree = an.tree
-    blocks = an.schedule
-    block_of = {L: i for i, blk in enumerate(blocks) for L in blk}
-    owner: dict[int, list] = {i: [] for i in range(len(blocks))}
-    for g in groups:
-        owner[min(block_of[L] for L in g.links)].append(g)
-    rhs = {L: b[L].copy() for L in tree.moving}
-    x_all, sig_all = {}, {}
-    for bi, blk in enumerate(blocks):
-        gs = owner[bi]
-        R = np.concatenate([rhs[L] for L in blk], axis=1)
-        x, sig = _solve_signed(an, gs, cols, list(blk), R)
-        sig_all.update(sig)
-        c0 = 0
-        for g in gs:
-            xg = x[:, c0:c0 + g.size]
-            x_all[_key(g)] = xg
-            for L in g.links:
-                if block_of[L] > bi:
-                    C = cols.group(g, L, sig.get(_key(g), 1.0))
-                    rhs[L] -= np.einsum("nij,nj->ni", C, xg)
-            c0 += g.size
-    return x_all, sig_all
 
 
 def _full_solve(an, groups, cols, b):

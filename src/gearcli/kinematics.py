@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .model import Mechanism
-from .spatial import cross, mv, rot_z_batch
+from .spatial import cross
 from .tree import Tree
 
 
@@ -63,8 +63,12 @@ def forward(mech: Mechanism, tree: Tree, q: np.ndarray, qd: np.ndarray | None = 
     for ji in tree.order:
         jt = mech.joints[ji]
         p, c = tree.parent[tree.index[jt.child]], tree.index[jt.child]
-        Rj0 = R[p] @ jt.R_pj                      # (N,3,3) joint frame at q = 0
-        r_pj = mv(R[p], jt.p_pj)                  # (N,3) o_p -> joint origin
+        if p == b:
+            Rj0 = np.broadcast_to(jt.R_pj, (N, 3, 3))   # (N,3,3) joint frame at q = 0
+            r_pj = np.broadcast_to(jt.p_pj, (N, 3))     # (N,3) o_p -> joint origin
+        else:
+            Rj0 = R[p] @ jt.R_pj
+            r_pj = R[p] @ jt.p_pj
         z = Rj0[:, :, 2]                          # (N,3) joint axis
         if jt.type == "prismatic":
             Rj[ji] = Rj0
@@ -72,20 +76,30 @@ def forward(mech: Mechanism, tree: Tree, q: np.ndarray, qd: np.ndarray | None = 
             w[c] = w[p]
             dw[c] = dw[p]
         else:
-            Rj[ji] = Rj0 @ rot_z_batch(q[:, ji])
+            Rj[ji] = _turn_z(Rj0, q[:, ji])
             oj[ji] = o[p] + r_pj
             w[c] = w[p] + z * qd[:, ji:ji + 1]
             dw[c] = dw[p] + z * qdd[:, ji:ji + 1] + cross(w[p], z) * qd[:, ji:ji + 1]
-        R[c] = Rj[ji] @ jt.R_jc
+        R[c] = Rj[ji] if np.array_equal(jt.R_jc, np.eye(3)) else Rj[ji] @ jt.R_jc
         r = oj[ji] - o[p]
         a_j = a[p] + cross(dw[p], r) + cross(w[p], cross(w[p], r))
         if jt.type == "prismatic":
             v = z * qd[:, ji:ji + 1]
             a_j = a_j + z * qdd[:, ji:ji + 1] + 2 * cross(w[p], v)
-        rc = mv(Rj[ji], jt.p_jc)
+        rc = Rj[ji] @ jt.p_jc
         o[c] = oj[ji] + rc
         a[c] = a_j + cross(dw[c], rc) + cross(w[c], cross(w[c], rc))
     return Kinematics(R, o, w, dw, a, Rj, oj)
+
+
+def _turn_z(R0: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """R0 @ Rz(q) for R0 (N,3,3) and angles q (N,), by columns."""
+    c, s = np.cos(q)[:, None], np.sin(q)[:, None]
+    out = np.empty(R0.shape)
+    out[:, :, 0] = c * R0[:, :, 0] + s * R0[:, :, 1]
+    out[:, :, 1] = c * R0[:, :, 1] - s * R0[:, :, 0]
+    out[:, :, 2] = R0[:, :, 2]
+    return out
 
 
 def velocities(mech: Mechanism, tree: Tree, kin: Kinematics, qd: np.ndarray):

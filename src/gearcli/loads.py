@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from .kinematics import Kinematics
-from .spatial import cross, mv
+from .spatial import cross, mtv, mv
 
 ZERO3 = None
 
@@ -39,8 +39,8 @@ def inertia_load(an, kin: Kinematics) -> dict[int, np.ndarray]:
         w, dw = kin.w[L], kin.dw[L]
         a_c = kin.a[L] + cross(dw, rc) + cross(w, cross(w, rc))
         F = link.mass * (a_c - g)
-        wb = np.einsum("nji,nj->ni", R, w)                     # R^T w
-        dwb = np.einsum("nji,nj->ni", R, dw)
+        wb = mtv(R, w)                                         # R^T w
+        dwb = mtv(R, dw)
         Nb = dwb @ link.inertia.T + cross(wb, wb @ link.inertia.T)
         out[L] = np.concatenate([F, mv(R, Nb) + cross(rc, F)], axis=1)
     return out

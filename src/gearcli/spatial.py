@@ -67,8 +67,17 @@ def rot_z_batch(q: np.ndarray) -> np.ndarray:
 
 
 def mv(R: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """Batched matrix-vector product: (N,3,3) or (3,3) times (N,3) or (3,)."""
-    return np.einsum("...ij,...j->...i", R, x)
+    """Batched matrix-vector product R x: (N,3,3) or (3,3) times (N,3) or (3,)."""
+    if R.ndim == 2:
+        return x @ R.T
+    if x.ndim == 1:
+        return R @ x
+    return R[:, :, 0] * x[:, 0:1] + R[:, :, 1] * x[:, 1:2] + R[:, :, 2] * x[:, 2:3]
+
+
+def mtv(R: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Batched R^T x for R (N,3,3) and x (N,3)."""
+    return R[:, 0, :] * x[:, 0:1] + R[:, 1, :] * x[:, 1:2] + R[:, 2, :] * x[:, 2:3]
 
 
 def mm(A: np.ndarray, B: np.ndarray) -> np.ndarray:
@@ -78,14 +87,14 @@ def mm(A: np.ndarray, B: np.ndarray) -> np.ndarray:
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Cross product of (N,3) arrays (broadcasting), faster than np.cross for small rows."""
-    return np.stack(
-        (
-            a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
-            a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-            a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0],
-        ),
-        axis=-1,
-    )
+    a, b = np.broadcast_arrays(a, b)
+    out = np.empty(a.shape, dtype=np.result_type(a, b))
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    np.subtract(a1 * b2, a2 * b1, out=out[..., 0])
+    np.subtract(a2 * b0, a0 * b2, out=out[..., 1])
+    np.subtract(a0 * b1, a1 * b0, out=out[..., 2])
+    return out
 
 
 def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
