@@ -6,6 +6,7 @@ Data flow: :func:`~gearcli.loader.load_mechanism` -> :func:`~gearcli.graph.analy
 """
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,7 +32,8 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
 
     ``progress(total=None, advance=None)`` is called with ``total`` once (number of
     samples) and with ``advance`` after each chunk.  The output is written to a temporary
-    file and renamed only when everything succeeded.
+    file and renamed only when everything succeeded; ``out_path="-"`` writes to stdout and
+    ``None`` writes nothing (summary only).
     """
     an = analysis or analyse(load_mechanism(mech_path))
     reader = TrajectoryReader(traj_path, an.independent_names, degrees=degrees, chunk=chunk)
@@ -57,9 +59,11 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
             if progress is not None:
                 progress(advance=len(part.t))
 
-    out = None if out_path is None else Path(out_path)
-    if out is None:
+    out = None if out_path is None or str(out_path) == "-" else Path(out_path)
+    if out_path is None:
         run(None)
+    elif out is None:
+        run(sys.stdout)
     else:
         with AtomicWriter(out) as f:
             run(f)
