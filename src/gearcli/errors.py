@@ -50,7 +50,7 @@ class Collector:
 
     def __init__(self, file: str, lines: dict[str, int] | None = None):
         self.file = file
-        self.lines = lines or {}
+        self.lines = lines if lines is not None else {}
         self.issues: list[Issue] = []
 
     def line_of(self, path: str) -> int | None:

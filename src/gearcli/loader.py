@@ -9,7 +9,9 @@ nothing below this module knows about them.
 """
 from __future__ import annotations
 
+import difflib
 import json
+import math
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
@@ -44,9 +46,11 @@ def load_mechanism(path: str | Path) -> Mechanism:
 
         return load_urdf(path)
     try:
-        text = path.read_text()
+        text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise MechanismError([Issue(str(path), "", None, f"cannot read file: {exc.strerror}")]) from None
+    except UnicodeDecodeError as exc:
+        raise MechanismError([Issue(str(path), "", None, f"not a UTF-8 text file (byte {exc.start})")]) from None
     return parse_mechanism(text, str(path))
 
 
@@ -96,16 +100,53 @@ def _json_path(parts) -> str:
     return out
 
 
+def _schema_messages(err) -> list[tuple[list, str]]:
+    """(path parts, message) pairs for one jsonschema error, made precise for the common
+    cases: an unknown key is reported at its own path (with a close match), a missing key
+    by name, and a oneOf by the branch whose type fits the value."""
+    path = list(err.absolute_path)
+    if err.validator == "additionalProperties" and isinstance(err.instance, dict):
+        allowed = list(err.schema.get("properties", {}))
+        out = []
+        for key in (k for k in err.instance if k not in allowed):
+            close = difflib.get_close_matches(str(key), allowed, n=1)
+            hint = f"did you mean '{close[0]}'?" if close else f"allowed: {', '.join(allowed)}"
+            out.append((path + [key], f"unknown key '{key}' ({hint})"))
+        return out
+    if err.validator == "required" and isinstance(err.instance, dict):
+        missing = [r for r in err.validator_value if r not in err.instance and repr(r) in err.message]
+        return [(path, f"missing required key '{r}'") for r in missing[:1]] or [(path, err.message)]
+    if err.validator == "oneOf" and err.context:
+        branches: dict = {}
+        for e in err.context:
+            branches.setdefault(e.relative_schema_path[0], []).append(e)
+        fitting = [b for b in branches.values()
+                   if not any(e.validator == "type" and list(e.absolute_path) == path for e in b)]
+        if len(fitting) == 1:
+            return [m for e in fitting[0] for m in _schema_messages(e)]
+        types = [s.get("type") for s in err.validator_value if isinstance(s, dict) and "type" in s]
+        if types:
+            return [(path, f"{err.instance!r} is not valid: expected {' or '.join(map(str, types))}")]
+    return [(path, err.message)]
+
+
 def _schema_issues(data, col: Collector) -> None:
     validator = jsonschema.Draft202012Validator(mechanism_schema())
     for err in sorted(validator.iter_errors(data), key=lambda e: list(map(str, e.absolute_path))):
-        if err.validator == "oneOf" and err.context:
-            # report the branch that got furthest, not the whole oneOf blurb
-            best = max(err.context, key=lambda e: len(e.absolute_path))
-            message = best.message
-        else:
-            message = err.message
-        col.add(_json_path(err.absolute_path), message)
+        for parts, message in _schema_messages(err):
+            col.add(_json_path(parts), message)
+
+
+def _nonfinite_issues(data, col: Collector, path: str = "") -> None:
+    """Report NaN and infinite numbers (YAML .nan, .inf), which the schema lets through."""
+    if isinstance(data, float) and not math.isfinite(data):
+        col.add(path, f"{data} is not a finite number")
+    elif isinstance(data, dict):
+        for k, v in data.items():
+            _nonfinite_issues(v, col, f"{path}.{k}" if path else str(k))
+    elif isinstance(data, list):
+        for i, v in enumerate(data):
+            _nonfinite_issues(v, col, f"{path}[{i}]")
 
 
 def parse_mechanism(text: str, file: str = "<string>") -> Mechanism:
@@ -116,6 +157,7 @@ def parse_mechanism(text: str, file: str = "<string>") -> Mechanism:
         col.add("", "a mechanism file must be a YAML mapping")
         col.raise_if_any()
     _schema_issues(data, col)
+    _nonfinite_issues(data, col)
     col.raise_if_any()
     mech = _build(data, col, file, lines)
     col.raise_if_any()
@@ -158,7 +200,8 @@ def joint_geometry(spec: dict, col: Collector, path: str):
     """(R_pj, p_pj, R_jc, p_jc) of a joint spec with ``dh`` or ``origin``/``axis``."""
     if "dh" in spec:
         if "origin" in spec or "axis" in spec:
-            col.add(path, "give the joint geometry either as dh or as origin/axis, not both")
+            col.add(f"{path}.{'origin' if 'origin' in spec else 'axis'}",
+                    "give the joint geometry either as dh or as origin/axis, not both")
         dh = spec["dh"]
         theta = _angle(dh, "theta", col, f"{path}.dh")
         alpha = _angle(dh, "alpha", col, f"{path}.dh")

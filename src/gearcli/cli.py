@@ -1,0 +1,269 @@
+"""The ``gearcli`` command line (typer + rich).
+
+Commands::
+
+    gearcli check MECH               validate a mechanism file
+    gearcli graph MECH [--json|--dot] canonical graph, structure matrix, solve order
+
+Every bad input (unreadable file, YAML or schema error, inconsistent geometry, ...) is
+reported as one line per problem on stderr, ``file:line: yaml.path: message``, with exit
+status 2 and no traceback; commands get that behaviour from :func:`reports_bad_input`.
+SI units throughout: m, kg, kg*m^2, rad (degrees only in ``*_deg`` fields of input files).
+"""
+from __future__ import annotations
+
+import functools
+import json
+import math
+from contextlib import contextmanager
+from pathlib import Path
+from typing import TYPE_CHECKING, Iterator
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from . import __version__
+from .errors import GearcliError
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .graph import Analysis
+
+EXIT_BAD_INPUT = 2
+JSON_DIGITS = 12  # significant digits of floats in JSON output
+
+app = typer.Typer(
+    name="gearcli",
+    help="Dynamics of geared robotic mechanisms: canonical graph, structure matrix, motor "
+         "torques, bearing loads and gear tooth forces.  SI units: m, kg, kg*m^2, rad, N, N*m.",
+    no_args_is_help=True,
+    add_completion=False,
+    rich_markup_mode=None,
+    pretty_exceptions_show_locals=False,
+)
+
+MECH_HELP = ("Mechanism file (YAML; see schemas/mechanism.schema.json).  Lengths in m, masses "
+             "in kg, inertias in kg*m^2, angles in rad (degrees in *_deg fields).")
+
+
+# ---------------------------------------------------------------------------------------
+# bad input -> one line per problem on stderr, exit status 2
+# ---------------------------------------------------------------------------------------
+def print_problems(lines: list[str]) -> None:
+    """Write each problem line verbatim to stderr (no markup, no wrapping)."""
+    for line in lines:
+        typer.echo(line, err=True)
+
+
+@contextmanager
+def bad_input_exits() -> Iterator[None]:
+    """Turn a :class:`~gearcli.errors.GearcliError` into problem lines and exit status 2."""
+    try:
+        yield
+    except GearcliError as exc:
+        print_problems(exc.lines())
+        raise typer.Exit(EXIT_BAD_INPUT) from None
+
+
+def reports_bad_input(command):
+    """Decorator for commands: bad input is reported by :func:`bad_input_exits`."""
+    @functools.wraps(command)
+    def wrapper(*args, **kwargs):
+        with bad_input_exits():
+            return command(*args, **kwargs)
+    return wrapper
+
+
+def load_analysis(path: Path) -> Analysis:
+    """Load and analyse a mechanism file (raises GearcliError on bad input).
+
+    Input problems the loader worked around (``Mechanism.warnings``) go to stderr, one
+    line each, without changing the exit status.
+    """
+    from .graph import analyse  # noqa: PLC0415  (keeps --help fast)
+    from .loader import load_mechanism  # noqa: PLC0415
+
+    mech = load_mechanism(path)
+    print_problems([f"warning: {w}" for w in getattr(mech, "warnings", ())])
+    return analyse(mech)
+
+
+# ---------------------------------------------------------------------------------------
+# formatting helpers
+# ---------------------------------------------------------------------------------------
+def round_sig(obj, digits: int = JSON_DIGITS):
+    """``obj`` with every float rounded to ``digits`` significant digits (-0.0 -> 0.0).
+
+    Recurses into dicts, lists and tuples; so -0.9999999999999991 becomes -1.0.
+    """
+    if isinstance(obj, float):
+        if not math.isfinite(obj):
+            return obj
+        return float(f"{obj:.{digits}g}") + 0.0
+    if isinstance(obj, dict):
+        return {k: round_sig(v, digits) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [round_sig(v, digits) for v in obj]
+    return obj
+
+
+def fmt_num(x: float) -> str:
+    """A number for tables: 6 significant digits, no negative zero."""
+    return f"{round_sig(float(x), 6):g}"
+
+
+def format_blocks(blocks) -> str:
+    """Solve order as ``{2} -> {4} -> {1, 3}`` from lists of link names."""
+    return " -> ".join("{" + ", ".join(block) + "}" for block in blocks)
+
+
+def stdout_console() -> Console:
+    """Console for tables: no markup parsing of user names, no auto-highlighting; plain
+    lines (solve order, ...) are never wrapped, so they stay greppable."""
+    return Console(markup=False, highlight=False, soft_wrap=True)
+
+
+def links_table(an: Analysis) -> Table:
+    """One row per link: level, primary/secondary, carrier, axis label, real joint."""
+    t = Table(title="Links (canonical graph)", title_justify="left")
+    for col in ("link", "level", "role", "carrier", "axis", "real joint"):
+        t.add_column(col)
+    n, prim = an.names, set(an.primary)
+    for i, name in enumerate(n):
+        if i == an.tree.base:
+            t.add_row(name, "0", "base", "-", "-", "-")
+            continue
+        jt = an.mech.joints[an.tree.parent_joint[i]]
+        t.add_row(name, str(an.level[i]), "primary" if i in prim else "secondary",
+                  n[an.canonical_parent[i]], str(an.label[i]), f"{jt.name}: {jt.parent} -> {jt.child}")
+    return t
+
+
+def gears_table(an: Analysis) -> Table:
+    """One row per gear pair: links j, k, carrier c, kind, ratio e_kj and circuit equation."""
+    t = Table(title="Gear pairs (fundamental circuits: theta_j,c = e_kj * theta_k,c)",
+              title_justify="left")
+    for col in ("pair", "j", "k", "carrier", "kind", "ratio e_kj", "equation"):
+        t.add_column(col)
+    n = an.names
+    equations = [fc["equation"] for fc in an.to_dict()["fundamental_circuits"]]
+    for c, equation in zip(an.circuits, equations):
+        gp = an.mech.gears[c.gear]
+        t.add_row(gp.name, n[c.j], n[c.k], n[c.carrier], gp.kind, fmt_num(c.ratio), equation)
+    return t
+
+
+def groups_table(an: Analysis) -> Table:
+    """Coaxial groups: a carrier and the links turning about one line relative to it."""
+    t = Table(title="Coaxial groups", title_justify="left")
+    for col in ("carrier", "axis", "coaxial links"):
+        t.add_column(col)
+    for g in an.groups:
+        if len(g.members) > 2:
+            t.add_row(an.names[g.carrier], str(g.label), ", ".join(an.name_of(g.members[1:])))
+    return t
+
+
+def structure_table(an: Analysis) -> Table:
+    """Structure matrix A: rows independent joints, columns motors (input = A^T x joint)."""
+    t = Table(title="Structure matrix A", title_justify="left",
+              caption="motor input rotations = A^T x independent joint rotations (rad)")
+    t.add_column("joint \\ motor")
+    for m in an.mech.motors:
+        t.add_column(f"{m.name} ({m.link})", justify="right")
+    for name, row in zip(an.independent_names, an.A):
+        t.add_row(name, *(fmt_num(x) for x in row))
+    return t
+
+
+def print_graph_tables(an: Analysis, console: Console) -> None:
+    """The human-readable ``gearcli graph`` report."""
+    console.print(f"Mechanism {an.mech.name} ({an.mech.source})", style="bold")
+    console.print(links_table(an))
+    console.print(gears_table(an))
+    if any(len(g.members) > 2 for g in an.groups):
+        console.print(groups_table(an))
+    console.print("Transmission lines:", style="bold")
+    for line in an.transmission_lines:
+        console.print("  " + " -> ".join(an.name_of(line)))
+    console.print(f"Degrees of freedom: {an.dof}  (independent joints: {', '.join(an.independent_names)})")
+    console.print(structure_table(an))
+    console.print(f"Pseudo-triangular: {'yes' if an.pseudo_triangular else 'no'}")
+    console.print("Solve order: " + format_blocks([an.name_of(b) for b in an.schedule]))
+
+
+# ---------------------------------------------------------------------------------------
+# commands
+# ---------------------------------------------------------------------------------------
+def _version(value: bool) -> None:
+    if value:
+        typer.echo(f"gearcli {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def main(
+    version: bool = typer.Option(False, "--version", callback=_version, is_eager=True,
+                                 help="Print the gearcli version and exit."),
+) -> None:
+    """Dynamics of geared robotic mechanisms (SI units: m, kg, kg*m^2, rad, N, N*m).
+
+    Bad input is reported one problem per line on stderr as file:line: yaml.path: message,
+    with exit status 2.
+    """
+
+
+@app.command()
+@reports_bad_input
+def check(mech: Path = typer.Argument(..., metavar="MECH", help=MECH_HELP, show_default=False)) -> None:
+    """Validate a mechanism file: schema, names, masses and inertias, joint tree, gear
+    geometry (pitch radii in m, cone angles), motors against the degrees of freedom, and
+    static determinacy of the loads.  Prints a one-line summary; exit 2 on bad input."""
+    an = load_analysis(mech)
+    m = an.mech
+    typer.echo(f"{mech}: OK ({an.dof} dof, {len(m.links)} links, {len(an.circuits)} gear pairs, "
+               f"{len(m.motors)} motors)")
+
+
+@app.command()
+@reports_bad_input
+def graph(
+    mech: Path = typer.Argument(..., metavar="MECH", help=MECH_HELP, show_default=False),
+    as_json: bool = typer.Option(False, "--json", help="Print the analysis as JSON (floats to "
+                                 f"{JSON_DIGITS} significant digits; ratios dimensionless)."),
+    as_dot: bool = typer.Option(False, "--dot", help="Print the canonical graph as Graphviz DOT "
+                                "(render with: dot -Tsvg)."),
+    real_joints: bool = typer.Option(False, "--real-joints", help="With --dot: draw the real "
+                                     "joints (bearings) instead of the canonical thin edges."),
+) -> None:
+    """Show the graph analysis: links with level, primary/secondary, carrier and axis label;
+    gear pairs with their fundamental-circuit equations; coaxial groups; transmission lines;
+    degrees of freedom; structure matrix A (rows: independent joints, columns: motors; motor
+    input rotations in rad = A^T x joint rotations in rad); pseudo-triangularity; solve order."""
+    if as_json and as_dot:
+        raise GearcliError("graph: give at most one of --json and --dot")
+    if real_joints and not as_dot:
+        raise GearcliError("graph: --real-joints only applies to --dot")
+    an = load_analysis(mech)
+    if as_json:
+        typer.echo(json.dumps(round_sig(an.to_dict()), indent=2))
+    elif as_dot:
+        from .dot import to_dot  # noqa: PLC0415
+
+        typer.echo(to_dot(an, real=real_joints), nl=False)
+    else:
+        print_graph_tables(an, stdout_console())
+
+
+# ---------------------------------------------------------------------------------------
+# solve: RESERVED for the lead engineer (motor torques, bearing loads, tooth forces along a
+# trajectory; see gearcli.dynamics).  Register it here with
+#     @app.command()
+#     @reports_bad_input
+#     def solve(...): ...
+# so that bad input gets the same one-line-per-problem report and exit status 2.
+# ---------------------------------------------------------------------------------------
+
+
+if __name__ == "__main__":  # pragma: no cover
+    app()

@@ -1,0 +1,29 @@
+"""Shared fixtures: the bundled mechanism files and an in-process ``gearcli`` runner."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+MECH_DIR = Path(__file__).resolve().parents[1] / "mechanisms"
+
+
+@pytest.fixture(scope="session")
+def mech_dir() -> Path:
+    """The directory of the bundled mechanism files."""
+    return MECH_DIR
+
+
+@pytest.fixture
+def run_cli():
+    """``run_cli("check", path)`` runs gearcli in-process; the result has ``exit_code``,
+    ``stdout`` and ``stderr`` (separately captured)."""
+    from gearcli.cli import app
+
+    runner = CliRunner()
+
+    def run(*args):
+        return runner.invoke(app, [str(a) for a in args])
+
+    return run
