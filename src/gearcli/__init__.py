@@ -21,6 +21,10 @@ _EXPORTS = {
     "load_mechanism": "loader",
     "parse_mechanism": "loader",
     "analyse": "graph",
+    "solve": "dynamics",
+    "Result": "dynamics",
+    "solve_file": "pipeline",
+    "read_trajectory": "trajectory",
     "Analysis": "graph",
     "Mechanism": "model",
     "MechanismError": "errors",
@@ -31,7 +35,10 @@ __all__ = ["__version__", *_EXPORTS]
 
 if TYPE_CHECKING:  # pragma: no cover
     from .errors import GearcliError, MechanismError
+    from .dynamics import Result, solve
     from .graph import Analysis, analyse
+    from .pipeline import solve_file
+    from .trajectory import read_trajectory
     from .loader import load_mechanism, parse_mechanism
     from .model import Mechanism
 

@@ -162,17 +162,15 @@ def solve_blocks(an, kin, b, q_all, general):
         r = np.concatenate(parts, axis=1)                               # (N, 6B) in F about o_F
         N = r.shape[0]
         if p.signed:
+            # the first sign pattern consistent with its own solution (tolerance for t ~ 0),
+            # else the least inconsistent one
             xs = [r @ Ai.T for Ai in p.Ainv]
-            x = xs[-1].copy()
-            chosen = np.zeros(N, bool)
-            pick = np.full(N, len(xs) - 1)
-            for k, (pat, xk) in enumerate(zip(p.patterns, xs)):
-                ok = ~chosen
-                for gi, s in zip(p.signed, pat):
-                    ok &= s * xk[:, p.offs[gi]] >= 0
-                x[ok] = xk[ok]
-                pick[ok] = k
-                chosen |= ok
+            tol = 1e-12 * (1.0 + np.abs(r).max(axis=1))
+            viol = np.stack([np.max([-s * xk[:, p.offs[gi]] for gi, s in zip(p.signed, pat)], axis=0)
+                             for pat, xk in zip(p.patterns, xs)], axis=1)        # (N, patterns)
+            ok = viol <= tol[:, None]
+            pick = np.where(ok.any(axis=1), np.argmax(ok, axis=1), np.argmin(viol, axis=1))
+            x = np.choose(pick[:, None], xs) if len(xs) < 32 else np.stack(xs)[pick, np.arange(N)]
             pat_arr = np.array(p.patterns)[pick]                       # (N, m)
         else:
             x = r @ p.Ainv[0].T

@@ -4,6 +4,7 @@ Commands::
 
     gearcli check MECH               validate a mechanism file
     gearcli graph MECH [--json|--dot] canonical graph, structure matrix, solve order
+    gearcli solve MECH TRAJ.csv [-o OUT.csv]  motor torques, bearing loads, tooth forces
 
 Every bad input (unreadable file, YAML or schema error, inconsistent geometry, ...) is
 reported as one line per problem on stderr, ``file:line: yaml.path: message``, with exit
@@ -255,14 +256,81 @@ def graph(
         print_graph_tables(an, stdout_console())
 
 
+# solve
 # ---------------------------------------------------------------------------------------
-# solve: RESERVED for the lead engineer (motor torques, bearing loads, tooth forces along a
-# trajectory; see gearcli.dynamics).  Register it here with
-#     @app.command()
-#     @reports_bad_input
-#     def solve(...): ...
-# so that bad input gets the same one-line-per-problem report and exit status 2.
-# ---------------------------------------------------------------------------------------
+TRAJ_HELP = ("Trajectory CSV: header t,q:<joint>,... for every independent joint (rad), "
+             "optional qd:/qdd: columns (rad/s, rad/s^2); time t in s, strictly increasing.")
+
+
+def summary_table(report) -> Table:
+    """Peak magnitude, RMS and time of the peak of every motor, mesh and bearing load."""
+    table = Table(title=f"{report.analysis.mech.name}: {report.samples} samples")
+    for col, just in (("load", "left"), ("unit", "left"), ("peak", "right"), ("RMS", "right"),
+                      ("t at peak [s]", "right")):
+        table.add_column(col, justify=just)
+    for st in report.summary.stats:
+        table.add_row(st.name, st.unit, fmt_num(st.peak), fmt_num(st.rms), fmt_num(st.t_peak))
+    return table
+
+
+@app.command()
+@reports_bad_input
+def solve(
+    mech: Path = typer.Argument(..., metavar="MECH", help=MECH_HELP, show_default=False),
+    traj: Path = typer.Argument(..., metavar="TRAJ.csv", help=TRAJ_HELP, show_default=False),
+    output: str = typer.Option(None, "-o", "--output", metavar="OUT.csv",
+                               help="Loads CSV to write, one row per sample ('-' for stdout). "
+                                    "Default: TRAJ.loads.csv beside the trajectory."),
+    degrees: bool = typer.Option(False, "--degrees", help="Angle columns of the trajectory are in "
+                                 "degrees (deg, deg/s, deg/s^2)."),
+    method: str = typer.Option("block", "--method", help="'block': the level-by-level schedule "
+                               "(fast); 'full': all equations simultaneously (cross-check)."),
+    verify: bool = typer.Option(False, "--verify", help="Compute every link's Newton-Euler "
+                                "residual from the solved forces and print the worst (relative)."),
+    chunk: int = typer.Option(50_000, "--chunk", min=100, help="Samples processed at once "
+                              "(bounds memory)."),
+) -> None:
+    """Motor torques (N*m), bearing reaction wrenches (N, N*m, parent on child, joint frame)
+    and gear tooth forces (N) at every sample of a trajectory.  Writes a CSV (columns in the
+    README) and prints, for every motor, gear mesh and bearing, the peak, RMS and time of
+    the peak."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn  # noqa: PLC0415
+
+    from .pipeline import solve_file  # noqa: PLC0415
+
+    if method not in ("block", "full"):
+        raise GearcliError(f"--method: expected 'block' or 'full', got '{method}'")
+    an = load_analysis(mech)
+    out = output if output is not None else str(traj.with_suffix(".loads.csv"))
+    err = Console(stderr=True)
+    to_stdout = out == "-"
+    progress = Progress(TextColumn("solving"), BarColumn(), TextColumn("{task.completed:,}/{task.total:,} samples"),
+                        TimeRemainingColumn(), console=err, transient=True)
+    task = None
+
+    def tick(total=None, advance=None):
+        nonlocal task
+        if total is not None:
+            if total > 4 * chunk:
+                progress.start()
+            task = progress.add_task("solve", total=total)
+        if advance is not None:
+            progress.update(task, advance=advance)
+
+    try:
+        report = solve_file(mech, traj, out, degrees=degrees, method=method, verify=verify,
+                            chunk=chunk, progress=tick, analysis=an)
+    finally:
+        progress.stop()
+    console = err if to_stdout else stdout_console()
+    console.print(summary_table(report))
+    ideal = [an.mech.gears[c.gear].name for c in an.circuits if c.geometry is None]
+    if ideal:
+        console.print("Ideal pairs (no mesh geometry; mesh torque instead of tooth forces): " + ", ".join(ideal))
+    if verify:
+        console.print(f"Worst Newton-Euler residual (relative): {report.residual:.3g}")
+    if not to_stdout:
+        console.print(f"Wrote {report.samples} rows to {out}")
 
 
 if __name__ == "__main__":  # pragma: no cover

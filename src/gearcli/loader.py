@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import difflib
 import json
+import re
 import math
 from functools import lru_cache
 from importlib import resources
@@ -23,6 +24,21 @@ import yaml
 from .errors import Collector, Issue, MechanismError
 from .model import GearPair, Joint, Link, Mechanism, Motor
 from .spatial import align_z, rot_x, rot_z, rpy_matrix
+
+
+class Loader(yaml.SafeLoader):
+    """SafeLoader that reads floats as YAML 1.2 does: ``1e-4`` is a number, not a string."""
+
+
+Loader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"""^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
+                |[-+]?(?:[0-9][0-9_]*)(?:[eE][-+]?[0-9]+)
+                |\.[0-9_]+(?:[eE][-+]?[0-9]+)?
+                |[-+]?\.(?:inf|Inf|INF)
+                |\.(?:nan|NaN|NAN))$""", re.X),
+    list("-+0123456789."),
+)
 
 
 @lru_cache(maxsize=1)
@@ -60,8 +76,8 @@ def yaml_lines(text: str, file: str) -> tuple[object, dict[str, int]]:
     Duplicate mapping keys and syntax errors raise :class:`MechanismError`.
     """
     try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
-        data = yaml.safe_load(text)
+        root = yaml.compose(text, Loader=Loader)
+        data = yaml.load(text, Loader=Loader)  # noqa: S506 (a SafeLoader subclass)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         line = mark.line + 1 if mark is not None else None

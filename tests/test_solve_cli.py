@@ -1,0 +1,140 @@
+"""`gearcli solve`: the CSV contract, agreement with the library, and bad input."""
+import io
+import re
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gearcli.dynamics import solve
+from gearcli.graph import analyse
+from gearcli.loader import load_mechanism, mechanism_schema
+from gearcli.report import column_names
+from gearcli.trajectory import read_trajectory, write_trajectory
+
+ROOT = Path(__file__).resolve().parents[1]
+BUNDLED = [("paper_2dof", "paper_2dof_traj.csv"), ("bendix_wrist", "bendix_wrist_traj.csv")]
+
+
+def load_csv(path):
+    text = Path(path).read_text()
+    header = text.splitlines()[0].split(",")
+    return header, np.loadtxt(io.StringIO(text), delimiter=",", skiprows=1, ndmin=2)
+
+
+@pytest.mark.parametrize("name, traj", BUNDLED)
+def test_solve_writes_the_documented_columns_and_matches_the_library(run_cli, mech_dir, tmp_path, name, traj):
+    mech, tpath = mech_dir / f"{name}.yaml", mech_dir / traj
+    out = tmp_path / "loads.csv"
+    r = run_cli("solve", mech, tpath, "-o", out, "--verify")
+    assert r.exit_code == 0, r.stderr
+    assert "peak" in r.stdout and "RMS" in r.stdout
+    resid = float(r.stdout.split("residual (relative):")[1].split()[0])
+    assert resid < 1e-9
+    an = analyse(load_mechanism(mech))
+    header, data = load_csv(out)
+    assert header == column_names(an)
+    tr = read_trajectory(tpath, an.independent_names)
+    assert data.shape[0] == len(tr.t)
+    res = solve(an, tr.q, tr.qd, tr.qdd)
+    col = {h: i for i, h in enumerate(header)}
+    for mi, m in enumerate(an.mech.motors):
+        assert np.allclose(data[:, col[f"motor:{m.name}"]], res.motor[:, mi], rtol=1e-8, atol=1e-9)
+    jt = an.mech.joints[0].name
+    assert np.allclose(data[:, col[f"joint:{jt}:fx"]], res.joint[:, 0, 0], rtol=1e-8, atol=1e-8)
+    assert np.allclose(data[:, col[f"joint:{jt}:radial"]], np.hypot(res.joint[:, 0, 0], res.joint[:, 0, 1]),
+                       rtol=1e-8, atol=1e-8)
+    assert np.all(data[:, [i for h, i in col.items() if h.endswith(":mz")]] == 0)
+
+
+@pytest.mark.parametrize("name, traj", BUNDLED)
+def test_full_method_gives_the_same_csv(run_cli, mech_dir, tmp_path, name, traj):
+    a, b = tmp_path / "a.csv", tmp_path / "b.csv"
+    assert run_cli("solve", mech_dir / f"{name}.yaml", mech_dir / traj, "-o", a).exit_code == 0
+    assert run_cli("solve", mech_dir / f"{name}.yaml", mech_dir / traj, "-o", b, "--method", "full").exit_code == 0
+    _, x = load_csv(a)
+    _, y = load_csv(b)
+    assert np.allclose(x, y, rtol=1e-8, atol=1e-9 * np.abs(x).max())
+
+
+def test_degrees_flag_and_stdout(run_cli, mech_dir, tmp_path):
+    t = np.linspace(0, 1, 301)
+    q = np.column_stack([np.sin(3 * t), np.cos(2 * t)])
+    rad, deg = tmp_path / "rad.csv", tmp_path / "deg.csv"
+    write_trajectory(rad, ["J1", "J2"], t, q)
+    write_trajectory(deg, ["J1", "J2"], t, np.rad2deg(q))
+    r1 = run_cli("solve", mech_dir / "paper_2dof.yaml", rad, "-o", "-")
+    r2 = run_cli("solve", mech_dir / "paper_2dof.yaml", deg, "-o", "-", "--degrees")
+    assert r1.exit_code == 0 and r2.exit_code == 0
+    x = np.loadtxt(io.StringIO(r1.stdout), delimiter=",", skiprows=1)
+    y = np.loadtxt(io.StringIO(r2.stdout), delimiter=",", skiprows=1)
+    assert x.shape == (301, len(r1.stdout.splitlines()[0].split(",")))
+    assert np.allclose(x, y, rtol=1e-7, atol=1e-7)
+    assert "peak" in r1.stderr   # summary goes to stderr when the CSV goes to stdout
+
+
+def test_chunking_does_not_change_the_output(run_cli, mech_dir, tmp_path):
+    a, b = tmp_path / "a.csv", tmp_path / "b.csv"
+    traj = mech_dir / "paper_2dof_traj.csv"
+    assert run_cli("solve", mech_dir / "paper_2dof.yaml", traj, "-o", a).exit_code == 0
+    assert run_cli("solve", mech_dir / "paper_2dof.yaml", traj, "-o", b, "--chunk", "300").exit_code == 0
+    _, x = load_csv(a)
+    _, y = load_csv(b)
+    assert np.allclose(x, y, rtol=1e-7, atol=1e-8 * np.abs(x).max())
+
+
+@pytest.mark.parametrize("text, expect", [
+    ("t,q:J1,q:J2\n0,0,0\n0.001,zz,0\n", "bad.csv:3: column 2 'q:J1': not a number"),
+    ("t,q:J1,q:J2\n0,0,0\n0.001,0,nan\n", "bad.csv:3: column 3 'q:J2'"),
+    ("t,q:J1,q:J2\n0,0,0\n-1,0,0\n", "bad.csv:3: column 1 't'"),
+    ("t,q:J1\n0,0\n", "bad.csv:1: missing column 'q:J2'"),
+    ("t,q:J1,q:J2,q:J3\n0,0,0,0\n", "bad.csv:1: column 4 'q:J3': unknown column"),
+])
+def test_bad_trajectory_one_line_exit_2_and_no_output(run_cli, mech_dir, tmp_path, text, expect):
+    bad = tmp_path / "bad.csv"
+    bad.write_text(text)
+    out = tmp_path / "out.csv"
+    out.write_text("previous contents\n")
+    r = run_cli("solve", mech_dir / "paper_2dof.yaml", bad, "-o", out)
+    assert r.exit_code == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and expect in lines[0], r.stderr
+    assert "Traceback" not in r.stderr
+    assert out.read_text() == "previous contents\n"
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".out.csv")]  # no temp left
+
+
+def test_bad_mechanism_and_missing_files(run_cli, mech_dir, tmp_path):
+    r = run_cli("solve", tmp_path / "nope.yaml", mech_dir / "paper_2dof_traj.csv", "-o", tmp_path / "o.csv")
+    assert r.exit_code == 2 and "nope.yaml" in r.stderr and "Traceback" not in r.stderr
+    r = run_cli("solve", mech_dir / "paper_2dof.yaml", tmp_path / "nope.csv", "-o", tmp_path / "o.csv")
+    assert r.exit_code == 2 and "nope.csv" in r.stderr
+    assert not (tmp_path / "o.csv").exists()
+    r = run_cli("solve", mech_dir / "paper_2dof.yaml", mech_dir / "paper_2dof_traj.csv", "--method", "magic")
+    assert r.exit_code == 2 and "--method" in r.stderr
+
+
+def test_readme_documents_every_schema_key_and_output_column():
+    readme = (ROOT / "README.md").read_text()
+    schema = mechanism_schema()
+
+    def keys(node):
+        for k, v in node.get("properties", {}).items():
+            yield k
+            yield from keys(v)
+        for v in node.get("$defs", {}).values():
+            yield from keys(v)
+        for v in node.get("oneOf", []):
+            yield from keys(v)
+    missing = sorted({k for k in keys(schema) if not re.search(rf"`[^`\n]*\b{k}\b[^`\n]*`", readme)})
+    assert not missing, f"README reference table lacks {missing}"
+    an = analyse(load_mechanism(ROOT / "mechanisms" / "paper_2dof.yaml"))
+    for c in column_names(an):
+        parts = c.split(":")
+        if len(parts) == 1:
+            assert f"`{c}`" in readme
+            continue
+        assert f"`{parts[0]}:<" in readme, c
+        if len(parts) > 2:
+            assert f"`{parts[-1]}`" in readme or f":{parts[-1]}`" in readme, c
