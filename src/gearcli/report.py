@@ -116,7 +116,7 @@ def format_rows(tab: np.ndarray, fmt: str = "%.9g") -> str:
     """CSV text of the rows of ``tab``."""
     n, m = tab.shape
     line = ",".join([fmt] * m) + "\n"
-    return (line * n) % tuple(tab.ravel().tolist())
+    return (line * n) % tuple((tab + 0.0).ravel().tolist())   # + 0.0: no negative zeros
 
 
 class AtomicWriter:
