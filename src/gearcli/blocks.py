@@ -19,7 +19,7 @@ import numpy as np
 from .kinematics import forward
 from .loads import Columns
 from .schedule import unknown_groups
-from .spatial import cross, mtv, mv
+from .spatial import cross
 
 
 @dataclass
@@ -125,6 +125,12 @@ def plans_of(an) -> list[BlockPlan]:
     return plans
 
 
+def _rotate(R, w6, transpose=False):
+    """Both halves of wrenches (N,6) rotated by R (N,3,3) (or by R^T)."""
+    w = w6.reshape(-1, 2, 3)                      # rows: force, moment
+    return np.matmul(w, R if transpose else R.transpose(0, 2, 1)).reshape(-1, 6)
+
+
 def _shift(w6, o_from, o_to):
     """Wrench (N,6) about o_from -> about o_to."""
     return np.concatenate([w6[:, :3], w6[:, 3:] + cross(o_from - o_to, w6[:, :3])], axis=1)
@@ -154,12 +160,13 @@ def solve_blocks(an, kin, b, q_all, general):
                         C = cols.group(g, L, sig.get((g.kind, g.index), 1.0))
                         rhs[L] -= np.einsum("nij,nj->ni", C, xg)
             continue
+        at_rest = p.F == tree.base        # F = base: world axes about the origin already
         RF, oF = kin.R[p.F], kin.o[p.F]
         parts = []
         for L in p.links:
-            w = _shift(rhs[L], kin.o[L], oF)
-            parts += [mtv(RF, w[:, :3]), mtv(RF, w[:, 3:])]
-        r = np.concatenate(parts, axis=1)                               # (N, 6B) in F about o_F
+            w = _shift(rhs[L], kin.o[L], oF) if L != p.F else rhs[L]
+            parts.append(w if at_rest else _rotate(RF, w, transpose=True))
+        r = np.concatenate(parts, axis=1) if len(parts) > 1 else parts[0]   # (N, 6B) in F about o_F
         N = r.shape[0]
         if p.signed:
             # the first sign pattern consistent with its own solution (tolerance for t ~ 0),
@@ -184,7 +191,7 @@ def solve_blocks(an, kin, b, q_all, general):
                 wF = xg @ Cp.T
                 if Cs is not None:
                     wF = wF + np.abs(xg) @ Cs.T
-                w = np.concatenate([mv(RF, wF[:, :3]), mv(RF, wF[:, 3:])], axis=1)   # world, about o_F
+                w = wF if at_rest else _rotate(RF, wF)                  # world axes, about o_F
                 P = _primary_side(an, g)
                 for L in later:
                     rhs[L] -= (1.0 if L == P else -1.0) * _shift(w, oF, kin.o[L])

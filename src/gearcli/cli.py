@@ -287,7 +287,7 @@ def solve(
                                "(fast); 'full': all equations simultaneously (cross-check)."),
     verify: bool = typer.Option(False, "--verify", help="Compute every link's Newton-Euler "
                                 "residual from the solved forces and print the worst (relative)."),
-    chunk: int = typer.Option(50_000, "--chunk", min=100, help="Samples processed at once "
+    chunk: int = typer.Option(20_000, "--chunk", min=100, help="Samples processed at once "
                               "(bounds memory)."),
 ) -> None:
     """Motor torques (N*m), bearing reaction wrenches (N, N*m, parent on child, joint frame)

@@ -24,7 +24,7 @@ from .blocks import solve_blocks
 from .loads import Columns, inertia_load
 from .schedule import unknown_groups
 
-DEFAULT_CHUNK = 50_000
+DEFAULT_CHUNK = 20_000
 
 
 @dataclass

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .model import Mechanism
-from .spatial import cross
+from .spatial import cross, mm_const, mv
 from .tree import Tree
 
 
@@ -63,32 +63,43 @@ def forward(mech: Mechanism, tree: Tree, q: np.ndarray, qd: np.ndarray | None = 
     for ji in tree.order:
         jt = mech.joints[ji]
         p, c = tree.parent[tree.index[jt.child]], tree.index[jt.child]
-        if p == b:
+        on_base = p == b                          # parent at rest: skip the zero terms
+        if on_base:
             Rj0 = np.broadcast_to(jt.R_pj, (N, 3, 3))   # (N,3,3) joint frame at q = 0
-            r_pj = np.broadcast_to(jt.p_pj, (N, 3))     # (N,3) o_p -> joint origin
+            oj0 = np.broadcast_to(jt.p_pj, (N, 3))      # (N,3) joint origin
         else:
-            Rj0 = R[p] @ jt.R_pj
-            r_pj = R[p] @ jt.p_pj
-        z = Rj0[:, :, 2]                          # (N,3) joint axis
+            Rj0 = mm_const(R[p], jt.R_pj)
+            oj0 = o[p] + mv(R[p], jt.p_pj)
+        z = np.ascontiguousarray(Rj0[:, :, 2])    # (N,3) joint axis
+        qd_j, qdd_j = qd[:, ji:ji + 1], qdd[:, ji:ji + 1]
         if jt.type == "prismatic":
             Rj[ji] = Rj0
-            oj[ji] = o[p] + r_pj + z * q[:, ji:ji + 1]
-            w[c] = w[p]
-            dw[c] = dw[p]
+            oj[ji] = oj0 + z * q[:, ji:ji + 1]
+            w[c], dw[c] = w[p], dw[p]
         else:
             Rj[ji] = _turn_z(Rj0, q[:, ji])
-            oj[ji] = o[p] + r_pj
-            w[c] = w[p] + z * qd[:, ji:ji + 1]
-            dw[c] = dw[p] + z * qdd[:, ji:ji + 1] + cross(w[p], z) * qd[:, ji:ji + 1]
-        R[c] = Rj[ji] if np.array_equal(jt.R_jc, np.eye(3)) else Rj[ji] @ jt.R_jc
-        r = oj[ji] - o[p]
-        a_j = a[p] + cross(dw[p], r) + cross(w[p], cross(w[p], r))
+            oj[ji] = oj0
+            if on_base:
+                w[c], dw[c] = z * qd_j, z * qdd_j
+            else:
+                w[c] = w[p] + z * qd_j
+                dw[c] = dw[p] + z * qdd_j + cross(w[p], z) * qd_j
+        R[c] = Rj[ji] if np.array_equal(jt.R_jc, np.eye(3)) else mm_const(Rj[ji], jt.R_jc)
+        if on_base:
+            a_j = zero
+        else:
+            r = oj[ji] - o[p]
+            a_j = a[p] + cross(dw[p], r) + cross(w[p], cross(w[p], r))
         if jt.type == "prismatic":
-            v = z * qd[:, ji:ji + 1]
-            a_j = a_j + z * qdd[:, ji:ji + 1] + 2 * cross(w[p], v)
-        rc = Rj[ji] @ jt.p_jc
-        o[c] = oj[ji] + rc
-        a[c] = a_j + cross(dw[c], rc) + cross(w[c], cross(w[c], rc))
+            a_j = a_j + z * qdd_j
+            if not on_base:
+                a_j = a_j + 2 * cross(w[p], z * qd_j)
+        if not np.any(jt.p_jc):
+            o[c], a[c] = oj[ji], a_j
+        else:
+            rc = mv(Rj[ji], jt.p_jc)
+            o[c] = oj[ji] + rc
+            a[c] = a_j + cross(dw[c], rc) + cross(w[c], cross(w[c], rc))
     return Kinematics(R, o, w, dw, a, Rj, oj)
 
 

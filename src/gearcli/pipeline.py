@@ -27,7 +27,7 @@ class SolveReport:
 
 
 def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, method: str = "block",
-               verify: bool = False, chunk: int = 50_000, progress=None, analysis: Analysis | None = None) -> SolveReport:
+               verify: bool = False, chunk: int = 20_000, progress=None, analysis: Analysis | None = None) -> SolveReport:
     """Solve a trajectory file and write the loads CSV (see :mod:`gearcli.report`).
 
     ``progress(total=None, advance=None)`` is called with ``total`` once (number of

@@ -71,13 +71,22 @@ def mv(R: np.ndarray, x: np.ndarray) -> np.ndarray:
     if R.ndim == 2:
         return x @ R.T
     if x.ndim == 1:
+        if R.flags.c_contiguous:   # one BLAS call instead of N small products
+            return (R.reshape(-1, 3) @ x).reshape(R.shape[0], 3)
         return R @ x
-    return R[:, :, 0] * x[:, 0:1] + R[:, :, 1] * x[:, 1:2] + R[:, :, 2] * x[:, 2:3]
+    return np.einsum("nij,nj->ni", R, x)
+
+
+def mm_const(R: np.ndarray, C: np.ndarray) -> np.ndarray:
+    """R @ C for a batch R (N,3,3) and one matrix C (3,3), as one BLAS call."""
+    if R.flags.c_contiguous:
+        return (R.reshape(-1, 3) @ C).reshape(R.shape)
+    return R @ C
 
 
 def mtv(R: np.ndarray, x: np.ndarray) -> np.ndarray:
     """Batched R^T x for R (N,3,3) and x (N,3)."""
-    return R[:, 0, :] * x[:, 0:1] + R[:, 1, :] * x[:, 1:2] + R[:, 2, :] * x[:, 2:3]
+    return np.einsum("nji,nj->ni", R, x)
 
 
 def mm(A: np.ndarray, B: np.ndarray) -> np.ndarray:
