@@ -35,8 +35,22 @@ class BlockPlan:
     parent_side: dict       # group position -> True when a joint basis is its parent's (rotate by -q)
 
 
+def _spread(an, g) -> bool:
+    """True when g's wrench is not one wrench applied +/- to two links: a motor acting on
+    several joints (a transmission) or an ideal coupling (torques on several links)."""
+    if g.kind == "motor":
+        mj = an.motor_joints[g.index] if an.motor_joints else None
+        return mj is not None and len(mj) > 1
+    if g.kind == "mesh":
+        return an.circuits[g.index].geometry is None
+    return False
+
+
 def _fixed_in(an, g) -> set[int]:
+    """Links in which the wrench basis of unknown g is fixed (empty: none, general solve)."""
     mech, tree = an.mech, an.tree
+    if _spread(an, g):
+        return set()
     if g.kind == "joint":
         jt = mech.joints[g.index]
         c = tree.index[jt.child]

@@ -333,5 +333,24 @@ def solve(
         console.print(f"Wrote {report.samples} rows to {out}")
 
 
+# ---------------------------------------------------------------------------------------
+# export
+# ---------------------------------------------------------------------------------------
+@app.command()
+@reports_bad_input
+def export(
+    mech: Path = typer.Argument(..., metavar="MECH", help=MECH_HELP, show_default=False),
+    output: Path = typer.Option(..., "-o", "--output", metavar="OUT.urdf",
+                                help="URDF file to write (written to a temporary file, then renamed)."),
+) -> None:
+    """Write a URDF of the mechanism: links with inertials, the joint tree, geared joints as
+    <mimic> where a single leader exists, motors as <transmission>, and the full gear
+    geometry in gearcli extension elements (namespace https://gearcli.dev/urdf/1)."""
+    from .urdf_export import export_urdf  # noqa: PLC0415
+
+    export_urdf(load_analysis(mech), output)
+    typer.echo(f"Wrote {output}")
+
+
 if __name__ == "__main__":  # pragma: no cover
     app()

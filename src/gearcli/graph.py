@@ -58,6 +58,10 @@ class Circuit:
     zj: np.ndarray  # axis of j relative to c, carrier frame
     zk: np.ndarray
     geometry: GearGeometry | None
+    # (B, A) real joint indices of a joint coupling q_B = ratio * q_A (GearPair.joints):
+    # row = e_B - ratio e_A; the ideal mesh torque acts on both joints, each joint's parent
+    # taking the reaction (``carrier`` is then B's parent, for display).
+    joints: tuple[int, int] | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -83,6 +87,10 @@ class Analysis:
     transmission_lines: tuple[tuple[int, ...], ...]
     pseudo_triangular: bool
     schedule: tuple[tuple[int, ...], ...] = field(default=())
+    # per motor: ((joint index, coefficient), ...) for a transmission motor (Motor.joints),
+    # None for a motor acting between its link and stator; () when no motor has joints
+    motor_joints: tuple = ()
+    open_loop: str = "chain"   # "tree": primary links form a tree (Mechanism.open_loop)
 
     @property
     def dof(self) -> int:
@@ -129,8 +137,7 @@ class Analysis:
             ],
             "fundamental_circuits": [
                 {"pair": mech.gears[c.gear].name, "j": n[c.j], "k": n[c.k], "carrier": n[c.carrier],
-                 "ratio": c.ratio, "equation": f"theta_{n[c.j]},{n[c.carrier]} = {c.ratio:.6g} * "
-                                               f"theta_{n[c.k]},{n[c.carrier]}"}
+                 "ratio": c.ratio, "equation": _equation(mech, n, c)}
                 for c in self.circuits
             ],
             "transmission_lines": [[n[i] for i in line] for line in self.transmission_lines],
@@ -139,7 +146,14 @@ class Analysis:
             "structure_matrix": self.A.tolist(),
             "pseudo_triangular": self.pseudo_triangular,
             "solve_order": [[n[i] for i in block] for block in self.schedule],
-        }
+        } | ({"open_loop": "tree"} if self.open_loop == "tree" else {})
+
+
+def _equation(mech: Mechanism, n, c: Circuit) -> str:
+    if c.joints is not None:
+        b, a = (mech.joints[x].name for x in c.joints)
+        return f"q_{b} = {c.ratio:.6g} * q_{a}"
+    return f"theta_{n[c.j]},{n[c.carrier]} = {c.ratio:.6g} * theta_{n[c.k]},{n[c.carrier]}"
 
 
 def _collinear(o1, z1, o2, z2, scale=1.0) -> bool:
@@ -173,6 +187,8 @@ def analyse(mech: Mechanism) -> Analysis:
             jp = tree.parent_joint[p]
             if not _collinear(ow[jp], zw[jp], ow[ji], zw[ji], scale):
                 break
+            if mech.joints[jp].type != "revolute" or mech.joints[ji].type != "revolute":
+                break  # a slider on the line of a revolute joint is not coaxial with it
             p = tree.parent[p]
         cparent[c] = p
     jin = tree.parent_joint  # joint into each link; its axis is the link's canonical axis
@@ -219,7 +235,8 @@ def analyse(mech: Mechanism) -> Analysis:
         for c in kids:
             if c in done:
                 continue
-            same = [d for d in kids if d not in done and _collinear(ow[jin[c]], zw[jin[c]], ow[jin[d]], zw[jin[d]], scale)]
+            same = [d for d in kids if d not in done and _collinear(ow[jin[c]], zw[jin[c]], ow[jin[d]], zw[jin[d]], scale)
+                    and mech.joints[jin[d]].type == mech.joints[jin[c]].type]
             done.update(same)
             Rp = home.R[p][0]
             groups.append(CoaxialGroup(p, label[c], tuple([p] + same), Rp.T @ zw[jin[c]]))
@@ -249,8 +266,14 @@ def analyse(mech: Mechanism) -> Analysis:
 
     # --- gear pairs: carriers, circuits, geometry -----------------------------------------
     circuits: list[Circuit] = []
+    jidx = {jt.name: ji for ji, jt in enumerate(mech.joints)}
     for gi, gp in enumerate(mech.gears):
         j, k = idx[gp.j], idx[gp.k]
+        if gp.joints is not None and gp.mesh_point is None:
+            circ = _joint_coupling(mech, tree, jidx, gi, gp, col)
+            if circ is not None:
+                circuits.append(circ)
+            continue
         cands = {}
         for gj in groups_of(j):
             for gk in groups_of(k):
@@ -292,8 +315,6 @@ def analyse(mech: Mechanism) -> Analysis:
             if geom is None:
                 continue
             ratio = geom.ratio
-        elif gp.kind == "bevel" or gp.teeth is not None and gp.ratio is None:
-            pass
         if ratio is None:
             continue
         circuits.append(Circuit(gi, j, k, c, float(ratio), row_j - ratio * row_k,
@@ -314,12 +335,26 @@ def analyse(mech: Mechanism) -> Analysis:
         col.raise_if_any()
     dof = J - G
     chain = primary[1:]
-    if len(chain) != dof:
+    open_loop = "tree" if mech.open_loop == "tree" else "chain"
+    if open_loop == "tree":
+        # every link whose own joint is not made dependent by a pair (its first link j)
+        dependent = {c.j for c in circuits}
+        chain = [idx[jt.child] for jt in mech.joints if idx[jt.child] not in dependent]
+        primary = [tree.base] + chain
+        if len(chain) != dof:
+            col.add("gears", f"the mechanism has {dof} degrees of freedom ({J} joints - {G} gear pairs "
+                    f"and couplings) but {len(chain)} joints are not made dependent by a pair")
+            col.raise_if_any()
+        B = np.zeros((dof, J))
+        for r, c in enumerate(chain):
+            B[r, jin[c]] = 1.0
+    elif len(chain) != dof:
         col.add("end_effector", f"the mechanism has {dof} degrees of freedom ({J} joints - {G} gear pairs) "
                 f"but its equivalent open-loop chain {' -> '.join(tree.links[i] for i in primary)} has "
                 f"{len(chain)} joints")
         col.raise_if_any()
-    B = canon[chain]
+    else:
+        B = canon[chain]
     Mfull = np.vstack([Gam, B])
     if np.linalg.matrix_rank(Mfull) < J:
         col.add("gears", "the gear trains lock the equivalent open-loop chain: its joint angles do not "
@@ -330,7 +365,7 @@ def analyse(mech: Mechanism) -> Analysis:
     independent = []
     for c in chain:
         jt = jin[c]
-        independent.append(jt if idx[mech.joints[jt].parent] == cparent[c] else -1)
+        independent.append(jt if open_loop == "tree" or idx[mech.joints[jt].parent] == cparent[c] else -1)
     independent_names = tuple(mech.joints[jt].name if jt >= 0 else f"{tree.links[cparent[c]]}-{tree.links[c]}"
                               for jt, c in zip(independent, chain))
 
@@ -338,9 +373,23 @@ def analyse(mech: Mechanism) -> Analysis:
     if len(mech.motors) != dof:
         col.add("motors", f"{len(mech.motors)} motor(s) for {dof} degree(s) of freedom: "
                 "a mechanism needs one motor per degree of freedom")
-    mlinks, mstators, mrows = [], [], []
+    mlinks, mstators, mrows, mjoints = [], [], [], []
     for m in mech.motors:
         x = idx[m.link]
+        if m.joints:
+            row = np.zeros(J)
+            pairs = []
+            for name, coef in m.joints:
+                if name not in jidx:
+                    col.add(f"{m.path}.joints", f"motor '{m.name}' drives unknown joint '{name}'")
+                    continue
+                row[jidx[name]] += coef
+                pairs.append((jidx[name], float(coef)))
+            mlinks.append(x)
+            mstators.append(idx[m.stator] if m.stator is not None else tree.parent[x])
+            mrows.append(row)
+            mjoints.append(tuple(pairs))
+            continue
         if x == tree.base:
             col.add(f"{m.path}.link", "a motor cannot drive the base")
             continue
@@ -353,6 +402,7 @@ def analyse(mech: Mechanism) -> Analysis:
         mlinks.append(x)
         mstators.append(s)
         mrows.append(row)
+        mjoints.append(None)
     col.raise_if_any()
     mrows = np.array(mrows).reshape(len(mrows), J)
     AT = mrows @ S
@@ -387,13 +437,39 @@ def analyse(mech: Mechanism) -> Analysis:
 
     an = Analysis(mech, tree, tuple(cparent), tuple(label), tuple(level), tuple(primary),
                   tuple(independent), independent_names, tuple(groups), tuple(circuits), canon, S,
-                  tuple(mlinks), tuple(mstators), mrows, AT.T.copy(), tuple(tlines), pseudo)
+                  tuple(mlinks), tuple(mstators), mrows, AT.T.copy(), tuple(tlines), pseudo,
+                  motor_joints=tuple(mjoints) if any(x is not None for x in mjoints) else (),
+                  open_loop=open_loop)
     from .schedule import solution_schedule  # noqa: PLC0415
 
     blocks = solution_schedule(an, col)
     col.raise_if_any()
     object.__setattr__(an, "schedule", blocks)
     return an
+
+
+def _joint_coupling(mech: Mechanism, tree: Tree, jidx: dict, gi: int, gp, col: Collector) -> Circuit | None:
+    """Circuit of an ideal coupling of two joint coordinates, q_B = ratio * q_A."""
+    ok = True
+    for name in gp.joints:
+        if name not in jidx:
+            col.add(f"{gp.path}.joints", f"coupling '{gp.name}' names unknown joint '{name}'")
+            ok = False
+    if not ok:
+        return None
+    b, a = (jidx[name] for name in gp.joints)
+    if a == b:
+        col.add(f"{gp.path}.joints", f"coupling '{gp.name}' couples joint '{gp.joints[0]}' to itself")
+        return None
+    if gp.ratio is None or gp.ratio == 0:
+        col.add(f"{gp.path}.ratio", f"coupling '{gp.name}' needs a nonzero ratio")
+        return None
+    row = np.zeros(len(mech.joints))
+    row[b] = 1.0
+    row[a] -= gp.ratio
+    jb, ja = mech.joints[b], mech.joints[a]
+    return Circuit(gi, tree.index[jb.child], tree.index[ja.child], tree.index[jb.parent], float(gp.ratio),
+                   row, jb.R_pj[:, 2].copy(), ja.R_pj[:, 2].copy(), None, joints=(b, a))
 
 
 def _auto_label(i: int) -> str:

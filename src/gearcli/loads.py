@@ -15,7 +15,11 @@ inertia tensor).  ``C_u,L`` (N, 6, size) is the wrench on L per unit of unknown 
 * mesh (gear geometry): the tooth force on j, ``ut + sigma tan(phi) us`` per unit of t with
   sigma = sign(t) (paper Eq. 14), at the pitch point; gear k receives the opposite;
 * mesh (ideal coupling): a moment about j's axis on j, -ratio times one about k's axis on k,
-  the carrier taking the reaction.
+  the carrier taking the reaction;
+* mesh (joint coupling q_B = ratio q_A, GearPair.joints): a unit generalised force of joint
+  B and -ratio times one of joint A, each on the joint's child and reversed on its parent
+  (a moment about the axis of a revolute joint, a force along that of a prismatic one);
+* motor with a transmission (Motor.joints): c times a unit generalised force of each joint.
 """
 from __future__ import annotations
 
@@ -64,6 +68,8 @@ class Columns:
         self.world = {}
         for ci, c in enumerate(an.circuits):
             Rc, oc = kin.R[c.carrier], kin.o[c.carrier]
+            if c.joints is not None:
+                continue  # joint coupling: see axial()
             if c.geometry is not None:
                 gm = c.geometry
                 self.world[ci] = dict(P=oc + mv(Rc, gm.P), ut=mv(Rc, gm.ut), us=mv(Rc, gm.us))
@@ -85,8 +91,22 @@ class Columns:
             cols = [_force_at(E[:, :, i], oj, o) for i in range(3)] + [_moment(E[:, :, 0]), _moment(E[:, :, 1])]
         return sign * np.stack(cols, axis=2)
 
+    def axial(self, ji: int, L: int) -> np.ndarray:
+        """(N, 6) wrench on link L of a unit generalised force of joint ``ji``: about its axis
+        (revolute) or along it through the joint origin (prismatic), on the child, reversed
+        on the parent; zero on any other link."""
+        an, kin = self.an, self.kin
+        jt = an.mech.joints[ji]
+        sign = float(an.tree.index[jt.child] == L) - float(an.tree.index[jt.parent] == L)
+        z = kin.Rj[ji][:, :, 2]
+        if jt.type == "prismatic":
+            return sign * _force_at(z, kin.oj[ji], kin.o[L])
+        return sign * _moment(z)
+
     def motor(self, mi: int, L: int) -> np.ndarray:
         an, kin = self.an, self.kin
+        if an.motor_joints and an.motor_joints[mi] is not None:
+            return sum(coef * self.axial(ji, L) for ji, coef in an.motor_joints[mi])[:, :, None]
         x = an.motor_links[mi]
         ji = an.tree.parent_joint[x]
         z = kin.Rj[ji][:, :, 2]
@@ -100,6 +120,9 @@ class Columns:
     def mesh(self, ci: int, L: int, sigma) -> np.ndarray:
         """(N, 6, 1) column of mesh unknown ``ci`` on link L; ``sigma`` = sign(t), (N,) or scalar."""
         c = self.an.circuits[ci]
+        if c.joints is not None:
+            b, a = c.joints
+            return (self.axial(b, L) - c.ratio * self.axial(a, L))[:, :, None]
         wv = self.world[ci]
         o = self.kin.o[L]
         if c.geometry is not None:

@@ -78,6 +78,10 @@ class GearPair:
     pressure_angle: float = np.deg2rad(20.0)
     cone_angles: tuple[float, float] | None = None
     path: str = ""
+    # A coupling of two real joint coordinates, q_{joints[0]} = ratio * q_{joints[1]} (a URDF
+    # <mimic>; j and k are the two joints' children).  Without mesh_point it is an ideal
+    # coupling acting on the two joints (torque pair, reactions on each joint's parent).
+    joints: tuple[str, str] | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -90,6 +94,10 @@ class Motor:
     link: str
     stator: str | None = None
     path: str = ""
+    # A transmission (URDF <transmission>): ((joint, c), ...).  The motor's input rotation is
+    # sum c * q_joint and its torque tau acts as c * tau about (along) each joint's axis, on
+    # the joint's child and reversed on its parent.  Empty: the default above.
+    joints: tuple[tuple[str, float], ...] = ()
 
 
 @dataclass(frozen=True, eq=False)
@@ -106,6 +114,11 @@ class Mechanism:
     gravity: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, -9.81]))
     source: str = "<memory>"
     lines: dict = field(default_factory=dict)
+    # "chain": the independent coordinates are the paper's equivalent open-loop chain
+    # base -> end_effector.  "tree": they are the joints of every link that is not the
+    # first link j of a gear pair or coupling (a branched robot, e.g. a URDF humanoid).
+    open_loop: str = "chain"
+    warnings: tuple[str, ...] = ()  # input problems that were worked around (e.g. URDF)
 
     def link(self, name: str) -> Link:
         for link in self.links:

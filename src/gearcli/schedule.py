@@ -41,11 +41,26 @@ def unknown_groups(an) -> list[UnknownGroup]:
         links = (tree.index[jt.parent], tree.index[jt.child])
         out.append(UnknownGroup("joint", ji, 5, tuple(x for x in links if x != b)))
     for ci, c in enumerate(an.circuits):
-        links = (c.j, c.k) if c.geometry is not None else (c.j, c.k, c.carrier)
+        if c.joints is not None:  # joint coupling: both joints' children and parents
+            links = _joint_links(mech, tree, c.joints)
+        else:
+            links = (c.j, c.k) if c.geometry is not None else (c.j, c.k, c.carrier)
         out.append(UnknownGroup("mesh", ci, 1, tuple(x for x in links if x != b)))
     for mi, (x, s) in enumerate(zip(an.motor_links, an.motor_stators)):
-        out.append(UnknownGroup("motor", mi, 1, tuple(y for y in (x, s) if y != b)))
+        mj = an.motor_joints[mi] if an.motor_joints else None
+        links = (x, s) if mj is None else _joint_links(mech, tree, [ji for ji, _ in mj])
+        out.append(UnknownGroup("motor", mi, 1, tuple(y for y in links if y != b)))
     return out
+
+
+def _joint_links(mech, tree, joints) -> tuple[int, ...]:
+    """Children and parents of real joints ``joints``, each link once."""
+    links: dict[int, None] = {}
+    for ji in joints:
+        jt = mech.joints[ji]
+        links.setdefault(tree.index[jt.child])
+        links.setdefault(tree.index[jt.parent])
+    return tuple(links)
 
 
 def solution_schedule(an, col: Collector | None = None) -> tuple[tuple[int, ...], ...]:

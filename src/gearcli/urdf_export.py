@@ -1,0 +1,204 @@
+"""Any gearcli mechanism -> a URDF that other tools load and gearcli reads back exactly.
+
+:func:`export_urdf` writes (through yourdfpy's writer, then lxml for what it does not
+write):
+
+* every link with its ``<inertial>`` (centre of mass and full tensor; massless links have
+  none) and every joint of the kinematic tree (``continuous`` for a revolute joint without
+  known limits, ``prismatic`` with placeholder limits of +-1000 m when none are known);
+* URDF puts a joint's axis through the child frame origin; a gearcli link frame may sit off
+  the axis (a D-H ``a``), so each URDF link frame is the gearcli frame moved onto its joint
+  axis (``frame_correction``), and centres of mass, inertias, child joints and mesh points
+  are re-expressed in it.  Joint frames are unchanged, so the reaction wrenches (given in
+  the joint frames) and every other result read back identically;
+* couplings of two joints (``GearPair.joints``, URDF mimic) as ``<mimic>``; every other
+  dependent joint whose motion follows one independent joint alone as
+  ``<mimic gearcli:derived="true">``, and motors on one joint as ``<transmission
+  gearcli:derived="true">`` (both for other tools; gearcli ignores them on reading);
+* the exact gearcli data in extension elements (namespace :data:`gearcli.urdf.NS`):
+  ``gearcli:mechanism`` (end effector, gravity, open loop), ``gearcli:gear`` (full gear
+  geometry; angles in rad), ``gearcli:motor`` (link, stator, transmission coefficients) and
+  ``gearcli:joint`` (axis labels).
+"""
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+from lxml import etree
+
+from .graph import Analysis, analyse
+from .model import Mechanism
+from .spatial import align_z
+from .urdf import NS, q
+
+PRISMATIC_LIMIT = 1000.0  # m, placeholder +- limits of a prismatic joint without known limits
+
+
+def _num(x: float) -> str:
+    return repr(float(x) + 0.0)
+
+
+def _vec(v) -> str:
+    return " ".join(_num(x) for x in np.ravel(v))
+
+
+def frame_correction(jt) -> tuple[np.ndarray, np.ndarray]:
+    """(R, t): the URDF frame of ``jt``'s child in the gearcli child frame.
+
+    With a = R_jc^T z (the axis in the child frame), the URDF child frame is the joint frame
+    turned by align_z(a)^T: its origin is on the axis and the joint turns about a in it.
+    It equals the gearcli frame when the joint was given by origin and axis.
+    """
+    a = jt.R_jc.T[:, 2]
+    Rp = align_z(a).T
+    return jt.R_jc.T @ Rp, -jt.R_jc.T @ jt.p_jc
+
+
+def export_urdf(mech: Mechanism | Analysis, path: str | Path | None = None) -> str:
+    """URDF text of ``mech`` (a Mechanism or its Analysis); also written to ``path``
+    (atomically: a temporary file renamed) when given."""
+    an = mech if isinstance(mech, Analysis) else analyse(mech)
+    root = to_element(an)
+    text = etree.tostring(root, pretty_print=True, xml_declaration=True, encoding="utf-8").decode("utf-8")
+    if path is not None:
+        path = Path(path)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent or ".")
+        try:
+            with os.fdopen(fd, "w", encoding="utf-8") as f:
+                f.write(text)
+            os.replace(tmp, path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+    return text
+
+
+def to_element(an: Analysis):
+    """The ``<robot>`` element of the URDF of analysed mechanism ``an``."""
+    import yourdfpy  # noqa: PLC0415
+
+    mech, tree = an.mech, an.tree
+    # URDF frame of every link in its gearcli frame: (R, t)
+    corr = {mech.base: (np.eye(3), np.zeros(3))}
+    for jt in mech.joints:
+        corr[jt.child] = frame_correction(jt)
+
+    def to_urdf(link: str, x):
+        R, t = corr[link]
+        return R.T @ (np.asarray(x, float) - t)
+
+    links = []
+    for link in mech.links:
+        R, _ = corr[link.name]
+        inertial = None
+        if link.mass > 0 or np.any(link.inertia != 0):
+            T = np.eye(4)
+            T[:3, 3] = to_urdf(link.name, link.com)
+            inertial = yourdfpy.Inertial(origin=T, mass=float(link.mass), inertia=R.T @ link.inertia @ R)
+        links.append(yourdfpy.Link(name=link.name, inertial=inertial))
+    joints = []
+    for jt in mech.joints:
+        Rc, _ = frame_correction(jt)
+        Rp, tp = corr[jt.parent]
+        a = jt.R_jc.T[:, 2]
+        T = np.eye(4)
+        T[:3, :3] = Rp.T @ jt.R_pj @ align_z(a).T
+        T[:3, 3] = Rp.T @ (jt.p_pj - tp)
+        limit = None
+        lim = jt.source.get("limit") if isinstance(jt.source, dict) else None
+        if jt.type == "prismatic":
+            jtype = "prismatic"
+            limit = yourdfpy.Limit(**lim) if lim else yourdfpy.Limit(
+                effort=1e6, velocity=1e3, lower=-PRISMATIC_LIMIT, upper=PRISMATIC_LIMIT)
+        elif lim and jt.source.get("urdf_type") == "revolute":
+            jtype, limit = "revolute", yourdfpy.Limit(**lim)
+        else:
+            jtype = "continuous"
+        joints.append(yourdfpy.Joint(name=jt.name, type=jtype, parent=jt.parent, child=jt.child,
+                                     origin=T, axis=np.array([float(x) + 0.0 for x in a]), limit=limit))
+    robot = yourdfpy.Robot(name=mech.name, links=links, joints=joints)
+    body = yourdfpy.URDF(robot=robot, build_scene_graph=False, load_meshes=False).write_xml().getroot()
+
+    root = etree.Element("robot", attrib={"name": mech.name}, nsmap={"gearcli": NS})
+    root.append(etree.Comment(f" written by gearcli export from {mech.source}; exact gear, motor and "
+                              f"mechanism data in the gearcli elements (namespace {NS}) "))
+    for el in list(body):
+        root.append(el)
+    jel = {el.get("name"): el for el in root.findall("joint")}
+
+    # --- couplings and derived mimics -------------------------------------------------
+    coupled = set()
+    for gi, gp in enumerate(mech.gears):
+        if gp.joints is None:
+            continue
+        b, a = gp.joints
+        coupled.add(b)
+        etree.SubElement(jel[b], "mimic", joint=a, multiplier=_num(gp.ratio), offset="0.0")
+        if gp.mesh_point is not None:
+            circ = next(c for c in an.circuits if c.gear == gi)
+            carrier = tree.links[circ.carrier]
+            g = etree.SubElement(jel[b], q("gear"), name=gp.name, kind=gp.kind, carrier=carrier)
+            _gear_attrs(g, gp, to_urdf(carrier, gp.mesh_point))
+    for ji, jt in enumerate(mech.joints):
+        if jt.name in coupled or ji in an.independent:
+            continue
+        nz = np.flatnonzero(np.abs(an.S[ji]) > 1e-12)
+        if len(nz) == 1 and an.independent[nz[0]] >= 0:
+            leader = mech.joints[an.independent[nz[0]]].name
+            etree.SubElement(jel[jt.name], "mimic", {q("derived"): "true"}, joint=leader,
+                             multiplier=_num(float(f"{an.S[ji, nz[0]]:.12g}")), offset="0.0")
+    for jt in mech.joints:
+        if jt.label is not None:
+            etree.SubElement(jel[jt.name], q("joint"), label=str(jt.label))
+
+    # --- derived transmissions (for other tools) ---------------------------------------
+    for mi, m in enumerate(mech.motors):
+        x, s = an.motor_links[mi], an.motor_stators[mi]
+        if m.joints:
+            if len(m.joints) != 1:
+                continue
+            joint, n = m.joints[0]
+        elif tree.parent[x] == s:
+            joint, n = mech.joints[tree.parent_joint[x]].name, 1.0
+        else:
+            continue
+        t = etree.SubElement(root, "transmission", {q("derived"): "true"}, name=f"{m.name}_transmission")
+        etree.SubElement(t, "type").text = "transmission_interface/SimpleTransmission"
+        etree.SubElement(etree.SubElement(t, "joint", name=joint), "hardwareInterface").text = \
+            "hardware_interface/EffortJointInterface"
+        act = etree.SubElement(t, "actuator", name=m.name)
+        etree.SubElement(act, "mechanicalReduction").text = _num(n)
+
+    # --- gearcli extension elements ---------------------------------------------------------
+    mattrs = {"end_effector": mech.end_effector, "gravity": _vec(mech.gravity)}
+    if an.open_loop == "tree":
+        mattrs["open_loop"] = "tree"
+    etree.SubElement(root, q("mechanism"), mattrs)
+    for gi, gp in enumerate(mech.gears):
+        if gp.joints is not None:
+            continue
+        circ = next(c for c in an.circuits if c.gear == gi)
+        carrier = tree.links[circ.carrier]
+        g = etree.SubElement(root, q("gear"), name=gp.name, j=gp.j, k=gp.k, kind=gp.kind, carrier=carrier)
+        if gp.ratio is not None:
+            g.set("ratio", _num(gp.ratio))
+        _gear_attrs(g, gp, None if gp.mesh_point is None else to_urdf(carrier, gp.mesh_point))
+    for mi, m in enumerate(mech.motors):
+        el = etree.SubElement(root, q("motor"), name=m.name, link=m.link, stator=tree.links[an.motor_stators[mi]])
+        if m.joints:
+            el.set("joints", " ".join(j for j, _ in m.joints))
+            el.set("coefficients", _vec([c for _, c in m.joints]))
+    return root
+
+
+def _gear_attrs(el, gp, mesh_point) -> None:
+    if gp.teeth is not None:
+        el.set("teeth", f"{gp.teeth[0]} {gp.teeth[1]}")
+    if mesh_point is not None:
+        el.set("mesh_point", _vec(mesh_point))
+    el.set("pressure_angle", _num(gp.pressure_angle))
+    if gp.cone_angles is not None:
+        el.set("cone_angles", _vec(gp.cone_angles))
