@@ -181,35 +181,36 @@ class _Reader:
         )
 
     # -- structure (lxml): names, references, types, numbers, tree ---------------------------
+    def register(self, el, kind: str, seen: dict) -> str | None:
+        """Record a named <link>/<joint> in ``seen``; its path, or None (reported) when it has
+        no name or a duplicate one."""
+        name = el.get("name")
+        if not name:
+            self.add(kind, f"a <{kind}> has no name", el)
+            return None
+        path = f"{kind} '{name}'"
+        if name in seen:
+            self.add(path, f"duplicate {kind} name '{name}' (first at line {seen[name].sourceline})", el)
+            return None
+        seen[name] = el
+        self.lines[path] = el.sourceline
+        return path
+
     def check_structure(self) -> None:
         root = self.root
         self.link_el: dict[str, object] = {}
         for el in root.findall("link"):
-            name = el.get("name")
-            if not name:
-                self.add("link", "a <link> has no name", el)
-                continue
-            path = f"link '{name}'"
-            if name in self.link_el:
-                self.add(path, f"duplicate link name '{name}' (first at line {self.link_el[name].sourceline})", el)
-                continue
-            self.link_el[name] = el
-            self.lines[path] = el.sourceline
-            self.check_inertial(el, path)
+            path = self.register(el, "link", self.link_el)
+            if path is not None:
+                self.check_inertial(el, path)
         self.joint_el: dict[str, object] = {}
         self.parent_of: dict[str, str] = {}   # link -> parent link
         self.joint_into: dict[str, str] = {}  # link -> joint whose child it is
         for el in root.findall("joint"):
+            path = self.register(el, "joint", self.joint_el)
+            if path is None:
+                continue
             name = el.get("name")
-            if not name:
-                self.add("joint", "a <joint> has no name", el)
-                continue
-            path = f"joint '{name}'"
-            if name in self.joint_el:
-                self.add(path, f"duplicate joint name '{name}' (first at line {self.joint_el[name].sourceline})", el)
-                continue
-            self.joint_el[name] = el
-            self.lines[path] = el.sourceline
             jtype = el.get("type")
             if jtype in ("floating", "planar"):
                 self.add(path, f"joint type '{jtype}' is not supported: gearcli analyses mechanisms on a "
