@@ -147,7 +147,19 @@ def _rotate(R, w6, transpose=False):
 
 def _shift(w6, o_from, o_to):
     """Wrench (N,6) about o_from -> about o_to."""
-    return np.concatenate([w6[:, :3], w6[:, 3:] + cross(o_from - o_to, w6[:, :3])], axis=1)
+    out = w6.copy()
+    out[:, 3:] += cross(o_from - o_to, w6[:, :3])
+    return out
+
+
+def _subtract(acc, sign, w6, o_from, o_to):
+    """acc (N,6) about o_to -= sign * (wrench w6 about o_from), in place."""
+    if sign > 0:
+        acc -= w6
+        acc[:, 3:] -= cross(o_from - o_to, w6[:, :3])
+    else:
+        acc += w6
+        acc[:, 3:] += cross(o_from - o_to, w6[:, :3])
 
 
 def solve_blocks(an, kin, b, q_all, general):
@@ -208,7 +220,7 @@ def solve_blocks(an, kin, b, q_all, general):
                 w = wF if at_rest else _rotate(RF, wF)                  # world axes, about o_F
                 P = _primary_side(an, g)
                 for L in later:
-                    rhs[L] -= (1.0 if L == P else -1.0) * _shift(w, oF, kin.o[L])
+                    _subtract(rhs[L], 1.0 if L == P else -1.0, w, oF, kin.o[L])
             if gi in p.signed:
                 sig_all[key] = pat_arr[:, p.signed.index(gi)]
             if p.parent_side.get(gi):
