@@ -329,3 +329,16 @@ def test_dot_real_joints(run_cli, mech_dir):
     assert '"1" -> "3"' in res.stdout and '"0" -> "3"' not in res.stdout
     canon = run_cli("graph", mech_dir / "coaxial_fig5.yaml", "--dot").stdout
     assert '"0" -> "3"' in canon and '"1" -> "3"' not in canon
+
+
+def test_bendix_axis_labels_follow_errata_item_9(mech_dir):
+    """Primary axes a, b, c; inputs 5 and 7 on axis a (concentric with link 1); 6 and 8 on
+    axis b; pinion 4 on an axis of its own."""
+    from gearcli.graph import analyse
+    from gearcli.loader import load_mechanism
+
+    an = analyse(load_mechanism(mech_dir / "bendix_wrist.yaml"))
+    lab = dict(zip(an.names, an.label))
+    assert (lab["1"], lab["2"], lab["3"]) == ("a", "b", "c")
+    assert lab["5"] == lab["7"] == "a" and lab["6"] == lab["8"] == "b"
+    assert lab["4"] not in ("a", "b", "c")

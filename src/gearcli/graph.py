@@ -193,11 +193,17 @@ def analyse(mech: Mechanism) -> Analysis:
         cparent[c] = p
     jin = tree.parent_joint  # joint into each link; its axis is the link's canonical axis
 
-    # labels: one per distinct line in space (explicit labels override the name)
+    # labels: one per distinct line in space (explicit labels override the name); the
+    # axes of the chain base -> end-effector are named first (a, b, c, ... as in the paper)
+    on_chain = set()
+    x = idx[mech.end_effector]
+    while x != tree.base and x is not None:
+        on_chain.add(x)
+        x = cparent[x]
     lines: list[tuple[np.ndarray, np.ndarray, str]] = []
     label = [None] * L
     explicit: dict[str, int] = {}
-    for ji in tree.order:
+    for ji in sorted(tree.order, key=lambda ji: idx[mech.joints[ji].child] not in on_chain):
         c = idx[mech.joints[ji].child]
         for k, (o, z, lab) in enumerate(lines):
             if _collinear(o, z, ow[ji], zw[ji], scale):

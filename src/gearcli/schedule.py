@@ -122,7 +122,7 @@ def solution_schedule(an, col: Collector | None = None) -> tuple[tuple[int, ...]
     order = []
     while heap:
         _, k = heapq.heappop(heap)
-        order.append(tuple(sorted(blocks[k], key=lambda x: (-an.level[x], x))))
+        order.append(tuple(sorted(blocks[k])))
         for a in users[k]:
             indeg[a] -= 1
             if indeg[a] == 0:
