@@ -19,8 +19,8 @@ def test_spline_derivatives_match_analytic_rates():
     t = np.linspace(0, 2, 2001)
     q, qd, qdd = sine(t)
     d1, d2 = derivatives(t, q)
-    assert np.max(np.abs(d1 - qd)) < 1e-9
-    assert np.max(np.abs(d2 - qdd)) < 1e-6
+    assert np.max(np.abs(d1 - qd)) < 1e-10     # README: 5e-12 rad/s
+    assert np.max(np.abs(d2 - qdd)) < 3e-8     # README: 1.5e-8 rad/s^2
 
 
 def test_spline_error_shrinks_with_step():

@@ -8,7 +8,7 @@ With ``degrees=True`` every angle column (q, qd, qdd) is in degrees (deg, deg/s,
 Missing rates/accelerations are derived from the positions with a quintic interpolating
 spline (:func:`scipy.interpolate.make_interp_spline`, k = 5, not-a-knot ends): for a smooth
 motion sampled at step h the error of the first derivative is O(h^5) and of the second
-O(h^4) (about 1e-9 rad/s^2 for a 1 Hz sine sampled at 1 kHz).  Long files are processed in
+O(h^4) (1.5e-8 rad/s^2 for a 1 Hz sine of 1 rad sampled at 1 kHz, 5e-12 rad/s on rates).  Long files are processed in
 chunks; each chunk's spline is fitted over the chunk plus ``PAD`` samples of each
 neighbour, so the result does not depend on the chunking to ~1e-14.
 """
