@@ -23,3 +23,8 @@ q = A * np.sin(f * t[:, None] + ph)
 qd = A * f * np.cos(f * t[:, None] + ph)
 qdd = -A * f**2 * np.sin(f * t[:, None] + ph)
 write_trajectory("mechanisms/bendix_wrist_traj.csv", ["J1", "J2", "J3"], t, q, qd, qdd)
+
+# geared_arm.urdf: shoulder, elbow (rad) and the left finger's slide (m: the angle columns'
+# unit rule applies to revolute joints; a prismatic joint's q is in m)
+q = np.column_stack([0.8 * np.sin(w * t), 0.6 * np.sin(1.5 * w * t + 0.3), 0.01 + 0.005 * np.sin(2 * w * t)])
+write_trajectory("mechanisms/geared_arm_traj.csv", ["shoulder", "elbow", "finger_left_joint"], t, q)

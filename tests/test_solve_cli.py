@@ -138,3 +138,20 @@ def test_readme_documents_every_schema_key_and_output_column():
         assert f"`{parts[0]}:<" in readme, c
         if len(parts) > 2:
             assert f"`{parts[-1]}`" in readme or f":{parts[-1]}`" in readme, c
+
+
+def test_degrees_leaves_prismatic_columns_in_metres(run_cli, mech_dir, tmp_path):
+    names = ["shoulder", "elbow", "finger_left_joint"]          # the last one slides (m)
+    t = np.linspace(0, 1, 201)
+    q = np.column_stack([0.5 * np.sin(3 * t), 0.3 * np.cos(2 * t), 0.01 + 0.004 * np.sin(5 * t)])
+    deg = q.copy()
+    deg[:, :2] = np.rad2deg(q[:, :2])
+    rad_p, deg_p = tmp_path / "rad.csv", tmp_path / "deg.csv"
+    write_trajectory(rad_p, names, t, q)
+    write_trajectory(deg_p, names, t, deg)
+    r1 = run_cli("solve", mech_dir / "geared_arm.urdf", rad_p, "-o", "-")
+    r2 = run_cli("solve", mech_dir / "geared_arm.urdf", deg_p, "-o", "-", "--degrees")
+    assert r1.exit_code == 0 and r2.exit_code == 0, r1.stderr + r2.stderr
+    x = np.loadtxt(io.StringIO(r1.stdout), delimiter=",", skiprows=1)
+    y = np.loadtxt(io.StringIO(r2.stdout), delimiter=",", skiprows=1)
+    assert np.allclose(x, y, rtol=1e-7, atol=1e-7 * np.abs(x).max())

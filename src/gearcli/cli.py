@@ -121,7 +121,10 @@ def format_blocks(blocks) -> str:
 def stdout_console() -> Console:
     """Console for tables: no markup parsing of user names, no auto-highlighting; plain
     lines (solve order, ...) are never wrapped, so they stay greppable."""
-    return Console(markup=False, highlight=False, soft_wrap=True)
+    console = Console(markup=False, highlight=False, soft_wrap=True)
+    if not console.is_terminal:   # piped or redirected: do not squeeze tables into 80 columns
+        console.width = max(console.width, 132)
+    return console
 
 
 def links_table(an: Analysis) -> Table:
@@ -267,7 +270,7 @@ def summary_table(report) -> Table:
     table = Table(title=f"{report.analysis.mech.name}: {report.samples} samples")
     for col, just in (("load", "left"), ("unit", "left"), ("peak", "right"), ("RMS", "right"),
                       ("t at peak [s]", "right")):
-        table.add_column(col, justify=just)
+        table.add_column(col, justify=just, no_wrap=(col == "load"))
     for st in report.summary.stats:
         table.add_row(st.name, st.unit, fmt_num(st.peak), fmt_num(st.rms), fmt_num(st.t_peak))
     return table
@@ -302,7 +305,9 @@ def solve(
         raise GearcliError(f"--method: expected 'block' or 'full', got '{method}'")
     an = load_analysis(mech)
     out = output if output is not None else str(traj.with_suffix(".loads.csv"))
-    err = Console(stderr=True)
+    err = Console(stderr=True, markup=False, highlight=False)
+    if not err.is_terminal:
+        err.width = max(err.width, 132)
     to_stdout = out == "-"
     progress = Progress(TextColumn("solving"), BarColumn(), TextColumn("{task.completed:,}/{task.total:,} samples"),
                         TimeRemainingColumn(), console=err, transient=True)

@@ -28,8 +28,6 @@ import numpy as np
 from .kinematics import Kinematics
 from .spatial import cross, mtv, mv
 
-ZERO3 = None
-
 
 def inertia_load(an, kin: Kinematics) -> dict[int, np.ndarray]:
     """b_L (N, 6) for every moving link (world frame, about the link origin)."""

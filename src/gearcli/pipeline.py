@@ -17,6 +17,12 @@ from .report import AtomicWriter, Summary, column_names, format_rows, table
 from .trajectory import TrajectoryReader
 
 
+def prismatic_independent(an: Analysis) -> list[str]:
+    """Names of the independent coordinates that are prismatic joints (m, not rad)."""
+    return [n for n, ji in zip(an.independent_names, an.independent)
+            if ji >= 0 and an.mech.joints[ji].type == "prismatic"]
+
+
 @dataclass
 class SolveReport:
     analysis: Analysis
@@ -36,7 +42,8 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
     ``None`` writes nothing (summary only).
     """
     an = analysis or analyse(load_mechanism(mech_path))
-    reader = TrajectoryReader(traj_path, an.independent_names, degrees=degrees, chunk=chunk)
+    reader = TrajectoryReader(traj_path, an.independent_names, degrees=degrees, chunk=chunk,
+                              linear=prismatic_independent(an))
     if progress is not None:
         progress(total=reader.count())
     summary = Summary.for_mechanism(an)

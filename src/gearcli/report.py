@@ -11,7 +11,8 @@ Columns, in order (units SI):
   force magnitude), ``gear:<pair>:<link>:radial`` and ``gear:<pair>:<link>:axial`` (N,
   the tooth force on that gear along its outward radial direction at the pitch point and
   along its positive axis), for j then k; per ideal pair (no geometry)
-  ``gear:<pair>:torque`` (N*m, mesh torque on j about its axis);
+  ``gear:<pair>:torque`` (N*m, mesh torque on j about its axis; N for a coupling of a
+  prismatic joint);
 * per real joint ``joint:<joint>:fx, fy, fz, mx, my, mz`` (N, N*m): reaction wrench the
   parent exerts on the child, in the joint frame, about its origin; then
   ``joint:<joint>:radial`` = hypot(fx, fy), ``axial`` = |fz|, ``bending`` = hypot(mx, my).
@@ -87,6 +88,7 @@ class Summary:
     @classmethod
     def for_mechanism(cls, an) -> "Summary":
         names = column_names(an)
+        ideal_unit = {an.mech.gears[c.gear].name: _ideal_unit(an, c) for c in an.circuits if c.geometry is None}
         pick = []
         for i, n in enumerate(names):
             kind = n.split(":")[0]
@@ -94,8 +96,9 @@ class Summary:
             if kind == "motor":
                 pick.append((i, f"motor {n[6:]}", "N·m"))
             elif kind == "gear" and last in ("t", "torque"):
-                pick.append((i, f"gear {n[5:-len(last) - 1]} {'tangential' if last == 't' else 'torque'}",
-                             "N" if last == "t" else "N·m"))
+                pair = n[5:-len(last) - 1]
+                pick.append((i, f"gear {pair} {'tangential' if last == 't' else 'torque'}",
+                             "N" if last == "t" else ideal_unit[pair]))
             elif kind == "joint" and last in ("radial", "axial", "bending"):
                 pick.append((i, f"bearing {n[6:-len(last) - 1]} {last}", "N·m" if last == "bending" else "N"))
         return cls([p[0] for p in pick], [Stat(p[1], p[2]) for p in pick])
@@ -110,6 +113,13 @@ class Summary:
                 st.peak, st.t_peak = float(v), float(t[imax[k]])
             st.sumsq += float(np.dot(X[:, k], X[:, k]))
             st.n += X.shape[0]
+
+
+def _ideal_unit(an, c) -> str:
+    """Unit of an ideal pair's mesh torque column: N*m, or N when its driven joint slides."""
+    if c.joints is not None and an.mech.joints[c.joints[0]].type == "prismatic":
+        return "N"
+    return "N·m"
 
 
 def format_rows(tab: np.ndarray, fmt: str = "%.9g") -> str:

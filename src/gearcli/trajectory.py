@@ -3,7 +3,8 @@
 Format: a header row, then one row per sample.  Columns ``t`` (s), ``q:<joint>`` (rad)
 for every independent joint (the joints of the equivalent open-loop chain, named as in
 the mechanism file), optionally ``qd:<joint>`` (rad/s) and ``qdd:<joint>`` (rad/s^2).
-With ``degrees=True`` every angle column (q, qd, qdd) is in degrees (deg, deg/s, deg/s^2).
+With ``degrees=True`` every angle column (q, qd, qdd) is in degrees (deg, deg/s, deg/s^2);
+columns of prismatic joints (``linear``) are in m, m/s, m/s^2 either way.
 
 Missing rates/accelerations are derived from the positions with a quintic interpolating
 spline (:func:`scipy.interpolate.make_interp_spline`, k = 5, not-a-knot ends): for a smooth
@@ -107,11 +108,14 @@ class TrajectoryReader:
     """Reads a trajectory CSV in chunks of ``chunk`` samples (see module docstring).
 
     Iterating yields :class:`Trajectory` chunks in SI units.  ``names`` are the independent
-    joint names (``Analysis.independent_names``).
+    joint names (``Analysis.independent_names``); ``linear`` names those of prismatic joints,
+    which ``degrees`` leaves alone.
     """
 
-    def __init__(self, path: str | Path, names, degrees: bool = False, chunk: int = 100_000):
+    def __init__(self, path: str | Path, names, degrees: bool = False, chunk: int = 100_000,
+                 linear=()):
         self.path, self.names, self.degrees = Path(path), list(names), degrees
+        self.linear = set(linear)
         self.chunk = max(int(chunk), 2 * PAD + 1)
         self.file = str(path)
         try:
@@ -146,7 +150,8 @@ class TrajectoryReader:
                 row += len(lines)
 
     def __iter__(self):
-        scale = math.pi / 180.0 if self.degrees else 1.0
+        scale = np.array([1.0 if (not self.degrees or n in self.linear) else math.pi / 180.0
+                          for n in self.names])
         c = self.cols
         last_t = None
         prev = None   # raw rows of the previous chunk (for the spline pad)
@@ -188,9 +193,9 @@ class TrajectoryReader:
         return Trajectory(t[sl], q[sl], qd[sl], qdd[sl])
 
 
-def read_trajectory(path, names, degrees: bool = False) -> Trajectory:
+def read_trajectory(path, names, degrees: bool = False, linear=()) -> Trajectory:
     """Read a whole trajectory CSV into memory (see :class:`TrajectoryReader`)."""
-    parts = list(TrajectoryReader(path, names, degrees, chunk=1 << 62))
+    parts = list(TrajectoryReader(path, names, degrees, chunk=1 << 62, linear=linear))
     return parts[0]
 
 
