@@ -37,14 +37,17 @@ def inertia_load(an, kin: Kinematics) -> dict[int, np.ndarray]:
     for L in tree.moving:
         link = mech.links[L]
         R = kin.R[L]
-        rc = mv(R, link.com)                                   # (N,3) o_L -> centre of mass
         w, dw = kin.w[L], kin.dw[L]
-        a_c = kin.a[L] + cross(dw, rc) + cross(w, cross(w, rc))
-        F = link.mass * (a_c - g)
         wb = mtv(R, w)                                         # R^T w
         dwb = mtv(R, dw)
         Nb = dwb @ link.inertia.T + cross(wb, wb @ link.inertia.T)
-        out[L] = np.concatenate([F, mv(R, Nb) + cross(rc, F)], axis=1)
+        if np.any(link.com):
+            rc = mv(R, link.com)                               # (N,3) o_L -> centre of mass
+            a_c = kin.a[L] + cross(dw, rc) + cross(w, cross(w, rc))
+            F = link.mass * (a_c - g)
+            out[L] = np.concatenate([F, mv(R, Nb) + cross(rc, F)], axis=1)
+        else:                                                  # centre of mass at the origin
+            out[L] = np.concatenate([link.mass * (kin.a[L] - g), mv(R, Nb)], axis=1)
     return out
 
 
