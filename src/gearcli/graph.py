@@ -19,12 +19,13 @@ Problems are reported with the file and YAML path of the offending element.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
 from .errors import Collector
 from .gears import GearGeometry, gear_geometry
-from .kinematics import forward
+from .kinematics import Kinematics, forward
 from .model import Mechanism
 from .tree import Tree, build_tree
 
@@ -166,50 +167,142 @@ def _collinear(o1, z1, o2, z2, scale=1.0) -> bool:
 def analyse(mech: Mechanism) -> Analysis:
     """Canonical graph, levels, circuits, structure matrix and schedule of ``mech``.
 
-    Raises :class:`~gearcli.errors.MechanismError` listing every structural problem.
+    The steps follow the paper's graph analysis, one private function each; problems are
+    collected in a :class:`~gearcli.errors.Collector` and raised after each step that
+    later steps depend on.  Raises :class:`~gearcli.errors.MechanismError` listing every
+    structural problem.
     """
     col = Collector(mech.source, mech.lines)
     tree = build_tree(mech, col)
     col.raise_if_any()
-    L, J = len(tree.links), len(mech.joints)
-    idx = tree.index
+    h = _home_axes(mech, tree)
+    cparent = _canonical_parents(h)
+    primary = _eolc(h, cparent)
+    label = _axis_labels(h, set(primary[1:]), col)
+    level = _levels(h, cparent)
+    canon = _canonical_angle_rows(h, cparent)
+    groups = _coaxial_groups(h, cparent, label)
+    if len(primary) < 2:
+        col.add("end_effector", "the end-effector must be a moving link, not the base")
+        col.raise_if_any()
+    circuits = _circuits(h, groups, canon, col)
+    col.raise_if_any()
+    ind = _independent_coordinates(h, cparent, canon, primary, circuits, col)
+    mot = _motors(h, cparent, groups, canon, ind.S.shape[1], col)
+    A = _structure_matrix(mot.rows, ind.S, col)
+    tlines, pseudo = _transmission_lines(h, circuits, ind.primary, ind.chain, mot.links)
+
+    an = Analysis(mech, tree, tuple(cparent), tuple(label), tuple(level), tuple(ind.primary),
+                  ind.independent, ind.independent_names, tuple(groups), tuple(circuits), canon,
+                  ind.S, tuple(mot.links), tuple(mot.stators), mot.rows, A, tuple(tlines), pseudo,
+                  motor_joints=tuple(mot.joints) if any(x is not None for x in mot.joints) else (),
+                  open_loop=ind.open_loop)
+    from .schedule import solution_schedule  # noqa: PLC0415
+
+    blocks = solution_schedule(an, col)
+    col.raise_if_any()
+    object.__setattr__(an, "schedule", blocks)
+    return an
+
+
+# --- home geometry ------------------------------------------------------------------------
+
+@dataclass(frozen=True, eq=False)
+class _Home:
+    """The real joint tree and its joint axis lines at the home configuration (q = 0).
+
+    Shared, read-only context of every analysis step.  Link ids index ``tree.links``
+    (L of them), joint ids index ``mech.joints`` (J of them).
+    """
+
+    mech: Mechanism
+    tree: Tree
+    idx: dict           # link name -> link id
+    jidx: dict          # joint name -> joint id
+    jin: tuple          # (L,) joint into each link, None for the base: its axis is the link's axis
+    kin: Kinematics     # forward kinematics at q = 0, one sample (arrays (1, 3), (1, 3, 3))
+    ow: list            # J arrays (3,): joint origins, world frame, m
+    zw: list            # J arrays (3,): unit joint axes, world frame
+    scale: float        # m: largest joint-origin distance (at least 1), scales TOL_LINE
+
+    @property
+    def L(self) -> int:
+        return len(self.tree.links)
+
+    @property
+    def J(self) -> int:
+        return len(self.mech.joints)
+
+    def collinear(self, a: int, b: int) -> bool:
+        """True if the axis lines of joints ``a`` and ``b`` coincide (home configuration)."""
+        return _collinear(self.ow[a], self.zw[a], self.ow[b], self.zw[b], self.scale)
+
+
+def _home_axes(mech: Mechanism, tree: Tree) -> _Home:
+    """Joint axis lines (origin ``ow``, m; unit direction ``zw``) in the world frame at
+    the home configuration, where every joint coordinate is zero."""
+    J = len(mech.joints)
     home = forward(mech, tree, np.zeros((1, J)))
-    zw = [home.Rj[ji][0, :, 2] for ji in range(J)]   # joint axes, world, home
+    zw = [home.Rj[ji][0, :, 2] for ji in range(J)]
     ow = [home.oj[ji][0] for ji in range(J)]
     scale = max([1.0] + [float(np.linalg.norm(x)) for x in ow])
+    jidx = {jt.name: ji for ji, jt in enumerate(mech.joints)}
+    return _Home(mech, tree, tree.index, jidx, tree.parent_joint, home, ow, zw, scale)
 
-    # --- canonical graph -------------------------------------------------------------
-    cparent = [None] * L
+
+# --- canonical graph ----------------------------------------------------------------------
+
+def _canonical_parents(h: _Home) -> list:
+    """Canonical parent (carrier) of every link, None for the base: list (L,) of link ids.
+
+    Tsai's canonical graph: a link whose revolute joint is collinear with its parent's own
+    revolute joint is re-attached to the grandparent, repeatedly, so that the thin-edged
+    path from the root to any link has distinct axis labels.  (A slider on the line of a
+    revolute joint is not coaxial with it.)
+    """
+    mech, tree = h.mech, h.tree
+    cparent = [None] * h.L
     for ji in tree.order:
-        c = idx[mech.joints[ji].child]
+        c = h.idx[mech.joints[ji].child]
         p = tree.parent[c]
         while p != tree.base:
             jp = tree.parent_joint[p]
-            if not _collinear(ow[jp], zw[jp], ow[ji], zw[ji], scale):
+            if not h.collinear(jp, ji):
                 break
             if mech.joints[jp].type != "revolute" or mech.joints[ji].type != "revolute":
-                break  # a slider on the line of a revolute joint is not coaxial with it
+                break
             p = tree.parent[p]
         cparent[c] = p
-    jin = tree.parent_joint  # joint into each link; its axis is the link's canonical axis
+    return cparent
 
-    # labels: one per distinct line in space (explicit labels override the name); the
-    # axes of the chain base -> end-effector are named first (a, b, c, ... as in the paper)
-    on_chain = set()
-    x = idx[mech.end_effector]
-    while x != tree.base and x is not None:
-        on_chain.add(x)
-        x = cparent[x]
+
+def _eolc(h: _Home, cparent: list) -> list[int]:
+    """Equivalent open-loop chain: link ids base -> end-effector along canonical parents
+    (base first; only the base if the end-effector is the base)."""
+    primary = [h.idx[h.mech.end_effector]]
+    while primary[-1] != h.tree.base:
+        primary.append(cparent[primary[-1]])
+    return primary[::-1]
+
+
+def _axis_labels(h: _Home, on_chain: set, col: Collector) -> list:
+    """Axis label of each link's canonical edge: list (L,) of str, None for the base.
+
+    One label per distinct line in space.  The axes of the chain base -> end-effector
+    (link ids ``on_chain``) are named first, a, b, c, ... as in the paper; a joint's
+    explicit ``label`` overrides the name of its line (and must not name two lines).
+    """
+    mech = h.mech
     lines: list[tuple[np.ndarray, np.ndarray, str]] = []
-    label = [None] * L
+    label = [None] * h.L
     explicit: dict[str, int] = {}
-    for ji in sorted(tree.order, key=lambda ji: idx[mech.joints[ji].child] not in on_chain):
-        c = idx[mech.joints[ji].child]
+    for ji in sorted(h.tree.order, key=lambda ji: h.idx[mech.joints[ji].child] not in on_chain):
+        c = h.idx[mech.joints[ji].child]
         for k, (o, z, lab) in enumerate(lines):
-            if _collinear(o, z, ow[ji], zw[ji], scale):
+            if _collinear(o, z, h.ow[ji], h.zw[ji], h.scale):
                 break
         else:
-            lines.append((ow[ji], zw[ji], _auto_label(len(lines))))
+            lines.append((h.ow[ji], h.zw[ji], _auto_label(len(lines))))
             k = len(lines) - 1
         given = mech.joints[ji].label
         if given is not None:
@@ -219,239 +312,149 @@ def analyse(mech: Mechanism) -> Analysis:
             o, z, _ = lines[k]
             lines[k] = (o, z, given)
         label[c] = k
-    label = [None if k is None else lines[k][2] for k in label]
+    return [None if k is None else lines[k][2] for k in label]
 
-    level = [0] * L
-    for ji in tree.order:
-        c = idx[mech.joints[ji].child]
+
+def _levels(h: _Home, cparent: list) -> list[int]:
+    """Level of each link: list (L,) of its thin-edge distance from the root in the
+    canonical graph (base 0)."""
+    level = [0] * h.L
+    for ji in h.tree.order:
+        c = h.idx[h.mech.joints[ji].child]
         level[c] = level[cparent[c]] + 1
+    return level
 
-    # canonical angle of each link (about its own joint axis) in real joint angles
-    canon = np.zeros((L, J))
-    for c in tree.moving:
-        p = cparent[c]
-        for ji in tree.path_up(c, p):
-            canon[c, ji] = float(np.sign(zw[ji] @ zw[jin[c]]))
 
-    # coaxial groups: carrier + children on one line
-    groups: list[CoaxialGroup] = []
-    for p in range(L):
-        kids = [c for c in tree.moving if cparent[c] == p]
+def _canonical_angle_rows(h: _Home, cparent: list) -> np.ndarray:
+    """(L, J) array: row i is the canonical angle of link i (its rotation relative to its
+    canonical parent, about its own joint axis, rad) in real joint angles; entries are
+    +-1 on the collinear joints between the link and its canonical parent, 0 elsewhere."""
+    canon = np.zeros((h.L, h.J))
+    for c in h.tree.moving:
+        for ji in h.tree.path_up(c, cparent[c]):
+            canon[c, ji] = float(np.sign(h.zw[ji] @ h.zw[h.jin[c]]))
+    return canon
+
+
+def _coaxial_groups(h: _Home, cparent: list, label: list) -> list[CoaxialGroup]:
+    """Coaxial groups: each carrier with the canonical children that turn about one line
+    (joints of one type), the line's reference direction given in the carrier frame."""
+    jin, groups = h.jin, []
+    for p in range(h.L):
+        kids = [c for c in h.tree.moving if cparent[c] == p]
         done: set[int] = set()
         for c in kids:
             if c in done:
                 continue
-            same = [d for d in kids if d not in done and _collinear(ow[jin[c]], zw[jin[c]], ow[jin[d]], zw[jin[d]], scale)
-                    and mech.joints[jin[d]].type == mech.joints[jin[c]].type]
+            same = [d for d in kids if d not in done and h.collinear(jin[c], jin[d])
+                    and h.mech.joints[jin[d]].type == h.mech.joints[jin[c]].type]
             done.update(same)
-            Rp = home.R[p][0]
-            groups.append(CoaxialGroup(p, label[c], tuple([p] + same), Rp.T @ zw[jin[c]]))
+            Rp = h.kin.R[p][0]
+            groups.append(CoaxialGroup(p, label[c], tuple([p] + same), Rp.T @ h.zw[jin[c]]))
+    return groups
 
-    # --- primary chain -------------------------------------------------------------------
-    ee = idx[mech.end_effector]
-    primary = [ee]
-    while primary[-1] != tree.base:
-        primary.append(cparent[primary[-1]])
-    primary = primary[::-1]
-    if len(primary) < 2:
-        col.add("end_effector", "the end-effector must be a moving link, not the base")
-        col.raise_if_any()
 
-    def relative(x: int, c: int, g: CoaxialGroup):
-        """Row (over real joints) of the rotation of x relative to c about x's axis, and
-        that axis in the world frame (home)."""
-        ref = zw[jin[g.members[1]]]
+def _groups_of(groups: list[CoaxialGroup], x: int) -> list[CoaxialGroup]:
+    return [g for g in groups if x in g.members]
 
-        def phi(m):
-            return np.zeros(J) if m == g.carrier else canon[m] * float(zw[jin[m]] @ ref)
-        z = zw[jin[x]] if x != g.carrier else zw[jin[c]]
-        return (phi(x) - phi(c)) * float(z @ ref), z
 
-    def groups_of(x):
-        return [g for g in groups if x in g.members]
+def _relative_rotation(h: _Home, canon: np.ndarray, x: int, c: int, g: CoaxialGroup):
+    """Rotation of link ``x`` relative to link ``c`` about x's axis, both in coaxial group
+    ``g``: its row (J,) over real joint angles (rad per rad), and that axis (3,) in the
+    world frame at home (c's axis if x is the group's carrier)."""
+    zw, jin = h.zw, h.jin
+    ref = zw[jin[g.members[1]]]
 
-    # --- gear pairs: carriers, circuits, geometry -----------------------------------------
+    def phi(m):
+        return np.zeros(h.J) if m == g.carrier else canon[m] * float(zw[jin[m]] @ ref)
+    z = zw[jin[x]] if x != g.carrier else zw[jin[c]]
+    return (phi(x) - phi(c)) * float(z @ ref), z
+
+
+# --- gear pairs: carriers, fundamental circuits, geometry ----------------------------------
+
+def _circuits(h: _Home, groups: list[CoaxialGroup], canon: np.ndarray, col: Collector) -> list[Circuit]:
+    """Fundamental circuit of each gear pair and joint coupling, in ``mech.gears`` order
+    (pairs with a problem are reported to ``col`` and left out)."""
     circuits: list[Circuit] = []
-    jidx = {jt.name: ji for ji, jt in enumerate(mech.joints)}
-    for gi, gp in enumerate(mech.gears):
-        j, k = idx[gp.j], idx[gp.k]
+    for gi, gp in enumerate(h.mech.gears):
+        j, k = h.idx[gp.j], h.idx[gp.k]
         if gp.joints is not None and gp.mesh_point is None:
-            circ = _joint_coupling(mech, tree, jidx, gi, gp, col)
-            if circ is not None:
-                circuits.append(circ)
-            continue
-        cands = {}
-        for gj in groups_of(j):
-            for gk in groups_of(k):
-                if gj is gk:
-                    continue
-                for c in set(gj.members) & set(gk.members) - {j, k}:
-                    cands[c] = (gj, gk)
-        if gp.carrier is not None:
-            c = idx[gp.carrier]
-            if c not in cands:
-                col.add(f"{gp.path}.carrier", f"'{gp.carrier}' cannot carry gears '{gp.j}' and '{gp.k}': "
-                        f"both gear axes must be fixed in the carrier"
-                        + (f" (possible carrier: {', '.join(tree.links[x] for x in sorted(cands))})" if cands else ""))
-                continue
-        elif len(cands) == 1:
-            c = next(iter(cands))
-        elif not cands:
-            col.add(f"{gp.path}.links", f"gears '{gp.j}' and '{gp.k}' share no carrier: no link holds both "
-                    "gear axes fixed (each gear must turn about a line fixed in the carrier)")
-            continue
+            circ = _joint_coupling(h.mech, h.tree, h.jidx, gi, gp, col)
         else:
-            col.add(f"{gp.path}", f"gears '{gp.j}' and '{gp.k}' have several possible carriers "
-                    f"({', '.join(tree.links[x] for x in sorted(cands))}): give carrier")
-            continue
-        gj, gk = cands[c]
-        row_j, zj_w = relative(j, c, gj)
-        row_k, zk_w = relative(k, c, gk)
-        Rc, oc = home.R[c][0], home.o[c][0]
-        geom = None
-        ratio = gp.ratio
-        if gp.mesh_point is not None:
-            pj = ow[jin[j]] if j != gj.carrier else ow[jin[c]]
-            pk = ow[jin[k]] if k != gk.carrier else ow[jin[c]]
-            geom, probs = gear_geometry(gp.kind, gp.mesh_point, Rc.T @ (pj - oc), Rc.T @ zj_w,
-                                        Rc.T @ (pk - oc), Rc.T @ zk_w, gp.teeth, gp.ratio,
-                                        gp.cone_angles, (gp.j, gp.k))
-            for fld, msg in probs:
-                col.add(f"{gp.path}.{fld}", msg)
-            if geom is None:
-                continue
-            ratio = geom.ratio
-        if ratio is None:
-            continue
-        circuits.append(Circuit(gi, j, k, c, float(ratio), row_j - ratio * row_k,
-                                Rc.T @ zj_w, Rc.T @ zk_w, geom))
-    col.raise_if_any()
+            circ = _gear_circuit(h, groups, canon, gi, gp, j, k, col)
+        if circ is not None:
+            circuits.append(circ)
+    return circuits
 
-    # --- degrees of freedom, independent coordinates ---------------------------------------
-    G = len(circuits)
-    Gam = np.array([c.row for c in circuits]).reshape(G, J)
-    rank = np.linalg.matrix_rank(Gam) if G else 0
-    if rank < G:
-        _, sv, Vt = np.linalg.svd(Gam.T)
-        null = Vt[rank:]  # left null vectors of Gam
-        involved = sorted({i for v in null for i in np.flatnonzero(np.abs(v) > 1e-8)})
-        col.add("gears", "redundant gear pairs make the loads statically indeterminate: "
-                + ", ".join(f"'{mech.gears[circuits[i].gear].name}' ({mech.gears[circuits[i].gear].path})"
-                            for i in involved))
-        col.raise_if_any()
-    dof = J - G
-    chain = primary[1:]
-    open_loop = "tree" if mech.open_loop == "tree" else "chain"
-    if open_loop == "tree":
-        # every link whose own joint is not made dependent by a pair (its first link j)
-        dependent = {c.j for c in circuits}
-        chain = [idx[jt.child] for jt in mech.joints if idx[jt.child] not in dependent]
-        primary = [tree.base] + chain
-        if len(chain) != dof:
-            col.add("gears", f"the mechanism has {dof} degrees of freedom ({J} joints - {G} gear pairs "
-                    f"and couplings) but {len(chain)} joints are not made dependent by a pair")
-            col.raise_if_any()
-        B = np.zeros((dof, J))
-        for r, c in enumerate(chain):
-            B[r, jin[c]] = 1.0
-    elif len(chain) != dof:
-        col.add("end_effector", f"the mechanism has {dof} degrees of freedom ({J} joints - {G} gear pairs) "
-                f"but its equivalent open-loop chain {' -> '.join(tree.links[i] for i in primary)} has "
-                f"{len(chain)} joints")
-        col.raise_if_any()
+
+def _gear_circuit(h: _Home, groups, canon, gi: int, gp, j: int, k: int, col: Collector) -> Circuit | None:
+    """Circuit of gear pair ``gp`` between links j and k: theta_{j,c} - e theta_{k,c} = 0,
+    with the ratio e given or derived from the mesh geometry."""
+    found = _gear_carrier(h, groups, gp, j, k, col)
+    if found is None:
+        return None
+    c, gj, gk = found
+    row_j, zj_w = _relative_rotation(h, canon, j, c, gj)
+    row_k, zk_w = _relative_rotation(h, canon, k, c, gk)
+    Rc = h.kin.R[c][0]
+    geom = None
+    ratio = gp.ratio
+    if gp.mesh_point is not None:
+        geom = _mesh_geometry(h, gp, j, k, c, gj, gk, zj_w, zk_w, col)
+        if geom is None:
+            return None
+        ratio = geom.ratio
+    if ratio is None:
+        return None
+    return Circuit(gi, j, k, c, float(ratio), row_j - ratio * row_k, Rc.T @ zj_w, Rc.T @ zk_w, geom)
+
+
+def _gear_carrier(h: _Home, groups, gp, j: int, k: int, col: Collector):
+    """Carrier c of gear pair ``gp``: a link sharing a coaxial group with each gear (both
+    gear axes fixed in it), given or unique.  Returns (c, group of j, group of k), or None
+    with an issue."""
+    cands = {}
+    for gj in _groups_of(groups, j):
+        for gk in _groups_of(groups, k):
+            if gj is gk:
+                continue
+            for c in set(gj.members) & set(gk.members) - {j, k}:
+                cands[c] = (gj, gk)
+    names = h.tree.links
+    if gp.carrier is not None:
+        c = h.idx[gp.carrier]
+        if c not in cands:
+            col.add(f"{gp.path}.carrier", f"'{gp.carrier}' cannot carry gears '{gp.j}' and '{gp.k}': "
+                    f"both gear axes must be fixed in the carrier"
+                    + (f" (possible carrier: {', '.join(names[x] for x in sorted(cands))})" if cands else ""))
+            return None
+    elif len(cands) == 1:
+        c = next(iter(cands))
+    elif not cands:
+        col.add(f"{gp.path}.links", f"gears '{gp.j}' and '{gp.k}' share no carrier: no link holds both "
+                "gear axes fixed (each gear must turn about a line fixed in the carrier)")
+        return None
     else:
-        B = canon[chain]
-    Mfull = np.vstack([Gam, B])
-    if np.linalg.matrix_rank(Mfull) < J:
-        col.add("gears", "the gear trains lock the equivalent open-loop chain: its joint angles do not "
-                "determine the motion of every link")
-        col.raise_if_any()
-    S = np.linalg.solve(Mfull, np.vstack([np.zeros((G, dof)), np.eye(dof)]))
-    S[np.abs(S) < 1e-15] = 0.0
-    independent = []
-    for c in chain:
-        jt = jin[c]
-        independent.append(jt if open_loop == "tree" or idx[mech.joints[jt].parent] == cparent[c] else -1)
-    independent_names = tuple(mech.joints[jt].name if jt >= 0 else f"{tree.links[cparent[c]]}-{tree.links[c]}"
-                              for jt, c in zip(independent, chain))
+        col.add(f"{gp.path}", f"gears '{gp.j}' and '{gp.k}' have several possible carriers "
+                f"({', '.join(names[x] for x in sorted(cands))}): give carrier")
+        return None
+    return (c, *cands[c])
 
-    # --- motors and structure matrix -------------------------------------------------------
-    if len(mech.motors) != dof:
-        col.add("motors", f"{len(mech.motors)} motor(s) for {dof} degree(s) of freedom: "
-                "a mechanism needs one motor per degree of freedom")
-    mlinks, mstators, mrows, mjoints = [], [], [], []
-    for m in mech.motors:
-        x = idx[m.link]
-        if m.joints:
-            row = np.zeros(J)
-            pairs = []
-            for name, coef in m.joints:
-                if name not in jidx:
-                    col.add(f"{m.path}.joints", f"motor '{m.name}' drives unknown joint '{name}'")
-                    continue
-                row[jidx[name]] += coef
-                pairs.append((jidx[name], float(coef)))
-            mlinks.append(x)
-            mstators.append(idx[m.stator] if m.stator is not None else tree.parent[x])
-            mrows.append(row)
-            mjoints.append(tuple(pairs))
-            continue
-        if x == tree.base:
-            col.add(f"{m.path}.link", "a motor cannot drive the base")
-            continue
-        s = idx[m.stator] if m.stator is not None else cparent[x]
-        g = next((g for g in groups_of(x) if s in g.members and x in g.members and s != x), None)
-        if g is None:
-            col.add(f"{m.path}.stator", f"stator link '{tree.links[s]}' does not share the axis of input link '{m.link}'")
-            continue
-        row, _ = relative(x, s, g)
-        mlinks.append(x)
-        mstators.append(s)
-        mrows.append(row)
-        mjoints.append(None)
-    col.raise_if_any()
-    mrows = np.array(mrows).reshape(len(mrows), J)
-    AT = mrows @ S
-    AT[np.abs(AT) < 1e-15] = 0.0
-    if np.linalg.matrix_rank(AT) < dof:
-        col.add("motors", "the motors do not drive every degree of freedom (structure matrix is singular)")
-        col.raise_if_any()
 
-    # --- transmission lines ------------------------------------------------------------------
-    heavy: dict[int, list[int]] = {i: [] for i in range(L)}
-    for c in circuits:
-        heavy[c.j].append(c.k)
-        heavy[c.k].append(c.j)
-    pset = set(primary)
-    tlines: list[tuple[int, ...]] = []
-
-    def extend(path):
-        for nb in heavy[path[-1]]:
-            if nb in path:
-                continue
-            if nb in pset:
-                tlines.append(tuple(path + [nb]))
-            else:
-                extend(path + [nb])
-    for x in mlinks:
-        if x in pset:
-            tlines.append((x,))
-        else:
-            extend([x])
-    ends = [line[-1] for line in tlines]
-    pseudo = all(ends.count(p) == 1 for p in chain)
-
-    an = Analysis(mech, tree, tuple(cparent), tuple(label), tuple(level), tuple(primary),
-                  tuple(independent), independent_names, tuple(groups), tuple(circuits), canon, S,
-                  tuple(mlinks), tuple(mstators), mrows, AT.T.copy(), tuple(tlines), pseudo,
-                  motor_joints=tuple(mjoints) if any(x is not None for x in mjoints) else (),
-                  open_loop=open_loop)
-    from .schedule import solution_schedule  # noqa: PLC0415
-
-    blocks = solution_schedule(an, col)
-    col.raise_if_any()
-    object.__setattr__(an, "schedule", blocks)
-    return an
+def _mesh_geometry(h: _Home, gp, j, k, c, gj, gk, zj_w, zk_w, col: Collector) -> GearGeometry | None:
+    """Gear geometry of ``gp`` from its mesh point, with both gear axes (points, m, and
+    directions) expressed in the carrier frame of c; None (with issues) if inconsistent."""
+    Rc, oc = h.kin.R[c][0], h.kin.o[c][0]
+    ow, jin = h.ow, h.jin
+    pj = ow[jin[j]] if j != gj.carrier else ow[jin[c]]
+    pk = ow[jin[k]] if k != gk.carrier else ow[jin[c]]
+    geom, probs = gear_geometry(gp.kind, gp.mesh_point, Rc.T @ (pj - oc), Rc.T @ zj_w,
+                                Rc.T @ (pk - oc), Rc.T @ zk_w, gp.teeth, gp.ratio,
+                                gp.cone_angles, (gp.j, gp.k))
+    for fld, msg in probs:
+        col.add(f"{gp.path}.{fld}", msg)
+    return geom
 
 
 def _joint_coupling(mech: Mechanism, tree: Tree, jidx: dict, gi: int, gp, col: Collector) -> Circuit | None:
@@ -476,6 +479,199 @@ def _joint_coupling(mech: Mechanism, tree: Tree, jidx: dict, gi: int, gp, col: C
     jb, ja = mech.joints[b], mech.joints[a]
     return Circuit(gi, tree.index[jb.child], tree.index[ja.child], tree.index[jb.parent], float(gp.ratio),
                    row, jb.R_pj[:, 2].copy(), ja.R_pj[:, 2].copy(), None, joints=(b, a))
+
+
+# --- degrees of freedom, independent coordinates -------------------------------------------
+
+class _Independent(NamedTuple):
+    """Independent coordinates q_ind (dof of them) and q = S q_ind."""
+
+    primary: list[int]     # primary links, base first (the EOLC, or the tree's free links)
+    chain: list[int]       # moving primary links, one per independent coordinate
+    open_loop: str         # "chain" or "tree"
+    S: np.ndarray          # (J, dof): every real joint angle from the independent ones
+    independent: tuple     # (dof,) joint id of each coordinate, -1 for a canonical angle
+    independent_names: tuple
+
+
+def _independent_coordinates(h: _Home, cparent: list, canon: np.ndarray, primary: list[int],
+                             circuits: list[Circuit], col: Collector) -> _Independent:
+    """Degrees of freedom (J - G), the independent coordinates and S (J, dof) solving the
+    circuit rows Gam q = 0 together with q_ind = B q (canonical angles of the EOLC, or the
+    free joints of a tree)."""
+    G, J = len(circuits), h.J
+    Gam = _circuit_matrix(h, circuits, col)
+    dof = J - G
+    open_loop = "tree" if h.mech.open_loop == "tree" else "chain"
+    if open_loop == "tree":
+        primary, chain, B = _tree_coordinates(h, circuits, dof, col)
+    else:
+        chain = primary[1:]
+        if len(chain) != dof:
+            col.add("end_effector", f"the mechanism has {dof} degrees of freedom ({J} joints - {G} gear pairs) "
+                    f"but its equivalent open-loop chain {' -> '.join(h.tree.links[i] for i in primary)} has "
+                    f"{len(chain)} joints")
+            col.raise_if_any()
+        B = canon[chain]
+    Mfull = np.vstack([Gam, B])
+    if np.linalg.matrix_rank(Mfull) < J:
+        col.add("gears", "the gear trains lock the equivalent open-loop chain: its joint angles do not "
+                "determine the motion of every link")
+        col.raise_if_any()
+    S = np.linalg.solve(Mfull, np.vstack([np.zeros((G, dof)), np.eye(dof)]))
+    S[np.abs(S) < 1e-15] = 0.0
+    independent = []
+    for c in chain:
+        jt = h.jin[c]
+        independent.append(jt if open_loop == "tree" or h.idx[h.mech.joints[jt].parent] == cparent[c] else -1)
+    names = tuple(h.mech.joints[jt].name if jt >= 0 else f"{h.tree.links[cparent[c]]}-{h.tree.links[c]}"
+                  for jt, c in zip(independent, chain))
+    return _Independent(primary, chain, open_loop, S, tuple(independent), names)
+
+
+def _circuit_matrix(h: _Home, circuits: list[Circuit], col: Collector) -> np.ndarray:
+    """(G, J) matrix Gam of the circuit rows; raises if it is rank deficient (redundant
+    gear pairs, whose loads would be statically indeterminate)."""
+    G = len(circuits)
+    Gam = np.array([c.row for c in circuits]).reshape(G, h.J)
+    rank = np.linalg.matrix_rank(Gam) if G else 0
+    if rank < G:
+        _, sv, Vt = np.linalg.svd(Gam.T)
+        null = Vt[rank:]  # left null vectors of Gam
+        involved = sorted({i for v in null for i in np.flatnonzero(np.abs(v) > 1e-8)})
+        gears = h.mech.gears
+        col.add("gears", "redundant gear pairs make the loads statically indeterminate: "
+                + ", ".join(f"'{gears[circuits[i].gear].name}' ({gears[circuits[i].gear].path})"
+                            for i in involved))
+        col.raise_if_any()
+    return Gam
+
+
+def _tree_coordinates(h: _Home, circuits: list[Circuit], dof: int, col: Collector):
+    """Open-loop tree (``open_loop: tree``): every link whose own joint is not made dependent
+    by a pair (its first link j) is primary.  Returns (primary, chain, B (dof, J))."""
+    dependent = {c.j for c in circuits}
+    chain = [h.idx[jt.child] for jt in h.mech.joints if h.idx[jt.child] not in dependent]
+    primary = [h.tree.base] + chain
+    if len(chain) != dof:
+        col.add("gears", f"the mechanism has {dof} degrees of freedom ({h.J} joints - {len(circuits)} gear pairs "
+                f"and couplings) but {len(chain)} joints are not made dependent by a pair")
+        col.raise_if_any()
+    B = np.zeros((dof, h.J))
+    for r, c in enumerate(chain):
+        B[r, h.jin[c]] = 1.0
+    return primary, chain, B
+
+
+# --- motors and structure matrix -----------------------------------------------------------
+
+class _Motors(NamedTuple):
+    """Per motor (``mech.motors`` order): input link, stator link, input rotation row."""
+
+    links: list[int]
+    stators: list[int]
+    rows: np.ndarray       # (M, J): motor input rotation in real joint angles
+    joints: list           # ((joint id, coefficient), ...) of a transmission motor, else None
+
+
+def _motors(h: _Home, cparent: list, groups: list[CoaxialGroup], canon: np.ndarray, dof: int,
+            col: Collector) -> _Motors:
+    """Input rotation of every motor as a row over real joint angles (one motor per dof)."""
+    if len(h.mech.motors) != dof:
+        col.add("motors", f"{len(h.mech.motors)} motor(s) for {dof} degree(s) of freedom: "
+                "a mechanism needs one motor per degree of freedom")
+    found = []
+    for m in h.mech.motors:
+        if m.joints:
+            found.append(_transmission_motor(h, m, col))
+        else:
+            found.append(_link_motor(h, cparent, groups, canon, m, col))
+    found = [f for f in found if f is not None]
+    col.raise_if_any()
+    rows = np.array([f[2] for f in found]).reshape(len(found), h.J)
+    return _Motors([f[0] for f in found], [f[1] for f in found], rows, [f[3] for f in found])
+
+
+def _transmission_motor(h: _Home, m, col: Collector):
+    """Motor driving a combination of joint coordinates (``Motor.joints``): (link, stator,
+    row (J,), ((joint id, coefficient), ...)); unknown joints are reported and skipped."""
+    x = h.idx[m.link]
+    row = np.zeros(h.J)
+    pairs = []
+    for name, coef in m.joints:
+        if name not in h.jidx:
+            col.add(f"{m.path}.joints", f"motor '{m.name}' drives unknown joint '{name}'")
+            continue
+        row[h.jidx[name]] += coef
+        pairs.append((h.jidx[name], float(coef)))
+    return x, _link_id(h, m.stator, h.tree.parent[x]), row, tuple(pairs)
+
+
+def _link_motor(h: _Home, cparent: list, groups, canon: np.ndarray, m, col: Collector):
+    """Motor turning its link relative to its stator (default: the link's carrier) about
+    their common axis: (link, stator, row (J,), None), or None with an issue."""
+    x = h.idx[m.link]
+    if x == h.tree.base:
+        col.add(f"{m.path}.link", "a motor cannot drive the base")
+        return None
+    s = _link_id(h, m.stator, cparent[x])
+    g = next((g for g in _groups_of(groups, x) if s in g.members and x in g.members and s != x), None)
+    if g is None:
+        col.add(f"{m.path}.stator", f"stator link '{h.tree.links[s]}' does not share the axis of input link '{m.link}'")
+        return None
+    row, _ = _relative_rotation(h, canon, x, s, g)
+    return x, s, row, None
+
+
+def _link_id(h: _Home, name: str | None, default: int) -> int:
+    """Id of link ``name``, or ``default`` if no name is given."""
+    return h.idx[name] if name is not None else default
+
+
+def _structure_matrix(mrows: np.ndarray, S: np.ndarray, col: Collector) -> np.ndarray:
+    """Structure matrix A (dof, M): motor input rotations = A^T q_ind (paper Eq. 22);
+    raises if singular (some dof driven by no motor)."""
+    AT = mrows @ S
+    AT[np.abs(AT) < 1e-15] = 0.0
+    if np.linalg.matrix_rank(AT) < S.shape[1]:
+        col.add("motors", "the motors do not drive every degree of freedom (structure matrix is singular)")
+        col.raise_if_any()
+    return AT.T.copy()
+
+
+# --- transmission lines --------------------------------------------------------------------
+
+def _transmission_lines(h: _Home, circuits: list[Circuit], primary: list[int], chain: list[int],
+                        mlinks: list[int]):
+    """Transmission lines: from each motor's input link along heavy edges (gear pairs) to the
+    first primary link reached (a path of link ids per branch; a single link if the input
+    link is primary).  Also whether the structure matrix is pseudo-triangular: every
+    primary link ends exactly one line."""
+    heavy: dict[int, list[int]] = {i: [] for i in range(h.L)}
+    for c in circuits:
+        heavy[c.j].append(c.k)
+        heavy[c.k].append(c.j)
+    pset = set(primary)
+    tlines: list[tuple[int, ...]] = []
+    for x in mlinks:
+        if x in pset:
+            tlines.append((x,))
+        else:
+            _extend_lines([x], heavy, pset, tlines)
+    ends = [line[-1] for line in tlines]
+    return tlines, all(ends.count(p) == 1 for p in chain)
+
+
+def _extend_lines(path: list[int], heavy: dict, pset: set, out: list) -> None:
+    """Depth-first extension of ``path`` along heavy edges, appending to ``out`` every
+    extension that reaches a primary link (in ``pset``)."""
+    for nb in heavy[path[-1]]:
+        if nb in path:
+            continue
+        if nb in pset:
+            out.append(tuple(path + [nb]))
+        else:
+            _extend_lines(path + [nb], heavy, pset, out)
 
 
 def _auto_label(i: int) -> str:

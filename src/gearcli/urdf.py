@@ -197,60 +197,73 @@ class _Reader:
         return path
 
     def check_structure(self) -> None:
-        root = self.root
+        """Names, references, types and numbers of every <link> and <joint>, then that the
+        joints form one tree (sets ``self.base``)."""
         self.link_el: dict[str, object] = {}
-        for el in root.findall("link"):
+        for el in self.root.findall("link"):
             path = self.register(el, "link", self.link_el)
             if path is not None:
                 self.check_inertial(el, path)
         self.joint_el: dict[str, object] = {}
         self.parent_of: dict[str, str] = {}   # link -> parent link
         self.joint_into: dict[str, str] = {}  # link -> joint whose child it is
-        for el in root.findall("joint"):
+        for el in self.root.findall("joint"):
             path = self.register(el, "joint", self.joint_el)
-            if path is None:
-                continue
-            name = el.get("name")
-            jtype = el.get("type")
-            if jtype in ("floating", "planar"):
-                self.add(path, f"joint type '{jtype}' is not supported: gearcli analyses mechanisms on a "
-                         "fixed base with one-degree-of-freedom joints (revolute, continuous, prismatic, fixed)", el)
-            elif jtype not in JOINT_TYPES and jtype != "fixed":
-                self.add(path, f"unknown joint type '{jtype}' (expected revolute, continuous, prismatic or fixed)"
-                         if jtype else "the joint has no type", el)
-            ends = {}
-            for end in ("parent", "child"):
-                sub = el.find(end)
-                link = sub.get("link") if sub is not None else None
-                if not link:
-                    self.add(path, f"the joint has no <{end} link=\"...\"/>", el)
-                elif link not in self.link_el:
-                    self.add(path, f"unknown {end} link '{link}'", sub)
-                else:
-                    ends[end] = link
-            if len(ends) == 2:
-                p, c = ends["parent"], ends["child"]
-                if p == c:
-                    self.add(path, f"the joint connects link '{p}' to itself", el)
-                elif c in self.joint_into:
-                    self.add(path, f"link '{c}' is already the child of joint '{self.joint_into[c]}' "
-                             "(a URDF is a tree: each link has one parent joint)", el)
-                else:
-                    self.joint_into[c] = name
-                    self.parent_of[c] = p
-            origin = el.find("origin")
-            self.vector(origin, "xyz", path)
-            self.vector(origin, "rpy", path)
-            axis_el = el.find("axis")
-            axis = self.vector(axis_el, "xyz", path)
-            if axis is not None and np.linalg.norm(axis) < 1e-12 and jtype in JOINT_TYPES:
-                self.add(path, "the joint axis is the zero vector", axis_el)
-            mimic = el.find("mimic")
-            if mimic is not None:
-                for attr in ("multiplier", "offset"):
-                    self.vector(mimic, attr, f"{path}.mimic", n=1)
+            if path is not None:
+                self.check_joint(el, path)
         if self.col.issues:
             return
+        self.check_tree()
+
+    def check_joint(self, el, path: str) -> None:
+        """Type, parent and child links (recorded in ``parent_of``/``joint_into``), origin,
+        axis and mimic numbers of one <joint>."""
+        jtype = el.get("type")
+        if jtype in ("floating", "planar"):
+            self.add(path, f"joint type '{jtype}' is not supported: gearcli analyses mechanisms on a "
+                     "fixed base with one-degree-of-freedom joints (revolute, continuous, prismatic, fixed)", el)
+        elif jtype not in JOINT_TYPES and jtype != "fixed":
+            self.add(path, f"unknown joint type '{jtype}' (expected revolute, continuous, prismatic or fixed)"
+                     if jtype else "the joint has no type", el)
+        self.check_joint_ends(el, path)
+        origin = el.find("origin")
+        self.vector(origin, "xyz", path)
+        self.vector(origin, "rpy", path)
+        axis_el = el.find("axis")
+        axis = self.vector(axis_el, "xyz", path)
+        if axis is not None and np.linalg.norm(axis) < 1e-12 and jtype in JOINT_TYPES:
+            self.add(path, "the joint axis is the zero vector", axis_el)
+        mimic = el.find("mimic")
+        if mimic is not None:
+            for attr in ("multiplier", "offset"):
+                self.vector(mimic, attr, f"{path}.mimic", n=1)
+
+    def check_joint_ends(self, el, path: str) -> None:
+        """The joint's <parent> and <child> links: known, distinct, one parent joint a link."""
+        ends = {}
+        for end in ("parent", "child"):
+            sub = el.find(end)
+            link = sub.get("link") if sub is not None else None
+            if not link:
+                self.add(path, f"the joint has no <{end} link=\"...\"/>", el)
+            elif link not in self.link_el:
+                self.add(path, f"unknown {end} link '{link}'", sub)
+            else:
+                ends[end] = link
+        if len(ends) == 2:
+            p, c = ends["parent"], ends["child"]
+            if p == c:
+                self.add(path, f"the joint connects link '{p}' to itself", el)
+            elif c in self.joint_into:
+                self.add(path, f"link '{c}' is already the child of joint '{self.joint_into[c]}' "
+                         "(a URDF is a tree: each link has one parent joint)", el)
+            else:
+                self.joint_into[c] = el.get("name")
+                self.parent_of[c] = p
+
+    def check_tree(self) -> None:
+        """One root link (the base, ``self.base``) from which every link hangs, no loop."""
+        root = self.root
         roots = [n for n in self.link_el if n not in self.parent_of]
         if not self.link_el:
             self.add("", "the robot has no links", root)
@@ -417,6 +430,15 @@ class _Reader:
     def couplings(self) -> list[GearPair]:
         """A GearPair(joints=(B, A)) per <mimic> of a movable joint; offsets kept in
         ``self.offset`` (absorbed into the joint frames later)."""
+        elements = self.mimic_leaders()
+        self.check_mimic_cycles(elements)
+        if self.col.issues:
+            return []
+        return [self.mimic_pair(b, a, m) for b, (a, m, c) in self.leader.items()]
+
+    def mimic_leaders(self) -> dict:
+        """``self.leader[B] = (A, multiplier, offset)`` for each valid <mimic> of a movable
+        joint B; returns the <mimic> elements by follower name."""
         self.leader: dict[str, tuple[str, float, float]] = {}
         elements = {}
         for name in self.joint_order:
@@ -444,7 +466,10 @@ class _Reader:
                 continue
             self.leader[name] = (a, m, c)
             elements[name] = el
-        # cycles
+        return elements
+
+    def check_mimic_cycles(self, elements: dict) -> None:
+        """Report each cycle of joints following one another (once, from its first joint)."""
         reported: set[str] = set()
         for start in self.leader:
             seen, x = [], start
@@ -458,24 +483,21 @@ class _Reader:
                 loop = cyc[cyc.index(first):] + cyc[:cyc.index(first)] + [first]
                 self.add(f"joint '{first}'.mimic", f"mimic cycle: {' -> '.join(loop)} "
                          "(each joint follows the next; no joint leads)", elements[first])
-        if self.col.issues:
-            return []
-        pairs = []
-        for b, (a, m, c) in self.leader.items():
-            jb, ja = self.movable[b], self.movable[a]
-            gear = self.joint_el[b].find(q("gear"))
-            kw = {}
-            if gear is not None:
-                kw = self.gear_geometry(gear, f"joint '{b}'.gearcli:gear", MIMIC_GEAR_ATTRS)
-                if jb.parent != ja.parent:
-                    self.add(f"joint '{b}'.gearcli:gear", f"gear geometry on a mimic needs both joints on one "
-                             f"carrier, but '{b}' hangs from '{jb.parent}' and '{a}' from '{ja.parent}' "
-                             "(give the pair as a top-level gearcli:gear)", gear)
-                kw.setdefault("carrier", jb.parent)
-            name = kw.pop("name", None) or f"mimic_{b}"
-            pairs.append(GearPair(name, jb.child, ja.child, ratio=m, joints=(b, a),
-                                  path=f"joint '{b}'.mimic", **kw))
-        return pairs
+
+    def mimic_pair(self, b: str, a: str, m: float) -> GearPair:
+        """The coupling q_B = m q_A, with the mesh geometry of B's gearcli:gear if any."""
+        jb, ja = self.movable[b], self.movable[a]
+        gear = self.joint_el[b].find(q("gear"))
+        kw = {}
+        if gear is not None:
+            kw = self.gear_geometry(gear, f"joint '{b}'.gearcli:gear", MIMIC_GEAR_ATTRS)
+            if jb.parent != ja.parent:
+                self.add(f"joint '{b}'.gearcli:gear", f"gear geometry on a mimic needs both joints on one "
+                         f"carrier, but '{b}' hangs from '{jb.parent}' and '{a}' from '{ja.parent}' "
+                         "(give the pair as a top-level gearcli:gear)", gear)
+            kw.setdefault("carrier", jb.parent)
+        name = kw.pop("name", None) or f"mimic_{b}"
+        return GearPair(name, jb.child, ja.child, ratio=m, joints=(b, a), path=f"joint '{b}'.mimic", **kw)
 
     def absorb_offsets(self, joints: list[Joint]) -> list[Joint]:
         """q_B = m q_A + c: count B from its offset (B's joint frame turned, or slid, by the
@@ -623,6 +645,9 @@ class _Reader:
 
     # -- motors ------------------------------------------------------------------------------------
     def motors(self, ext, has_gears: bool) -> list[Motor]:
+        """The gearcli:motor elements if any; else a motor per actuator of the usable
+        <transmission>s and (without gearcli:gear elements) a direct drive per joint that is
+        driven by none, in joint order."""
         if ext["motors"]:
             out = [self.extension_motor(el) for el in ext["motors"]]
             plain = [t for t in self.root.findall("transmission") if t.get(q("derived")) != "true"]
@@ -630,10 +655,28 @@ class _Reader:
                 self.warn("", f"{len(plain)} <transmission> element(s) are ignored: the gearcli:motor "
                           "elements define the motors")
             return [m for m in out if m is not None]
+        driven: dict[str, str] = {}
+        acts = self.transmission_motors(self.usable_transmissions(), driven)
+        if not has_gears:
+            # a direct drive for every joint that leads no driven mimic group
+            led = {self.chain_leader(j) for j in driven}
+            for name, jt in self.movable.items():
+                if name not in self.leader and name not in led:
+                    acts.append((self.joint_order.index(name), 0, Motor(name, jt.child, jt.parent, f"joint '{name}'")))
+        acts.sort(key=lambda t: (t[0], t[1]))
+        motors = [m for _, _, m in acts]
+        seen: dict[str, str] = {}
+        for m in motors:
+            if m.name in seen:
+                self.add(m.path, f"duplicate motor (actuator) name '{m.name}' (also in {seen[m.name]})")
+            seen[m.name] = m.path
+        return motors
+
+    def usable_transmissions(self) -> list:
+        """(spec, element) of each <transmission> that names known, movable joints and has a
+        supported type; the others are reported (errors) or ignored (warnings)."""
         specs = read_transmissions(self.root)
         elements = self.root.findall("transmission")
-        driven: dict[str, str] = {}
-        acts: list[tuple[int, int, Motor]] = []  # (first joint position, order, motor)
         kept = []
         for spec, el in zip(specs, elements):
             if el.get(q("derived")) == "true":
@@ -658,7 +701,13 @@ class _Reader:
                 self.warn(path, f"transmission '{spec.name}' drives fixed joint(s) {', '.join(fixed)}: ignored", el)
                 continue
             kept.append((spec, el))
-        # a transmission on a mimic follower is dropped when its leader has its own actuator
+        return kept
+
+    def transmission_motors(self, kept: list, driven: dict) -> list:
+        """(first joint position, order, Motor) per actuator of the transmissions ``kept``;
+        ``driven[joint]`` = name of the transmission that drives it.  A transmission on a mimic
+        follower is dropped when its leader has its own actuator."""
+        acts: list[tuple[int, int, Motor]] = []
         own = {j for spec, _ in kept for j in spec.joints if j not in self.leader}
         for spec, el in kept:
             followers = [j for j in spec.joints if j in self.leader]
@@ -678,20 +727,7 @@ class _Reader:
                 pos = min(self.joint_order.index(j) for j, _ in act.joints)
                 acts.append((pos, k, Motor(act.name, first.child, first.parent, spec.path,
                                            joints=tuple((j, float(c)) for j, c in act.joints))))
-        if not has_gears:
-            # a direct drive for every joint that leads no driven mimic group
-            led = {self.chain_leader(j) for j in driven}
-            for name, jt in self.movable.items():
-                if name not in self.leader and name not in led:
-                    acts.append((self.joint_order.index(name), 0, Motor(name, jt.child, jt.parent, f"joint '{name}'")))
-        acts.sort(key=lambda t: (t[0], t[1]))
-        motors = [m for _, _, m in acts]
-        seen: dict[str, str] = {}
-        for m in motors:
-            if m.name in seen:
-                self.add(m.path, f"duplicate motor (actuator) name '{m.name}' (also in {seen[m.name]})")
-            seen[m.name] = m.path
-        return motors
+        return acts
 
     def chain_leader(self, name: str) -> str:
         while name in self.leader:
