@@ -428,8 +428,8 @@ class _Reader:
 
     # -- mimic couplings ------------------------------------------------------------------------
     def couplings(self) -> list[GearPair]:
-        """A GearPair(joints=(B, A)) per <mimic> of a movable joint; offsets kept in
-        ``self.offset`` (absorbed into the joint frames later)."""
+        """A GearPair(joints=(B, A)) per <mimic> of a movable joint; the offsets stay in
+        ``self.leader`` (absorbed into the joint frames later)."""
         elements = self.mimic_leaders()
         self.check_mimic_cycles(elements)
         if self.col.issues:
