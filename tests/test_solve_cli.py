@@ -155,3 +155,17 @@ def test_degrees_leaves_prismatic_columns_in_metres(run_cli, mech_dir, tmp_path)
     x = np.loadtxt(io.StringIO(r1.stdout), delimiter=",", skiprows=1)
     y = np.loadtxt(io.StringIO(r2.stdout), delimiter=",", skiprows=1)
     assert np.allclose(x, y, rtol=1e-7, atol=1e-7 * np.abs(x).max())
+
+
+def test_readme_library_example_runs(monkeypatch):
+    """The README's Python example runs as written, and its named columns match."""
+    readme = (ROOT / "README.md").read_text()
+    block = readme.split("## The library", 1)[1].split("```python", 1)[1].split("```", 1)[0]
+    monkeypatch.chdir(ROOT)
+    env: dict = {}
+    exec(compile(block, "README.md", "exec"), env)   # noqa: S102 (our own README)
+    res, an, cols = env["res"], env["an"], env["cols"]
+    assert res.residual < 1e-9
+    assert list(cols) == column_names(an)
+    assert np.array_equal(cols["motor:motor5"], res.motor[:, 1])
+    assert np.allclose(cols["joint:J1:bending"], np.hypot(res.joint[:, 0, 3], res.joint[:, 0, 4]))

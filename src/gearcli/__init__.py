@@ -24,6 +24,7 @@ _EXPORTS = {
     "solve": "dynamics",
     "Result": "dynamics",
     "solve_file": "pipeline",
+    "named_columns": "report",
     "read_trajectory": "trajectory",
     "Analysis": "graph",
     "Mechanism": "model",
@@ -38,6 +39,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from .dynamics import Result, solve
     from .graph import Analysis, analyse
     from .pipeline import solve_file
+    from .report import named_columns
     from .trajectory import read_trajectory
     from .loader import load_mechanism, parse_mechanism
     from .model import Mechanism

@@ -64,6 +64,15 @@ def table(an, t: np.ndarray, res: Result) -> np.ndarray:
     return np.hstack(parts)
 
 
+def named_columns(an, res: Result, t: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """The output CSV columns as a dict ``{column name: (N,) array}`` (see module docstring);
+    ``t`` defaults to the sample index."""
+    if t is None:
+        t = np.arange(res.motor.shape[0], dtype=float)
+    tab = table(an, np.asarray(t, float), res)
+    return {name: tab[:, i] for i, name in enumerate(column_names(an))}
+
+
 @dataclass
 class Stat:
     name: str
