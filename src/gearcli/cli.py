@@ -271,8 +271,14 @@ def summary_table(report) -> Table:
     for col, just in (("load", "left"), ("unit", "left"), ("peak", "right"), ("RMS", "right"),
                       ("t at peak [s]", "right")):
         table.add_column(col, justify=just, no_wrap=(col == "load"))
+    largest: dict[str, float] = {}
     for st in report.summary.stats:
-        table.add_row(st.name, st.unit, fmt_num(st.peak), fmt_num(st.rms), fmt_num(st.t_peak))
+        largest[st.unit] = max(largest.get(st.unit, 0.0), st.peak)
+    for st in report.summary.stats:
+        if st.peak <= 1e-12 * largest[st.unit]:   # rounding noise of an unloaded direction
+            table.add_row(st.name, st.unit, "0", "0", "-")
+        else:
+            table.add_row(st.name, st.unit, fmt_num(st.peak), fmt_num(st.rms), fmt_num(st.t_peak))
     return table
 
 
