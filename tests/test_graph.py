@@ -342,3 +342,25 @@ def test_bendix_axis_labels_follow_errata_item_9(mech_dir):
     assert (lab["1"], lab["2"], lab["3"]) == ("a", "b", "c")
     assert lab["5"] == lab["7"] == "a" and lab["6"] == lab["8"] == "b"
     assert lab["4"] not in ("a", "b", "c")
+
+
+def test_check_determinate_reports_singular_equations(mech_dir):
+    """The numerical safety net behind the structural schedule: a mesh whose tooth force
+    direction has been zeroed leaves its tangential force undetermined."""
+    import dataclasses
+
+    from gearcli.errors import Collector
+    from gearcli.graph import analyse
+    from gearcli.loader import load_mechanism
+    from gearcli.schedule import check_determinate
+
+    an = analyse(load_mechanism(mech_dir / "paper_2dof.yaml"))
+    col = Collector("paper_2dof.yaml")
+    check_determinate(an, col)
+    assert not col.issues
+    c = an.circuits[0]
+    broken = dataclasses.replace(c, geometry=dataclasses.replace(c.geometry, ut=0 * c.geometry.ut,
+                                                                  us=0 * c.geometry.us))
+    object.__setattr__(an, "circuits", (broken,) + an.circuits[1:])
+    check_determinate(an, col)
+    assert len(col.issues) == 1 and "statically indeterminate" in col.issues[0].message

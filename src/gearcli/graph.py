@@ -197,11 +197,13 @@ def analyse(mech: Mechanism) -> Analysis:
                   ind.S, tuple(mot.links), tuple(mot.stators), mot.rows, A, tuple(tlines), pseudo,
                   motor_joints=tuple(mot.joints) if any(x is not None for x in mot.joints) else (),
                   open_loop=ind.open_loop)
-    from .schedule import solution_schedule  # noqa: PLC0415
+    from .schedule import check_determinate, solution_schedule  # noqa: PLC0415
 
     blocks = solution_schedule(an, col)
     col.raise_if_any()
     object.__setattr__(an, "schedule", blocks)
+    check_determinate(an, col)
+    col.raise_if_any()
     return an
 
 
