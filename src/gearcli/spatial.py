@@ -54,18 +54,6 @@ def skew(v) -> np.ndarray:
     return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
 
 
-def rot_z_batch(q: np.ndarray) -> np.ndarray:
-    """Rotations about z by angles ``q`` (N,) -> (N, 3, 3)."""
-    c, s = np.cos(q), np.sin(q)
-    R = np.zeros(q.shape + (3, 3))
-    R[..., 0, 0] = c
-    R[..., 0, 1] = -s
-    R[..., 1, 0] = s
-    R[..., 1, 1] = c
-    R[..., 2, 2] = 1.0
-    return R
-
-
 def mv(R: np.ndarray, x: np.ndarray) -> np.ndarray:
     """Batched matrix-vector product R x: (N,3,3) or (3,3) times (N,3) or (3,)."""
     if R.ndim == 2:
@@ -89,11 +77,6 @@ def mtv(R: np.ndarray, x: np.ndarray) -> np.ndarray:
     return np.einsum("nji,nj->ni", R, x)
 
 
-def mm(A: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """Batched matrix product."""
-    return np.matmul(A, B)
-
-
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Cross product of (N,3) arrays (broadcasting), faster than np.cross for small rows."""
     a, b = np.broadcast_arrays(a, b)
@@ -104,11 +87,3 @@ def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     np.subtract(a2 * b0, a0 * b2, out=out[..., 1])
     np.subtract(a0 * b1, a1 * b0, out=out[..., 2])
     return out
-
-
-def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return np.einsum("...i,...i->...", a, b)
-
-
-def unit(v: np.ndarray) -> np.ndarray:
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)

@@ -80,6 +80,18 @@ def _by_role(elements, prefix: str):
     return list(elements)
 
 
+def _parts(t, n: int, kind: str, probs: list) -> tuple[list, list]:
+    """The <joint> and <actuator> children of transmission ``t`` when there are ``n`` of
+    each; otherwise a problem is recorded and both lists are empty."""
+    joints, acts = t.findall("joint"), t.findall("actuator")
+    if len(joints) != n or len(acts) != n:
+        word = {1: "one", 2: "two"}[n]
+        probs.append(f"a {kind} needs {word} <joint> and {word} <actuator>, "
+                     f"got {len(joints)} and {len(acts)}")
+        return [], []
+    return joints, acts
+
+
 def read_transmissions(root) -> list[TransmissionSpec]:
     """Every ``<transmission>`` child of ``root`` (an lxml ``<robot>`` element)."""
     out = []
@@ -90,11 +102,8 @@ def read_transmissions(root) -> list[TransmissionSpec]:
         spec.joints = [j.get("name") for j in t.findall("joint")]
         probs = spec.problems
         if kind == "SimpleTransmission":
-            joints, acts = t.findall("joint"), t.findall("actuator")
-            if len(joints) != 1 or len(acts) != 1:
-                probs.append(f"a SimpleTransmission needs one <joint> and one <actuator>, "
-                             f"got {len(joints)} and {len(acts)}")
-            else:
+            joints, acts = _parts(t, 1, kind, probs)
+            if joints:
                 a = acts[0]
                 text = a.findtext("mechanicalReduction")
                 if text is None:
@@ -102,11 +111,8 @@ def read_transmissions(root) -> list[TransmissionSpec]:
                 n = _number(text, "mechanicalReduction", probs)
                 spec.actuators = [Actuation(a.get("name") or name, ((joints[0].get("name"), n),))]
         elif kind == "DifferentialTransmission":
-            joints, acts = t.findall("joint"), t.findall("actuator")
-            if len(joints) != 2 or len(acts) != 2:
-                probs.append(f"a DifferentialTransmission needs two <joint> and two <actuator>, "
-                             f"got {len(joints)} and {len(acts)}")
-            else:
+            joints, acts = _parts(t, 2, kind, probs)
+            if joints:
                 a1, a2 = _by_role(acts, "actuator")
                 j1, j2 = _by_role(joints, "joint")
                 na1, na2 = (_number(a.findtext("mechanicalReduction"), "mechanicalReduction", probs) for a in (a1, a2))
