@@ -26,8 +26,8 @@ from pathlib import Path
 import numpy as np
 
 from gearcli.dynamics import solve
-from gearcli.graph import analyse
-from gearcli.loader import load_mechanism
+from gearcli import analyse
+from gearcli import load_mechanism
 from gearcli.trajectory import write_trajectory
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -11,10 +11,10 @@ from pathlib import Path
 
 import numpy as np
 
-from gearcli.dynamics import joint_space, solve
-from gearcli.graph import analyse
-from gearcli.kinematics import forward
-from gearcli.loader import load_mechanism
+from gearcli.dynamics.solve import joint_space, solve
+from gearcli import analyse
+from gearcli.dynamics.kinematics import forward
+from gearcli import load_mechanism
 
 MECH = Path(__file__).resolve().parents[1] / "mechanisms"
 

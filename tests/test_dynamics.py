@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 from factories import PAPER_2DOF_PARAMS, paper_2dof_variant, planetary_2dof, spatial_3dof
-from gearcli.dynamics import joint_space, solve
-from gearcli.graph import analyse
-from gearcli.kinematics import forward, velocities
-from gearcli.loader import load_mechanism, parse_mechanism
+from gearcli.dynamics.solve import joint_space, solve
+from gearcli import analyse
+from gearcli.dynamics.kinematics import forward, velocities
+from gearcli import load_mechanism, parse_mechanism
 
 ROOT = Path(__file__).resolve().parents[1]
 MECH_DIR = ROOT / "mechanisms"

@@ -13,7 +13,7 @@ import pytest
 import yaml
 
 from gearcli import analyse, load_mechanism, parse_mechanism
-from gearcli.dot import to_dot
+from gearcli.report.dot import to_dot
 
 MECHS = ("paper_2dof", "bendix_wrist", "coaxial_fig5")
 
@@ -334,8 +334,8 @@ def test_dot_real_joints(run_cli, mech_dir):
 def test_bendix_axis_labels_follow_errata_item_9(mech_dir):
     """Primary axes a, b, c; inputs 5 and 7 on axis a (concentric with link 1); 6 and 8 on
     axis b; pinion 4 on an axis of its own."""
-    from gearcli.graph import analyse
-    from gearcli.loader import load_mechanism
+    from gearcli import analyse
+    from gearcli import load_mechanism
 
     an = analyse(load_mechanism(mech_dir / "bendix_wrist.yaml"))
     lab = dict(zip(an.names, an.label))
@@ -350,9 +350,9 @@ def test_check_determinate_reports_singular_equations(mech_dir):
     import dataclasses
 
     from gearcli.errors import Collector
-    from gearcli.graph import analyse
-    from gearcli.loader import load_mechanism
-    from gearcli.schedule import check_determinate
+    from gearcli import analyse
+    from gearcli import load_mechanism
+    from gearcli.dynamics.determinacy import check_determinate
 
     an = analyse(load_mechanism(mech_dir / "paper_2dof.yaml"))
     col = Collector("paper_2dof.yaml")

@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from gearcli.dynamics import solve
-from gearcli.graph import analyse
-from gearcli.loader import load_mechanism, parse_mechanism
+from gearcli.dynamics.solve import solve
+from gearcli import analyse
+from gearcli import load_mechanism, parse_mechanism
 
 MECH = Path(__file__).resolve().parents[1] / "mechanisms"
 

@@ -7,11 +7,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gearcli.dynamics import solve
-from gearcli.graph import analyse
-from gearcli.loader import load_mechanism, mechanism_schema
-from gearcli.report import column_names
-from gearcli.trajectory import read_trajectory, write_trajectory
+from gearcli.dynamics.solve import solve
+from gearcli import analyse
+from gearcli import load_mechanism
+from gearcli.io.yaml_reader import mechanism_schema
+from gearcli.report.columns import column_names
+from gearcli.io.trajectory import read_trajectory, write_trajectory
 
 ROOT = Path(__file__).resolve().parents[1]
 BUNDLED = [("paper_2dof", "paper_2dof_traj.csv"), ("bendix_wrist", "bendix_wrist_traj.csv")]

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from gearcli.errors import TrajectoryError
-from gearcli.trajectory import TrajectoryReader, derivatives, read_trajectory, write_trajectory
+from gearcli.io.trajectory import TrajectoryReader, derivatives, read_trajectory, write_trajectory
 
 NAMES = ["J1", "J2"]
 

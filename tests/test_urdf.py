@@ -29,12 +29,13 @@ import numpy as np
 import pytest
 
 from gearcli import MechanismError
-from gearcli.dynamics import solve
-from gearcli.graph import analyse
-from gearcli.loader import load_mechanism
+from gearcli.dynamics.solve import solve
+from gearcli import analyse
+from gearcli import load_mechanism
 from gearcli.spatial import align_z
-from gearcli.urdf import joint_efforts, load_urdf, parse_urdf
-from gearcli.urdf_export import export_urdf
+from gearcli.io.urdf_reader import load_urdf, parse_urdf
+from gearcli.report.efforts import joint_efforts
+from gearcli.report.urdf_writer import export_urdf
 
 pin = pytest.importorskip("pinocchio")
 

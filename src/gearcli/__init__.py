@@ -18,16 +18,16 @@ __version__ = "0.1.0"
 
 # public name -> submodule defining it
 _EXPORTS = {
-    "load_mechanism": "loader",
-    "parse_mechanism": "loader",
-    "analyse": "graph",
-    "solve": "dynamics",
-    "Result": "dynamics",
+    "load_mechanism": "io",
+    "parse_mechanism": "io.yaml_reader",
+    "analyse": "pipeline",
+    "solve": "dynamics.solve",
+    "Result": "dynamics.solve",
     "solve_file": "pipeline",
-    "named_columns": "report",
-    "read_trajectory": "trajectory",
-    "Analysis": "graph",
-    "Mechanism": "model",
+    "named_columns": "report.columns",
+    "read_trajectory": "io.trajectory",
+    "Analysis": "analysis.graph",
+    "Mechanism": "model.mechanism",
     "MechanismError": "errors",
     "GearcliError": "errors",
 }
@@ -35,14 +35,15 @@ _EXPORTS = {
 __all__ = ["__version__", *_EXPORTS]
 
 if TYPE_CHECKING:  # pragma: no cover
+    from .analysis.graph import Analysis
+    from .dynamics.solve import Result, solve
     from .errors import GearcliError, MechanismError
-    from .dynamics import Result, solve
-    from .graph import Analysis, analyse
-    from .pipeline import solve_file
-    from .report import named_columns
-    from .trajectory import read_trajectory
-    from .loader import load_mechanism, parse_mechanism
-    from .model import Mechanism
+    from .io import load_mechanism
+    from .io.trajectory import read_trajectory
+    from .io.yaml_reader import parse_mechanism
+    from .model.mechanism import Mechanism
+    from .pipeline import analyse, solve_file
+    from .report.columns import named_columns
 
 
 def __getattr__(name: str):

@@ -28,7 +28,7 @@ from . import __version__
 from .errors import GearcliError
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .graph import Analysis
+    from .analysis.graph import Analysis
 
 EXIT_BAD_INPUT = 2
 JSON_DIGITS = 12  # significant digits of floats in JSON output
@@ -81,8 +81,8 @@ def load_analysis(path: Path) -> Analysis:
     Input problems the loader worked around (``Mechanism.warnings``) go to stderr, one
     line each, without changing the exit status.
     """
-    from .graph import analyse  # noqa: PLC0415  (keeps --help fast)
-    from .loader import load_mechanism  # noqa: PLC0415
+    from .pipeline import analyse  # noqa: PLC0415  (keeps --help fast)
+    from .io import load_mechanism  # noqa: PLC0415
 
     mech = load_mechanism(path)
     print_problems([f"warning: {w}" for w in getattr(mech, "warnings", ())])
@@ -252,7 +252,7 @@ def graph(
     if as_json:
         typer.echo(json.dumps(round_sig(an.to_dict()), indent=2))
     elif as_dot:
-        from .dot import to_dot  # noqa: PLC0415
+        from .report.dot import to_dot  # noqa: PLC0415
 
         typer.echo(to_dot(an, real=real_joints), nl=False)
     else:
@@ -357,7 +357,7 @@ def export(
     """Write a URDF of the mechanism: links with inertials, the joint tree, geared joints as
     <mimic> where a single leader exists, motors as <transmission>, and the full gear
     geometry in gearcli extension elements (namespace https://gearcli.dev/urdf/1)."""
-    from .urdf_export import export_urdf  # noqa: PLC0415
+    from .report.urdf_writer import export_urdf  # noqa: PLC0415
 
     export_urdf(load_analysis(mech), output)
     typer.echo(f"Wrote {output}")

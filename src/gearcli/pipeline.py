@@ -10,11 +10,30 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from .dynamics import solve
-from .graph import Analysis, analyse
-from .loader import load_mechanism
-from .report import AtomicWriter, Summary, column_names, format_rows, table
-from .trajectory import TrajectoryReader
+from .dynamics.solve import solve
+from .analysis.graph import Analysis
+from .analysis.graph import analyse as analyse_graph
+from .dynamics.determinacy import check_determinate
+from .errors import Collector
+from .io import load_mechanism
+from .model.mechanism import Mechanism
+from .report.columns import AtomicWriter, Summary, column_names, format_rows, table
+from .io.trajectory import TrajectoryReader
+
+
+def analyse(mech: Mechanism) -> Analysis:
+    """Analyse ``mech`` and check that its loads are determined.
+
+    The graph analysis (:func:`gearcli.analysis.graph.analyse`: canonical graph, levels,
+    circuits, structure matrix, schedule) followed by the numerical determinacy check of the
+    load equations (:func:`gearcli.dynamics.determinacy.check_determinate`).  Raises
+    :class:`~gearcli.errors.MechanismError` listing every problem.
+    """
+    an = analyse_graph(mech)
+    col = Collector(mech.source, mech.lines)
+    check_determinate(an, col)
+    col.raise_if_any()
+    return an
 
 
 def prismatic_independent(an: Analysis) -> list[str]:

@@ -22,7 +22,7 @@ import numpy as np
 from .kinematics import forward
 from .blocks import solve_blocks
 from .loads import Columns, inertia_load
-from .schedule import unknown_groups
+from ..analysis.schedule import unknown_groups
 
 DEFAULT_CHUNK = 20_000
 

@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model import Mechanism
-from .spatial import cross, mm_const, mv
-from .tree import Tree
+from ..model.mechanism import Mechanism
+from ..spatial import cross, mm_const, mv
+from ..analysis.tree import Tree
 
 
 @dataclass

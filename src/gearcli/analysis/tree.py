@@ -5,8 +5,8 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass
 
-from .errors import Collector
-from .model import Mechanism
+from ..errors import Collector
+from ..model.mechanism import Mechanism
 
 
 @dataclass(frozen=True)

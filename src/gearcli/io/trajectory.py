@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import make_interp_spline
 
-from .errors import TrajectoryError
+from ..errors import TrajectoryError
 
 PAD = 64
 

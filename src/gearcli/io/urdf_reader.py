@@ -47,12 +47,12 @@ from pathlib import Path
 import numpy as np
 from lxml import etree
 
-from .errors import Collector, Issue, MechanismError
-from .loader import check_inertia
-from .model import GEAR_KINDS, GearPair, Joint, Link, Mechanism, Motor
-from .spatial import align_z, matrix_rpy, rot_z
-from .transmissions import KINDS as TRANSMISSION_KINDS
-from .transmissions import read_transmissions
+from ..errors import Collector, Issue, MechanismError
+from ..model.validate import check_inertia
+from ..model.mechanism import GEAR_KINDS, GearPair, Joint, Link, Mechanism, Motor
+from ..spatial import align_z, matrix_rpy, rot_z
+from .urdf_transmissions import KINDS as TRANSMISSION_KINDS
+from .urdf_transmissions import read_transmissions
 
 NS = "https://gearcli.dev/urdf/1"
 """XML namespace of gearcli's URDF extension elements (prefix ``gearcli``)."""
@@ -803,36 +803,4 @@ def _lump(parts) -> tuple[float, np.ndarray, np.ndarray]:
     return M, com, 0.5 * (I + I.T)
 
 
-def joint_efforts(an, res) -> np.ndarray:
-    """(N, J) generalised force on every real joint about (along) its axis, on the child:
-    the sum of the motors acting on it and the ideal couplings of its coordinate (N*m, N).
-
-    Valid when every motor acts on real joints (a transmission motor, or a motor whose stator
-    is its link's joint parent) and every ideal pair is a joint coupling (``GearPair.joints``):
-    true for every URDF import.  Together with ``Result.joint`` it gives the whole wrench each
-    joint transmits (what Pinocchio calls ``data.f``).
-    """
-    mech, tree = an.mech, an.tree
-    N = res.motor.shape[0]
-    out = np.zeros((N, len(mech.joints)))
-    for mi in range(len(an.motor_links)):
-        mj = an.motor_joints[mi] if an.motor_joints else None
-        if mj is None:
-            ji = tree.parent_joint[an.motor_links[mi]]
-            if tree.parent[an.motor_links[mi]] != an.motor_stators[mi]:
-                raise ValueError(f"motor '{mech.motors[mi].name}' does not act on one real joint")
-            mj = ((ji, 1.0),)
-        for ji, c in mj:
-            out[:, ji] += c * res.motor[:, mi]
-    for ci, c in enumerate(an.circuits):
-        if c.joints is None:
-            if c.geometry is None:
-                raise ValueError(f"ideal pair '{mech.gears[c.gear].name}' is not a joint coupling")
-            continue
-        b, a = c.joints
-        out[:, b] += res.gear_t[:, ci]
-        out[:, a] -= c.ratio * res.gear_t[:, ci]
-    return out
-
-
-__all__ = ["NS", "load_urdf", "parse_urdf", "joint_efforts"]
+__all__ = ["NS", "load_urdf", "parse_urdf"]

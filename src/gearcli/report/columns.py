@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .dynamics import Result
+from ..dynamics.solve import Result
 
 
 def column_names(an) -> list[str]:

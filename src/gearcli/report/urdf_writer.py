@@ -29,10 +29,10 @@ from pathlib import Path
 import numpy as np
 from lxml import etree
 
-from .graph import Analysis, analyse
-from .model import Mechanism
-from .spatial import align_z
-from .urdf import NS, q
+from ..analysis.graph import Analysis, analyse
+from ..model.mechanism import Mechanism
+from ..spatial import align_z
+from ..io.urdf_reader import NS, q
 
 PRISMATIC_LIMIT = 1000.0  # m, placeholder +- limits of a prismatic joint without known limits
 

@@ -18,8 +18,8 @@ import numpy as np
 
 from .kinematics import forward
 from .loads import Columns
-from .schedule import unknown_groups
-from .spatial import cross
+from ..analysis.schedule import unknown_groups
+from ..spatial import cross
 
 
 @dataclass

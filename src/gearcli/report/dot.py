@@ -13,7 +13,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .graph import Analysis
+    from ..analysis.graph import Analysis
 
 HEAVY_PENWIDTH = 4
 

@@ -18,15 +18,16 @@ Problems are reported with the file and YAML path of the offending element.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import NamedTuple
 
 import numpy as np
 
-from .errors import Collector
-from .gears import GearGeometry, gear_geometry
-from .kinematics import Kinematics, forward
-from .model import Mechanism
+from ..errors import Collector
+from ..model.gears import GearGeometry, gear_geometry
+from .home import Placements, home_placements
+from ..model.mechanism import Mechanism
+from .schedule import solution_schedule
 from .tree import Tree, build_tree
 
 TOL_LINE = 1e-9
@@ -197,14 +198,9 @@ def analyse(mech: Mechanism) -> Analysis:
                   ind.S, tuple(mot.links), tuple(mot.stators), mot.rows, A, tuple(tlines), pseudo,
                   motor_joints=tuple(mot.joints) if any(x is not None for x in mot.joints) else (),
                   open_loop=ind.open_loop)
-    from .schedule import check_determinate, solution_schedule  # noqa: PLC0415
-
     blocks = solution_schedule(an, col)
     col.raise_if_any()
-    object.__setattr__(an, "schedule", blocks)
-    check_determinate(an, col)
-    col.raise_if_any()
-    return an
+    return replace(an, schedule=blocks)
 
 
 # --- home geometry ------------------------------------------------------------------------
@@ -222,7 +218,7 @@ class _Home:
     idx: dict           # link name -> link id
     jidx: dict          # joint name -> joint id
     jin: tuple          # (L,) joint into each link, None for the base: its axis is the link's axis
-    kin: Kinematics     # forward kinematics at q = 0, one sample (arrays (1, 3), (1, 3, 3))
+    kin: Placements     # link and joint frames at q = 0 (R[i] (3, 3), o[i] (3,), world frame)
     ow: list            # J arrays (3,): joint origins, world frame, m
     zw: list            # J arrays (3,): unit joint axes, world frame
     scale: float        # m: largest joint-origin distance (at least 1), scales TOL_LINE
@@ -244,9 +240,9 @@ def _home_axes(mech: Mechanism, tree: Tree) -> _Home:
     """Joint axis lines (origin ``ow``, m; unit direction ``zw``) in the world frame at
     the home configuration, where every joint coordinate is zero."""
     J = len(mech.joints)
-    home = forward(mech, tree, np.zeros((1, J)))
-    zw = [home.Rj[ji][0, :, 2] for ji in range(J)]
-    ow = [home.oj[ji][0] for ji in range(J)]
+    home = home_placements(mech, tree)
+    zw = [home.Rj[ji][:, 2] for ji in range(J)]
+    ow = [home.oj[ji] for ji in range(J)]
     scale = max([1.0] + [float(np.linalg.norm(x)) for x in ow])
     jidx = {jt.name: ji for ji, jt in enumerate(mech.joints)}
     return _Home(mech, tree, tree.index, jidx, tree.parent_joint, home, ow, zw, scale)
@@ -351,7 +347,7 @@ def _coaxial_groups(h: _Home, cparent: list, label: list) -> list[CoaxialGroup]:
             same = [d for d in kids if d not in done and h.collinear(jin[c], jin[d])
                     and h.mech.joints[jin[d]].type == h.mech.joints[jin[c]].type]
             done.update(same)
-            Rp = h.kin.R[p][0]
+            Rp = h.kin.R[p]
             groups.append(CoaxialGroup(p, label[c], tuple([p] + same), Rp.T @ h.zw[jin[c]]))
     return groups
 
@@ -399,7 +395,7 @@ def _gear_circuit(h: _Home, groups, canon, gi: int, gp, j: int, k: int, col: Col
     c, gj, gk = found
     row_j, zj_w = _relative_rotation(h, canon, j, c, gj)
     row_k, zk_w = _relative_rotation(h, canon, k, c, gk)
-    Rc = h.kin.R[c][0]
+    Rc = h.kin.R[c]
     geom = None
     ratio = gp.ratio
     if gp.mesh_point is not None:
@@ -447,7 +443,7 @@ def _gear_carrier(h: _Home, groups, gp, j: int, k: int, col: Collector):
 def _mesh_geometry(h: _Home, gp, j, k, c, gj, gk, zj_w, zk_w, col: Collector) -> GearGeometry | None:
     """Gear geometry of ``gp`` from its mesh point, with both gear axes (points, m, and
     directions) expressed in the carrier frame of c; None (with issues) if inconsistent."""
-    Rc, oc = h.kin.R[c][0], h.kin.o[c][0]
+    Rc, oc = h.kin.R[c], h.kin.o[c]
     ow, jin = h.ow, h.jin
     pj = ow[jin[j]] if j != gj.carrier else ow[jin[c]]
     pk = ow[jin[k]] if k != gk.carrier else ow[jin[c]]

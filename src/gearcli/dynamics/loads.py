@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from .kinematics import Kinematics
-from .spatial import cross, mtv, mv
+from ..spatial import cross, mtv, mv
 
 
 def inertia_load(an, kin: Kinematics) -> dict[int, np.ndarray]:

@@ -21,9 +21,10 @@ import jsonschema
 import numpy as np
 import yaml
 
-from .errors import Collector, Issue, MechanismError
-from .model import GearPair, Joint, Link, Mechanism, Motor
-from .spatial import align_z, rot_x, rot_z, rpy_matrix
+from ..errors import Collector, Issue, MechanismError
+from ..model.mechanism import GearPair, Joint, Link, Mechanism, Motor
+from ..model.validate import check_inertia, inertia_matrix
+from ..spatial import align_z, rot_x, rot_z, rpy_matrix
 
 
 class Loader(yaml.SafeLoader):
@@ -47,20 +48,13 @@ def mechanism_schema() -> dict:
     try:
         text = resources.files("gearcli").joinpath("schemas/mechanism.schema.json").read_text()
     except (FileNotFoundError, ModuleNotFoundError, OSError):
-        text = (Path(__file__).resolve().parents[2] / "schemas" / "mechanism.schema.json").read_text()
+        text = (Path(__file__).resolve().parents[3] / "schemas" / "mechanism.schema.json").read_text()
     return json.loads(text)
 
 
-def load_mechanism(path: str | Path) -> Mechanism:
-    """Read a mechanism from a YAML file or a URDF (``.urdf``) file.
-
-    Raises :class:`~gearcli.errors.MechanismError` listing every problem found.
-    """
+def load_yaml(path: str | Path) -> Mechanism:
+    """Read a mechanism from a YAML file; raises :class:`~gearcli.errors.MechanismError`."""
     path = Path(path)
-    if path.suffix.lower() in (".urdf", ".xml"):
-        from .urdf import load_urdf  # noqa: PLC0415  (optional stage)
-
-        return load_urdf(path)
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
@@ -178,30 +172,6 @@ def parse_mechanism(text: str, file: str = "<string>") -> Mechanism:
     mech = _build(data, col, file, lines)
     col.raise_if_any()
     return mech
-
-
-def inertia_matrix(spec) -> np.ndarray:
-    """Inertia tensor from ``[Ixx, Iyy, Izz]`` or ``{ixx, iyy, izz, ixy, ixz, iyz}``."""
-    if isinstance(spec, dict):
-        ixx, iyy, izz = spec["ixx"], spec["iyy"], spec["izz"]
-        ixy, ixz, iyz = spec.get("ixy", 0.0), spec.get("ixz", 0.0), spec.get("iyz", 0.0)
-        return np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]], float)
-    return np.diag(np.asarray(spec, float))
-
-
-def check_inertia(I: np.ndarray, mass: float) -> str | None:
-    """Why ``I`` is not a physical inertia tensor about the centre of mass, or None."""
-    w = np.linalg.eigvalsh(I)
-    scale = max(float(np.max(np.abs(w))), 1e-300)
-    if mass > 0 and np.all(w == 0):
-        return None  # point mass
-    if w[0] < -1e-12 * scale:
-        return f"inertia tensor is not positive semi-definite (eigenvalues {np.array2string(w, precision=4)})"
-    a, b, c = w
-    if a + b < c * (1 - 1e-9) - 1e-15:
-        return (f"principal moments {np.array2string(w, precision=4)} violate the triangle "
-                "inequality (I1 + I2 >= I3)")
-    return None
 
 
 def _angle(spec: dict, key: str, col: Collector, path: str) -> float:

@@ -1,0 +1,32 @@
+"""Semantic checks shared by every mechanism reader (YAML and URDF).
+
+Each check returns why a value is not physical, or None; the readers attach the message
+to the place in their file.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def inertia_matrix(spec) -> np.ndarray:
+    """Inertia tensor from ``[Ixx, Iyy, Izz]`` or ``{ixx, iyy, izz, ixy, ixz, iyz}``."""
+    if isinstance(spec, dict):
+        ixx, iyy, izz = spec["ixx"], spec["iyy"], spec["izz"]
+        ixy, ixz, iyz = spec.get("ixy", 0.0), spec.get("ixz", 0.0), spec.get("iyz", 0.0)
+        return np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]], float)
+    return np.diag(np.asarray(spec, float))
+
+
+def check_inertia(I: np.ndarray, mass: float) -> str | None:
+    """Why ``I`` is not a physical inertia tensor about the centre of mass, or None."""
+    w = np.linalg.eigvalsh(I)
+    scale = max(float(np.max(np.abs(w))), 1e-300)
+    if mass > 0 and np.all(w == 0):
+        return None  # point mass
+    if w[0] < -1e-12 * scale:
+        return f"inertia tensor is not positive semi-definite (eigenvalues {np.array2string(w, precision=4)})"
+    a, b, c = w
+    if a + b < c * (1 - 1e-9) - 1e-15:
+        return (f"principal moments {np.array2string(w, precision=4)} violate the triangle "
+                "inequality (I1 + I2 >= I3)")
+    return None
