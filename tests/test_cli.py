@@ -8,7 +8,7 @@ import sys
 import pytest
 
 import gearcli
-from gearcli.cli import format_blocks, round_sig
+from gearcli.report.tables import format_blocks, round_sig
 
 BUNDLED = ("paper_2dof", "bendix_wrist", "coaxial_fig5")
 

@@ -13,6 +13,7 @@ import pytest
 import yaml
 
 from gearcli import analyse, load_mechanism, parse_mechanism
+from gearcli.report.graph_json import analysis_dict
 from gearcli.report.dot import to_dot
 
 MECHS = ("paper_2dof", "bendix_wrist", "coaxial_fig5")
@@ -42,7 +43,7 @@ EXPECTED["coaxial_fig5"] = EXPECTED["paper_2dof"]  # same canonical graph (Fig. 
 # helpers
 # --------------------------------------------------------------------------------------
 def lib_dict(mech_dir, name: str) -> dict:
-    return analyse(load_mechanism(mech_dir / f"{name}.yaml")).to_dict()
+    return analysis_dict(analyse(load_mechanism(mech_dir / f"{name}.yaml")))
 
 
 def cli_dict(run_cli, mech_dir, name: str) -> dict:
@@ -287,7 +288,7 @@ def test_shuffled_file_same_analysis(mech_dir, name, seed):
     for key in ("links", "joints", "gears", "motors"):
         rng.shuffle(data[key])
     shuffled = parse_mechanism(yaml.safe_dump(data, sort_keys=False), f"{name}-shuffled.yaml")
-    got = analyse(shuffled).to_dict()
+    got = analysis_dict(analyse(shuffled))
     assert comparable(got) == comparable(lib_dict(mech_dir, name))
     if name == "paper_2dof":
         order = got["solve_order"]

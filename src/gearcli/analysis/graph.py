@@ -113,50 +113,6 @@ class Analysis:
     def carriers(self) -> dict[str, str]:
         return {self.names[i]: self.names[self.canonical_parent[i]] for i in self.secondary}
 
-    def to_dict(self) -> dict:
-        """Machine-readable summary (the ``gearcli graph --json`` output)."""
-        mech, n = self.mech, self.names
-        return {
-            "mechanism": mech.name,
-            "dof": self.dof,
-            "levels": {n[i]: self.level[i] for i in range(len(n))},
-            "primary": [n[i] for i in self.primary],
-            "secondary": [n[i] for i in self.secondary],
-            "carriers": self.carriers,
-            "canonical_graph": {
-                "thin_edges": [
-                    {"parent": n[self.canonical_parent[i]], "child": n[i], "label": self.label[i]}
-                    for i in self.tree.moving
-                ],
-                "heavy_edges": [
-                    {"pair": mech.gears[c.gear].name, "links": [n[c.j], n[c.k]], "carrier": n[c.carrier]}
-                    for c in self.circuits
-                ],
-            },
-            "coaxial_groups": [
-                {"carrier": n[g.carrier], "label": g.label, "links": [n[i] for i in g.members[1:]]}
-                for g in self.groups if len(g.members) > 2
-            ],
-            "fundamental_circuits": [
-                {"pair": mech.gears[c.gear].name, "j": n[c.j], "k": n[c.k], "carrier": n[c.carrier],
-                 "ratio": c.ratio, "equation": _equation(mech, n, c)}
-                for c in self.circuits
-            ],
-            "transmission_lines": [[n[i] for i in line] for line in self.transmission_lines],
-            "independent_joints": list(self.independent_names),
-            "motors": [m.name for m in mech.motors],
-            "structure_matrix": self.A.tolist(),
-            "pseudo_triangular": self.pseudo_triangular,
-            "solve_order": [[n[i] for i in block] for block in self.schedule],
-        } | ({"open_loop": "tree"} if self.open_loop == "tree" else {})
-
-
-def _equation(mech: Mechanism, n, c: Circuit) -> str:
-    if c.joints is not None:
-        b, a = (mech.joints[x].name for x in c.joints)
-        return f"q_{b} = {c.ratio:.6g} * q_{a}"
-    return f"theta_{n[c.j]},{n[c.carrier]} = {c.ratio:.6g} * theta_{n[c.k]},{n[c.carrier]}"
-
 
 def _collinear(o1, z1, o2, z2, scale=1.0) -> bool:
     if np.linalg.norm(np.cross(z1, z2)) > TOL_LINE:
