@@ -121,6 +121,16 @@ def _collinear(o1, z1, o2, z2, scale=1.0) -> bool:
     return np.linalg.norm(d - (d @ z1) * z1) <= TOL_LINE * max(scale, 1.0)
 
 
+def _first_collinear(O, Z, o, z, scale=1.0):
+    """Index of the first line (origins O (k, 3), unit directions Z (k, 3)) that coincides
+    with the line (o, z) as :func:`_collinear` decides, or None."""
+    d = o - O
+    hit = ((np.linalg.norm(np.cross(Z, z), axis=1) <= TOL_LINE)
+           & (np.linalg.norm(d - np.sum(d * Z, axis=1)[:, None] * Z, axis=1) <= TOL_LINE * max(scale, 1.0)))
+    k = np.flatnonzero(hit)
+    return int(k[0]) if k.size else None
+
+
 def analyse(mech: Mechanism) -> Analysis:
     """Canonical graph, levels, circuits, structure matrix and schedule of ``mech``.
 
@@ -248,14 +258,14 @@ def _axis_labels(h: _Home, on_chain: set, col: Collector) -> list:
     """
     mech = h.mech
     lines: list[tuple[np.ndarray, np.ndarray, str]] = []
+    O, Z = np.zeros((h.J, 3)), np.zeros((h.J, 3))  # the lines so far, as arrays (vectorised test)
     label = [None] * h.L
     explicit: dict[str, int] = {}
     for ji in sorted(h.tree.order, key=lambda ji: h.idx[mech.joints[ji].child] not in on_chain):
         c = h.idx[mech.joints[ji].child]
-        for k, (o, z, lab) in enumerate(lines):
-            if _collinear(o, z, h.ow[ji], h.zw[ji], h.scale):
-                break
-        else:
+        k = _first_collinear(O[:len(lines)], Z[:len(lines)], h.ow[ji], h.zw[ji], h.scale)
+        if k is None:
+            O[len(lines)], Z[len(lines)] = h.ow[ji], h.zw[ji]
             lines.append((h.ow[ji], h.zw[ji], _auto_label(len(lines))))
             k = len(lines) - 1
         given = mech.joints[ji].label

@@ -4,11 +4,11 @@ which order (paper, "Dynamic Analysis").
 Each moving link gives 6 equations.  Unknowns: 5 per joint (3 forces, 2 moments: a
 revolute joint transmits no moment about its axis), 1 per gear mesh (the tangential tooth
 force t), 1 per motor (its torque).  The equation/unknown incidence is block-
-triangularised (Dulmage-Mendelsohn: a perfect matching, then the strongly connected
-components of the dependency graph); the blocks are the irreducible sets of links whose
-equations must be solved simultaneously.  Among the orders the dependencies allow, the
-paper's is taken: highest level first, a primary link before the secondary links of its
-level.
+triangularised (Dulmage-Mendelsohn: a perfect matching, found as a maximum flow, then
+the strongly connected components of the dependency graph); the blocks are the
+irreducible sets of links whose equations must be solved simultaneously.  Among the
+orders the dependencies allow, the paper's is taken: highest level first, a primary link
+before the secondary links of its level.
 """
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import connected_components, maximum_bipartite_matching
+from scipy.sparse.csgraph import breadth_first_order, connected_components, maximum_flow
 
 from ..errors import Collector
 
@@ -64,49 +64,99 @@ def _joint_links(mech, tree, joints) -> tuple[int, ...]:
 
 
 def solution_schedule(an, col: Collector | None = None) -> tuple[tuple[int, ...], ...]:
-    """Blocks of link ids in solution order (see module docstring)."""
+    """Blocks of link ids in solution order (see module docstring).
+
+    The perfect matching of equations to unknowns is found as a maximum flow (Dinic's
+    algorithm, O(V^2 E), on the compressed network source -> link (6 equations) -> unknown
+    group (``size`` scalars) -> sink), so the time stays polynomial (in practice linear) in
+    the number of links.  The irreducible blocks and their partial order do not depend on
+    which perfect matching is found (Dulmage-Mendelsohn), so neither does the schedule.
+    """
     tree = an.tree
     moving = tree.moving
-    row_of_link = {x: i for i, x in enumerate(moving)}
     groups = unknown_groups(an)
-    rows, cols = [], []
-    ncol = 0
-    for g in groups:
-        for s in range(g.size):
-            for x in g.links:
-                r0 = 6 * row_of_link[x]
-                rows.extend(range(r0, r0 + 6))
-                cols.extend([ncol] * 6)
-            ncol += 1
     nrow = 6 * len(moving)
+    ncol = sum(g.size for g in groups)
     if ncol != nrow:
         if col is not None:
             col.add("", f"{nrow} equations for {ncol} unknowns: the loads are not statically determinate")
         return ()
-    Inc = csr_matrix((np.ones(len(rows)), (rows, cols)), shape=(nrow, ncol))
-    Inc.data[:] = 1.0
-    match = maximum_bipartite_matching(Inc, perm_type="column")  # match[r] = column of row r
-    if np.any(match < 0):
-        bad = sorted({moving[r // 6] for r in np.flatnonzero(match < 0)})
+    net = _Network(moving, groups)
+    if net.value < nrow:
         if col is not None:
+            bad = net.overdetermined_links()
             col.add("", "the loads are statically indeterminate: no unique solution for the equations of links "
                     + ", ".join(f"'{tree.links[x]}'" for x in bad))
         return ()
-    row_of_col = np.empty(ncol, int)
-    row_of_col[match] = np.arange(nrow)
-    Inc = Inc.tocoo()
-    dep = csr_matrix((np.ones(Inc.nnz), (Inc.row, row_of_col[Inc.col])), shape=(nrow, nrow))
-    ncomp, comp = connected_components(dep, directed=True, connection="strong")
-    link_comp = {x: comp[6 * row_of_link[x]] for x in moving}
+    comp, after = net.blocks()
+    return _ordered_blocks(an, moving, comp, after)
+
+
+class _Network:
+    """Flow network of the equation/unknown incidence, compressed: node 0 the source,
+    1..L the moving links (capacity 6 from the source), L+1..L+G the unknown groups
+    (capacity ``size`` to the sink), L+G+1 the sink."""
+
+    def __init__(self, moving: list[int], groups: list[UnknownGroup]):
+        L, G = len(moving), len(groups)
+        self.L, self.G = L, G
+        node = {x: 1 + i for i, x in enumerate(moving)}
+        sink = L + G + 1
+        src, dst, cap = [], [], []
+        for gi, g in enumerate(groups):
+            for x in g.links:
+                src.append(node[x])
+                dst.append(L + 1 + gi)
+                cap.append(g.size)
+            src.append(L + 1 + gi)
+            dst.append(sink)
+            cap.append(g.size)
+        src += [0] * L
+        dst += list(range(1, L + 1))
+        cap += [6] * L
+        n = sink + 1
+        self.cap = csr_matrix((np.asarray(cap, np.int32), (src, dst)), shape=(n, n))
+        self.cap.sum_duplicates()
+        res = maximum_flow(self.cap, 0, sink, method="dinic")
+        self.value = res.flow_value
+        self.flow = res.flow.tocsr()
+        # link-group incidence (L, G) and the flow on it
+        self.inc = self.cap[1:L + 1, L + 1:L + 1 + G].tocsr()
+        self.inc.data[:] = 1
+        used = self.flow[1:L + 1, L + 1:L + 1 + G].tocsr()
+        used.data = (used.data > 0).astype(np.int32)
+        used.eliminate_zeros()
+        self.used = used
+
+    def blocks(self):
+        """Strong components of the link dependency graph (link a after link b when a's
+        equations contain an unknown matched to b's) and, per component, the set of
+        components it comes after."""
+        dep = (self.inc @ self.used.T).tocoo()  # dep[a, b] > 0: a uses an unknown solved with b
+        _, comp = connected_components(dep.tocsr(), directed=True, connection="strong")
+        after: dict[int, set[int]] = {int(k): set() for k in comp}
+        for a, b in zip(comp[dep.row], comp[dep.col]):
+            if a != b:
+                after[int(a)].add(int(b))
+        return comp, after
+
+    def overdetermined_links(self) -> list[int]:
+        """Positions (in ``moving``) of the links whose equations cannot all be matched:
+        the links reachable from the source in the residual network (the over-determined
+        part of the Dulmage-Mendelsohn decomposition, the same for every maximum flow)."""
+        residual = (self.cap - self.flow).tocsr()
+        residual.data = (residual.data > 0).astype(np.int32)
+        residual.eliminate_zeros()
+        order = breadth_first_order(residual, 0, directed=True, return_predecessors=False)
+        return sorted(int(v) - 1 for v in order if 1 <= v <= self.L)
+
+
+def _ordered_blocks(an, moving: list[int], comp: np.ndarray, after: dict[int, set[int]]):
+    """The blocks in the paper's order among those the dependencies allow: highest level
+    first, a primary link before the secondary links of its level, then by link id."""
     blocks: dict[int, list[int]] = {}
-    for x in moving:
-        blocks.setdefault(link_comp[x], []).append(x)
-    # dependencies between blocks: block A after block B if A's rows use B's unknowns
-    after: dict[int, set[int]] = {k: set() for k in blocks}
-    for r, c in zip(Inc.row, Inc.col):
-        a, b = comp[r], comp[row_of_col[c]]
-        if a != b:
-            after[a].add(b)
+    for i, x in enumerate(moving):
+        blocks.setdefault(int(comp[i]), []).append(x)
     prim = set(an.primary)
 
     def key(k):

@@ -8,28 +8,62 @@ from ..errors import Collector
 from .kinematics import forward
 from .loads import Columns
 
+_RTOL = 1e-10
+
+
+def block_unknowns(an) -> list[list]:
+    """Unknown groups owned by each block of ``an.schedule``: a group belongs to the first
+    block (in solution order) that holds one of its links.  Per block, a list of
+    :class:`~gearcli.analysis.schedule.UnknownGroup`."""
+    block_of = {x: i for i, blk in enumerate(an.schedule) for x in blk}
+    owned: list[list] = [[] for _ in an.schedule]
+    for g in unknown_groups(an):
+        owned[min(block_of[x] for x in g.links)].append(g)
+    return owned
+
+
+def _block_matrix(cols: Columns, blk: tuple, groups: list) -> np.ndarray:
+    """(6 len(blk), n) matrix of a block's equations in its own unknowns (world frame)."""
+    pos = {x: i for i, x in enumerate(blk)}
+    A = np.zeros((6 * len(blk), sum(g.size for g in groups)))
+    c0 = 0
+    for g in groups:
+        for x in g.links:
+            if x in pos:
+                A[6 * pos[x]:6 * pos[x] + 6, c0:c0 + g.size] = cols.group(g, x, 1.0)[0]
+        c0 += g.size
+    return A
+
+
+def _rank(A: np.ndarray) -> int:
+    sv = np.linalg.svd(A, compute_uv=False)
+    return int(np.sum(sv > _RTOL * sv[0])) if sv.size and sv[0] > 0 else 0
+
 
 def check_determinate(an, col: Collector) -> None:
-    """Numerical check that the equations determine every load: the full equation matrix
-    (all links, all unknowns) must be regular at the home configuration or, failing that,
-    at a random one.  The structural schedule cannot see a zero lever arm or a motor whose
-    axis carries no load; this can."""
-    groups = unknown_groups(an)
-    moving = an.tree.moving
-    pos = {L: i for i, L in enumerate(moving)}
+    """Numerical check that the equations determine every load.
+
+    The equations are block triangular in the schedule's order, so the full equation
+    matrix (all links, all unknowns) is regular exactly when every block's own square
+    matrix is.  Each block is checked at the home configuration or, failing that, at a
+    random one (cost linear in the number of blocks).  The structural schedule cannot see
+    a zero lever arm or a motor whose axis carries no load; this can.
+    """
+    owned = block_unknowns(an)
     J = len(an.mech.joints)
     rng = np.random.default_rng(0)
-    for q_ind in (np.zeros((1, an.dof)), rng.uniform(-np.pi, np.pi, (1, an.dof))):
-        cols = Columns(an, forward(an.mech, an.tree, (q_ind @ an.S.T).reshape(1, J)))
-        A = np.zeros((6 * len(moving), sum(g.size for g in groups)))
-        c0 = 0
-        for g in groups:
-            for L in g.links:
-                A[6 * pos[L]:6 * pos[L] + 6, c0:c0 + g.size] = cols.group(g, L, 1.0)[0]
-            c0 += g.size
-        sv = np.linalg.svd(A, compute_uv=False)
-        if sv[-1] > 1e-10 * sv[0]:
-            return
-    col.add("", f"the loads are statically indeterminate: the equations of the moving links are "
-            f"singular (rank {int(np.sum(sv > 1e-10 * sv[0]))} of {A.shape[1]}); check the gear "
-            "geometry and the motors")
+    configs = [np.zeros((1, an.dof)), rng.uniform(-np.pi, np.pi, (1, an.dof))]
+    cols = [Columns(an, forward(an.mech, an.tree, (q @ an.S.T).reshape(1, J))) for q in configs]
+    rank, total = 0, 0
+    for blk, groups in zip(an.schedule, owned):
+        n = sum(g.size for g in groups)
+        best = 0
+        for c in cols:
+            A = _block_matrix(c, blk, groups)
+            best = max(best, _rank(A) if A.shape[0] == n else min(A.shape))
+            if best == n == A.shape[0]:
+                break
+        rank, total = rank + best, total + n
+    if rank < total or total != 6 * len(an.tree.moving):
+        col.add("", f"the loads are statically indeterminate: the equations of the moving links are "
+                f"singular (rank {rank} of {total}); check the gear geometry and the motors")
