@@ -307,7 +307,8 @@ def spatial_3dof(seed: int = 20240607, j5_parent: str = "1") -> tuple[str, dict]
         "motors": [{"name": "motor4", "link": "4"}, {"name": "motor5", "link": "5"},
                    {"name": "motor3", "link": "3", "stator": "2"}],
     }
-    info = dict(ratios={"4-1": e41, "5-6": e56, "6-2": e62}, ring=("4-1", 1), gravity=gravity)
+    info = dict(ratios={"4-1": e41, "5-6": e56, "6-2": e62}, ring=("4-1", 1), gravity=gravity,
+                home=W, axes=axes, parents=parents, links=links)   # for the tests' own kinematics
     return dump(doc), info
 
 
