@@ -15,6 +15,9 @@ from __future__ import annotations
 
 import functools
 import json
+import os
+import signal
+import sys
 from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Iterator
@@ -30,6 +33,9 @@ if TYPE_CHECKING:  # pragma: no cover
     from .analysis.graph import Analysis
 
 EXIT_BAD_INPUT = 2
+EXIT_BROKEN_PIPE = 141    # 128 + SIGPIPE, what a shell reports for a writer killed by it
+EXIT_INTERRUPTED = 130    # 128 + SIGINT
+EXIT_TERMINATED = 143     # 128 + SIGTERM
 
 app = typer.Typer(
     name="gearcli",
@@ -54,14 +60,69 @@ def print_problems(lines: list[str]) -> None:
         typer.echo(line, err=True)
 
 
+class Terminated(BaseException):
+    """SIGTERM, raised as an exception so that every ``finally`` (temporary files) runs."""
+
+
+def _raise_terminated(signum, frame):
+    raise Terminated()
+
+
 @contextmanager
-def bad_input_exits() -> Iterator[None]:
-    """Turn a :class:`~gearcli.errors.GearcliError` into problem lines and exit status 2."""
+def _sigterm_raises() -> Iterator[None]:
+    try:
+        old = signal.signal(signal.SIGTERM, _raise_terminated)
+    except ValueError:   # not the main thread: leave signals alone
+        yield
+        return
     try:
         yield
+    finally:
+        signal.signal(signal.SIGTERM, old)
+
+
+def _silence_stdout() -> None:
+    """Point the stdout descriptor at /dev/null, so that the interpreter's final flush of
+    a broken or full stdout does not print an error (no-op when stdout is not a file)."""
+    try:
+        fd = sys.stdout.fileno()
+    except (AttributeError, OSError, ValueError):
+        return
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, fd)
+    os.close(devnull)
+
+
+@contextmanager
+def bad_input_exits() -> Iterator[None]:
+    """Turn every failure that is not a bug into one line on stderr and an exit status.
+
+    :class:`~gearcli.errors.GearcliError` (bad input, an unwritable output): its lines,
+    status 2.  A failing stdout (a full device): ``stdout: cannot write: ...``, status 2.
+    A closed pipe (``gearcli ... | head -1``): no message, status 141.  Ctrl-C: one line,
+    status 130; SIGTERM: one line, status 143 (temporary files are removed first).
+    """
+    try:
+        with _sigterm_raises():
+            yield
+            sys.stdout.flush()
     except GearcliError as exc:
         print_problems(exc.lines())
         raise typer.Exit(EXIT_BAD_INPUT) from None
+    except BrokenPipeError:
+        _silence_stdout()
+        raise typer.Exit(EXIT_BROKEN_PIPE) from None
+    except OSError as exc:   # readers report their own files; what is left is stdout
+        _silence_stdout()
+        where = f"{exc.filename}: cannot access" if exc.filename else "stdout: cannot write"
+        print_problems([f"{where}: {exc.strerror or exc}"])
+        raise typer.Exit(EXIT_BAD_INPUT) from None
+    except KeyboardInterrupt:
+        print_problems(["gearcli: interrupted"])
+        raise typer.Exit(EXIT_INTERRUPTED) from None
+    except Terminated:
+        print_problems(["gearcli: terminated (SIGTERM)"])
+        raise typer.Exit(EXIT_TERMINATED) from None
 
 
 def reports_bad_input(command):
@@ -194,12 +255,14 @@ def solve(
     progress = Progress(TextColumn("solving"), BarColumn(), TextColumn("{task.completed:,}/{task.total:,} samples"),
                         TimeRemainingColumn(), console=err, transient=True)
     task = None
+    started = False
 
     def tick(total=None, advance=None):
-        nonlocal task
+        nonlocal task, started
         if total is not None:
             if total > 4 * chunk:
                 progress.start()
+                started = True
             task = progress.add_task("solve", total=total)
         if advance is not None:
             progress.update(task, advance=advance)
@@ -208,7 +271,8 @@ def solve(
         report = solve_file(mech, traj, out, degrees=degrees, method=method, verify=verify,
                             chunk=chunk, progress=tick, analysis=an)
     finally:
-        progress.stop()
+        if started:
+            progress.stop()
     console = err if to_stdout else stdout_console()
     console.print(summary_table(report))
     ideal = [an.mech.gears[c.gear].name for c in an.circuits if c.geometry is None]
@@ -227,15 +291,23 @@ def solve(
 @reports_bad_input
 def export(
     mech: Path = typer.Argument(..., metavar="MECH", help=MECH_HELP, show_default=False),
-    output: Path = typer.Option(..., "-o", "--output", metavar="OUT.urdf",
-                                help="URDF file to write (written to a temporary file, then renamed)."),
+    output: str = typer.Option(..., "-o", "--output", metavar="OUT.urdf",
+                               help="URDF file to write (written to a temporary file, then renamed; "
+                                    "'-' for stdout)."),
 ) -> None:
     """Write a URDF of the mechanism: links with inertials, the joint tree, geared joints as
     <mimic> where a single leader exists, motors as <transmission>, and the full gear
     geometry in gearcli extension elements (namespace https://gearcli.dev/urdf/1)."""
     from .report.urdf_writer import export_urdf  # noqa: PLC0415
 
-    export_urdf(load_analysis(mech), output)
+    from .io.output import output_target  # noqa: PLC0415
+
+    output_target(output, (mech,))   # refuse a bad -o before any work
+    an = load_analysis(mech)
+    if output == "-":
+        typer.echo(export_urdf(an), nl=False)
+        return
+    export_urdf(an, output)
     typer.echo(f"Wrote {output}")
 
 

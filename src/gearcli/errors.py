@@ -42,7 +42,12 @@ class MechanismError(GearcliError):
 
 
 class TrajectoryError(GearcliError):
-    """A trajectory file or array is invalid."""
+    """A trajectory file or array is invalid; ``issue`` (an :class:`Issue`: file, place
+    such as ``column 2 'q:J1'``, line, message) says where when it is known."""
+
+    def __init__(self, issue: Issue | str):
+        self.issue = issue if isinstance(issue, Issue) else None
+        super().__init__(str(issue))
 
 
 class Collector:

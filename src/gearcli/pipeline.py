@@ -6,19 +6,28 @@ Data flow: :func:`~gearcli.loader.load_mechanism` -> :func:`~gearcli.graph.analy
 """
 from __future__ import annotations
 
+import math
 import sys
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
+
+import numpy as np
 
 from .dynamics.solve import solve
 from .analysis.graph import Analysis
 from .analysis.graph import analyse as analyse_graph
 from .dynamics.determinacy import check_determinate
-from .errors import Collector
+from .errors import Collector, Issue, TrajectoryError
 from .io import load_mechanism
-from .model.mechanism import Mechanism
-from .report.columns import AtomicWriter, Summary, column_names, format_rows, table
+from .io.output import atomic_output, output_target
 from .io.trajectory import TrajectoryReader
+from .model.mechanism import Mechanism
+from .report.columns import Summary, column_names, first_non_finite, format_rows, table
+
+VERIFY_TOLERANCE = 1e-8
+"""``--verify`` fails when the worst relative Newton-Euler residual exceeds this (or is
+not finite); a sound solve gives ~1e-15."""
 
 
 def analyse(mech: Mechanism) -> Analysis:
@@ -56,31 +65,45 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
     """Solve a trajectory file and write the loads CSV (see :mod:`gearcli.report`).
 
     ``progress(total=None, advance=None)`` is called with ``total`` once (number of
-    samples) and with ``advance`` after each chunk.  The output is written to a temporary
-    file and renamed only when everything succeeded; ``out_path="-"`` writes to stdout and
-    ``None`` writes nothing (summary only).
+    samples) and with ``advance`` after each chunk.  The output is written atomically
+    (:func:`gearcli.io.output.atomic_output`: nothing is written unless everything
+    succeeded); ``out_path="-"`` writes to stdout after the whole trajectory was read and
+    checked, streaming the loads (a non-finite load or a failed ``verify`` found while
+    streaming stops the output with an error); ``None`` writes nothing (summary only).
+
+    Every output sample is checked finite before it is written
+    (:class:`~gearcli.errors.TrajectoryError` naming the first bad sample and column);
+    with ``verify`` the worst residual of every chunk must be finite and at most
+    :data:`VERIFY_TOLERANCE`.
     """
+    if out_path is not None:
+        output_target(out_path, (mech_path, traj_path))   # refuse a bad -o before any work
     an = analysis or analyse(load_mechanism(mech_path))
     reader = TrajectoryReader(traj_path, an.independent_names, degrees=degrees, chunk=chunk,
                               linear=prismatic_independent(an))
     if progress is not None:
         progress(total=reader.count())
     summary = Summary.for_mechanism(an)
+    names = column_names(an)
     worst = 0.0
     n = 0
 
     def run(f):
         nonlocal worst, n
         if f is not None:
-            f.write(",".join(column_names(an)) + "\n")
+            f.write(",".join(names) + "\n")
         for part in reader:
-            res = solve(an, part.q, part.qd, part.qdd, method=method, chunk=chunk, verify=verify)
-            tab = table(an, part.t, res)
+            with np.errstate(all="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                res = solve(an, part.q, part.qd, part.qdd, method=method, chunk=chunk, verify=verify)
+                tab = table(an, part.t, res)
+            _check_loads(reader, part, tab, names)
+            if verify:
+                _check_residual(reader, part, res.residual)
+                worst = max(worst, res.residual)
             summary.add(tab)
             if f is not None:
                 f.write(format_rows(tab))
-            if verify:
-                worst = max(worst, res.residual)
             n += len(part.t)
             if progress is not None:
                 progress(advance=len(part.t))
@@ -89,8 +112,34 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
     if out_path is None:
         run(None)
     elif out is None:
+        for _ in reader:   # read and check the whole trajectory before streaming
+            pass
         run(sys.stdout)
     else:
-        with AtomicWriter(out) as f:
+        with atomic_output(out, (mech_path, traj_path)) as f:
             run(f)
     return SolveReport(an, n, summary, worst if verify else None, out)
+
+
+def _sample_line(reader: TrajectoryReader, part, i: int) -> int | None:
+    return None if part.line is None else int(part.line[i])
+
+
+def _check_loads(reader: TrajectoryReader, part, tab: np.ndarray, names: list[str]) -> None:
+    """Raise naming the first sample (and output column) whose load is not finite."""
+    bad = first_non_finite(tab)
+    if bad is None:
+        return
+    i, c = bad
+    raise TrajectoryError(Issue(reader.file, f"sample t = {part.t[i]:.9g} s", _sample_line(reader, part, i),
+                                f"load '{names[c]}' is {tab[i, c]} (the trajectory gives no finite loads "
+                                "here; nothing written)"))
+
+
+def _check_residual(reader: TrajectoryReader, part, r: float) -> None:
+    if math.isfinite(r) and r <= VERIFY_TOLERANCE:
+        return
+    raise TrajectoryError(Issue(reader.file, "--verify", None,
+                                f"worst Newton-Euler residual {r:.3g} between t = {part.t[0]:.9g} s and "
+                                f"{part.t[-1]:.9g} s exceeds the tolerance {VERIFY_TOLERANCE:g} "
+                                "(loads not trustworthy; nothing written)"))

@@ -12,96 +12,197 @@ motion sampled at step h the error of the first derivative is O(h^5) and of the 
 O(h^4) (1.5e-8 rad/s^2 for a 1 Hz sine of 1 rad sampled at 1 kHz, 5e-12 rad/s on rates).  Long files are processed in
 chunks; each chunk's spline is fitted over the chunk plus ``PAD`` samples of each
 neighbour, so the result does not depend on the chunking to ~1e-14.
+
+Hostile input is refused with an :class:`~gearcli.errors.Issue` naming the line and the
+column: bytes that are not UTF-8 (a UTF-8 byte-order mark is accepted), a bad or empty
+cell, a wrong number of cells, values that are not finite or beyond ``MAX_ABS`` in SI
+units, time not increasing by at least ``MIN_STEP``, lines longer than ``MAX_LINE``.
+Separators ``,``, ``;`` or tab (taken from the header) and double-quoted cells are
+accepted.  Positions-only files need 3 samples (2 when rates are given): rates are then
+derived by the highest-degree interpolating spline the samples allow (k = min(5, N - 1)).
 """
 from __future__ import annotations
 
-import itertools
+import csv
 import math
+import os
+import re
+import stat
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from scipy.interpolate import make_interp_spline
 
-from ..errors import TrajectoryError
+from ..errors import Issue, TrajectoryError
 
 PAD = 64
+MAX_ABS = 1e12        # largest |value| accepted, SI units (s, rad, m and their rates)
+MIN_STEP = 1e-9       # s, smallest time step
+MAX_LINE = 1 << 20    # characters per line
+SEPARATORS = ",;\t"
+_NUMBER = re.compile(r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)?|nan)", re.I)
 
 
 @dataclass
 class Trajectory:
-    """Samples of the independent joints: ``t`` (N,), ``q``, ``qd``, ``qdd`` (N, dof)."""
+    """Samples of the independent joints: ``t`` (N,), ``q``, ``qd``, ``qdd`` (N, dof);
+    ``line`` (N,) the file line of every sample (None for arrays not read from a file)."""
 
     t: np.ndarray
     q: np.ndarray
     qd: np.ndarray
     qdd: np.ndarray
+    line: np.ndarray | None = None
+
+
+def show(text: str, limit: int = 40) -> str:
+    """``text`` for a one-line message: control characters escaped, at most ``limit``."""
+    text = text.encode("unicode_escape", "backslashreplace").decode("ascii") \
+        if not text.isprintable() else text
+    return text if len(text) <= limit else text[:limit - 1] + "…"
 
 
 def derivatives(t: np.ndarray, y: np.ndarray, order: int = 2) -> list[np.ndarray]:
-    """First ``order`` derivatives of samples ``y`` (N, m) at times ``t`` by a quintic
-    interpolating spline (lower degree when there are fewer than 6 samples)."""
+    """First ``order`` derivatives of samples ``y`` (N, m) at times ``t`` (N,) by the
+    interpolating spline of degree k = min(5, N - 1) (not-a-knot ends).
+
+    Raises ValueError when N - 1 < ``order`` (too few samples for the derivatives).
+    """
     n = len(t)
-    k = min(5, n - 1 if (n - 1) % 2 == 1 else n - 2)
-    if k < 1:
-        return [np.zeros_like(y) for _ in range(order)]
+    k = min(5, n - 1)
+    if k < order:
+        raise ValueError(f"{n} samples allow a spline of degree {k} < {order}")
     spl = make_interp_spline(t, y, k=k)
     return [spl.derivative(i)(t) for i in range(1, order + 1)]
+
+
+def _fail(file: str, line: int | None, place: str, message: str) -> TrajectoryError:
+    return TrajectoryError(Issue(file, place, line, message))
+
+
+def _place(header: list[str], c: int) -> str:
+    return f"column {c + 1} '{show(header[c])}'" if c < len(header) else f"column {c + 1}"
+
+
+def _check_utf8(file: str, lines: list[str], linenos: list[int]) -> None:
+    """Refuse text read with ``surrogateescape`` that held bytes other than UTF-8."""
+    try:
+        "".join(lines).encode("utf-8")
+        return
+    except UnicodeEncodeError:
+        pass
+    for text, ln in zip(lines, linenos):
+        try:
+            text.encode("utf-8")
+        except UnicodeEncodeError as exc:
+            byte = ord(text[exc.start]) - 0xDC00
+            raise _fail(file, ln, f"character {exc.start + 1}", f"byte 0x{byte:02x} is not UTF-8 "
+                        "(save the file as UTF-8 or ASCII text)") from None
+
+
+def _split(line: str, sep: str) -> list[str]:
+    try:
+        return [c.strip() for c in next(csv.reader([line.rstrip("\r\n")], delimiter=sep, quotechar='"'), [""])]
+    except csv.Error:
+        return line.rstrip("\r\n").split(sep)
+
+
+def _expected(names: list[str]) -> str:
+    qs = [f"q:{n}" for n in names[:6]] + (["…"] if len(names) > 6 else [])
+    return "expected t, " + ", ".join(qs) + " and optional qd:/qdd: columns, separated by ',', ';' or tab"
 
 
 def _columns(header: list[str], names: list[str], file: str) -> dict:
     """Map of column kind -> list of column indices (or None) per independent joint."""
     pos: dict[str, int] = {}
     for i, h in enumerate(header):
-        h = h.strip()
         if h in pos:
-            raise TrajectoryError(f"{file}:1: column {i + 1} '{h}': duplicate column")
+            raise _fail(file, 1, _place(header, i), "duplicate column")
         pos[h] = i
-    if "t" not in pos:
-        raise TrajectoryError(f"{file}:1: missing column 't' (time, s)")
     known = {"t"} | {f"{p}:{n}" for p in ("q", "qd", "qdd") for n in names}
     for h, i in pos.items():
         if h not in known:
-            raise TrajectoryError(f"{file}:1: column {i + 1} '{h}': unknown column (expected t, "
-                                  + ", ".join(f"q:{n}" for n in names) + " and optional qd:/qdd: columns)")
+            what = "empty column name" if not h else "unknown column"
+            raise _fail(file, 1, _place(header, i), f"{what} ({_expected(names)})")
+    if "t" not in pos:
+        raise _fail(file, 1, "", "missing column 't' (time, s)")
     for n in names:
         if f"q:{n}" not in pos:
-            raise TrajectoryError(f"{file}:1: missing column 'q:{n}' (independent joint '{n}', rad)")
+            raise _fail(file, 1, "", f"missing column 'q:{show(n)}' (independent joint '{show(n)}', rad)")
     out = {"t": pos["t"]}
     for p in ("q", "qd", "qdd"):
         cols = [pos.get(f"{p}:{n}") for n in names]
         if p != "q" and any(c is None for c in cols) and any(c is not None for c in cols):
             missing = [f"{p}:{n}" for n, c in zip(names, cols) if c is None]
-            raise TrajectoryError(f"{file}:1: give {p}: columns for every joint or for none (missing {', '.join(missing)})")
+            raise _fail(file, 1, "", f"give {p}: columns for every joint or for none (missing "
+                        f"{show(', '.join(missing), 80)})")
         out[p] = None if cols[0] is None else cols
     return out
 
 
-def _parse_rows(lines: list[str], first_row: int, header: list[str], file: str) -> np.ndarray:
-    """Rows of floats; on failure, find and report the first bad cell."""
+def _bad_cell(lines: list[str], linenos: list[int], header: list[str], sep: str, file: str) -> TrajectoryError:
+    """The error for the first unreadable cell (called when fast parsing failed)."""
+    for text, ln in zip(lines, linenos):
+        cells = _split(text, sep)
+        if len(cells) != len(header):
+            return _fail(file, ln, "", f"row has {len(cells)} columns, the header has {len(header)} "
+                         f"(separator '{show(sep)}')")
+        for c, cell in enumerate(cells):
+            if not _NUMBER.fullmatch(cell):
+                hint = " (decimal comma? use '.')" if re.fullmatch(r"[+-]?\d*,\d+", cell) else ""
+                what = "empty cell" if not cell else f"not a number: '{show(cell)}'{hint}"
+                return _fail(file, ln, _place(header, c), what)
+        try:
+            np.loadtxt([text], delimiter=sep, quotechar='"', comments=None, ndmin=2)
+        except ValueError:
+            return _fail(file, ln, "", "cannot read the row as numbers")
+    return _fail(file, linenos[0], "", "cannot read the rows as numbers")
+
+
+def _parse_rows(lines: list[str], linenos: list[int], header: list[str], sep: str, file: str) -> np.ndarray:
+    """Rows of floats (n, ncol); on failure, find and report the first bad cell."""
+    _check_utf8(file, lines, linenos)
     try:
-        data = np.loadtxt(lines, delimiter=",", ndmin=2, dtype=float)
-        if data.shape[1] != len(header):
-            raise ValueError
+        data = np.loadtxt(lines, delimiter=sep, quotechar='"', comments=None, ndmin=2, dtype=float)
+        ok = data.shape == (len(lines), len(header))
     except ValueError:
-        for r, line in enumerate(lines):
-            cells = line.rstrip("\r\n").split(",")
-            row = first_row + r
-            if len(cells) != len(header):
-                raise TrajectoryError(f"{file}:{row}: row has {len(cells)} columns, the header has {len(header)}") from None
-            for c, cell in enumerate(cells):
-                try:
-                    float(cell)
-                except ValueError:
-                    raise TrajectoryError(f"{file}:{row}: column {c + 1} '{header[c].strip()}': "
-                                          f"not a number: '{cell.strip()}'") from None
-        raise TrajectoryError(f"{file}:{first_row}: cannot parse rows") from None
-    bad = ~np.isfinite(data)
-    if bad.any():
-        r, c = np.argwhere(bad)[0]
-        raise TrajectoryError(f"{file}:{first_row + r}: column {c + 1} '{header[c].strip()}': "
-                              f"value is {data[r, c]} (NaN or infinite)")
+        ok = False
+    if not ok:
+        raise _bad_cell(lines, linenos, header, sep, file)
     return data
+
+
+def _check_values(data: np.ndarray, si: np.ndarray, lines: list[str], linenos: list[int],
+                  header: list[str], sep: str, file: str) -> None:
+    """Refuse non-finite values and values beyond ``MAX_ABS`` in SI units."""
+    bad = ~np.isfinite(data) | (np.abs(si) > MAX_ABS)
+    if not bad.any():
+        return
+    r, c = (int(x) for x in np.argwhere(bad)[0])
+    cell = show(_split(lines[r], sep)[c]) if c < len(_split(lines[r], sep)) else str(data[r, c])
+    if not math.isfinite(data[r, c]):
+        raise _fail(file, linenos[r], _place(header, c), f"value '{cell}' is not a finite number (NaN or infinite)")
+    raise _fail(file, linenos[r], _place(header, c), f"value {cell} is out of range (|x| <= {MAX_ABS:g} "
+                "in SI units: s, rad, m and their rates)")
+
+
+def _check_time(t: np.ndarray, last_t: float | None, linenos: list[int], place: str, file: str) -> None:
+    """Time must increase by at least ``MIN_STEP`` (also across chunks)."""
+    tt = t if last_t is None else np.concatenate([[last_t], t])
+    off = 0 if last_t is None else 1
+    dt = np.diff(tt)
+    bad = np.flatnonzero(dt < MIN_STEP * (1 - 1e-6))   # 1e-6: rounding of t values
+    if bad.size == 0:
+        return
+    r = int(bad[0])
+    ln = linenos[r + 1 - off]
+    if dt[r] <= 0:
+        raise _fail(file, ln, place, f"time {tt[r + 1]:.9g} s is not after the previous {tt[r]:.9g} s "
+                    "(time must increase strictly)")
+    raise _fail(file, ln, place, f"time step {dt[r]:.3g} s after t = {tt[r]:.9g} s is below the minimum "
+                f"{MIN_STEP:g} s")
 
 
 class TrajectoryReader:
@@ -109,7 +210,8 @@ class TrajectoryReader:
 
     Iterating yields :class:`Trajectory` chunks in SI units.  ``names`` are the independent
     joint names (``Analysis.independent_names``); ``linear`` names those of prismatic joints,
-    which ``degrees`` leaves alone.
+    which ``degrees`` leaves alone.  Every problem raises
+    :class:`~gearcli.errors.TrajectoryError` with an :class:`~gearcli.errors.Issue`.
     """
 
     def __init__(self, path: str | Path, names, degrees: bool = False, chunk: int = 100_000,
@@ -118,15 +220,42 @@ class TrajectoryReader:
         self.linear = set(linear)
         self.chunk = max(int(chunk), 2 * PAD + 1)
         self.file = str(path)
-        try:
-            with open(self.path) as f:
-                head = f.readline()
-        except OSError as exc:
-            raise TrajectoryError(f"{self.file}: cannot read file: {exc.strerror}") from None
+        with self._open() as f:
+            head = self._readline(f, 1)
+        head = head.removeprefix("\ufeff")
         if not head.strip():
-            raise TrajectoryError(f"{self.file}:1: empty file (expected a header row)")
-        self.header = [h.strip() for h in head.rstrip("\r\n").split(",")]
+            raise _fail(self.file, 1, "", "empty file (expected a header row: t,q:<joint>,...)")
+        _check_utf8(self.file, [head], [1])
+        self.sep = next((s for s in SEPARATORS if s in head), ",")
+        self.header = _split(head, self.sep)
         self.cols = _columns(self.header, self.names, self.file)
+        self.scale = self._column_scale()
+
+    def _open(self):
+        """The file as text (undecodable bytes kept as surrogates, refused per chunk)."""
+        try:
+            if not stat.S_ISREG(os.stat(self.path).st_mode):
+                raise _fail(self.file, None, "", "not a regular file")
+            return open(self.path, encoding="utf-8", errors="surrogateescape")
+        except OSError as exc:
+            raise _fail(self.file, None, "", f"cannot read file: {exc.strerror}") from None
+
+    def _readline(self, f, lineno: int) -> str:
+        line = f.readline(MAX_LINE)
+        if len(line) == MAX_LINE and not line.endswith("\n"):
+            raise _fail(self.file, lineno, "", f"line longer than {MAX_LINE} characters")
+        return line
+
+    def _column_scale(self) -> np.ndarray:
+        """Factor to SI of every file column (pi/180 for angle columns with ``degrees``)."""
+        scale = np.ones(len(self.header))
+        if self.degrees:
+            deg = math.pi / 180.0
+            for p in ("q", "qd", "qdd"):
+                for n, c in zip(self.names, self.cols[p] or ()):
+                    if n not in self.linear:
+                        scale[c] = deg
+        return scale
 
     def count(self) -> int:
         """Number of samples (data rows), by a fast line count."""
@@ -138,59 +267,83 @@ class TrajectoryReader:
         return max(n - 1, 0)
 
     def _raw(self):
-        """Yield (first file row number, array of rows)."""
-        with open(self.path) as f:
-            f.readline()
-            row = 2
+        """Yield (array of rows in SI units (n, ncol), line numbers (n,)), checked."""
+        c_t = self.cols["t"]
+        last_t = None
+        with self._open() as f:
+            self._readline(f, 1)
+            lineno = 1
             while True:
-                lines = [ln for ln in itertools.islice(f, self.chunk) if ln.strip()]
+                lines, linenos = [], []
+                while len(lines) < self.chunk:
+                    lineno += 1
+                    text = self._readline(f, lineno)
+                    if not text:
+                        break
+                    if text.strip():
+                        lines.append(text)
+                        linenos.append(lineno)
                 if not lines:
                     return
-                yield row, _parse_rows(lines, row, self.header, self.file)
-                row += len(lines)
+                data = _parse_rows(lines, linenos, self.header, self.sep, self.file)
+                si = data * self.scale
+                _check_values(data, si, lines, linenos, self.header, self.sep, self.file)
+                _check_time(si[:, c_t], last_t, linenos, _place(self.header, c_t), self.file)
+                last_t = si[-1, c_t]
+                yield si, np.asarray(linenos)
 
     def __iter__(self):
-        scale = np.array([1.0 if (not self.degrees or n in self.linear) else math.pi / 180.0
-                          for n in self.names])
-        c = self.cols
-        last_t = None
-        prev = None   # raw rows of the previous chunk (for the spline pad)
+        prev = None   # rows of the previous chunk (for the spline pad)
         pending = None
-        for row, data in self._raw():
-            t = data[:, c["t"]]
-            dt = np.diff(t)
-            if last_t is not None and t[0] <= last_t:
-                raise TrajectoryError(f"{self.file}:{row}: column 1 't': time {t[0]:g} s is not after the previous {last_t:g} s")
-            if np.any(dt <= 0):
-                r = int(np.flatnonzero(dt <= 0)[0]) + 1
-                raise TrajectoryError(f"{self.file}:{row + r}: column {c['t'] + 1} 't': time {t[r]:g} s is not after "
-                                      f"the previous {t[r - 1]:g} s (time must increase strictly)")
-            last_t = t[-1]
+        for data, lines in self._raw():
             if pending is not None:
-                yield self._finish(prev, pending, data, scale)
+                yield self._finish(prev, pending, (data, lines))
                 prev = pending
-            pending = data
+            pending = (data, lines)
         if pending is None:
-            raise TrajectoryError(f"{self.file}: no samples after the header")
-        yield self._finish(prev, pending, None, scale)
+            raise _fail(self.file, None, "", "no samples after the header")
+        yield self._finish(prev, pending, None)
 
-    def _finish(self, prev, cur, nxt, scale) -> Trajectory:
+    def _finish(self, prev, cur, nxt) -> Trajectory:
         c = self.cols
-        parts = [x for x in (None if prev is None else prev[-PAD:], cur, None if nxt is None else nxt[:PAD]) if x is not None]
-        a = 0 if prev is None else min(PAD, len(prev))
-        data = np.concatenate(parts) if len(parts) > 1 else cur
-        t = data[:, c["t"]]
-        q = data[:, c["q"]] * scale
-        qd = data[:, c["qd"]] * scale if c["qd"] is not None else None
-        qdd = data[:, c["qdd"]] * scale if c["qdd"] is not None else None
+        parts = [x for x in (None if prev is None else (prev[0][-PAD:], prev[1][-PAD:]), cur,
+                             None if nxt is None else (nxt[0][:PAD], nxt[1][:PAD])) if x is not None]
+        a = 0 if prev is None else min(PAD, len(prev[0]))
+        data = np.concatenate([p[0] for p in parts])
+        lines = np.concatenate([p[1] for p in parts])
+        t, q = data[:, c["t"]], data[:, c["q"]]
+        qd = data[:, c["qd"]] if c["qd"] is not None else None
+        qdd = data[:, c["qdd"]] if c["qdd"] is not None else None
         if qd is None:
-            qd, d2 = derivatives(t, q, 2)
-            if qdd is None:
-                qdd = d2
+            d = self._derive(t, q, 2 if qdd is None else 1, lines, "q")
+            qd, qdd = d[0], (d[1] if qdd is None else qdd)
         elif qdd is None:
-            (qdd,) = derivatives(t, qd, 1)
-        sl = slice(a, a + len(cur))
-        return Trajectory(t[sl], q[sl], qd[sl], qdd[sl])
+            (qdd,) = self._derive(t, qd, 1, lines, "qd")
+        sl = slice(a, a + len(cur[0]))
+        return Trajectory(t[sl], q[sl], qd[sl], qdd[sl], lines[sl])
+
+    def _derive(self, t, y, order: int, lines, kind: str) -> list[np.ndarray]:
+        """Spline derivatives, with a clear error when too few samples or not finite."""
+        need = order + 1
+        if len(t) < need:
+            given = "positions only" if kind == "q" else "no qdd: columns"
+            raise _fail(self.file, None, "", f"{len(t)} sample{'s' if len(t) != 1 else ''} with {given}: rates and accelerations "
+                        f"are derived by spline, which needs at least {need} samples (or give the "
+                        "qd: and qdd: columns)")
+        try:
+            with np.errstate(all="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                out = derivatives(t, y, order)
+        except (ValueError, np.linalg.LinAlgError) as exc:
+            raise _fail(self.file, None, "", f"cannot fit the interpolating spline: {show(str(exc), 80)}") from None
+        for i, d in enumerate(out):
+            bad = ~np.isfinite(d)
+            if bad.any():
+                r, j = (int(x) for x in np.argwhere(bad)[0])
+                what = ("qd" if i == 0 else "qdd") if kind == "q" else "qdd"
+                raise _fail(self.file, int(lines[r]), f"{what}:{show(self.names[j])}",
+                            "derived by spline is not finite (time steps too small for the values?)")
+        return out
 
 
 def read_trajectory(path, names, degrees: bool = False, linear=()) -> Trajectory:

@@ -19,8 +19,7 @@ Columns, in order (units SI):
 """
 from __future__ import annotations
 
-import os
-import tempfile
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -79,12 +78,25 @@ class Stat:
     unit: str
     peak: float = 0.0
     t_peak: float = float("nan")
-    sumsq: float = 0.0
+    scale: float = 0.0    # sum of squares = scale**2 * ssq (no overflow for huge loads)
+    ssq: float = 0.0
     n: int = 0
 
     @property
     def rms(self) -> float:
-        return float(np.sqrt(self.sumsq / self.n)) if self.n else float("nan")
+        return self.scale * math.sqrt(self.ssq / self.n) if self.n else float("nan")
+
+    def add_squares(self, x: np.ndarray) -> None:
+        """Accumulate the squares of ``x`` (N,) >= 0, scaled as in LAPACK's dnrm2."""
+        m = float(x.max()) if x.size else 0.0
+        if m == 0.0:
+            return
+        s = float(np.dot(x / m, x / m))
+        if m > self.scale:
+            self.ssq = self.ssq * (self.scale / m) ** 2 + s
+            self.scale = m
+        else:
+            self.ssq += s * (m / self.scale) ** 2
 
 
 @dataclass
@@ -120,7 +132,7 @@ class Summary:
             v = X[imax[k], k]
             if v > st.peak or st.n == 0:
                 st.peak, st.t_peak = float(v), float(t[imax[k]])
-            st.sumsq += float(np.dot(X[:, k], X[:, k]))
+            st.add_squares(X[:, k])
             st.n += X.shape[0]
 
 
@@ -131,31 +143,17 @@ def _ideal_unit(an, c) -> str:
     return "N·m"
 
 
+def first_non_finite(tab: np.ndarray) -> tuple[int, int] | None:
+    """(row, column) of the first NaN or infinite entry of ``tab`` (N, ncol), or None."""
+    bad = ~np.isfinite(tab)
+    if not bad.any():
+        return None
+    r, c = np.argwhere(bad)[0]
+    return int(r), int(c)
+
+
 def format_rows(tab: np.ndarray, fmt: str = "%.9g") -> str:
     """CSV text of the rows of ``tab``."""
     n, m = tab.shape
     line = ",".join([fmt] * m) + "\n"
     return (line * n) % tuple((tab + 0.0).ravel().tolist())   # + 0.0: no negative zeros
-
-
-class AtomicWriter:
-    """A text file written to a temporary file beside the target and renamed on success,
-    so that a failure never leaves a partial output."""
-
-    def __init__(self, path: str | Path):
-        self.path = Path(path)
-        self.tmp = None
-
-    def __enter__(self):
-        d = self.path.parent if str(self.path.parent) else Path(".")
-        fd, self.tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".tmp", dir=d)
-        self.f = os.fdopen(fd, "w")
-        return self.f
-
-    def __exit__(self, exc_type, exc, tb):
-        self.f.close()
-        if exc_type is None:
-            os.replace(self.tmp, self.path)
-        else:
-            os.unlink(self.tmp)
-        return False

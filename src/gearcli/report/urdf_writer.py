@@ -22,8 +22,6 @@ write):
 """
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +30,7 @@ from lxml import etree
 from ..analysis.graph import Analysis, analyse
 from ..model.mechanism import Mechanism
 from ..spatial import align_z
+from ..io.output import output_target, write_text
 from ..io.urdf_reader import NS, q
 
 PRISMATIC_LIMIT = 1000.0  # m, placeholder +- limits of a prismatic joint without known limits
@@ -58,22 +57,22 @@ def frame_correction(jt) -> tuple[np.ndarray, np.ndarray]:
 
 
 def export_urdf(mech: Mechanism | Analysis, path: str | Path | None = None) -> str:
-    """URDF text of ``mech`` (a Mechanism or its Analysis); also written to ``path``
-    (atomically: a temporary file renamed) when given."""
+    """URDF text of ``mech`` (a Mechanism or its Analysis); also written to ``path`` when
+    given, atomically (:func:`gearcli.io.output.write_text`; never over the mechanism's
+    own source file)."""
     an = mech if isinstance(mech, Analysis) else analyse(mech)
+    if path is not None:
+        output_target(path, _sources(an.mech))
     root = to_element(an)
     text = etree.tostring(root, pretty_print=True, xml_declaration=True, encoding="utf-8").decode("utf-8")
     if path is not None:
-        path = Path(path)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent or ".")
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8") as f:
-                f.write(text)
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+        write_text(path, text, _sources(an.mech))
     return text
+
+
+def _sources(mech: Mechanism) -> list[str]:
+    src = getattr(mech, "source", None)
+    return [src] if isinstance(src, str) and src and Path(src).exists() else []
 
 
 def to_element(an: Analysis):
