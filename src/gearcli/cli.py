@@ -5,6 +5,8 @@ Commands::
     gearcli check MECH               validate a mechanism file
     gearcli graph MECH [--json|--dot] canonical graph, structure matrix, solve order
     gearcli solve MECH TRAJ.csv [-o OUT.csv]  motor torques, bearing loads, tooth forces
+    gearcli verify DESIGN.yaml       design checks of rated mechanisms (exit 0/1/2)
+    gearcli plot LOADS.csv COLUMN... -o FIG.png   columns over time
 
 Every bad input (unreadable file, YAML or schema error, inconsistent geometry, ...) is
 reported as one line per problem on stderr, ``file:line: yaml.path: message``, with exit
@@ -309,6 +311,71 @@ def export(
         return
     export_urdf(an, output)
     typer.echo(f"Wrote {output}")
+
+
+# ---------------------------------------------------------------------------------------
+# verify, plot
+# ---------------------------------------------------------------------------------------
+EXIT_CHECK_FAILED = 1
+
+
+@app.command()
+@reports_bad_input
+def verify(
+    design: Path = typer.Argument(..., metavar="DESIGN.yaml", show_default=False,
+                                  help="Design manifest (schemas/design.schema.json): cases of rated "
+                                       "mechanisms, trajectories and limits."),
+    junit: Path = typer.Option(None, "--junit", metavar="FILE", help="Write JUnit XML (one testcase per check)."),
+    json_out: Path = typer.Option(None, "--json", metavar="FILE", help="Write the checks as JSON."),
+    markdown: Path = typer.Option(None, "--markdown", metavar="FILE", help="Write a Markdown table (CI job summary)."),
+    plots: Path = typer.Option(None, "--plots", metavar="DIR", help="Write a PNG of each failing or tight "
+                               "(< 10 % margin) check along its worst trajectory."),
+    jobs: int = typer.Option(None, "-j", "--jobs", min=1, help="Worker processes (default: the number of cores)."),
+    dask: str = typer.Option(None, "--dask", metavar="ADDRESS", help="Run on an existing dask.distributed "
+                             "cluster (scheduler address, e.g. tcp://host:8786)."),
+) -> None:
+    """Check motors (peak/RMS torque, speed, power), bearings (ISO 281 life, static safety,
+    tilting moment), gear teeth (bending and contact stress) and column limits along every
+    trajectory of each case.  Exit 0 when every check passes, 1 when any fails, 2 on bad input."""
+    from rich.progress import BarColumn, Progress, TextColumn  # noqa: PLC0415
+
+    from .batch.manifest import load_manifest  # noqa: PLC0415
+    from .batch.outputs import rich_table  # noqa: PLC0415
+    from .batch.verify import count_jobs, run_verify  # noqa: PLC0415
+
+    manifest = load_manifest(design)
+    err = Console(stderr=True, markup=False, highlight=False)
+    progress = Progress(TextColumn("verifying"), BarColumn(), TextColumn("{task.completed}/{task.total} trajectories"),
+                        console=err, transient=True)
+    task = progress.add_task("verify", total=count_jobs(manifest))
+    with progress:
+        outcome = run_verify(design, jobs=jobs, dask_address=dask, junit=junit, json_path=json_out,
+                             markdown_path=markdown, plots_dir=plots, manifest=manifest,
+                             progress=lambda: progress.update(task, advance=1))
+    console = stdout_console()
+    console.print(rich_table(outcome.rows))
+    failed = [r for r in outcome.rows if not r.passed]
+    for r in failed:
+        typer.echo(f"FAILED {r.case}: {r.name}: worst {r.value:.4g} {r.unit} against limit {r.limit:.4g} {r.unit}")
+    typer.echo(f"{len(outcome.rows) - len(failed)} of {len(outcome.rows)} checks passed" +
+               (f"; {len(outcome.plots)} plot(s) in {plots}" if plots else ""))
+    if failed:
+        raise typer.Exit(EXIT_CHECK_FAILED)
+
+
+@app.command()
+@reports_bad_input
+def plot(
+    loads: Path = typer.Argument(..., metavar="LOADS.csv", show_default=False, help="A CSV written by gearcli solve."),
+    columns: list[str] = typer.Argument(..., metavar="COLUMN_OR_GLOB...", show_default=False,
+                                        help="Column names or shell patterns, e.g. 'motor:*' 'gear:5-1:t'."),
+    output: Path = typer.Option(..., "-o", "--output", metavar="FIG.png|svg|pdf", help="Figure to write."),
+) -> None:
+    """Draw columns of a loads CSV over time (one axis per unit: N, N*m, rad/s, W)."""
+    from .report.plots import plot_loads_csv  # noqa: PLC0415
+
+    n = plot_loads_csv(loads, columns, output)
+    typer.echo(f"Wrote {output} ({n} columns)")
 
 
 if __name__ == "__main__":  # pragma: no cover

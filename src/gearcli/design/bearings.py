@@ -25,19 +25,13 @@ import math
 
 import numpy as np
 
+from ..model.ratings import BEARING_FACTOR_DEFAULTS
+
 LIFE_EXPONENT = {"ball": 3.0, "roller": 10.0 / 3.0}
 """p of ISO 281: L10 = (C/P)^p."""
 
-# Documented defaults (README, "Bearings"): ISO 281 Table 3 for a radial deep-groove ball
-# bearing at Fa/C0 ~ 0.07 (normal clearance), and for a tapered/angular roller bearing the
-# factors of ISO 281 Table 4 with a contact angle alpha = 15 deg (e = 1.5 tan(alpha),
-# X = 0.4, Y = 0.4 cot(alpha)); static factors from ISO 76 Tables 1 and 2.
-_ALPHA = math.radians(15.0)
-FACTOR_DEFAULTS = {
-    "ball": {"X": 0.56, "Y": 1.6, "e": 0.27, "X0": 0.6, "Y0": 0.5},
-    "roller": {"X": 0.4, "Y": round(0.4 / math.tan(_ALPHA), 2), "e": round(1.5 * math.tan(_ALPHA), 2),
-               "X0": 0.5, "Y0": round(0.22 / math.tan(_ALPHA), 2)},
-}
+FACTOR_DEFAULTS = BEARING_FACTOR_DEFAULTS
+"""Default X, Y, e, X0, Y0 by bearing type (see :mod:`gearcli.model.ratings`)."""
 
 
 def equivalent_dynamic_load(Fr, Fa, X: float, Y: float, e: float) -> np.ndarray:

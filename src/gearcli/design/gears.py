@@ -23,8 +23,7 @@ import math
 
 import numpy as np
 
-STEEL_ELASTIC_COEFFICIENT = 189.8e3
-"""Z_E of steel on steel (E = 206 GPa, nu = 0.3), sqrt(Pa) (ISO 6336-2)."""
+from ..model.ratings import STEEL_ELASTIC_COEFFICIENT
 
 # Shigley, Table 14-2: Lewis form factor Y, 20 deg pressure angle, full-depth teeth.
 LEWIS_TABLE = (

@@ -42,6 +42,8 @@ class Result:
     ``gear_t`` (N, G): tangential tooth force on gear j by gear k, N, positive when it turns
     j in j's positive sense (for an ideal coupling: the mesh torque on j, N*m).
     ``gear_sep`` (N, G): separating force magnitude |t| tan(phi), N.
+    ``motor_speed`` (N, M): speed of each motor's input rotation, A^T qd (rad/s; m/s for a
+    prismatic input).
     ``gear_radial``, ``gear_axial`` (N, G, 2): components of the tooth force on gear j and on
     gear k along each gear's own outward radial direction (towards the pitch point) and its
     positive axis, N.
@@ -56,6 +58,7 @@ class Result:
     gear_axial: np.ndarray
     residual: float | None = None
     meta: dict = field(default_factory=dict)
+    motor_speed: np.ndarray | None = None   # (N, M) motor speeds A^T qd, rad/s (m/s linear)
 
 
 def joint_space(an, q_ind, qd_ind=None, qdd_ind=None):
@@ -121,6 +124,7 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
         res = Result(*(np.concatenate([getattr(p, f) for p in parts]) for f in
                        ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial")))
     res.residual = worst if verify else None
+    res.motor_speed = qd @ an.A
     return res
 
 

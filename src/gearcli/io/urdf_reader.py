@@ -51,6 +51,7 @@ from ..errors import Collector, Issue, MechanismError
 from ..model.validate import check_inertia
 from ..model.mechanism import GEAR_KINDS, GearPair, Joint, Link, Mechanism, Motor
 from ..spatial import align_z, matrix_rpy, rot_z
+from .ratings_reader import attach_urdf_ratings
 from .urdf_transmissions import KINDS as TRANSMISSION_KINDS
 from .urdf_transmissions import read_transmissions
 
@@ -91,7 +92,7 @@ def parse_urdf(text: str | bytes, file: str = "<string>") -> Mechanism:
         msg = str(exc.msg if getattr(exc, "msg", None) else exc)
         msg = msg.split(", line ")[0]
         raise MechanismError([Issue(file, "", line, f"malformed XML: {msg}")]) from None
-    return _Reader(root, data, file).build()
+    return attach_urdf_ratings(_Reader(root, data, file).build(), root, file)
 
 
 def _floats(text: str | None, n: int | None = None) -> np.ndarray | None:
@@ -399,6 +400,8 @@ class _Reader:
                 if local == "joint":
                     label = sub.get("label")
                     self.unknown_attrs(sub, ("label",), path)
+                elif local == "bearing":
+                    continue  # read by io.ratings_reader
                 elif local != "gear":
                     self.add(path, f"unknown element gearcli:{local} in a joint (expected gearcli:joint "
                              "or gearcli:gear)", sub)
@@ -543,6 +546,8 @@ class _Reader:
                 ext["gears"].append(el)
             elif local == "motor":
                 ext["motors"].append(el)
+            elif local in ("motor_rating", "gear_rating"):
+                continue  # read by io.ratings_reader
             else:
                 self.add(f"gearcli:{local}", f"unknown gearcli element gearcli:{local} (expected gearcli:mechanism, "
                          "gearcli:gear or gearcli:motor)", el)

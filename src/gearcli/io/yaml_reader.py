@@ -23,6 +23,7 @@ import yaml
 
 from ..errors import Collector, Issue, MechanismError
 from ..model.mechanism import GearPair, Joint, Link, Mechanism, Motor
+from .ratings_reader import attach_yaml_ratings
 from ..model.validate import check_inertia, inertia_matrix
 from ..spatial import align_z, rot_x, rot_z, rpy_matrix
 
@@ -169,7 +170,7 @@ def parse_mechanism(text: str, file: str = "<string>") -> Mechanism:
     _schema_issues(data, col)
     _nonfinite_issues(data, col)
     col.raise_if_any()
-    mech = _build(data, col, file, lines)
+    mech = attach_yaml_ratings(_build(data, col, file, lines), data, col)
     col.raise_if_any()
     return mech
 

@@ -20,6 +20,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .ratings import BearingRating, GearRating, JointLimit, MotorRating
+
 
 @dataclass(frozen=True, eq=False)
 class Link:
@@ -52,6 +54,8 @@ class Joint:
     label: str | None = None
     source: dict = field(default_factory=dict)
     path: str = ""
+    bearings: tuple[BearingRating, ...] | None = None   # rated bearings (design checks)
+    limit: JointLimit | None = None                     # URDF <limit effort velocity>
 
 
 GEAR_KINDS = ("external", "internal", "bevel")
@@ -82,6 +86,7 @@ class GearPair:
     # <mimic>; j and k are the two joints' children).  Without mesh_point it is an ideal
     # coupling acting on the two joints (torque pair, reactions on each joint's parent).
     joints: tuple[str, str] | None = None
+    rating: GearRating | None = None   # tooth rating (design checks)
 
 
 @dataclass(frozen=True, eq=False)
@@ -98,6 +103,7 @@ class Motor:
     # sum c * q_joint and its torque tau acts as c * tau about (along) each joint's axis, on
     # the joint's child and reversed on its parent.  Empty: the default above.
     joints: tuple[tuple[str, float], ...] = ()
+    rating: MotorRating | None = None   # design checks
 
 
 @dataclass(frozen=True, eq=False)

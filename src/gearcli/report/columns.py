@@ -15,7 +15,10 @@ Columns, in order (units SI):
   prismatic joint);
 * per real joint ``joint:<joint>:fx, fy, fz, mx, my, mz`` (N, N*m): reaction wrench the
   parent exerts on the child, in the joint frame, about its origin; then
-  ``joint:<joint>:radial`` = hypot(fx, fy), ``axial`` = |fz|, ``bending`` = hypot(mx, my).
+  ``joint:<joint>:radial`` = hypot(fx, fy), ``axial`` = |fz|, ``bending`` = hypot(mx, my);
+* per motor ``motor:<motor>:speed`` (rad/s, m/s for a prismatic input: the motor's input
+  rate A^T qd) and ``motor:<motor>:power`` (W, torque x speed, negative when braking),
+  appended last so that the columns above keep their positions.
 """
 from __future__ import annotations
 
@@ -43,6 +46,8 @@ def column_names(an) -> list[str]:
             cols += [f"gear:{gp.name}:{link}:radial", f"gear:{gp.name}:{link}:axial"]
     for jt in mech.joints:
         cols += [f"joint:{jt.name}:{c}" for c in ("fx", "fy", "fz", "mx", "my", "mz", "radial", "axial", "bending")]
+    for m in mech.motors:
+        cols += [f"motor:{m.name}:speed", f"motor:{m.name}:power"]
     return cols
 
 
@@ -60,6 +65,10 @@ def table(an, t: np.ndarray, res: Result) -> np.ndarray:
     for ji in range(W.shape[1]):
         w = W[:, ji]
         parts += [w, np.stack([np.hypot(w[:, 0], w[:, 1]), np.abs(w[:, 2]), np.hypot(w[:, 3], w[:, 4])], axis=1)]
+    if res.motor_speed is None:
+        raise ValueError("Result.motor_speed is missing (results come from gearcli.solve)")
+    speed = res.motor_speed
+    parts.append(np.stack([speed, res.motor * speed], axis=2).reshape(speed.shape[0], -1))
     return np.hstack(parts)
 
 
@@ -70,6 +79,18 @@ def named_columns(an, res: Result, t: np.ndarray | None = None) -> dict[str, np.
         t = np.arange(res.motor.shape[0], dtype=float)
     tab = table(an, np.asarray(t, float), res)
     return {name: tab[:, i] for i, name in enumerate(column_names(an))}
+
+
+def column_unit(name: str) -> str:
+    """SI unit of an output column (rotary joints; see the README's column table)."""
+    last = name.rsplit(":", 1)[-1]
+    if name.startswith("motor:"):
+        return {"speed": "rad/s", "power": "W"}.get(last, "N·m") if name.count(":") == 2 else "N·m"
+    if name == "t":
+        return "s"
+    if name.startswith("tau:") or last in ("torque", "mx", "my", "mz", "bending"):
+        return "N·m"
+    return "N"
 
 
 @dataclass
@@ -114,7 +135,11 @@ class Summary:
         for i, n in enumerate(names):
             kind = n.split(":")[0]
             last = n.rsplit(":", 1)[-1]
-            if kind == "motor":
+            if kind == "motor" and last in ("speed", "power") and n.count(":") == 2:
+                lin = _motor_linear(an, n.split(":")[1])
+                pick.append((i, f"motor {n.split(':')[1]} {last}",
+                             "W" if last == "power" else ("m/s" if lin else "rad/s")))
+            elif kind == "motor":
                 pick.append((i, f"motor {n[6:]}", "N·m"))
             elif kind == "gear" and last in ("t", "torque"):
                 pair = n[5:-len(last) - 1]
@@ -134,6 +159,13 @@ class Summary:
                 st.peak, st.t_peak = float(v), float(t[imax[k]])
             st.add_squares(X[:, k])
             st.n += X.shape[0]
+
+
+def _motor_linear(an, name: str) -> bool:
+    """True when motor ``name`` drives a prismatic input directly (speed in m/s)."""
+    mi = [m.name for m in an.mech.motors].index(name)
+    link = an.mech.motors[mi].link
+    return any(j.child == link and j.type == "prismatic" for j in an.mech.joints) and not an.mech.motors[mi].joints
 
 
 def _ideal_unit(an, c) -> str:

@@ -1,0 +1,168 @@
+"""Design manifests (``gearcli verify DESIGN.yaml``): read, validate, and prepare every case.
+
+The manifest is validated against ``schemas/design.schema.json``; then every case's
+mechanism is loaded and analysed, its checks built, and every trajectory read, so that all
+problems of the manifest and of every file it names are reported together (one line each,
+``file:line: place: message``) before any work runs.
+"""
+from __future__ import annotations
+
+import glob
+import json
+from dataclasses import dataclass
+from functools import lru_cache
+from importlib import resources
+from pathlib import Path
+
+import jsonschema
+
+from ..design.checks import Check, Requirements, build_checks
+from ..errors import Collector, GearcliError, Issue, MechanismError
+from ..io import load_mechanism
+from ..io.trajectory import read_trajectory
+from ..io.yaml_reader import yaml_lines
+from ..pipeline import analyse, prismatic_independent
+
+REQUIREMENT_KEYS = ("cycles_per_hour", "bearing_life_h", "min_static_safety", "min_bending_safety",
+                    "min_contact_safety")
+
+
+@lru_cache(maxsize=1)
+def design_schema() -> dict:
+    """The JSON Schema of design manifests (``schemas/design.schema.json``)."""
+    try:
+        text = resources.files("gearcli").joinpath("schemas/design.schema.json").read_text()
+    except (FileNotFoundError, ModuleNotFoundError, OSError):
+        text = (Path(__file__).resolve().parents[3] / "schemas" / "design.schema.json").read_text()
+    return json.loads(text)
+
+
+class ManifestError(GearcliError):
+    """Problems in a manifest or in the files it names, one line each."""
+
+    def __init__(self, lines: list[str]):
+        self.problems = list(lines)
+        super().__init__("\n".join(self.problems))
+
+    def lines(self) -> list[str]:
+        return list(self.problems)
+
+
+@dataclass(frozen=True)
+class Case:
+    """One case of a manifest, ready to run."""
+
+    name: str
+    mechanism: Path
+    trajectories: tuple[Path, ...]
+    degrees: bool
+    req: Requirements
+    checks: tuple[Check, ...]
+
+
+@dataclass(frozen=True)
+class Manifest:
+    path: Path
+    name: str
+    cases: tuple[Case, ...]
+
+
+def _schema_issues(data, col: Collector) -> None:
+    validator = jsonschema.Draft202012Validator(design_schema())
+    for err in sorted(validator.iter_errors(data), key=lambda e: list(map(str, e.absolute_path))):
+        path = ""
+        for p in err.absolute_path:
+            path += f"[{p}]" if isinstance(p, int) else (f".{p}" if path else str(p))
+        msg = err.message
+        if err.validator == "additionalProperties":
+            allowed = ", ".join(err.schema.get("properties", {}))
+            msg = f"{msg} (allowed: {allowed})"
+        elif err.validator == "anyOf":
+            msg = "give max_abs or max_rms (or both)"
+        col.add(path, msg)
+
+
+def load_manifest(path: str | Path) -> Manifest:
+    """Read and validate a manifest and everything it names; raises
+    :class:`~gearcli.errors.MechanismError` listing every problem."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise MechanismError([Issue(str(path), "", None, f"cannot read file: {getattr(exc, 'strerror', exc)}")]) from None
+    data, lines = yaml_lines(text, str(path))
+    col = Collector(str(path), lines)
+    if not isinstance(data, dict):
+        col.add("", "a design manifest must be a YAML mapping with a list of cases")
+        col.raise_if_any()
+    _schema_issues(data, col)
+    col.raise_if_any()
+    issues: list[str] = []
+    cases, names = [], {}
+    for i, spec in enumerate(data["cases"]):
+        case = _prepare_case(spec, f"cases[{i}]", path.parent, col, issues)
+        if case is None:
+            continue
+        if case.name in names:
+            col.add(f"cases[{i}].name", f"duplicate case name '{case.name}' (first at {names[case.name]})")
+        names[case.name] = f"cases[{i}]"
+        cases.append(case)
+    if col.issues or issues:
+        raise ManifestError([str(i) for i in col.issues] + issues)
+    return Manifest(path, data.get("name", path.stem), tuple(cases))
+
+
+def _trajectory_paths(spec, where: str, base: Path, col: Collector) -> list[Path]:
+    patterns = spec["trajectories"]
+    patterns = [patterns] if isinstance(patterns, str) else patterns
+    out = []
+    for j, pat in enumerate(patterns):
+        full = str(base / pat)
+        found = sorted(glob.glob(full)) if glob.has_magic(pat) else ([full] if Path(full).is_file() else [])
+        if not found:
+            sub = f"{where}.trajectories" + (f"[{j}]" if not isinstance(spec["trajectories"], str) else "")
+            col.add(sub, f"no trajectory file matches '{pat}' (relative to {base})")
+        out += [Path(f) for f in found]
+    return out
+
+
+def _prepare_case(spec: dict, where: str, base: Path, col: Collector, issues: list) -> Case | None:
+    mech_path = base / spec["mechanism"]
+    req = Requirements(**{k: spec[k] for k in REQUIREMENT_KEYS if k in spec},
+                       limits=tuple(spec.get("limits", ())), limits_path=f"{where}.limits")
+    if req.bearing_life_h is not None and req.cycles_per_hour is None:
+        col.add(f"{where}.bearing_life_h", "a bearing life in hours needs the duty's cycles_per_hour")
+    trajs = _trajectory_paths(spec, where, base, col)
+    try:
+        an = analyse(load_mechanism(mech_path))
+    except GearcliError as exc:
+        issues += exc.lines()
+        return None
+    ccol = Collector(str(col.file), col.lines)
+    mcol = Collector(an.mech.source, an.mech.lines)
+    checks = _split_build(an, req, ccol, mcol)
+    col.issues += ccol.issues
+    issues += [str(i) for i in mcol.issues]
+    if not checks:
+        col.add(f"{where}.mechanism", f"nothing to check: '{spec['mechanism']}' has no ratings and the case no limits")
+    for tp in trajs:
+        try:
+            read_trajectory(tp, an.independent_names, degrees=spec.get("degrees", False),
+                            linear=prismatic_independent(an))
+        except GearcliError as exc:
+            issues += exc.lines()
+    name = spec.get("name", Path(spec["mechanism"]).stem)
+    return Case(name, mech_path, tuple(trajs), bool(spec.get("degrees", False)), req, tuple(checks))
+
+
+def _split_build(an, req: Requirements, ccol: Collector, mcol: Collector) -> list[Check]:
+    """Build the checks; problems with a manifest path (``limits``) go to ``ccol``, the
+    others (ratings in the mechanism file) to ``mcol``."""
+    both = Collector(mcol.file, mcol.lines)
+    checks = build_checks(an, req, both)
+    for issue in both.issues:
+        if issue.path.startswith(req.limits_path):
+            ccol.add(issue.path, issue.message)
+        else:
+            mcol.issues.append(issue)
+    return checks

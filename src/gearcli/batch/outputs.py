@@ -1,0 +1,124 @@
+"""Reports of a verification run: rich table, JUnit XML, JSON, Markdown.
+
+One row per check: case, component, quantity, worst value, limit, margin in % (positive
+when the check passes), worst trajectory and the time in it; failures first.  Infinite
+values (a bearing that never turns has an infinite life) are written as ``inf`` in text and
+``null`` in JSON.
+"""
+from __future__ import annotations
+
+import json
+import math
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+from rich.table import Table
+from rich.text import Text
+
+from ..report.columns import AtomicWriter
+
+WARN_MARGIN = 10.0
+"""%: a passing check with less margin is flagged (and plotted with ``--plots``)."""
+
+
+@dataclass(frozen=True)
+class Row:
+    case: str
+    component: str
+    quantity: str
+    value: float
+    limit: float
+    unit: str
+    margin: float
+    passed: bool
+    trajectory: str
+    time: float
+
+    @property
+    def name(self) -> str:
+        return f"{self.component}: {self.quantity}"
+
+
+def rows_of(results) -> list[Row]:
+    """Every verdict as a :class:`Row`, failures first (then by margin), stable otherwise."""
+    rows = []
+    for r in results:
+        for v in r.verdicts:
+            traj = r.case.trajectories[v.trajectory]
+            rows.append(Row(r.case.name, v.check.component, v.check.quantity, v.value, v.check.limit,
+                            v.check.unit, v.margin, v.passed, Path(traj).name, v.time))
+    return sorted(rows, key=lambda row: (row.passed, row.margin))
+
+
+def fmt(x: float) -> str:
+    return "inf" if math.isinf(x) else f"{x:.4g}"
+
+
+def rich_table(rows: list[Row]) -> Table:
+    table = Table(title="Design checks")
+    for head, just in (("", "left"), ("case", "left"), ("component", "left"), ("quantity", "left"),
+                       ("worst", "right"), ("limit", "right"), ("unit", "left"), ("margin %", "right"),
+                       ("trajectory", "left"), ("t [s]", "right")):
+        table.add_column(head, justify=just)
+    for r in rows:
+        style = "red" if not r.passed else ("yellow" if r.margin < WARN_MARGIN else "green")
+        table.add_row(Text("FAIL" if not r.passed else "ok", style=style), r.case, r.component, r.quantity,
+                      fmt(r.value), fmt(r.limit), r.unit, Text(fmt(r.margin), style=style), r.trajectory,
+                      f"{r.time:.4g}")
+    return table
+
+
+def write_junit(rows: list[Row], path, suite: str) -> None:
+    """JUnit XML: one ``<testsuite>`` per case, one ``<testcase>`` per check; a failing
+    check has a ``<failure>`` with the worst value, limit and margin."""
+    root = ET.Element("testsuites", name=suite, tests=str(len(rows)),
+                      failures=str(sum(not r.passed for r in rows)))
+    for case in dict.fromkeys(r.case for r in rows):
+        mine = [r for r in rows if r.case == case]
+        ts = ET.SubElement(root, "testsuite", name=case, tests=str(len(mine)),
+                           failures=str(sum(not r.passed for r in mine)), errors="0", skipped="0")
+        for r in mine:
+            tc = ET.SubElement(ts, "testcase", classname=f"{suite}.{case}", name=r.name, time="0")
+            text = (f"{r.name}: worst {fmt(r.value)} {r.unit} (limit {fmt(r.limit)} {r.unit}), margin "
+                    f"{fmt(r.margin)} %, in {r.trajectory} at t = {r.time:.4g} s")
+            if r.passed:
+                ET.SubElement(tc, "system-out").text = text
+            else:
+                ET.SubElement(tc, "failure", message=text, type="DesignCheckFailed").text = text
+    ET.indent(root)
+    with AtomicWriter(path) as f:
+        f.write('<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n")
+
+
+def _num(x: float):
+    return None if math.isinf(x) or math.isnan(x) else x
+
+
+def write_json(rows: list[Row], path, manifest: str) -> None:
+    doc = {"manifest": manifest, "passed": all(r.passed for r in rows),
+           "checks": [{"case": r.case, "component": r.component, "quantity": r.quantity, "value": _num(r.value),
+                       "limit": r.limit, "unit": r.unit, "margin_pct": _num(r.margin), "passed": r.passed,
+                       "trajectory": r.trajectory, "time": _num(r.time)} for r in rows]}
+    with AtomicWriter(path) as f:
+        json.dump(doc, f, indent=2)
+        f.write("\n")
+
+
+def markdown(rows: list[Row], manifest: str) -> str:
+    failed = sum(not r.passed for r in rows)
+    head = (f"## Design checks: {manifest}\n\n"
+            + (f"**{failed} of {len(rows)} checks failed.**\n\n" if failed else f"All {len(rows)} checks passed.\n\n"))
+    lines = ["| | case | component | quantity | worst | limit | unit | margin % | trajectory | t [s] |",
+             "|---|---|---|---|---:|---:|---|---:|---|---:|"]
+    for r in rows:
+        mark = "❌" if not r.passed else ("⚠️" if r.margin < WARN_MARGIN else "✅")
+        cells = [mark, r.case, r.component, r.quantity, fmt(r.value), fmt(r.limit), r.unit, fmt(r.margin),
+                 r.trajectory, f"{r.time:.4g}"]
+        lines.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
+    return head + "\n".join(lines) + "\n"
+
+
+def write_markdown(rows: list[Row], path, manifest: str) -> None:
+    with AtomicWriter(path) as f:
+        f.write(markdown(rows, manifest))

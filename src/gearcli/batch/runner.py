@@ -1,0 +1,134 @@
+"""Run a manifest's checks: one job per (case, trajectory), serially, in processes or on Dask.
+
+A job solves one trajectory and reduces it to the partial sums of every check of its case
+(:func:`gearcli.design.evaluate.partials`); the partials are merged per case in trajectory
+order (:func:`gearcli.design.evaluate.combine`).  Jobs carry only paths and flags, so they
+run the same in this process, in a process pool (``jobs`` > 1) or on a Dask cluster
+(``dask_address``), and the results are identical whichever way they ran.
+"""
+from __future__ import annotations
+
+import os
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from ..design.checks import build_checks
+from ..design.evaluate import Samples, Verdict, combine, partials, signal
+from ..dynamics.solve import solve
+from ..errors import Collector
+from ..io import load_mechanism
+from ..io.trajectory import read_trajectory
+from ..pipeline import analyse, prismatic_independent
+from ..report.columns import named_columns
+from .manifest import Case, Manifest
+
+
+@dataclass(frozen=True)
+class Job:
+    """One trajectory of one case (picklable: paths and flags only)."""
+
+    case: int
+    trajectory: int
+    mechanism: str
+    path: str
+    degrees: bool
+    req: object   # design.checks.Requirements
+
+
+@lru_cache(maxsize=8)
+def _analysis(mech_path: str, mtime: float):
+    return analyse(load_mechanism(mech_path))
+
+
+def case_analysis(mech_path: str | Path):
+    """The analysed mechanism, cached per process (keyed by path and modification time)."""
+    return _analysis(str(mech_path), os.path.getmtime(mech_path))
+
+
+def solve_samples(an, traj_path, degrees: bool) -> Samples:
+    """Solve a trajectory file: times, every output column, and every real joint's rate."""
+    tr = read_trajectory(traj_path, an.independent_names, degrees=degrees, linear=prismatic_independent(an))
+    res = solve(an, tr.q, tr.qd, tr.qdd)
+    return Samples(tr.t, named_columns(an, res, tr.t), tr.qd @ an.S.T)
+
+
+def run_job(job: Job) -> list[tuple]:
+    """The partials of every check of the job's case on the job's trajectory."""
+    an = case_analysis(job.mechanism)
+    checks = build_checks(an, job.req, Collector(job.mechanism))
+    return partials(checks, solve_samples(an, job.path, job.degrees), an.mech)
+
+
+def jobs_of(manifest: Manifest) -> list[Job]:
+    return [Job(ci, ti, str(c.mechanism), str(tp), c.degrees, c.req)
+            for ci, c in enumerate(manifest.cases) for ti, tp in enumerate(c.trajectories)]
+
+
+@dataclass(frozen=True)
+class CaseResult:
+    case: Case
+    verdicts: tuple[Verdict, ...]
+
+
+def run_manifest(manifest: Manifest, jobs: int | None = None, dask_address: str | None = None,
+                 progress=None) -> list[CaseResult]:
+    """Run every job and merge the partials; ``progress()`` is called after each job.
+
+    ``jobs``: worker processes (None: the number of cores; 1: this process);
+    ``dask_address``: the scheduler of an existing dask.distributed cluster (then ``jobs``
+    is ignored).
+    """
+    todo = jobs_of(manifest)
+    if dask_address is not None:
+        results = _run_dask(todo, dask_address, progress)
+    else:
+        results = _run_local(todo, jobs or os.cpu_count() or 1, progress)
+    out = []
+    for ci, case in enumerate(manifest.cases):
+        parts = [results[(ci, ti)] for ti in range(len(case.trajectories))]
+        verdicts = [combine(ch, [p[k] for p in parts], case.req.cycles_per_hour) for k, ch in enumerate(case.checks)]
+        out.append(CaseResult(case, tuple(verdicts)))
+    return out
+
+
+def _run_local(todo: list[Job], workers: int, progress) -> dict:
+    results = {}
+    if workers <= 1 or len(todo) <= 1:
+        for job in todo:
+            results[(job.case, job.trajectory)] = run_job(job)
+            if progress:
+                progress()
+        return results
+    with ProcessPoolExecutor(max_workers=min(workers, len(todo))) as pool:
+        futures = {pool.submit(run_job, job): job for job in todo}
+        for fut in as_completed(futures):
+            job = futures[fut]
+            results[(job.case, job.trajectory)] = fut.result()
+            if progress:
+                progress()
+    return results
+
+
+def _run_dask(todo: list[Job], address: str, progress) -> dict:
+    from dask.distributed import Client, as_completed as dask_completed  # noqa: PLC0415 (optional)
+
+    results = {}
+    with Client(address, set_as_default=False) as client:
+        futures = {client.submit(run_job, job, pure=False): job for job in todo}
+        for fut in dask_completed(list(futures)):
+            job = futures[fut]
+            results[(job.case, job.trajectory)] = fut.result()
+            if progress:
+                progress()
+    return results
+
+
+def worst_samples(result: CaseResult, verdict: Verdict) -> tuple[np.ndarray, np.ndarray]:
+    """Time and signal of a check along its worst trajectory (for plots)."""
+    an = case_analysis(result.case.mechanism)
+    s = solve_samples(an, result.case.trajectories[verdict.trajectory], result.case.degrees)
+    return s.t, signal(verdict.check, s, an.mech)

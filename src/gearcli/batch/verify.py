@@ -1,0 +1,75 @@
+"""``gearcli verify``: manifest in, verdicts and reports out (the CLI is a thin layer on it)."""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..report.plots import plot_check
+from .manifest import load_manifest
+from .outputs import WARN_MARGIN, rows_of, write_json, write_junit, write_markdown
+from .runner import jobs_of, run_manifest, worst_samples
+
+SIGNAL_LABELS = {"abs": "|{}|", "col": "{}", "rate": "joint rate", "bearing_P": "dynamic equivalent load P",
+                 "bearing_P0": "static equivalent load P0", "bending": "Lewis root bending stress",
+                 "contact": "Hertz contact stress"}
+LIMIT_LABELS = {"peak": "limit", "rms": "RMS limit", "safety": "allowable / required safety",
+                "life": "P_eq giving the required life"}
+
+
+@dataclass
+class VerifyOutcome:
+    rows: list
+    results: list
+    plots: list
+
+    @property
+    def passed(self) -> bool:
+        return all(r.passed for r in self.rows)
+
+
+def count_jobs(manifest) -> int:
+    return len(jobs_of(manifest))
+
+
+def run_verify(manifest_path, *, jobs: int | None = None, dask_address: str | None = None, junit=None,
+               json_path=None, markdown_path=None, plots_dir=None, progress=None, manifest=None) -> VerifyOutcome:
+    """Run a manifest (already loaded with :func:`load_manifest` when ``manifest`` is given)
+    and write the requested reports; ``progress(total=..)`` once, then ``progress()`` per job."""
+    manifest = manifest or load_manifest(manifest_path)
+    results = run_manifest(manifest, jobs=jobs, dask_address=dask_address, progress=progress)
+    rows = rows_of(results)
+    suite = manifest.name
+    if junit:
+        write_junit(rows, junit, suite)
+    if json_path:
+        write_json(rows, json_path, str(manifest_path))
+    if markdown_path:
+        write_markdown(rows, markdown_path, str(manifest_path))
+    plots = write_plots(results, Path(plots_dir)) if plots_dir else []
+    return VerifyOutcome(rows, results, plots)
+
+
+def _slug(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_")
+
+
+def write_plots(results, directory: Path) -> list[Path]:
+    """One PNG per failing or tight (< 10 % margin) check: its quantity along the worst
+    trajectory with the level that just meets the limit."""
+    directory.mkdir(parents=True, exist_ok=True)
+    out = []
+    for r in results:
+        for v in r.verdicts:
+            if v.passed and v.margin >= WARN_MARGIN:
+                continue
+            ch = v.check
+            t, y = worst_samples(r, v)
+            label = SIGNAL_LABELS[ch.signal[0]].format(ch.signal[1] if ch.signal[0] in ("abs", "col") else "")
+            path = directory / f"{_slug(r.case.name)}__{_slug(ch.component)}__{_slug(ch.quantity)}.png"
+            status = "FAIL" if not v.passed else "tight"
+            title = (f"{r.case.name}: {ch.name} ({status}, margin {v.margin:.3g} %)\n"
+                     f"worst trajectory {Path(r.case.trajectories[v.trajectory]).name}")
+            plot_check(t, y, v.signal_limit, path, title, f"{label} [{ch.signal_unit}]", LIMIT_LABELS[ch.kind])
+            out.append(path)
+    return out

@@ -1,0 +1,177 @@
+"""The design checks of one mechanism: which quantity of which component, against what limit.
+
+:func:`build_checks` turns the ratings of an analysed mechanism (``Motor.rating``,
+``Joint.bearings``, ``Joint.limit``, ``GearPair.rating``) and a case's requirements
+(:class:`Requirements`) into a list of :class:`Check`.  Each check names a *signal*, a
+quantity with one value per trajectory sample (computed by :mod:`gearcli.design.evaluate`),
+and how the samples of a duty cycle are reduced to the value compared with the limit:
+
+* ``peak``: max over the samples <= limit;
+* ``rms``: time-weighted RMS over the whole duty cycle <= limit;
+* ``safety``: ``rating`` / max over the samples >= limit (static safety, tooth stresses);
+* ``life``: ISO 281 rating life in hours >= limit (``rating`` = C, ``exponent`` = p).
+"""
+from __future__ import annotations
+
+import difflib
+from dataclasses import dataclass, field
+
+from ..errors import Collector
+from ..report.columns import column_names, column_unit
+from .bearings import LIFE_EXPONENT
+from .gears import lewis_form_factor, virtual_spur
+
+MODULE_RTOL = 0.01
+"""Relative tolerance of module * teeth / 2 against the pitch radius from the geometry."""
+
+
+@dataclass(frozen=True)
+class Requirements:
+    """A case's requirements (manifest keys of the same names); None: not checked."""
+
+    cycles_per_hour: float | None = None
+    bearing_life_h: float | None = None
+    min_static_safety: float = 1.0
+    min_bending_safety: float = 1.0
+    min_contact_safety: float = 1.0
+    limits: tuple = ()   # ({"column": str, "max_abs": float, "max_rms": float}, ...)
+    limits_path: str = "limits"
+
+
+@dataclass(frozen=True)
+class Check:
+    """One check.  ``signal`` is a tuple understood by :func:`gearcli.design.evaluate.signal`."""
+
+    component: str
+    quantity: str
+    unit: str            # unit of the value compared with the limit
+    limit: float
+    kind: str            # "peak" | "rms" | "safety" | "life"
+    signal: tuple
+    signal_unit: str     # unit of the signal (what a plot shows)
+    rating: float = 0.0  # safety: allowable of the signal; life: C
+    exponent: float = 0.0
+    extra: dict = field(default_factory=dict, compare=False)
+
+    @property
+    def name(self) -> str:
+        return f"{self.component}: {self.quantity}"
+
+
+def build_checks(an, req: Requirements, col: Collector) -> list[Check]:
+    """Every check of the analysed mechanism ``an`` under ``req``; problems go to ``col``."""
+    checks = _motor_checks(an) + _bearing_checks(an, req, col) + _gear_checks(an, req, col)
+    checks += _joint_limit_checks(an) + _column_checks(an, req, col)
+    return checks
+
+
+def _motor_checks(an) -> list[Check]:
+    out = []
+    for m in an.mech.motors:
+        r = m.rating
+        if r is None:
+            continue
+        c = f"motor {m.name}"
+        out += [Check(c, "peak torque", "N·m", r.peak_torque, "peak", ("abs", f"motor:{m.name}"), "N·m"),
+                Check(c, "RMS torque", "N·m", r.rms_torque, "rms", ("col", f"motor:{m.name}"), "N·m"),
+                Check(c, "speed", "rad/s", r.max_speed, "peak", ("abs", f"motor:{m.name}:speed"), "rad/s")]
+        if r.max_power is not None:
+            out.append(Check(c, "power", "W", r.max_power, "peak", ("abs", f"motor:{m.name}:power"), "W"))
+    return out
+
+
+def _bearing_checks(an, req: Requirements, col: Collector) -> list[Check]:
+    out = []
+    for ji, jt in enumerate(an.mech.joints):
+        if not jt.bearings:
+            continue
+        if jt.type != "revolute":
+            col.add(jt.bearings[0].path, f"bearings are rated on revolute joints; '{jt.name}' is {jt.type}")
+            continue
+        for bi, b in enumerate(jt.bearings):
+            c = f"bearing {jt.name}/{b.name}"
+            if req.bearing_life_h is not None:
+                out.append(Check(c, "L10 life", "h", req.bearing_life_h, "life", ("bearing_P", ji, bi), "N",
+                                 rating=b.C, exponent=LIFE_EXPONENT[b.type]))
+            out.append(Check(c, "static safety s0", "", req.min_static_safety, "safety", ("bearing_P0", ji, bi),
+                             "N", rating=b.C0))
+            if b.M is not None:
+                out.append(Check(c, "tilting moment", "N·m", b.M, "peak", ("abs", f"joint:{jt.name}:bending"), "N·m"))
+    return out
+
+
+def _gear_checks(an, req: Requirements, col: Collector) -> list[Check]:
+    out = []
+    for c in an.circuits:
+        gp = an.mech.gears[c.gear]
+        r = gp.rating
+        if r is None or c.geometry is None:
+            continue
+        g = c.geometry
+        teeth = gp.teeth if gp.teeth is not None else (2 * g.r_j / r.module, 2 * g.r_k / r.module)
+        if gp.teeth is not None:
+            for link, z, rad in zip((gp.j, gp.k), gp.teeth, (g.r_j, g.r_k)):
+                if abs(r.module * z / 2 - rad) > MODULE_RTOL * rad:
+                    col.add(f"{r.path}.module", f"module {r.module:g} m x {z} teeth / 2 = {r.module * z / 2:g} m "
+                            f"disagrees with the pitch radius {rad:g} m of gear '{link}' from the mesh geometry")
+        try:
+            stress = _stress_factors(gp, g, teeth, r)
+        except ValueError as exc:
+            col.add(f"{r.path}.module", f"gear pair '{gp.name}': {exc}")
+            continue
+        comp = f"gear {gp.name}"
+        out += [Check(comp, "bending safety", "", req.min_bending_safety, "safety", ("bending", gp.name),
+                      "Pa", rating=r.bending_stress_limit, extra=stress),
+                Check(comp, "contact safety", "", req.min_contact_safety, "safety", ("contact", gp.name),
+                      "Pa", rating=r.contact_stress_limit, extra=stress)]
+    return out
+
+
+def _stress_factors(gp, g, teeth, r) -> dict:
+    """Lewis and Hertz constants of a pair: sigma_F = kF |t|, sigma_H = kH sqrt(|t|).
+
+    Bevel gears use their virtual spur gears (:func:`gearcli.design.gears.virtual_spur`).
+    """
+    zj, dj = virtual_spur(teeth[0], 2 * g.r_j, g.cone_j)
+    zk, dk = virtual_spur(teeth[1], 2 * g.r_k, g.cone_k)
+    K = r.application_factor * r.load_sharing_factor
+    Y = min(lewis_form_factor(zj), lewis_form_factor(zk))
+    d1, u = min(dj, dk), max(dj, dk) / min(dj, dk)
+    return {"K": K, "Y": Y, "d1": d1, "u": u, "alpha": gp.pressure_angle, "internal": g.ring is not None,
+            "module": r.module, "b": r.face_width, "ZE": r.elastic_coefficient}
+
+
+def _joint_limit_checks(an) -> list[Check]:
+    out = []
+    independent = set(an.independent_names)
+    for ji, jt in enumerate(an.mech.joints):
+        lim = jt.limit
+        if lim is None:
+            continue
+        lin = jt.type == "prismatic"
+        if lim.effort is not None and jt.name in independent:
+            out.append(Check(f"joint {jt.name}", "effort", "N" if lin else "N·m", lim.effort, "peak",
+                             ("abs", f"tau:{jt.name}"), "N" if lin else "N·m"))
+        if lim.velocity is not None:
+            out.append(Check(f"joint {jt.name}", "velocity", "m/s" if lin else "rad/s", lim.velocity, "peak",
+                             ("rate", ji), "m/s" if lin else "rad/s"))
+    return out
+
+
+def _column_checks(an, req: Requirements, col: Collector) -> list[Check]:
+    out = []
+    names = column_names(an)
+    for i, lim in enumerate(req.limits):
+        name = lim["column"]
+        if name not in names:
+            close = difflib.get_close_matches(name, names, n=1)
+            col.add(f"{req.limits_path}[{i}].column", f"unknown output column '{name}'"
+                    + (f" (did you mean '{close[0]}'?)" if close else ""))
+            continue
+        unit = column_unit(name)
+        if "max_abs" in lim:
+            out.append(Check(f"column {name}", "max abs", unit, lim["max_abs"], "peak", ("abs", name), unit))
+        if "max_rms" in lim:
+            out.append(Check(f"column {name}", "RMS", unit, lim["max_rms"], "rms", ("col", name), unit))
+    return out
+

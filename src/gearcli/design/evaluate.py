@@ -1,0 +1,139 @@
+"""Evaluate design checks: signals along one trajectory, partial sums, the duty-cycle verdict.
+
+The work is split so that it can run anywhere: :func:`partials` reduces one trajectory to a
+few numbers per check (picklable, small), and :func:`combine` merges the partials of every
+trajectory of a case, always in the case's trajectory order, so the verdict is the same
+whichever process or machine evaluated each trajectory.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import bearings as B
+from .checks import Check
+from .gears import hertz_contact_stress, lewis_bending_stress
+
+
+@dataclass(frozen=True)
+class Samples:
+    """One solved trajectory: times ``t`` (N,), output columns by name (each (N,)), and the
+    rates of every real joint ``rates`` (N, J), rad/s."""
+
+    t: np.ndarray
+    cols: dict
+    rates: np.ndarray
+
+
+def bearing_loads(s: Samples, joint: str, bearings, bi: int) -> tuple[np.ndarray, np.ndarray]:
+    """Radial and axial load (N) on bearing ``bi`` of a joint, per sample.
+
+    One bearing takes the whole reaction force; two share its force and tilting moment as
+    a shaft on two supports (:func:`gearcli.design.bearings.split_two_bearings`), the
+    locating one taking the axial force.
+    """
+    c = s.cols
+    axial = np.abs(c[f"joint:{joint}:fz"]) if bearings[bi].locating else np.zeros_like(s.t)
+    if len(bearings) == 1:
+        return c[f"joint:{joint}:radial"], axial
+    F = np.column_stack([c[f"joint:{joint}:f{a}"] for a in "xyz"])
+    M = np.column_stack([c[f"joint:{joint}:m{a}"] for a in "xyz"])
+    R = B.split_two_bearings(F, M, bearings[0].position, bearings[1].position)[bi]
+    return np.hypot(R[:, 0], R[:, 1]), axial
+
+
+def signal(check: Check, s: Samples, mech) -> np.ndarray:
+    """The check's quantity at every sample, (N,), in ``check.signal_unit``."""
+    kind = check.signal[0]
+    if kind == "abs":
+        return np.abs(s.cols[check.signal[1]])
+    if kind == "col":
+        return s.cols[check.signal[1]]
+    if kind == "rate":
+        return np.abs(s.rates[:, check.signal[1]])
+    if kind in ("bearing_P", "bearing_P0"):
+        jt = mech.joints[check.signal[1]]
+        b = jt.bearings[check.signal[2]]
+        Fr, Fa = bearing_loads(s, jt.name, jt.bearings, check.signal[2])
+        if kind == "bearing_P":
+            return B.equivalent_dynamic_load(Fr, Fa, b.X, b.Y, b.e)
+        return B.static_equivalent_load(Fr, Fa, b.X0, b.Y0)
+    x, ft = check.extra, s.cols[f"gear:{check.signal[1]}:t"]
+    if kind == "bending":
+        return lewis_bending_stress(ft, x["module"], x["b"], x["Y"], x["K"])
+    if kind == "contact":
+        return hertz_contact_stress(ft, x["d1"], x["b"], x["u"], x["alpha"], x["ZE"], x["K"], x["internal"])
+    raise ValueError(f"unknown signal {check.signal!r}")
+
+
+def weight_rate(check: Check, s: Samples) -> np.ndarray:
+    """|relative rotation rate| of a life check's bearing (its joint rate), rad/s."""
+    return np.abs(s.rates[:, check.signal[1]])
+
+
+def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
+    """Per check, the trajectory's (peak, t at peak, sum, weight sum, revolutions, score).
+
+    ``sum``/``weight`` are sum x^2 dt / sum dt (rms) or sum |w| dt P^p / sum |w| dt (life);
+    ``score`` ranks trajectories for "worst trajectory" (peak, RMS or equivalent load).
+    """
+    dt = B.sample_weights(s.t)
+    out = []
+    for ch in checks:
+        x = signal(ch, s, mech)
+        k = int(np.argmax(np.abs(x))) if x.size else 0
+        peak, tp = (float(np.abs(x[k])), float(s.t[k])) if x.size else (0.0, math.nan)
+        total = wsum = revs = 0.0
+        score = peak
+        if ch.kind == "rms":
+            total, wsum = float(np.sum(x * x * dt)), float(np.sum(dt))
+            score = math.sqrt(total / wsum) if wsum > 0 else 0.0
+        elif ch.kind == "life":
+            w = weight_rate(ch, s) * dt
+            total, wsum, revs = float(np.sum(w * x ** ch.exponent)), float(np.sum(w)), float(np.sum(w)) / (2 * math.pi)
+            score = (total / wsum) ** (1 / ch.exponent) if wsum > 0 else 0.0
+        out.append((peak, tp, total, wsum, revs, score))
+    return out
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """The outcome of one check over a case's duty cycle."""
+
+    check: Check
+    value: float
+    passed: bool
+    margin: float          # %, positive when passing
+    trajectory: int        # index of the worst trajectory in the case
+    time: float            # s, time of the worst sample in it
+    signal_limit: float    # the signal level that just meets the limit (for plots)
+
+
+def combine(check: Check, parts: list[tuple], cycles_per_hour: float | None) -> Verdict:
+    """Merge the partials of a case's trajectories (in order) into a :class:`Verdict`."""
+    scores = [p[5] for p in parts]
+    worst = int(np.argmax(scores))
+    t_worst = parts[worst][1]
+    peak = max(p[0] for p in parts)
+    if check.kind == "peak":
+        value, sig_lim = peak, check.limit
+    elif check.kind == "rms":
+        wsum = sum(p[3] for p in parts)
+        value = math.sqrt(sum(p[2] for p in parts) / wsum) if wsum > 0 else 0.0
+        sig_lim = check.limit
+    elif check.kind == "safety":
+        value = math.inf if peak <= 0 else check.rating / peak
+        sig_lim = check.rating / check.limit
+    else:
+        wsum = sum(p[3] for p in parts)
+        P_eq = (sum(p[2] for p in parts) / wsum) ** (1 / check.exponent) if wsum > 0 else 0.0
+        rev_h = sum(p[4] for p in parts) * (cycles_per_hour or 0.0)
+        value = B.rating_life_hours(B.rating_life_mrev(check.rating, P_eq, check.exponent), rev_h)
+        sig_lim = B.required_equivalent_load(check.rating, check.limit, rev_h, check.exponent)
+    if check.kind in ("peak", "rms"):
+        margin = 100.0 * (check.limit - value) / check.limit
+    else:
+        margin = math.inf if math.isinf(value) else 100.0 * (value - check.limit) / check.limit
+    return Verdict(check, value, margin >= 0, margin, worst, t_worst, sig_lim)

@@ -1,0 +1,203 @@
+"""Component ratings in mechanism files -> :mod:`gearcli.model.ratings`, attached to the model.
+
+YAML keys (schema in ``schemas/mechanism.schema.json``): ``motors[].rating``,
+``joints[].bearings``, ``gears[].rating``.  URDF: each joint's ``<limit effort velocity>``,
+and the extension elements ``<gearcli:bearing .../>`` inside a ``<joint>``,
+``<gearcli:motor_rating motor= .../>`` and ``<gearcli:gear_rating gear= .../>`` under
+``<robot>`` (attributes named as the YAML keys).  Problems are reported like every other
+input problem (file, line, place, message) and raised together.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+from lxml import etree
+
+from ..errors import Collector, Issue, MechanismError
+from ..model.mechanism import Mechanism
+from ..model.ratings import (BEARING_FACTOR_DEFAULTS, STEEL_ELASTIC_COEFFICIENT, BearingRating, GearRating,
+                             JointLimit, MotorRating)
+
+NS = "https://gearcli.dev/urdf/1"
+MOTOR_KEYS = ("peak_torque", "rms_torque", "max_speed", "max_power")
+BEARING_KEYS = ("name", "position", "C", "C0", "type", "X", "Y", "e", "X0", "Y0", "locating", "M")
+GEAR_KEYS = ("module", "face_width", "bending_stress_limit", "contact_stress_limit",
+             "elastic_coefficient", "application_factor", "load_sharing_factor")
+
+
+def _positive(spec: dict, keys, path: str, add) -> None:
+    for key in keys:
+        v = spec.get(key)
+        if isinstance(v, (int, float)) and not isinstance(v, bool) and not v > 0:
+            add(f"{path}.{key}", f"{key} must be positive, got {v:g}")
+
+
+def motor_rating(spec: dict, path: str, add) -> MotorRating:
+    """A :class:`MotorRating` from a mapping with the keys of :data:`MOTOR_KEYS`."""
+    _positive(spec, MOTOR_KEYS, path, add)
+    if spec["rms_torque"] > spec["peak_torque"]:
+        add(f"{path}.rms_torque", f"rms_torque {spec['rms_torque']:g} exceeds peak_torque {spec['peak_torque']:g}")
+    power = spec.get("max_power")
+    return MotorRating(float(spec["peak_torque"]), float(spec["rms_torque"]), float(spec["max_speed"]),
+                       None if power is None else float(power), path)
+
+
+def bearing_ratings(specs: list[dict], path: str, add) -> tuple[BearingRating, ...]:
+    """The bearings of one joint (one or two), factors defaulted by type (documented)."""
+    out = []
+    for i, spec in enumerate(specs):
+        p = f"{path}[{i}]"
+        _positive(spec, ("C", "C0", "X", "Y", "e", "M"), p, add)
+        f = {**BEARING_FACTOR_DEFAULTS[spec["type"]], **{k: spec[k] for k in ("X", "Y", "e", "X0", "Y0") if k in spec}}
+        if spec.get("M") is not None and len(specs) == 2:
+            add(f"{p}.M", "a moment rating M is for a single bearing (two bearings carry the moment as radial loads)")
+        if len(specs) == 1 and spec.get("locating") is False:
+            add(f"{p}.locating", "a joint's only bearing takes the axial load: it cannot be non-locating")
+        out.append(BearingRating(spec["name"], float(spec["position"]), float(spec["C"]), float(spec["C0"]),
+                                 spec["type"], float(f["X"]), float(f["Y"]), float(f["e"]), float(f["X0"]),
+                                 float(f["Y0"]), bool(spec.get("locating", len(specs) == 1)),
+                                 None if spec.get("M") is None else float(spec["M"]), p))
+    if len(out) == 2:
+        if out[0].name == out[1].name:
+            add(f"{path}[1].name", f"duplicate bearing name '{out[1].name}'")
+        if out[0].position == out[1].position:
+            add(f"{path}[1].position", "two bearings of a joint need different positions")
+        if sum(b.locating for b in out) != 1:
+            add(path, "with two bearings, exactly one needs 'locating: true' (the one that takes the axial load)")
+    return tuple(out)
+
+
+def gear_rating(spec: dict, path: str, add) -> GearRating:
+    """A :class:`GearRating` from a mapping with the keys of :data:`GEAR_KEYS`."""
+    _positive(spec, GEAR_KEYS, path, add)
+    return GearRating(float(spec["module"]), float(spec["face_width"]), float(spec["bending_stress_limit"]),
+                      float(spec["contact_stress_limit"]), float(spec.get("elastic_coefficient", STEEL_ELASTIC_COEFFICIENT)),
+                      float(spec.get("application_factor", 1.0)), float(spec.get("load_sharing_factor", 1.0)), path)
+
+
+def attach_yaml_ratings(mech: Mechanism, data: dict, col: Collector) -> Mechanism:
+    """``mech`` with the ratings of the (schema-valid) YAML ``data`` attached; issues to ``col``."""
+    motors = tuple(replace(m, rating=motor_rating(s["rating"], f"motors[{i}].rating", col.add))
+                   if "rating" in s else m for i, (m, s) in enumerate(zip(mech.motors, data.get("motors", []))))
+    joints = tuple(replace(j, bearings=bearing_ratings(s["bearings"], f"joints[{i}].bearings", col.add))
+                   if "bearings" in s else j for i, (j, s) in enumerate(zip(mech.joints, data["joints"])))
+    gears = []
+    for i, (g, s) in enumerate(zip(mech.gears, data.get("gears", []))):
+        if "rating" in s:
+            if g.mesh_point is None:
+                col.add(f"gears[{i}].rating", "a gear rating needs the mesh geometry (mesh_point)")
+            g = replace(g, rating=gear_rating(s["rating"], f"gears[{i}].rating", col.add))
+        gears.append(g)
+    return replace(mech, motors=motors, joints=joints, gears=tuple(gears))
+
+
+# -- URDF ---------------------------------------------------------------------------------
+def _urdf_spec(el, keys, required, path: str, add) -> dict | None:
+    """Attributes of a rating element as a mapping: numbers parsed, ``type`` and ``name``
+    kept as strings, ``locating`` as a boolean; None (with issues) when one is bad."""
+    spec: dict = {}
+    ok = True
+    for attr, text in el.attrib.items():
+        key = etree.QName(attr).localname
+        if key not in keys:
+            add(path, f"unknown attribute '{key}' (allowed: {', '.join(keys)})")
+            ok = False
+        elif key in ("name", "motor", "gear"):
+            spec[key] = text
+        elif key == "type":
+            if text not in BEARING_FACTOR_DEFAULTS:
+                add(f"{path}.type", f"bearing type must be 'ball' or 'roller', got '{text}'")
+                ok = False
+            spec[key] = text
+        elif key == "locating":
+            if text not in ("true", "false"):
+                add(f"{path}.locating", f"locating must be 'true' or 'false', got '{text}'")
+                ok = False
+            spec[key] = text == "true"
+        else:
+            try:
+                spec[key] = float(text)
+            except ValueError:
+                spec[key] = math.nan
+            if not math.isfinite(spec[key]):
+                add(f"{path}.{key}", f"{key} must be a finite number, got '{text}'")
+                ok = False
+    for key in required:
+        if key not in spec:
+            add(path, f"missing attribute '{key}'")
+            ok = False
+    return spec if ok else None
+
+
+def _urdf_limit(el, path: str, warn) -> JointLimit | None:
+    """A joint's ``<limit effort velocity>``; non-positive values are not limits (warning)."""
+    lim = el.find("limit")
+    if lim is None:
+        return None
+    vals = {}
+    for key in ("effort", "velocity"):
+        try:
+            v = float(lim.get(key, "nan"))
+        except ValueError:
+            v = math.nan
+        if lim.get(key) is not None and not v > 0:
+            warn(f"{path}.limit", f"limit {key}=\"{lim.get(key)}\" is not a positive limit: not checked", lim)
+        vals[key] = v if v > 0 else None
+    return None if vals == {"effort": None, "velocity": None} else JointLimit(vals["effort"], vals["velocity"], path)
+
+
+def _ext(el, local: str) -> list:
+    return [s for s in el if isinstance(s.tag, str) and s.tag == f"{{{NS}}}{local}"]
+
+
+def attach_urdf_ratings(mech: Mechanism, root, file: str) -> Mechanism:
+    """``mech`` (read from the URDF ``root``) with joint limits and gearcli rating elements."""
+    issues: list[Issue] = []
+    warnings = list(mech.warnings)
+
+    def adder(el):
+        return lambda path, msg: issues.append(Issue(file, path, el.sourceline, msg))
+
+    def warn(path, msg, el):
+        warnings.append(str(Issue(file, path, el.sourceline, msg)))
+
+    joints = {j.name: j for j in mech.joints}
+    for el in root.findall("joint"):
+        name, path = el.get("name"), f"joint '{el.get('name')}'"
+        specs = []
+        for i, b in enumerate(_ext(el, "bearing")):
+            specs.append(_urdf_spec(b, BEARING_KEYS, ("name", "position", "C", "C0", "type"),
+                                    f"{path}.gearcli:bearing[{i}]", adder(b)))
+        if name not in joints:
+            if specs:
+                adder(el)(path, "bearings on a fixed joint (its links are merged into one body)")
+            continue
+        if len(specs) > 2:
+            adder(el)(path, f"a joint has one or two bearings, got {len(specs)}")
+        elif specs and None not in specs:
+            joints[name] = replace(joints[name], bearings=bearing_ratings(specs, f"{path}.gearcli:bearing", adder(el)))
+        limit = _urdf_limit(el, path, warn)
+        if limit is not None:
+            joints[name] = replace(joints[name], limit=limit)
+    motors = {m.name: m for m in mech.motors}
+    gears = {g.name: g for g in mech.gears}
+    for kind, table, keys, builder in (("motor", motors, MOTOR_KEYS, motor_rating),
+                                       ("gear", gears, GEAR_KEYS, gear_rating)):
+        required = [k for k in keys if k not in ("max_power", "elastic_coefficient", "application_factor",
+                                                 "load_sharing_factor")]
+        for el in _ext(root, f"{kind}_rating"):
+            path = f"gearcli:{kind}_rating '{el.get(kind)}'"
+            spec = _urdf_spec(el, (kind, *keys), (kind, *required), path, adder(el))
+            if spec is None:
+                continue
+            if spec[kind] not in table:
+                adder(el)(path, f"unknown {kind} '{spec[kind]}' (known: {', '.join(table)})")
+            elif kind == "gear" and table[spec[kind]].mesh_point is None:
+                adder(el)(path, "a gear rating needs the mesh geometry (a gearcli:gear with mesh_point)")
+            else:
+                table[spec[kind]] = replace(table[spec[kind]], rating=builder(spec, path, adder(el)))
+    if issues:
+        raise MechanismError(issues)
+    return replace(mech, joints=tuple(joints.values()), motors=tuple(motors.values()),
+                   gears=tuple(gears.values()), warnings=tuple(warnings))

@@ -1,0 +1,149 @@
+"""Figures (matplotlib, optional extra ``plot``): output columns over time, and a design
+check's quantity along its worst trajectory with its limit.
+
+Files are written through a temporary file and renamed; the format follows the extension
+(``.png``, ``.svg``, ``.pdf``).
+"""
+from __future__ import annotations
+
+import fnmatch
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import GearcliError
+from .columns import column_unit
+
+FORMATS = (".png", ".svg", ".pdf")
+
+
+def _pyplot():
+    try:
+        import matplotlib  # noqa: PLC0415 (optional dependency)
+    except ImportError:
+        raise GearcliError("plots need matplotlib: pip install 'gearcli[plot]'") from None
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    return plt
+
+
+def _save(fig, path: Path) -> None:
+    plt = _pyplot()
+    d = path.parent if str(path.parent) else Path(".")
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=d)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, dpi=100, format=path.suffix[1:])
+        os.replace(tmp, path)
+    except BaseException:
+        os.unlink(tmp)
+        raise
+    finally:
+        plt.close(fig)
+
+
+def check_output_path(path: str | Path) -> Path:
+    path = Path(path)
+    if path.suffix.lower() not in FORMATS:
+        raise GearcliError(f"{path}: the figure format must be one of {', '.join(FORMATS)} (from the extension)")
+    return path
+
+
+def select_columns(header: list[str], patterns: list[str], file: str) -> list[str]:
+    """Columns of ``header`` matching any of ``patterns`` (names or shell globs), in header
+    order; a pattern that matches nothing is an error."""
+    out = []
+    for p in patterns:
+        hits = [h for h in header if fnmatch.fnmatchcase(h, p)]
+        if not hits:
+            raise GearcliError(f"{file}:1: no column matches '{p}'")
+        out += [h for h in hits if h not in out]
+    return [h for h in header if h in out]
+
+
+def plot_columns(t: np.ndarray, series: dict, units: dict, out: str | Path, title: str = "") -> None:
+    """Columns over time: one axis per unit (sharing t), units on the axes.
+
+    ``series`` maps column name to (N,) values, ``units`` column name to its unit.
+    """
+    plt = _pyplot()
+    groups: dict[str, list[str]] = {}
+    for name in series:
+        groups.setdefault(units[name], []).append(name)
+    fig, axes = plt.subplots(len(groups), 1, sharex=True, figsize=(8, 2.6 * len(groups) + 0.6), squeeze=False)
+    for ax, (unit, names) in zip(axes[:, 0], groups.items()):
+        for n in names:
+            ax.plot(t, series[n], label=n, lw=1.2)
+        ax.set_ylabel(f"[{unit}]" if unit else "value")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize="small", loc="best")
+    axes[-1, 0].set_xlabel("t [s]")
+    if title:
+        axes[0, 0].set_title(title)
+    fig.tight_layout()
+    _save(fig, check_output_path(out))
+
+
+def plot_check(t: np.ndarray, y: np.ndarray, limit: float, out: str | Path, title: str, ylabel: str,
+               limit_label: str) -> None:
+    """A check's quantity ``y`` over ``t`` (its worst trajectory) and the level ``limit``."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7, 3.2))
+    ax.plot(t, y, lw=1.2, label="value")
+    if np.isfinite(limit):
+        ax.axhline(limit, color="red", ls="--", lw=1.2, label=limit_label)
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize="medium")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize="small", loc="best")
+    fig.tight_layout()
+    _save(fig, check_output_path(out))
+
+
+def read_loads_csv(path: str | Path) -> tuple[list[str], np.ndarray]:
+    """Header and (N, ncol) data of a loads CSV; bad files raise GearcliError naming the row."""
+    path = Path(path)
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise GearcliError(f"{path}: cannot read file: {getattr(exc, 'strerror', None) or exc}") from None
+    if not lines:
+        raise GearcliError(f"{path}: empty file")
+    header = lines[0].split(",")
+    if header[0] != "t":
+        raise GearcliError(f"{path}:1: the first column must be 't' (a CSV written by gearcli solve)")
+    rows = []
+    for i, line in enumerate(lines[1:], start=2):
+        cells = line.split(",")
+        if len(cells) != len(header):
+            raise GearcliError(f"{path}:{i}: {len(cells)} cells, the header has {len(header)}")
+        try:
+            rows.append([float(c) for c in cells])
+        except ValueError:
+            bad = next(j for j, c in enumerate(cells) if not _is_float(c))
+            raise GearcliError(f"{path}:{i}: column {bad + 1} '{header[bad]}': not a number") from None
+    if not rows:
+        raise GearcliError(f"{path}: no data rows")
+    return header, np.array(rows)
+
+
+def _is_float(text: str) -> bool:
+    try:
+        float(text)
+        return True
+    except ValueError:
+        return False
+
+
+def plot_loads_csv(path, patterns: list[str], out) -> int:
+    """Plot the columns of a loads CSV matching ``patterns`` into ``out``; returns their count."""
+    out = check_output_path(out)
+    header, data = read_loads_csv(path)
+    names = select_columns(header, patterns, str(path))
+    series = {n: data[:, header.index(n)] for n in names}
+    plot_columns(data[:, 0], series, {n: column_unit(n) for n in names}, out, title=Path(path).name)
+    return len(names)
