@@ -504,3 +504,18 @@ def test_summary_rms_of_huge_loads_does_not_overflow():
         st.n += len(chunk)
     expect = 1e200 * np.sqrt((10 * 1 + 10 * 9) / 25)
     assert np.isclose(st.rms, expect, rtol=1e-12)
+
+
+def test_every_module_imports_and_no_private_atomic_writer_is_left():
+    """One atomic writer (gearcli.io.output): no module keeps its own temp-file code."""
+    import importlib
+    import pkgutil
+
+    import gearcli
+
+    for m in pkgutil.walk_packages(gearcli.__path__, "gearcli."):
+        importlib.import_module(m.name)
+    for path in (SRC / "gearcli").rglob("*.py"):
+        if path.name != "output.py":
+            text = path.read_text()
+            assert "mkstemp" not in text and "AtomicWriter" not in text and "os.replace" not in text, path

@@ -144,8 +144,9 @@ def _link_proc_fd(fd: int, target: str, root: int) -> None:
 
 @contextmanager
 def atomic_output(path: str | os.PathLike, inputs: Iterable[str | os.PathLike] = (),
-                  encoding: str = "utf-8") -> Iterator[IO[str]]:
-    """Context manager yielding a text file that becomes ``path`` only on success.
+                  encoding: str = "utf-8", binary: bool = False) -> Iterator[IO]:
+    """Context manager yielding a text file (a binary one with ``binary``) that becomes
+    ``path`` only on success.
 
     ``path`` is checked by :func:`output_target` (``"-"`` is refused here: the caller
     writes to stdout itself).  On any exception, nothing is left: neither a partial output
@@ -162,7 +163,7 @@ def atomic_output(path: str | os.PathLike, inputs: Iterable[str | os.PathLike] =
         raise OutputError(name, f"cannot create the file: {exc.strerror}") from None
     f = None
     try:
-        f = os.fdopen(fd, "w", encoding=encoding, newline="")
+        f = os.fdopen(fd, "wb") if binary else os.fdopen(fd, "w", encoding=encoding, newline="")
         yield f
         f.flush()
         if tmp is None:

@@ -7,13 +7,12 @@ Files are written through a temporary file and renamed; the format follows the e
 from __future__ import annotations
 
 import fnmatch
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import GearcliError
+from ..io.output import atomic_output
 from .columns import column_unit
 
 FORMATS = (".png", ".svg", ".pdf")
@@ -31,16 +30,11 @@ def _pyplot():
 
 
 def _save(fig, path: Path) -> None:
+    """Write ``fig`` atomically (:func:`gearcli.io.output.atomic_output`)."""
     plt = _pyplot()
-    d = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=d)
-    os.close(fd)
     try:
-        fig.savefig(tmp, dpi=100, format=path.suffix[1:])
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+        with atomic_output(path, binary=True) as f:
+            fig.savefig(f, dpi=100, format=path.suffix[1:])
     finally:
         plt.close(fig)
 
