@@ -88,7 +88,8 @@ def test_directory_instead_of_file(run_cli, tmp_path):
 
 
 def test_not_utf8(run_cli, tmp_path):
-    assert_bad(run_cli, tmp_path, b"\xff\xfename: x\n", [("", None, "not a UTF-8 text file")])
+    assert_bad(run_cli, tmp_path, b"\xff\xfename: x\n", [("", 1, "not a UTF-8 text file")])
+    assert_bad(run_cli, tmp_path, b"name: x\nbase: a\ndescription: caf\xe9\n", [("", 3, r"not a UTF-8 text file \(byte 32\)")])
 
 
 def test_empty_file(run_cli, tmp_path):

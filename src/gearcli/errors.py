@@ -19,8 +19,22 @@ class Issue:
     message: str
 
     def __str__(self) -> str:
+        """``file[:line]: [path: ]message`` on one line, path and message capped to
+        :data:`MAX_PATH` and :data:`MAX_MESSAGE` characters (a 100 kB name in the input is
+        not echoed whole)."""
         where = self.file if self.line is None else f"{self.file}:{self.line}"
-        return f"{where}: {self.path}: {self.message}" if self.path else f"{where}: {self.message}"
+        message = capped(self.message, MAX_MESSAGE)
+        return f"{where}: {capped(self.path, MAX_PATH)}: {message}" if self.path else f"{where}: {message}"
+
+
+MAX_PATH = 160
+MAX_MESSAGE = 400
+
+
+def capped(text: str, limit: int) -> str:
+    """``text`` on one line, cut to ``limit`` characters with an ellipsis."""
+    text = " ".join(str(text).splitlines())
+    return text if len(text) <= limit else text[:limit - 1] + "…"
 
 
 class GearcliError(Exception):

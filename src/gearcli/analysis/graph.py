@@ -498,9 +498,14 @@ def _circuit_matrix(h: _Home, circuits: list[Circuit], col: Collector) -> np.nda
     gear pairs, whose loads would be statically indeterminate)."""
     G = len(circuits)
     Gam = np.array([c.row for c in circuits]).reshape(G, h.J)
-    rank = np.linalg.matrix_rank(Gam) if G else 0
+    # rows scaled to unit length; a pair redundant within the ratio tolerance (1e-6, as
+    # ratios are checked against the geometry) is redundant: rounded mesh points must not
+    # turn two redundant planets into "0 degrees of freedom"
+    Gn = Gam / np.maximum(np.linalg.norm(Gam, axis=1, keepdims=True), 1e-300)
+    sv = np.linalg.svd(Gn, compute_uv=False) if G else np.zeros(0)
+    rank = int(np.sum(sv > 1e-6 * sv[0])) if G else 0
     if rank < G:
-        _, sv, Vt = np.linalg.svd(Gam.T)
+        _, sv, Vt = np.linalg.svd(Gn.T)
         null = Vt[rank:]  # left null vectors of Gam
         involved = sorted({i for v in null for i in np.flatnonzero(np.abs(v) > 1e-8)})
         gears = h.mech.gears

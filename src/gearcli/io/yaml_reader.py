@@ -11,36 +11,19 @@ from __future__ import annotations
 
 import difflib
 import json
-import re
-import math
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 
 import jsonschema
 import numpy as np
-import yaml
 
-from ..errors import Collector, Issue, MechanismError
+from ..errors import Collector
 from ..model.mechanism import GearPair, Joint, Link, Mechanism, Motor
 from .ratings_reader import attach_yaml_ratings
-from ..model.validate import check_inertia, inertia_matrix
+from ..model.validate import check_inertia, inertia_matrix, number_problem
 from ..spatial import align_z, rot_x, rot_z, rpy_matrix
-
-
-class Loader(yaml.SafeLoader):
-    """SafeLoader that reads floats as YAML 1.2 does: ``1e-4`` is a number, not a string."""
-
-
-Loader.add_implicit_resolver(
-    "tag:yaml.org,2002:float",
-    re.compile(r"""^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
-                |[-+]?(?:[0-9][0-9_]*)(?:[eE][-+]?[0-9]+)
-                |\.[0-9_]+(?:[eE][-+]?[0-9]+)?
-                |[-+]?\.(?:inf|Inf|INF)
-                |\.(?:nan|NaN|NAN))$""", re.X),
-    list("-+0123456789."),
-)
+from .yaml_safe import read_text, yaml_lines
 
 
 @lru_cache(maxsize=1)
@@ -55,53 +38,7 @@ def mechanism_schema() -> dict:
 
 def load_yaml(path: str | Path) -> Mechanism:
     """Read a mechanism from a YAML file; raises :class:`~gearcli.errors.MechanismError`."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise MechanismError([Issue(str(path), "", None, f"cannot read file: {exc.strerror}")]) from None
-    except UnicodeDecodeError as exc:
-        raise MechanismError([Issue(str(path), "", None, f"not a UTF-8 text file (byte {exc.start})")]) from None
-    return parse_mechanism(text, str(path))
-
-
-def yaml_lines(text: str, file: str) -> tuple[object, dict[str, int]]:
-    """Parse YAML ``text``; return the data and a map YAML path -> 1-based line.
-
-    Duplicate mapping keys and syntax errors raise :class:`MechanismError`.
-    """
-    try:
-        root = yaml.compose(text, Loader=Loader)
-        data = yaml.load(text, Loader=Loader)  # noqa: S506 (a SafeLoader subclass)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        line = mark.line + 1 if mark is not None else None
-        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise MechanismError([Issue(file, "", line, f"YAML syntax error: {problem}")]) from None
-    lines: dict[str, int] = {}
-    col = Collector(file, lines)
-
-    def walk(node, path: str) -> None:
-        lines[path] = node.start_mark.line + 1
-        if isinstance(node, yaml.MappingNode):
-            seen = set()
-            for key, value in node.value:
-                k = key.value
-                sub = f"{path}.{k}" if path else str(k)
-                if k in seen:
-                    lines[sub] = key.start_mark.line + 1
-                    col.add(sub, f"duplicate key '{k}'")
-                seen.add(k)
-                walk(value, sub)
-                lines[sub] = key.start_mark.line + 1
-        elif isinstance(node, yaml.SequenceNode):
-            for i, item in enumerate(node.value):
-                walk(item, f"{path}[{i}]")
-
-    if root is not None:
-        walk(root, "")
-    col.raise_if_any()
-    return data, lines
+    return parse_mechanism(read_text(path), str(path))
 
 
 def _json_path(parts) -> str:
@@ -138,26 +75,41 @@ def _schema_messages(err) -> list[tuple[list, str]]:
         types = [s.get("type") for s in err.validator_value if isinstance(s, dict) and "type" in s]
         if types:
             return [(path, f"{err.instance!r} is not valid: expected {' or '.join(map(str, types))}")]
-    return [(path, err.message)]
+    return [(path, _short_message(err))]
 
 
-def _schema_issues(data, col: Collector) -> None:
+def _short_message(err) -> str:
+    """jsonschema's message with a long echoed value shortened (``[...] is not of type``)."""
+    message = err.message
+    if len(message) > 200:
+        whole = repr(err.instance)
+        if whole in message:
+            message = message.replace(whole, whole[:60] + "…")
+    return message
+
+
+def _schema_issues(data, col: Collector, skip: set) -> None:
+    """Schema violations, except at the paths in ``skip`` (already reported)."""
     validator = jsonschema.Draft202012Validator(mechanism_schema())
     for err in sorted(validator.iter_errors(data), key=lambda e: list(map(str, e.absolute_path))):
         for parts, message in _schema_messages(err):
-            col.add(_json_path(parts), message)
+            if _json_path(parts) not in skip:
+                col.add(_json_path(parts), message)
 
 
-def _nonfinite_issues(data, col: Collector, path: str = "") -> None:
-    """Report NaN and infinite numbers (YAML .nan, .inf), which the schema lets through."""
-    if isinstance(data, float) and not math.isfinite(data):
-        col.add(path, f"{data} is not a finite number")
-    elif isinstance(data, dict):
+def _number_issues(data, col: Collector, path: str = "") -> None:
+    """Report numbers the schema lets through but no mechanism has: NaN, infinities (YAML
+    .nan, .inf) and magnitudes beyond :data:`~gearcli.model.validate.MAX_ABS`."""
+    if isinstance(data, dict):
         for k, v in data.items():
-            _nonfinite_issues(v, col, f"{path}.{k}" if path else str(k))
+            _number_issues(v, col, f"{path}.{k}" if path else str(k))
     elif isinstance(data, list):
         for i, v in enumerate(data):
-            _nonfinite_issues(v, col, f"{path}[{i}]")
+            _number_issues(v, col, f"{path}[{i}]")
+    else:
+        why = number_problem(data)
+        if why:
+            col.add(path, why)
 
 
 def parse_mechanism(text: str, file: str = "<string>") -> Mechanism:
@@ -167,8 +119,8 @@ def parse_mechanism(text: str, file: str = "<string>") -> Mechanism:
     if not isinstance(data, dict):
         col.add("", "a mechanism file must be a YAML mapping")
         col.raise_if_any()
-    _schema_issues(data, col)
-    _nonfinite_issues(data, col)
+    _number_issues(data, col)
+    _schema_issues(data, col, {i.path for i in col.issues})
     col.raise_if_any()
     mech = attach_yaml_ratings(_build(data, col, file, lines), data, col)
     col.raise_if_any()

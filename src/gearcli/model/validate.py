@@ -5,6 +5,8 @@ to the place in their file.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 
@@ -29,4 +31,23 @@ def check_inertia(I: np.ndarray, mass: float) -> str | None:
     if a + b < c * (1 - 1e-9) - 1e-15:
         return (f"principal moments {np.array2string(w, precision=4)} violate the triangle "
                 "inequality (I1 + I2 >= I3)")
+    return None
+
+
+MAX_ABS = 1e12
+"""Largest magnitude accepted for any number in a mechanism file (SI units): beyond it
+products of lengths, masses and rates leave the range where float64 results mean anything."""
+
+
+def number_problem(x) -> str | None:
+    """Why the number ``x`` (int or float; bools are not numbers here) is refused, or None:
+    not finite, or larger in magnitude than :data:`MAX_ABS`."""
+    if isinstance(x, bool) or not isinstance(x, (int, float)):
+        return None
+    if isinstance(x, float) and not math.isfinite(x):
+        return f"{x} is not a finite number"
+    if abs(x) > MAX_ABS:
+        text = f"{x:.6g}" if isinstance(x, float) or abs(x) < 10**300 else f"an integer of {len(str(abs(x)))} digits"
+        limit = f"{MAX_ABS:.0e}".replace("e+", "e")
+        return f"{text} is out of range (|x| <= {limit} in SI units)"
     return None

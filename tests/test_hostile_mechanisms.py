@@ -1,0 +1,229 @@
+"""Hostile mechanism files (issue 8): every one ends in exit status 2 with a single line
+``file[:line]: place: what is wrong`` (capped in length), never a traceback, a hang or a
+memory blow-up.
+
+Each case is a small edit of a bundled mechanism or a generated file.  Cases run through
+the in-process CLI runner; the resource-limit cases also through a real ``gearcli``
+subprocess (so that a traceback, a crash or a runaway would be seen as the user sees it).
+"""
+from __future__ import annotations
+
+import math
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PAPER = (ROOT / "mechanisms" / "paper_2dof.yaml").read_text()
+MAX_LINE = 700   # characters of one reported line (file name + place + capped message)
+
+
+def replaced(old: str, new: str, text: str = PAPER) -> str:
+    assert text.count(old) == 1, f"{old!r} must occur once"
+    return text.replace(old, new)
+
+
+def line_of(text: str, needle: str) -> int:
+    return next(i + 1 for i, s in enumerate(text.splitlines()) if needle in s)
+
+
+def check_one_line(res_code: int, stderr: str, stdout: str, path: Path, line: int | None,
+                   place: str, reason: str) -> str:
+    """Assert one located line on stderr, exit 2, nothing on stdout, no traceback."""
+    assert "Traceback" not in stderr, stderr
+    assert res_code == 2, (res_code, stderr[:2000])
+    assert stdout == ""
+    got = stderr.splitlines()
+    assert len(got) == 1, got[:5]
+    where = f"{path}:{line}" if line is not None else f"{path}"
+    prefix = f"{where}: {place}: " if place else f"{where}: "
+    assert got[0].startswith(prefix), (got[0][:300], prefix)
+    assert re.search(reason, got[0][len(prefix):]), (got[0][:300], reason)
+    assert len(got[0]) <= MAX_LINE + len(str(path))
+    return got[0]
+
+
+def bad(run_cli, tmp_path, text, line, place, reason, name="bad.yaml") -> str:
+    path = tmp_path / name
+    path.write_bytes(text) if isinstance(text, bytes) else path.write_text(text)
+    res = run_cli("check", path)
+    return check_one_line(res.exit_code, res.stderr, res.stdout, path, line, place, reason)
+
+
+def bad_subprocess(tmp_path, text, line, place, reason, name="bad.yaml", timeout=60) -> str:
+    path = tmp_path / name
+    path.write_bytes(text) if isinstance(text, bytes) else path.write_text(text)
+    env_path = str(ROOT / "src")
+    res = subprocess.run([sys.executable, "-c", "import sys; sys.path.insert(0, sys.argv[1]); "
+                          "from gearcli.cli import app; sys.argv = ['gearcli', 'check', sys.argv[2]]; app()",
+                          env_path, str(path)], capture_output=True, text=True, timeout=timeout)
+    return check_one_line(res.returncode, res.stderr, res.stdout, path, line, place, reason)
+
+
+# --------------------------------------------------------------------------------------
+# numbers: too large for a float, non-finite, beyond physical sense
+# --------------------------------------------------------------------------------------
+BIG_INT = "1" + "0" * 400
+
+
+@pytest.mark.parametrize("old,new,place", [
+    ("mass: 4.0", f"mass: {BIG_INT}", "links[1].mass"),
+    ("com: [-0.2, 0, 0]", f"com: [-0.2, {BIG_INT}, 0]", "links[1].com[1]"),
+    ("inertia: [0.005, 0.06, 0.06]", f"inertia: [0.005, {BIG_INT}, 0.06]", "links[1].inertia[1]"),
+    ("theta_deg: 0, d: 0.0, a: 0.4", f"theta_deg: {BIG_INT}, d: 0.0, a: 0.4", "joints[0].dh.theta_deg"),
+    ("theta_deg: 0, d: 0.0, a: 0.4", f"theta_deg: 0, d: {BIG_INT}, a: 0.4", "joints[0].dh.d"),
+    ("origin: {xyz: [-0.2, 0, 0.05]}", f"origin: {{xyz: [-0.2, 0, 0.05], rpy_deg: [{BIG_INT}, 0, 0]}}",
+     "joints[3].origin.rpy_deg[0]"),
+    ("axis: [1, 0, 0]", f"axis: [{BIG_INT}, 0, 0]", "joints[3].axis[0]"),
+    ("ratio: -3.0", f"ratio: -{BIG_INT}", "gears[0].ratio"),
+    ("teeth: [30, 30]", f"teeth: [30, {BIG_INT}]", "gears[1].teeth[1]"),
+    ("mesh_point: [0.09, 0, -0.05]", f"mesh_point: [{BIG_INT}, 0, -0.05]", "gears[0].mesh_point[0]"),
+    ("pressure_angle_deg: 20", f"pressure_angle_deg: {BIG_INT}", "gears[0].pressure_angle_deg"),
+    ("gravity: [0, 0, -9.81]", f"gravity: [0, 0, -{BIG_INT}]", "gravity[2]"),
+])
+def test_integer_too_large_for_a_float(run_cli, tmp_path, old, new, place):
+    text = replaced(old, new)
+    bad(run_cli, tmp_path, text, line_of(text, BIG_INT), place,
+        r"an integer of 40[01] digits is out of range \(\|x\| <= 1e12 in SI units\)")
+
+
+def test_integer_beyond_python_conversion_limit(run_cli, tmp_path):
+    text = replaced("mass: 4.0", "mass: " + "9" * 5000)
+    bad(run_cli, tmp_path, text, line_of(text, "9999"), "", r"an integer of 5000 digits is out of range")
+
+
+@pytest.mark.parametrize("old,new,place,shown", [
+    ("theta_deg: 0, d: 0.0, a: 0.4", "theta_deg: 1e300, d: 0.0, a: 0.4", "joints[0].dh.theta_deg", "1e+300"),
+    ("mesh_point: [0.09, 0, -0.05]", "mesh_point: [1e300, 0, 0]", "gears[0].mesh_point[0]", "1e+300"),
+    ("axis: [1, 0, 0]", "axis: [1e308, 0, 0]", "joints[3].axis[0]", "1e+308"),
+    ("gravity: [0, 0, -9.81]", "gravity: [0, 0, -1e300]", "gravity[2]", "-1e+300"),
+    ("mass: 4.0", "mass: 1e300", "links[1].mass", "1e+300"),
+    ("mass: 4.0", "mass: 2e12", "links[1].mass", "2e+12"),
+    ("inertia: [0.005, 0.06, 0.06]", "inertia: [0.005, 0.06, 1.5e13]", "links[1].inertia[2]", "1.5e+13"),
+])
+def test_number_beyond_physical_sense(run_cli, tmp_path, old, new, place, shown):
+    text = replaced(old, new)
+    bad(run_cli, tmp_path, text, line_of(text, new.split(":")[-1].strip()[:6]), place,
+        rf"^{re.escape(shown)} is out of range \(\|x\| <= 1e12 in SI units\)$")
+
+
+def test_non_finite_number(run_cli, tmp_path):
+    text = replaced("mesh_point: [0.09, 0, -0.05]", "mesh_point: [.inf, 0, -0.05]")
+    bad(run_cli, tmp_path, text, line_of(text, ".inf"), "gears[0].mesh_point[0]", "^inf is not a finite number$")
+
+
+def test_largest_accepted_numbers_still_load(run_cli, tmp_path):
+    """The limit is not a rounding accident: 1e12 itself is accepted (and then refused for
+    what it means physically, not as a number)."""
+    from gearcli import load_mechanism
+    path = tmp_path / "ok.yaml"
+    path.write_text(replaced("gravity: [0, 0, -9.81]", "gravity: [0, 0, -1e12]"))
+    assert load_mechanism(path).gravity[2] == -1e12
+
+
+# --------------------------------------------------------------------------------------
+# structure: nesting, recursive aliases, alias bombs, size
+# --------------------------------------------------------------------------------------
+def test_deep_nesting(run_cli, tmp_path):
+    text = "name: x\nlinks: " + "[" * 900 + "]" * 900 + "\n"
+    bad(run_cli, tmp_path, text, 2, "", r"YAML nesting deeper than 64 levels")
+
+
+def test_deep_nesting_subprocess(tmp_path):
+    text = "name: x\nlinks: " + "[" * 200000 + "]" * 200000 + "\n"
+    bad_subprocess(tmp_path, text, 2, "", r"YAML nesting deeper than 64 levels")
+
+
+@pytest.mark.parametrize("text,line", [("a: &a [*a]\n", 1), ("name: x\nb: &b {c: [1, {d: *b}]}\n", 2)])
+def test_self_referencing_alias(run_cli, tmp_path, text, line):
+    bad(run_cli, tmp_path, text, line, "", r"alias '\*[ab]' refers to a node that contains it")
+
+
+BOMB = ('a: &a ["lol","lol","lol","lol","lol","lol","lol","lol","lol"]\n'
+        + "".join(f"{c}: &{c} [{', '.join(['*' + p] * 9)}]\n" for p, c in zip("abcdefgh", "bcdefghi")))
+
+
+def test_alias_bomb_fails_fast_and_small(tmp_path):
+    assert len(BOMB) < 500
+    line = bad_subprocess(tmp_path, BOMB, 9, "", "^YAML aliases expand the document to more than [\\d,]+ nodes", timeout=30)
+    assert len(line) < 300 + len(str(tmp_path))
+
+
+def test_alias_bomb_as_description(run_cli, tmp_path):
+    inline = ("[&a [lol,lol,lol,lol,lol,lol,lol,lol,lol], "
+              + ", ".join(f"&{c} [{', '.join(['*' + p] * 9)}]" for p, c in zip("abcdefg", "bcdefgh")) + "]")
+    text = replaced("description: Two-dof geared manipulator of Fig. 1 in the paper", "description: " + inline)
+    bad(run_cli, tmp_path, text, line_of(text, "description:"), "", "YAML aliases expand the document")
+
+
+def test_aliases_within_reason_still_load(tmp_path):
+    """Ordinary use of anchors (a shared inertia, reused many times) is not refused."""
+    from gearcli import load_mechanism
+    text = replaced("inertia: [0.005, 0.06, 0.06]", "inertia: &I [0.005, 0.06, 0.06]")
+    text = replaced("inertia: [0.003, 0.025, 0.025]", "inertia: *I", text)
+    path = tmp_path / "ok.yaml"
+    path.write_text(text)
+    mech = load_mechanism(path)
+    assert mech.links[2].inertia[1, 1] == 0.06
+
+
+def test_long_value_not_echoed(run_cli, tmp_path):
+    text = PAPER + "description: [" + ", ".join(["xxxxxxxxxx"] * 20000) + "]\n"
+    text = replaced("description: Two-dof geared manipulator of Fig. 1 in the paper\n", "", text)
+    line = bad(run_cli, tmp_path, text, line_of(text, "description: ["), "description",
+               r"^\['xxxxxxxxxx', .{0,80}… is not of type 'string'$")
+    assert len(line) < 200 + len(str(tmp_path))
+
+
+def test_100kB_link_name_not_echoed(run_cli, tmp_path):
+    big = "y" * 100_000
+    text = replaced('child: "2"', f'child: "{big}"')
+    line = bad(run_cli, tmp_path, text, line_of(text, big), "joints[1].child", "^unknown link 'yyyy")
+    assert big not in line
+
+
+def test_file_size_limit(run_cli, tmp_path):
+    text = PAPER + "#" + "x" * (17 * 2**20) + "\n"
+    bad(run_cli, tmp_path, text, None, "", r"^file is larger than 16 MiB, the limit for a mechanism file$")
+
+
+# --------------------------------------------------------------------------------------
+# redundant planets: statically indeterminate (the pairs named), never "0 degrees of freedom"
+# --------------------------------------------------------------------------------------
+def planetary(angles_deg, digits: int) -> str:
+    """Sun S and carrier C on the base axis, planets on C meshing S and a ring fixed to the
+    base; coordinates rounded to ``digits`` decimals (as a designer writes them)."""
+    rs, rp = 0.02, 0.01
+    rc, rr = rs + rp, rs + 2 * rp
+    links = ["  - {name: '0'}", "  - {name: S, mass: 0.2, inertia: [0.0001, 0.0001, 0.0001]}",
+             "  - {name: C, mass: 0.5, inertia: [0.001, 0.001, 0.001]}"]
+    joints = ["  - {name: JS, parent: '0', child: S}", "  - {name: JC, parent: '0', child: C, origin: {xyz: [0, 0, 0.01]}}"]
+    gears = []
+    for i, deg in enumerate(angles_deg):
+        c, s = (round(f(math.radians(deg)), digits) for f in (math.cos, math.sin))
+        links.append(f"  - {{name: P{i}, mass: 0.05, inertia: [0.00001, 0.00001, 0.00001]}}")
+        joints.append(f"  - {{name: JP{i}, parent: C, child: P{i}, origin: {{xyz: [{rc * c}, {rc * s}, 0]}}}}")
+        gears.append(f"  - {{name: S-P{i}, links: [S, P{i}], teeth: [20, 10], mesh_point: [{rs * c}, {rs * s}, -0.01]}}")
+        gears.append(f"  - {{name: P{i}-R, links: [P{i}, '0'], kind: internal, teeth: [10, 40], "
+                     f"mesh_point: [{rr * c}, {rr * s}, -0.01]}}")
+    return ("name: planetary\nbase: '0'\nend_effector: C\nlinks:\n" + "\n".join(links) + "\njoints:\n"
+            + "\n".join(joints) + "\ngears:\n" + "\n".join(gears) + "\nmotors:\n  - {name: M, link: S}\n")
+
+
+@pytest.mark.parametrize("angles", [(0, 120), (0, 120, 240)])
+@pytest.mark.parametrize("digits", [10, 12])
+def test_redundant_planets(run_cli, tmp_path, angles, digits):
+    text = planetary(angles, digits)
+    pairs = ", ".join(f"'S-P{i}' \\(gears\\[{2 * i}\\]\\), 'P{i}-R' \\(gears\\[{2 * i + 1}\\]\\)" for i in range(len(angles)))
+    bad(run_cli, tmp_path, text, line_of(text, "gears:"), "gears",
+        "^redundant gear pairs make the loads statically indeterminate: " + pairs + "$")
+
+
+def test_single_planet_is_fine(run_cli, tmp_path):
+    path = tmp_path / "one.yaml"
+    path.write_text(planetary((0,), 10))
+    res = run_cli("check", path)
+    assert res.exit_code == 0, res.stderr
