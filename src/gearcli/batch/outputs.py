@@ -16,7 +16,7 @@ from pathlib import Path
 from rich.table import Table
 from rich.text import Text
 
-from ..io.output import atomic_output
+from ..io.output import write_text
 
 WARN_MARGIN = 10.0
 """%: a passing check with less margin is flagged (and plotted with ``--plots``)."""
@@ -87,8 +87,7 @@ def write_junit(rows: list[Row], path, suite: str) -> None:
             else:
                 ET.SubElement(tc, "failure", message=text, type="DesignCheckFailed").text = text
     ET.indent(root)
-    with atomic_output(path) as f:
-        f.write('<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n")
+    write_text(path, '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n")
 
 
 def _num(x: float):
@@ -100,9 +99,7 @@ def write_json(rows: list[Row], path, manifest: str) -> None:
            "checks": [{"case": r.case, "component": r.component, "quantity": r.quantity, "value": _num(r.value),
                        "limit": r.limit, "unit": r.unit, "margin_pct": _num(r.margin), "passed": r.passed,
                        "trajectory": r.trajectory, "time": _num(r.time)} for r in rows]}
-    with atomic_output(path) as f:
-        json.dump(doc, f, indent=2)
-        f.write("\n")
+    write_text(path, json.dumps(doc, indent=2) + "\n")
 
 
 def markdown(rows: list[Row], manifest: str) -> str:
@@ -120,5 +117,4 @@ def markdown(rows: list[Row], manifest: str) -> str:
 
 
 def write_markdown(rows: list[Row], path, manifest: str) -> None:
-    with atomic_output(path) as f:
-        f.write(markdown(rows, manifest))
+    write_text(path, markdown(rows, manifest))

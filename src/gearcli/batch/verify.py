@@ -5,6 +5,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..io.output import output_target
 from ..report.plots import plot_check
 from .manifest import load_manifest
 from .outputs import WARN_MARGIN, rows_of, write_json, write_junit, write_markdown
@@ -37,6 +38,7 @@ def run_verify(manifest_path, *, jobs: int | None = None, dask_address: str | No
     """Run a manifest (already loaded with :func:`load_manifest` when ``manifest`` is given)
     and write the requested reports; ``progress(total=..)`` once, then ``progress()`` per job."""
     manifest = manifest or load_manifest(manifest_path)
+    check_outputs(manifest, junit, json_path, markdown_path)
     results = run_manifest(manifest, jobs=jobs, dask_address=dask_address, progress=progress)
     rows = rows_of(results)
     suite = manifest.name
@@ -48,6 +50,14 @@ def run_verify(manifest_path, *, jobs: int | None = None, dask_address: str | No
         write_markdown(rows, markdown_path, str(manifest_path))
     plots = write_plots(results, Path(plots_dir)) if plots_dir else []
     return VerifyOutcome(rows, results, plots)
+
+
+def check_outputs(manifest, *paths) -> None:
+    """Refuse, before any work, report paths that cannot be written or name an input file."""
+    inputs = [manifest.path] + [p for c in manifest.cases for p in (c.mechanism, *c.trajectories)]
+    for p in paths:
+        if p is not None:
+            output_target(p, inputs)
 
 
 def _slug(text: str) -> str:

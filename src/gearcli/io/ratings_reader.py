@@ -155,6 +155,7 @@ def attach_urdf_ratings(mech: Mechanism, root, file: str) -> Mechanism:
     """``mech`` (read from the URDF ``root``) with joint limits and gearcli rating elements."""
     issues: list[Issue] = []
     warnings = list(mech.warnings)
+    lines = dict(mech.lines)   # rating paths -> element lines, for checks made later
 
     def adder(el):
         return lambda path, msg: issues.append(Issue(file, path, el.sourceline, msg))
@@ -167,6 +168,7 @@ def attach_urdf_ratings(mech: Mechanism, root, file: str) -> Mechanism:
         name, path = el.get("name"), f"joint '{el.get('name')}'"
         specs = []
         for i, b in enumerate(_ext(el, "bearing")):
+            lines[f"{path}.gearcli:bearing[{i}]"] = b.sourceline
             specs.append(_urdf_spec(b, BEARING_KEYS, ("name", "position", "C", "C0", "type"),
                                     f"{path}.gearcli:bearing[{i}]", adder(b)))
         if name not in joints:
@@ -188,6 +190,7 @@ def attach_urdf_ratings(mech: Mechanism, root, file: str) -> Mechanism:
                                                  "load_sharing_factor")]
         for el in _ext(root, f"{kind}_rating"):
             path = f"gearcli:{kind}_rating '{el.get(kind)}'"
+            lines[path] = el.sourceline
             spec = _urdf_spec(el, (kind, *keys), (kind, *required), path, adder(el))
             if spec is None:
                 continue
@@ -200,4 +203,4 @@ def attach_urdf_ratings(mech: Mechanism, root, file: str) -> Mechanism:
     if issues:
         raise MechanismError(issues)
     return replace(mech, joints=tuple(joints.values()), motors=tuple(motors.values()),
-                   gears=tuple(gears.values()), warnings=tuple(warnings))
+                   gears=tuple(gears.values()), warnings=tuple(warnings), lines=lines)

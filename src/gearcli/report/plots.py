@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import GearcliError
-from ..io.output import atomic_output
+from ..io.output import atomic_output, output_target
 from .columns import column_unit
 
 FORMATS = (".png", ".svg", ".pdf")
@@ -136,6 +136,7 @@ def _is_float(text: str) -> bool:
 def plot_loads_csv(path, patterns: list[str], out) -> int:
     """Plot the columns of a loads CSV matching ``patterns`` into ``out``; returns their count."""
     out = check_output_path(out)
+    output_target(out, [path])
     header, data = read_loads_csv(path)
     names = select_columns(header, patterns, str(path))
     series = {n: data[:, header.index(n)] for n in names}

@@ -1,0 +1,231 @@
+"""`gearcli verify`: verdicts against hand statics, exit codes, reports, batch execution."""
+import json
+import math
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+DESIGNS = ROOT / "designs"
+
+# A rotor: one link on a vertical axis (joint J, z up), centre of mass at (r, 0, h) in the
+# joint frame, turning at a constant rate w.  By hand (Newton-Euler, principal axes along the
+# joint frame, no angular acceleration): the reaction on the rotor is F = m (a - g) with
+# a = -w^2 r e_x, i.e. F = (-m w^2 r, 0, m g); its moment about the joint origin is
+# c x F = (0, -m r (h w^2 + g), 0).  The radial resultant m w^2 r therefore acts at the
+# height z* = h + g / w^2, and two bearings at 0 and L share it by the lever rule.
+M, R, H, W, G, T = 2.0, 0.05, 0.03, 10.0, 9.81, 2.0
+L = 0.1
+
+
+def rotor_yaml(bearings: str) -> str:
+    return f"""
+name: rotor
+base: "0"
+end_effector: "1"
+links:
+  - name: "0"
+  - {{name: "1", mass: {M}, com: [{R}, 0, {H}], inertia: [0.01, 0.01, 0.02]}}
+joints:
+  - name: J
+    parent: "0"
+    child: "1"
+    origin: {{xyz: [0, 0, 0]}}
+    bearings: {bearings}
+motors:
+  - {{name: m, link: "1", rating: {{peak_torque: 1, rms_torque: 0.5, max_speed: 20}}}}
+"""
+
+
+def write_rotor_case(tmp_path, bearings, life=1000.0, name="rotor"):
+    (tmp_path / f"{name}.yaml").write_text(rotor_yaml(bearings))
+    t = np.linspace(0, T, 401)
+    np.savetxt(tmp_path / f"{name}.csv", np.column_stack([t, W * t, np.full_like(t, W), 0 * t]),
+               delimiter=",", header="t,q:J,qd:J,qdd:J", comments="")
+    return (f"  - {{name: {name}, mechanism: {name}.yaml, trajectories: [{name}.csv], cycles_per_hour: {3600 / T},"
+            f" bearing_life_h: {life}, min_static_safety: 1.5}}\n")
+
+
+def run_json(run_cli, tmp_path, manifest_text, *args):
+    man = tmp_path / "design.yaml"
+    man.write_text(manifest_text)
+    out = tmp_path / "out.json"
+    r = run_cli("verify", man, "--json", out, "-j", "1", *args)
+    return r, (json.loads(out.read_text()) if out.exists() else None)
+
+
+def by_name(doc):
+    return {(c["case"], c["component"], c["quantity"]): c for c in doc["checks"]}
+
+
+def l10h_closed_form(C, P):
+    # constant load and speed: L10h = (C/P)^3 1e6 / (3600 n[rev/s])
+    return (C / P) ** 3 * 1e6 / (3600 * W / (2 * math.pi))
+
+
+def test_two_bearing_rotor_life_and_static_safety_by_hand(run_cli, tmp_path):
+    case = write_rotor_case(tmp_path, f"[{{name: a, position: 0, C: 5000, C0: 2000, type: ball, locating: true}},"
+                                      f" {{name: b, position: {L}, C: 5000, C0: 2000, type: ball}}]")
+    r, doc = run_json(run_cli, tmp_path, "cases:\n" + case)
+    assert r.exit_code == 0, r.stdout + r.stderr
+    checks = by_name(doc)
+    Fr_total, Fa = M * W**2 * R, M * G
+    z_star = H + G / W**2
+    Fr_b = Fr_total * z_star / L                  # 12.81 N
+    Fr_a = abs(Fr_total * (L - z_star) / L)       # 2.81 N (the resultant acts beyond b)
+    P_a = 0.56 * Fr_a + 1.6 * Fa                  # Fa/Fr > e = 0.27: X Fr + Y Fa
+    P_b = Fr_b                                    # no axial load on the floating bearing
+    life_a = checks[("rotor", "bearing J/a", "L10 life")]["value"]
+    life_b = checks[("rotor", "bearing J/b", "L10 life")]["value"]
+    assert life_a == pytest.approx(l10h_closed_form(5000, P_a), rel=1e-6)
+    assert life_b == pytest.approx(l10h_closed_form(5000, P_b), rel=1e-6)
+    s0_a = checks[("rotor", "bearing J/a", "static safety s0")]["value"]
+    assert s0_a == pytest.approx(2000 / max(0.6 * Fr_a + 0.5 * Fa, Fr_a), rel=1e-6)
+    s0_b = checks[("rotor", "bearing J/b", "static safety s0")]["value"]
+    assert s0_b == pytest.approx(2000 / Fr_b, rel=1e-6)
+
+
+def test_single_bearing_takes_the_whole_reaction_and_its_moment(run_cli, tmp_path):
+    case = write_rotor_case(tmp_path, "[{name: x, position: 0, C: 3000, C0: 3000, type: roller, M: 1.2}]")
+    r, doc = run_json(run_cli, tmp_path, "cases:\n" + case)
+    checks = by_name(doc)
+    Fr, Fa = M * W**2 * R, M * G
+    P = 0.4 * Fr + 1.49 * Fa                           # roller defaults, Fa/Fr > e = 0.4
+    life = checks[("rotor", "bearing J/x", "L10 life")]["value"]
+    assert life == pytest.approx((3000 / P) ** (10 / 3) * 1e6 / (3600 * W / (2 * math.pi)), rel=1e-6)
+    moment = checks[("rotor", "bearing J/x", "tilting moment")]
+    assert moment["value"] == pytest.approx(M * R * (H * W**2 + G), rel=1e-9)   # 1.281 N*m
+    assert not moment["passed"] and r.exit_code == 1                              # above M = 1.2
+    assert moment["margin_pct"] == pytest.approx(100 * (1.2 - 1.281) / 1.2, rel=1e-6)
+
+
+def test_bundled_example_passes_and_writes_junit_json_markdown(run_cli, tmp_path):
+    xml, js, md = tmp_path / "r.xml", tmp_path / "r.json", tmp_path / "r.md"
+    r = run_cli("verify", DESIGNS / "ci_example.yaml", "--junit", xml, "--json", js, "--markdown", md, "-j", "1")
+    assert r.exit_code == 0, r.stdout + r.stderr
+    doc = json.loads(js.read_text())
+    assert doc["passed"] and len(doc["checks"]) > 40
+    root = ET.parse(xml).getroot()
+    cases = root.findall(".//testcase")
+    assert len(cases) == len(doc["checks"]) and not root.findall(".//failure")
+    assert int(root.get("tests")) == len(cases) and root.get("failures") == "0"
+    text = md.read_text()
+    assert "All" in text and text.count("\n|") == len(doc["checks"]) + 2
+    kinds = {c["component"].split()[0] for c in doc["checks"]}
+    assert kinds == {"motor", "bearing", "gear", "column"}
+
+
+def test_tight_manifest_exits_1_naming_the_limit_and_plots_it(run_cli, tmp_path):
+    xml, plots = tmp_path / "r.xml", tmp_path / "plots"
+    r = run_cli("verify", DESIGNS / "ci_tight.yaml", "--junit", xml, "--plots", plots, "-j", "1")
+    assert r.exit_code == 1
+    assert "FAILED wrist_motion: column motor:motor5" in r.stdout
+    failures = ET.parse(xml).getroot().findall(".//testcase/failure/..")
+    assert [f.get("name") for f in failures] == ["column motor:motor5: max abs"]
+    assert "limit 0.25" in failures[0].find("failure").get("message")
+    pngs = sorted(plots.glob("*.png"))
+    assert pngs and all(p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in pngs)
+    assert any("motor5" in p.name for p in pngs)
+
+
+def test_bad_manifest_lists_every_problem_before_running(run_cli, tmp_path):
+    (tmp_path / "bad.yaml").write_text("name: x\nbase: '0'\n")      # not a valid mechanism
+    man = tmp_path / "design.yaml"
+    man.write_text(f"""cases:
+  - mechanism: {ROOT / 'mechanisms' / 'bendix_wrist_rated.yaml'}
+    trajectories: [missing_*.csv]
+    bearing_life_h: 100
+    limits:
+      - {{column: "gear:4-1:tt", max_abs: 1}}
+  - mechanism: bad.yaml
+    trajectories: {ROOT / 'mechanisms' / 'bendix_wrist_traj.csv'}
+    speed: 3
+""")
+    xml = tmp_path / "r.xml"
+    r = run_cli("verify", man, "--junit", xml)
+    assert r.exit_code == 2
+    err = r.stderr
+    assert "cases[1]: Additional properties are not allowed ('speed' was unexpected)" in err
+    r = run_cli("verify", man.with_name("d2.yaml"))
+    assert r.exit_code == 2 and "cannot read file" in r.stderr
+    man.write_text(man.read_text().replace("    speed: 3\n", ""))
+    r = run_cli("verify", man, "--junit", xml)
+    assert r.exit_code == 2 and not xml.exists()
+    lines = r.stderr.strip().splitlines()
+    assert any("design.yaml:3: cases[0].trajectories[0]: no trajectory file matches 'missing_*.csv'" in x for x in lines)
+    assert any("cases[0].bearing_life_h: a bearing life in hours needs the duty's cycles_per_hour" in x for x in lines)
+    assert any("cases[0].limits[0].column: unknown output column 'gear:4-1:tt' (did you mean 'gear:4-1:t'?)" in x
+               for x in lines)
+    assert any(x.startswith(str(tmp_path / "bad.yaml")) for x in lines)
+    assert "Traceback" not in r.stderr
+
+
+def test_rating_problems_in_the_mechanism_file_name_their_line(run_cli, tmp_path):
+    text = (ROOT / "mechanisms" / "bendix_wrist_rated.yaml").read_text()
+    bad = text.replace("locating: true}\n      - {name: upper, position: 0.05, C: 4490",
+                       "locating: false}\n      - {name: upper, position: 0.05, C: 4490", 1)
+    path = tmp_path / "wrist.yaml"
+    path.write_text(bad)
+    r = run_cli("check", path)
+    assert r.exit_code == 2
+    line = next(i for i, x in enumerate(bad.splitlines(), 1) if "name: J1" in x) + 5
+    assert f"wrist.yaml:{line}: joints[0].bearings: with two bearings, exactly one needs 'locating: true'" in r.stderr
+    path.write_text(text.replace("rating: {module: 0.002", "rating: {module: 0.0025", 1))
+    man = tmp_path / "d.yaml"
+    man.write_text(f"cases:\n  - {{mechanism: wrist.yaml, trajectories: {ROOT / 'mechanisms' / 'bendix_wrist_traj.csv'}}}\n")
+    r = run_cli("verify", man)
+    assert r.exit_code == 2
+    assert "gears[1].rating.module: module 0.0025 m x 25 teeth / 2 = 0.03125 m disagrees with the pitch radius 0.025 m" in r.stderr
+
+
+def test_parallel_and_dask_runs_give_identical_results(run_cli, tmp_path):
+    pytest.importorskip("dask.distributed")
+    from dask.distributed import LocalCluster
+
+    case = write_rotor_case(tmp_path, "[{name: x, position: 0, C: 3000, C0: 3000, type: ball}]")
+    (tmp_path / "rotor2.csv").write_text((tmp_path / "rotor.csv").read_text())
+    wrist = ROOT / "mechanisms"
+    text = ("cases:\n" + case.replace("[rotor.csv]", "[rotor.csv, rotor2.csv]")
+            + f"  - {{name: wrist, mechanism: {wrist / 'bendix_wrist_rated.yaml'}, "
+              f"trajectories: [{wrist / 'bendix_wrist_traj.csv'}], cycles_per_hour: 100, bearing_life_h: 1000}}\n")
+    _, serial = run_json(run_cli, tmp_path, text)
+    _, pool = run_json(run_cli, tmp_path, text, "-j", "2")
+    with LocalCluster(n_workers=1, processes=False, threads_per_worker=1, dashboard_address=None) as cluster:
+        _, dask = run_json(run_cli, tmp_path, text, "--dask", cluster.scheduler_address)
+    assert serial is not None and len(serial["checks"]) > 40
+    assert pool == serial
+    assert dask == serial
+
+
+def test_plot_command_draws_matching_columns(run_cli, tmp_path):
+    loads = tmp_path / "w.csv"
+    assert run_cli("solve", ROOT / "mechanisms" / "bendix_wrist.yaml", ROOT / "mechanisms" / "bendix_wrist_traj.csv",
+                   "-o", loads).exit_code == 0
+    fig = tmp_path / "f.svg"
+    r = run_cli("plot", loads, "motor:motor?", "gear:4-1:t", "motor:*:power", "-o", fig)
+    assert r.exit_code == 0, r.stderr
+    assert "(7 columns)" in r.stdout and fig.read_text().lstrip().startswith("<?xml")
+    r = run_cli("plot", loads, "motor:nothing*", "-o", tmp_path / "g.png")
+    assert r.exit_code == 2 and "no column matches 'motor:nothing*'" in r.stderr
+    assert not (tmp_path / "g.png").exists()
+    r = run_cli("plot", loads, "t", "-o", tmp_path / "g.gif")
+    assert r.exit_code == 2 and "format" in r.stderr
+
+
+def test_readme_documents_every_manifest_key():
+    import re
+
+    from gearcli.batch.manifest import design_schema
+
+    readme = (ROOT / "README.md").read_text()
+
+    def keys(node):
+        for k, v in node.get("properties", {}).items():
+            yield k
+            yield from keys(v)
+        for v in node.get("$defs", {}).values():
+            yield from keys(v)
+    missing = sorted({k for k in keys(design_schema()) if not re.search(rf"`[^`\n]*\b{k}\b[^`\n]*`", readme)})
+    assert not missing, f"README lacks manifest keys {missing}"
