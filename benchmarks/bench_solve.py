@@ -25,10 +25,10 @@ from pathlib import Path
 
 import numpy as np
 
-from gearcli.dynamics import solve
+from gearcli import solve
 from gearcli import analyse
 from gearcli import load_mechanism
-from gearcli.trajectory import write_trajectory
+from gearcli.io.trajectory import write_trajectory
 
 ROOT = Path(__file__).resolve().parents[1]
 

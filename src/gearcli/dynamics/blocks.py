@@ -11,19 +11,22 @@ sample.  Blocks with no such frame fall back to the general (world-frame) solve.
 """
 from __future__ import annotations
 
-import itertools
 from dataclasses import dataclass
 
 import numpy as np
 
-from .kinematics import forward
-from .loads import Columns
 from ..analysis.schedule import unknown_groups
 from ..spatial import cross
+from .equations import Columns
+from .general import is_geared, mesh_names, solve_general
+from .kinematics import Kinematics, forward
+from .signs import resolve_signs, sign_patterns
 
 
-@dataclass
+@dataclass(frozen=True, eq=False)
 class BlockPlan:
+    """Precomputed solve of one block of the schedule (built once per analysis)."""
+
     links: tuple[int, ...]
     groups: list            # UnknownGroup owned by the block
     F: int | None           # frame link, None -> general solve
@@ -31,6 +34,7 @@ class BlockPlan:
     offs: np.ndarray        # column offsets of the groups
     patterns: list          # sign patterns
     Ainv: list              # inverse matrix per pattern, (n, 6*len(links))
+    names: list             # gear pair names of the signed unknowns (messages)
     C: dict                 # group position -> (C_plus (6,size), C_sep (6,size)) in F about o_F, primary side
     parent_side: dict       # group position -> True when a joint basis is its parent's (rotate by -q)
 
@@ -75,25 +79,62 @@ def _primary_side(an, g) -> int:
     return an.circuits[g.index].j
 
 
-def make_plans(an) -> list[BlockPlan]:
-    """Block plans of ``an.schedule`` (computed once per analysis)."""
-    tree = an.tree
-    groups = unknown_groups(an)
-    blocks = an.schedule
-    block_of = {L: i for i, blk in enumerate(blocks) for L in blk}
-    owned: dict[int, list] = {i: [] for i in range(len(blocks))}
+def _owned_groups(an, groups) -> dict[int, list]:
+    """Unknown groups of each block: a group belongs to the first block it acts on."""
+    block_of = {L: i for i, blk in enumerate(an.schedule) for L in blk}
+    owned: dict[int, list] = {i: [] for i in range(len(an.schedule))}
     for g in groups:
         owned[min(block_of[L] for L in g.links)].append(g)
+    return owned
+
+
+def _constant_matrices(an, blk, gs, offs, signed, to_F, cols) -> list[np.ndarray]:
+    """Inverse of the block matrix in F about o_F, for each sign pattern."""
+    Ainv = []
+    for pat in sign_patterns(len(signed)):
+        sig = dict(zip(signed, pat))
+        A = np.zeros((6 * len(blk), offs[-1]))
+        for gi, g in enumerate(gs):
+            for L in g.links:
+                if L in blk:
+                    r0 = 6 * blk.index(L)
+                    A[r0:r0 + 6, offs[gi]:offs[gi + 1]] = to_F(cols.group(g, L, sig.get(gi, 1.0)), L)
+        Ainv.append(np.linalg.inv(A))
+    return Ainv
+
+
+def _propagation_columns(an, F, gs, signed, to_F, cols) -> tuple[dict, dict]:
+    """Per group: its wrench on its primary-side link in F (ut part, us part) and whether a
+    joint's basis is its parent's (the solution is then rotated by -q to the child's)."""
+    C, parent_side = {}, {}
+    for gi, g in enumerate(gs):
+        P = _primary_side(an, g)
+        if gi in signed:
+            cp, cm = to_F(cols.group(g, P, 1.0), P), to_F(cols.group(g, P, -1.0), P)
+            C[gi] = ((cp + cm) / 2, (cp - cm) / 2)
+        else:
+            C[gi] = (to_F(cols.group(g, P, 1.0), P), None)
+        if g.kind == "joint":
+            jt = an.mech.joints[g.index]
+            parent_side[gi] = jt.type != "prismatic" and F != an.tree.index[jt.child]
+    return C, parent_side
+
+
+def make_plans(an) -> tuple[BlockPlan, ...]:
+    """Block plans of ``an.schedule`` (computed once per analysis, owned by the solver)."""
+    tree = an.tree
+    owned = _owned_groups(an, unknown_groups(an))
     home = forward(an.mech, tree, np.zeros((1, len(an.mech.joints))))
     cols = Columns(an, home)
     plans = []
-    for bi, blk in enumerate(blocks):
+    for bi, blk in enumerate(an.schedule):
         gs = owned[bi]
         offs = np.cumsum([0] + [g.size for g in gs])
-        signed = [i for i, g in enumerate(gs) if g.kind == "mesh" and an.circuits[g.index].geometry is not None]
+        signed = [i for i, g in enumerate(gs) if is_geared(an, g)]
+        names = mesh_names(an, gs, signed)
         common = set.intersection(*[_fixed_in(an, g) for g in gs]) if gs else set()
         if not common or offs[-1] != 6 * len(blk):
-            plans.append(BlockPlan(tuple(blk), gs, None, signed, offs, [], [], {}, {}))
+            plans.append(BlockPlan(tuple(blk), gs, None, signed, offs, [], [], names, {}, {}))
             continue
         F = min(common, key=lambda x: (x != tree.base, x))  # prefer the base: no rotation
         RF, oF = home.R[F][0], home.o[F][0]
@@ -104,39 +145,11 @@ def make_plans(an) -> list[BlockPlan]:
             f, m = col[:3], col[3:] + np.cross(home.o[L][0] - oF, col[:3], axis=0)
             return np.vstack([RF.T @ f, RF.T @ m])
 
-        patterns = list(itertools.product((1.0, -1.0), repeat=len(signed)))
-        Ainv = []
-        for pat in patterns:
-            sig = dict(zip(signed, pat))
-            A = np.zeros((6 * len(blk), offs[-1]))
-            for gi, g in enumerate(gs):
-                for L in g.links:
-                    if L in blk:
-                        r0 = 6 * blk.index(L)
-                        A[r0:r0 + 6, offs[gi]:offs[gi + 1]] = to_F(cols.group(g, L, sig.get(gi, 1.0)), L)
-            Ainv.append(np.linalg.inv(A))
-        C, parent_side = {}, {}
-        for gi, g in enumerate(gs):
-            P = _primary_side(an, g)
-            if g.kind == "mesh" and gi in signed:
-                cp = to_F(cols.group(g, P, 1.0), P)
-                cm = to_F(cols.group(g, P, -1.0), P)
-                C[gi] = ((cp + cm) / 2, (cp - cm) / 2)   # ut part, us part
-            else:
-                C[gi] = (to_F(cols.group(g, P, 1.0), P), None)
-            if g.kind == "joint":
-                jt = an.mech.joints[g.index]
-                parent_side[gi] = jt.type != "prismatic" and F != tree.index[jt.child]
-        plans.append(BlockPlan(tuple(blk), gs, F, signed, offs, patterns, Ainv, C, parent_side))
-    return plans
-
-
-def plans_of(an) -> list[BlockPlan]:
-    plans = an.__dict__.get("_plans")
-    if plans is None:
-        plans = make_plans(an)
-        object.__setattr__(an, "_plans", plans)
-    return plans
+        Ainv = _constant_matrices(an, blk, gs, offs, signed, to_F, cols)
+        C, parent_side = _propagation_columns(an, F, gs, signed, to_F, cols)
+        plans.append(BlockPlan(tuple(blk), gs, F, signed, offs, sign_patterns(len(signed)), Ainv, names,
+                               C, parent_side))
+    return tuple(plans)
 
 
 def _rotate(R, w6, transpose=False):
@@ -162,72 +175,77 @@ def _subtract(acc, sign, w6, o_from, o_to):
         acc[:, 3:] += cross(o_from - o_to, w6[:, :3])
 
 
-def solve_blocks(an, kin, b, q_all, general):
-    """Block-by-block solve.  ``general(groups, links, rhs)`` solves a block without a
-    constant frame.  Returns x_all (post-rotation joint bases) and the mesh signs."""
-    tree = an.tree
-    plans = plans_of(an)
+def _general_block(an, p: BlockPlan, cols: Columns, rhs: dict, later: dict, x_all: dict, sig_all: dict):
+    """Solve a block without a constant frame (world frame) and pass its loads on."""
+    R = np.concatenate([rhs[L] for L in p.links], axis=1)
+    x, sig = solve_general(an, cols, p.groups, list(p.links), R)
+    sig_all.update(sig)
+    for gi, g in enumerate(p.groups):
+        xg = x[:, p.offs[gi]:p.offs[gi + 1]]
+        x_all[(g.kind, g.index)] = xg
+        for L in later[gi]:
+            C = cols.group(g, L, sig.get((g.kind, g.index), 1.0))
+            rhs[L] -= np.einsum("nij,nj->ni", C, xg)
+
+
+def _constant_block(an, p: BlockPlan, kin: Kinematics, rhs: dict):
+    """Solve a block in its constant frame F: x (N, n), signs (N, m), r (N, 6B) in F."""
+    at_rest = p.F == an.tree.base        # F = base: world axes about the origin already
+    RF, oF = kin.R[p.F], kin.o[p.F]
+    parts = []
+    for L in p.links:
+        w = _shift(rhs[L], kin.o[L], oF) if L != p.F else rhs[L]
+        parts.append(w if at_rest else _rotate(RF, w, transpose=True))
+    r = np.concatenate(parts, axis=1) if len(parts) > 1 else parts[0]   # (N, 6B) in F about o_F
+    N = r.shape[0]
+    if not p.signed:
+        return r @ p.Ainv[0].T, np.zeros((N, 0))
+
+    def solve_pattern(k, idx):
+        return (r if idx.size == N else r[idx]) @ p.Ainv[k].T
+
+    scale = 1.0 + np.abs(r).max(axis=1)
+    return resolve_signs(solve_pattern, len(p.signed), [int(p.offs[gi]) for gi in p.signed], N, scale, p.names)
+
+
+def _child_basis(x: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """A revolute joint's reaction (N, 5) from its parent's basis to its child's (turn by -q)."""
+    c, s = np.cos(q), np.sin(q)
+    out = x.copy()
+    out[:, 0], out[:, 1] = c * x[:, 0] + s * x[:, 1], -s * x[:, 0] + c * x[:, 1]
+    out[:, 3], out[:, 4] = c * x[:, 3] + s * x[:, 4], -s * x[:, 3] + c * x[:, 4]
+    return out
+
+
+def solve_blocks(an, plans, kin: Kinematics, b: dict, q_all: np.ndarray):
+    """Block-by-block solve in schedule order (highest level first).
+
+    ``b`` are the d'Alembert loads (:func:`~.inertia.inertia_load`), ``q_all`` (N, J) every
+    real joint's coordinate.  Returns ({(kind, index): (N, size)} unknowns, joint reactions
+    in their child's basis; {(kind, index): (N,) sign of t}).
+    """
     block_of = {L: i for i, p in enumerate(plans) for L in p.links}
-    rhs = {L: b[L].copy() for L in tree.moving}
+    rhs = {L: b[L].copy() for L in an.tree.moving}
     x_all, sig_all = {}, {}
     cols = None
     for bi, p in enumerate(plans):
+        later = {gi: [L for L in g.links if block_of[L] > bi] for gi, g in enumerate(p.groups)}
         if p.F is None:
-            if cols is None:
-                cols = Columns(an, kin)
-            R = np.concatenate([rhs[L] for L in p.links], axis=1)
-            x, sig = general(p.groups, list(p.links), R)
-            sig_all.update(sig)
-            for gi, g in enumerate(p.groups):
-                xg = x[:, p.offs[gi]:p.offs[gi + 1]]
-                x_all[(g.kind, g.index)] = xg
-                for L in g.links:
-                    if block_of[L] > bi:
-                        C = cols.group(g, L, sig.get((g.kind, g.index), 1.0))
-                        rhs[L] -= np.einsum("nij,nj->ni", C, xg)
+            cols = cols if cols is not None else Columns(an, kin)
+            _general_block(an, p, cols, rhs, later, x_all, sig_all)
             continue
-        at_rest = p.F == tree.base        # F = base: world axes about the origin already
-        RF, oF = kin.R[p.F], kin.o[p.F]
-        parts = []
-        for L in p.links:
-            w = _shift(rhs[L], kin.o[L], oF) if L != p.F else rhs[L]
-            parts.append(w if at_rest else _rotate(RF, w, transpose=True))
-        r = np.concatenate(parts, axis=1) if len(parts) > 1 else parts[0]   # (N, 6B) in F about o_F
-        N = r.shape[0]
-        if p.signed:
-            # the first sign pattern consistent with its own solution (tolerance for t ~ 0),
-            # else the least inconsistent one
-            xs = [r @ Ai.T for Ai in p.Ainv]
-            tol = 1e-12 * (1.0 + np.abs(r).max(axis=1))
-            viol = np.stack([np.max([-s * xk[:, p.offs[gi]] for gi, s in zip(p.signed, pat)], axis=0)
-                             for pat, xk in zip(p.patterns, xs)], axis=1)        # (N, patterns)
-            ok = viol <= tol[:, None]
-            pick = np.where(ok.any(axis=1), np.argmax(ok, axis=1), np.argmin(viol, axis=1))
-            x = np.choose(pick[:, None], xs) if len(xs) < 32 else np.stack(xs)[pick, np.arange(N)]
-            pat_arr = np.array(p.patterns)[pick]                       # (N, m)
-        else:
-            x = r @ p.Ainv[0].T
-        # contributions of solved unknowns to later links, and results
+        x, signs = _constant_block(an, p, kin, rhs)
+        at_rest = p.F == an.tree.base
         for gi, g in enumerate(p.groups):
             xg = x[:, p.offs[gi]:p.offs[gi + 1]]
-            key = (g.kind, g.index)
-            Cp, Cs = p.C[gi]
-            later = [L for L in g.links if block_of[L] > bi]
-            if later:
-                wF = xg @ Cp.T
-                if Cs is not None:
-                    wF = wF + np.abs(xg) @ Cs.T
-                w = wF if at_rest else _rotate(RF, wF)                  # world axes, about o_F
+            if later[gi]:
+                Cp, Cs = p.C[gi]
+                wF = xg @ Cp.T if Cs is None else xg @ Cp.T + np.abs(xg) @ Cs.T
+                w = wF if at_rest else _rotate(kin.R[p.F], wF)           # world axes, about o_F
                 P = _primary_side(an, g)
-                for L in later:
-                    _subtract(rhs[L], 1.0 if L == P else -1.0, w, oF, kin.o[L])
+                for L in later[gi]:
+                    _subtract(rhs[L], 1.0 if L == P else -1.0, w, kin.o[p.F], kin.o[L])
             if gi in p.signed:
-                sig_all[key] = pat_arr[:, p.signed.index(gi)]
-            if p.parent_side.get(gi):
-                qj = q_all[:, g.index]
-                c, s = np.cos(qj), np.sin(qj)
-                xg = xg.copy()
-                xg[:, 0], xg[:, 1] = c * x[:, p.offs[gi]] + s * x[:, p.offs[gi] + 1], -s * x[:, p.offs[gi]] + c * x[:, p.offs[gi] + 1]
-                xg[:, 3], xg[:, 4] = c * x[:, p.offs[gi] + 3] + s * x[:, p.offs[gi] + 4], -s * x[:, p.offs[gi] + 3] + c * x[:, p.offs[gi] + 4]
-            x_all[key] = xg
+                sig_all[(g.kind, g.index)] = signs[:, p.signed.index(gi)]
+            x_all[(g.kind, g.index)] = _child_basis(xg, q_all[:, g.index]) if p.parent_side.get(gi) else xg
     return x_all, sig_all

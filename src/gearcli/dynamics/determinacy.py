@@ -6,7 +6,7 @@ import numpy as np
 from ..analysis.schedule import unknown_groups
 from ..errors import Collector
 from .kinematics import forward
-from .loads import Columns
+from .equations import Columns
 
 _RTOL = 1e-10
 

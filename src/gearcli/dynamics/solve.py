@@ -6,23 +6,30 @@ motor torques, the reaction wrench of every real joint and the contact force of 
 mesh at every sample.
 
 Method ``"block"`` (default) solves the Newton-Euler equations block by block in the
-schedule of :mod:`gearcli.schedule` (highest level first, one link or a few coupled levels
-at a time).  Method ``"full"`` assembles all 6 x (moving links) equations and solves them
-simultaneously; it exists to cross-check the schedule.  Both are exact: the |t| of the
-separating tooth force (Eq. 14) makes the equations piecewise linear, and each sample is
-solved with the sign pattern of the tangential forces that is consistent with its solution.
+schedule of :mod:`gearcli.analysis.schedule` (highest level first, one link or a few coupled
+levels at a time; :mod:`.blocks`).  Method ``"full"`` assembles all 6 x (moving links)
+equations and solves them simultaneously (:mod:`.general`); it exists to cross-check the
+schedule.  Both are exact: the |t| of the separating tooth force (Eq. 14) makes the
+equations piecewise linear, and each sample is solved with the sign pattern of the
+tangential forces that is consistent with its own solution (:mod:`.signs`).
+
+Model/Data split: the :class:`~gearcli.analysis.graph.Analysis` is never modified; the
+precomputed block plans live in a :class:`Solver`, built once per analysis.
 """
 from __future__ import annotations
 
-import itertools
-from dataclasses import dataclass, field
+import weakref
+from dataclasses import dataclass
 
 import numpy as np
 
-from .kinematics import forward
-from .blocks import solve_blocks
-from .loads import Columns, inertia_load
 from ..analysis.schedule import unknown_groups
+from .blocks import make_plans, solve_blocks
+from .equations import Columns
+from .general import is_geared, solve_full
+from .inertia import inertia_load
+from .kinematics import forward
+from .signs import SignError, sign_violation
 
 DEFAULT_CHUNK = 20_000
 
@@ -42,11 +49,11 @@ class Result:
     ``gear_t`` (N, G): tangential tooth force on gear j by gear k, N, positive when it turns
     j in j's positive sense (for an ideal coupling: the mesh torque on j, N*m).
     ``gear_sep`` (N, G): separating force magnitude |t| tan(phi), N.
-    ``motor_speed`` (N, M): speed of each motor's input rotation, A^T qd (rad/s; m/s for a
-    prismatic input).
     ``gear_radial``, ``gear_axial`` (N, G, 2): components of the tooth force on gear j and on
     gear k along each gear's own outward radial direction (towards the pitch point) and its
     positive axis, N.
+    ``residual``: with ``verify``, the worst relative Newton-Euler residual of any link and
+    sample, and of the sign of every t against the sign pattern used (else None).
     """
 
     motor: np.ndarray
@@ -57,7 +64,6 @@ class Result:
     gear_radial: np.ndarray
     gear_axial: np.ndarray
     residual: float | None = None
-    meta: dict = field(default_factory=dict)
     motor_speed: np.ndarray | None = None   # (N, M) motor speeds A^T qd, rad/s (m/s linear)
 
 
@@ -84,197 +90,110 @@ def _check_shapes(an, *arrays):
     return out
 
 
-def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, verify: bool = False,
-          progress=None) -> Result:
+class Solver:
+    """Inverse dynamics of one analysed mechanism: owns the precomputed block plans.
+
+    ``Solver(an).solve(q, qd, qdd)``; :func:`solve` keeps one per analysis.
+    """
+
+    def __init__(self, an):
+        self.an = an
+        self.groups = unknown_groups(an)
+        self.plans = make_plans(an)
+
+    def solve(self, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK,
+              verify: bool = False) -> Result:
+        """See :func:`solve`."""
+        q, qd, qdd = _check_shapes(self.an, q, qd, qdd)
+        if method not in ("block", "full"):
+            raise ValueError(f"unknown method '{method}' (expected 'block' or 'full')")
+        parts = []
+        for s in range(0, q.shape[0], chunk):
+            sl = slice(s, s + chunk)
+            try:
+                parts.append(self._chunk(q[sl], qd[sl], qdd[sl], method, verify))
+            except SignError as exc:
+                raise SignError(exc.sample + s, exc.meshes) from None
+        if len(parts) == 1:
+            res = parts[0]
+        else:
+            res = Result(*(np.concatenate([getattr(p, f) for p in parts]) for f in
+                           ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial")))
+            res.residual = max(p.residual for p in parts) if verify else None
+        res.motor_speed = qd @ self.an.A
+        return res
+
+    def _chunk(self, q_ind, qd_ind, qdd_ind, method, verify) -> Result:
+        an = self.an
+        q, qd, qdd = joint_space(an, q_ind, qd_ind, qdd_ind)
+        kin = forward(an.mech, an.tree, q, qd, qdd)
+        b = inertia_load(an, kin)
+        cols = Columns(an, kin) if (method == "full" or verify) else None
+        if method == "block":
+            x, sig = solve_blocks(an, self.plans, kin, b, q)
+        else:
+            x, sig = solve_full(an, cols, b)
+        res = _result(an, self.groups, x)
+        if verify:
+            res.residual = residual(an, self.groups, cols, b, x, sig)
+        return res
+
+
+_SOLVERS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def solver_for(an) -> Solver:
+    """The :class:`Solver` of ``an`` (built on first use, kept while ``an`` lives)."""
+    sol = _SOLVERS.get(an)
+    if sol is None:
+        sol = _SOLVERS[an] = Solver(an)
+    return sol
+
+
+def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, verify: bool = False) -> Result:
     """Inverse dynamics along a trajectory.
 
     Parameters
     ----------
     an : Analysis
-        From :func:`gearcli.graph.analyse`.
+        From :func:`gearcli.analyse`.
     q, qd, qdd : array_like, shape (N, dof) or (dof,)
         Independent joint angles (rad), rates (rad/s) and accelerations (rad/s^2), in the
-        order of ``an.independent_names``.
+        order of ``an.independent_names`` (m, m/s, m/s^2 for a prismatic joint).
     method : {"block", "full"}
         Block schedule (default) or one simultaneous solve of all equations.
     chunk : int
         Samples processed at once (bounds memory).
     verify : bool
         Also compute the worst Newton-Euler residual of any link (``Result.residual``,
-        relative to the largest load of the sample).
-    progress : callable(int), optional
-        Called with the number of samples done after each chunk.
+        relative to the largest load of the sample) and check the sign of every t.
+
+    Raises
+    ------
+    SignError
+        when no sign pattern of the tooth forces is consistent at some sample (named).
     """
-    q, qd, qdd = _check_shapes(an, q, qd, qdd)
-    if method not in ("block", "full"):
-        raise ValueError(f"unknown method '{method}' (expected 'block' or 'full')")
-    parts = []
-    worst = 0.0
-    for s in range(0, q.shape[0], chunk):
-        sl = slice(s, s + chunk)
-        r = _solve_chunk(an, q[sl], qd[sl], qdd[sl], method, verify)
-        parts.append(r)
-        if verify:
-            worst = max(worst, r.residual)
-        if progress is not None:
-            progress(min(chunk, q.shape[0] - s))
-    if len(parts) == 1:
-        res = parts[0]
-    else:
-        res = Result(*(np.concatenate([getattr(p, f) for p in parts]) for f in
-                       ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial")))
-    res.residual = worst if verify else None
-    res.motor_speed = qd @ an.A
-    return res
-
-
-def _solve_chunk(an, q_ind, qd_ind, qdd_ind, method, verify) -> Result:
-    q, qd, qdd = joint_space(an, q_ind, qd_ind, qdd_ind)
-    kin = forward(an.mech, an.tree, q, qd, qdd)
-    b = inertia_load(an, kin)
-    cols = Columns(an, kin) if (method == "full" or verify) else _LazyColumns(an, kin)
-    groups = unknown_groups(an)
-    if method == "block":
-        def general(gs, links, rhs):
-            return _solve_signed(an, gs, cols, links, rhs)
-        x, sig = solve_blocks(an, kin, b, q, general)
-    else:
-        x, sig = _full_solve(an, groups, cols, b)
-    res = _result(an, groups, x)
-    if verify:
-        res.residual = residual(an, groups, cols, b, x, sig)
-    return res
-
-
-class _LazyColumns:
-    """Columns built on first use (the fast block path rarely needs them)."""
-
-    def __init__(self, an, kin):
-        self.an, self.kin, self._c = an, kin, None
-
-    def __getattr__(self, name):
-        if self._c is None:
-            self._c = Columns(self.an, self.kin)
-        return getattr(self._c, name)
-
-
-def _key(g):
-    return (g.kind, g.index)
-
-
-def _is_signed(an, g) -> bool:
-    return g.kind == "mesh" and an.circuits[g.index].geometry is not None
-
-
-def _assemble(an, groups, cols, links, sig):
-    """Matrix (N, 6*len(links), n) of ``groups`` on ``links``; sig[key] gives mesh signs."""
-    N = cols.kin.n
-    pos = {L: i for i, L in enumerate(links)}
-    n = sum(g.size for g in groups)
-    A = np.zeros((N, 6 * len(links), n))
-    c0 = 0
-    for g in groups:
-        for L in g.links:
-            if L in pos:
-                r0 = 6 * pos[L]
-                A[:, r0:r0 + 6, c0:c0 + g.size] = cols.group(g, L, sig.get(_key(g), 1.0))
-        c0 += g.size
-    return A
-
-
-def _solve_signed(an, groups, cols, links, rhs):
-    """Solve A(sigma) x = rhs over ``links`` exactly: for each sample, a sign pattern of the
-    tangential tooth forces that agrees with the solution.  Returns x (N, n) and signs."""
-    N = rhs.shape[0]
-    signed = [i for i, g in enumerate(groups) if _is_signed(an, g)]
-    offs = np.cumsum([0] + [g.size for g in groups])
-    n = offs[-1]
-    x = np.zeros((N, n))
-    sig = {_key(groups[i]): np.ones(N) for i in signed}
-    todo = np.arange(N)
-    patterns = list(itertools.product((1.0, -1.0), repeat=len(signed)))
-    scale = 1.0 + np.max(np.abs(rhs), axis=1)
-    best_err = np.full(N, np.inf)
-    for pat in patterns:
-        if todo.size == 0:
-            break
-        s = {_key(groups[i]): np.full(todo.size, p) for i, p in zip(signed, pat)}
-        sub = _SubCols(cols, todo)
-        A = _assemble(an, groups, sub, links, s)
-        xs = np.linalg.solve(A, rhs[todo][:, :, None])[:, :, 0]
-        viol = np.zeros(todo.size)
-        for i, p in zip(signed, pat):
-            viol = np.maximum(viol, -p * xs[:, offs[i]])
-        better = viol < best_err[todo]
-        idx = todo[better]
-        x[idx] = xs[better]
-        best_err[idx] = viol[better]
-        for i, p in zip(signed, pat):
-            sig[_key(groups[i])][idx] = p
-        ok = viol <= 1e-12 * scale[todo]
-        todo = todo[~ok]
-    return x, sig
-
-
-class _SubCols:
-    """Columns restricted to a subset of samples."""
-
-    def __init__(self, cols: Columns, idx):
-        self.cols, self.idx = cols, idx
-        self.kin = _SubKin(cols.kin, idx)
-
-    def group(self, g, L, sigma=1.0):
-        if g.kind == "mesh":
-            c = self.cols.an.circuits[g.index]
-            if c.geometry is not None:
-                full = np.ones(self.cols.kin.n)
-                full[self.idx] = sigma
-                return self.cols.mesh(g.index, L, full)[self.idx]
-        return self.cols.group(g, L, sigma)[self.idx]
-
-
-class _SubKin:
-    def __init__(self, kin, idx):
-        self.n = len(idx)
-
-
-def _full_solve(an, groups, cols, b):
-    links = list(an.tree.moving)
-    R = np.concatenate([b[L] for L in links], axis=1)
-    N = R.shape[0]
-    offs = np.cumsum([0] + [g.size for g in groups])
-    signed = [i for i, g in enumerate(groups) if _is_signed(an, g)]
-    sig = {_key(groups[i]): np.ones(N) for i in signed}
-    x = np.zeros((N, offs[-1]))
-    todo = np.arange(N)
-    for _ in range(len(signed) + 2):
-        sub = _SubCols(cols, todo)
-        A = _assemble(an, groups, sub, links, {k: v[todo] for k, v in sig.items()})
-        x[todo] = np.linalg.solve(A, R[todo][:, :, None])[:, :, 0]
-        changed = np.zeros(todo.size, bool)
-        for i in signed:
-            k = _key(groups[i])
-            new = np.where(x[todo, offs[i]] < 0, -1.0, 1.0)
-            changed |= new != sig[k][todo]
-            sig[k][todo] = new
-        todo = todo[changed]
-        if todo.size == 0:
-            break
-    x_all = {_key(g): x[:, offs[i]:offs[i + 1]] for i, g in enumerate(groups)}
-    return x_all, sig
+    return solver_for(an).solve(q, qd, qdd, method=method, chunk=chunk, verify=verify)
 
 
 def residual(an, groups, cols, b, x_all, sig) -> float:
-    """Worst relative Newton-Euler residual over links and samples."""
+    """Worst relative Newton-Euler residual over links and samples, and worst relative
+    disagreement of a solved t with the sign used for its separating force."""
     worst = 0.0
     for L in an.tree.moving:
         tot = -b[L]
         for g in groups:
             if L in g.links:
-                C = cols.group(g, L, sig.get(_key(g), 1.0))
-                tot = tot + np.einsum("nij,nj->ni", C, x_all[_key(g)])
+                C = cols.group(g, L, sig.get((g.kind, g.index), 1.0))
+                tot = tot + np.einsum("nij,nj->ni", C, x_all[(g.kind, g.index)])
         scale = 1.0 + np.max(np.abs(b[L]), axis=1)
         worst = max(worst, float(np.max(np.abs(tot).max(axis=1) / scale)))
+    signed = [(g.kind, g.index) for g in groups if is_geared(an, g)]
+    if signed:
+        t = np.column_stack([x_all[k][:, 0] for k in signed])
+        signs = np.column_stack([np.broadcast_to(sig.get(k, 1.0), t.shape[:1]) for k in signed])
+        scale = 1.0 + np.max(np.abs(np.concatenate([b[L] for L in an.tree.moving], axis=1)), axis=1)
+        worst = max(worst, sign_violation(t, signs, scale))
     return worst
 
 

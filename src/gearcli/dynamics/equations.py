@@ -1,11 +1,17 @@
-"""Wrench columns of the unknown loads, and the inertia (d'Alembert) load of every link.
+"""Left-hand sides of the Newton-Euler balance equations: the wrench columns of the unknowns.
 
-Newton-Euler equations of link L are written in the base frame about the link origin o_L:
+The balance of a primary link i (paper Eqs. 15-16) and of a secondary link j (Eqs. 19-20)
+are one equation written for every moving link L, in the base frame about the link origin
+o_L (the paper writes the moments about the centre of mass; the two forms are equivalent)::
 
-    sum over unknowns u of  C_u,L x_u  =  b_L,      b_L = [F*_L - m g ; N*_L + r_c x (F*_L - m g)]
+    sum over unknowns u acting on L of  C_u,L x_u  =  b_L
 
-with F* = m a_c and N* = I dw + w x (I w) (paper Eqs. 17-18, centre of mass anywhere, full
-inertia tensor).  ``C_u,L`` (N, 6, size) is the wrench on L per unit of unknown u:
+with the d'Alembert load b_L of :mod:`gearcli.dynamics.inertia` (Eqs. 17-18) on the right.
+The unknowns of link L are the reactions of its joints (f, n of Eqs. 15-16 and 19-20, on the
+real joints, which is the documented equivalent of the canonical-to-real conversion of
+Eqs. 23-24), the tangential tooth forces t of its gear meshes (Eq. 14) and the torques of
+the motors acting on it.  :meth:`Columns.balance` assembles the columns of one link;
+``C_u,L`` (N, 6, size) is the wrench on L per unit of unknown u:
 
 * joint (revolute): forces along x, y, z and moments about x, y of the joint frame, at the
   joint origin, on the child (+) by the parent; the parent receives the opposite wrench;
@@ -25,30 +31,24 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..spatial import cross, mv
 from .kinematics import Kinematics
-from ..spatial import cross, mtv, mv
 
 
-def inertia_load(an, kin: Kinematics) -> dict[int, np.ndarray]:
-    """b_L (N, 6) for every moving link (world frame, about the link origin)."""
-    mech, tree = an.mech, an.tree
-    g = mech.gravity
-    out = {}
-    for L in tree.moving:
-        link = mech.links[L]
-        R = kin.R[L]
-        w, dw = kin.w[L], kin.dw[L]
-        wb = mtv(R, w)                                         # R^T w
-        dwb = mtv(R, dw)
-        Nb = dwb @ link.inertia.T + cross(wb, wb @ link.inertia.T)
-        if np.any(link.com):
-            rc = mv(R, link.com)                               # (N,3) o_L -> centre of mass
-            a_c = kin.a[L] + cross(dw, rc) + cross(w, cross(w, rc))
-            F = link.mass * (a_c - g)
-            out[L] = np.concatenate([F, mv(R, Nb) + cross(rc, F)], axis=1)
-        else:                                                  # centre of mass at the origin
-            out[L] = np.concatenate([link.mass * (kin.a[L] - g), mv(R, Nb)], axis=1)
-    return out
+def tooth_force_direction(ut: np.ndarray, us: np.ndarray, sigma, tan_phi: float) -> np.ndarray:
+    """Tooth force on gear j per unit of tangential force t (paper Eq. 14, ERRATA 7).
+
+    g_jk = t ut + |t| tan(phi) us = t (ut + sigma tan(phi) us), sigma = sign(t).
+
+    Parameters
+    ----------
+    ut : (N, 3) unit tangential direction (turns j in j's positive sense), base frame.
+    us : (N, 3) unit separating direction on j (away from the mesh partner, perpendicular to
+        the pitch element), base frame.
+    sigma : (N,) or scalar, sign of t.
+    tan_phi : tangent of the pressure angle.
+    """
+    return ut + (np.asarray(sigma, float).reshape(-1, 1) * tan_phi) * us
 
 
 def _force_at(d: np.ndarray, point: np.ndarray, origin: np.ndarray) -> np.ndarray:
@@ -61,7 +61,10 @@ def _moment(d: np.ndarray) -> np.ndarray:
 
 
 class Columns:
-    """World-frame directions of every unknown for one chunk of samples."""
+    """Wrench columns C_u,L of every unknown u on every link L, base frame, about o_L.
+
+    Built for one chunk of samples from its :class:`~gearcli.dynamics.kinematics.Kinematics`.
+    """
 
     def __init__(self, an, kin: Kinematics):
         self.an, self.kin = an, kin
@@ -128,7 +131,7 @@ class Columns:
         o = self.kin.o[L]
         if c.geometry is not None:
             sign = 1.0 if L == c.j else -1.0
-            d = wv["ut"] + (np.asarray(sigma, float).reshape(-1, 1) * self.tan_phi[ci]) * wv["us"]
+            d = tooth_force_direction(wv["ut"], wv["us"], sigma, self.tan_phi[ci])
             return sign * _force_at(d, wv["P"], o)[:, :, None]
         col = 0.0
         if L == c.j:
@@ -140,8 +143,26 @@ class Columns:
         return col[:, :, None]
 
     def group(self, g, L: int, sigma=1.0) -> np.ndarray:
+        """(N, 6, g.size) columns of unknown group ``g`` on link L (sigma: sign of t)."""
         if g.kind == "joint":
             return self.joint(g.index, L)
         if g.kind == "motor":
             return self.motor(g.index, L)
         return self.mesh(g.index, L, sigma)
+
+    def balance(self, groups, L: int, signs: dict | None = None) -> np.ndarray:
+        """Left-hand side of link L's balance (Eqs. 15-16 primary, 19-20 secondary).
+
+        Returns the (N, 6, n) matrix whose columns are the wrenches on L of the unknowns of
+        ``groups`` (n scalars in their order; zero for a group not acting on L); ``signs``
+        maps ``(kind, index)`` of a geared mesh to sign(t), (N,) (default +1).
+        """
+        signs = signs or {}
+        n = sum(g.size for g in groups)
+        out = np.zeros((self.kin.n, 6, n))
+        c0 = 0
+        for g in groups:
+            if L in g.links:
+                out[:, :, c0:c0 + g.size] = self.group(g, L, signs.get((g.kind, g.index), 1.0))
+            c0 += g.size
+        return out
