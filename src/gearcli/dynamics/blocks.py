@@ -20,7 +20,7 @@ from ..spatial import cross
 from .equations import Columns
 from .general import is_geared, mesh_names, solve_general
 from .kinematics import Kinematics, forward
-from .signs import resolve_signs, sign_patterns
+from .signs import pattern_index, resolve_signs, sign_patterns
 
 
 @dataclass(frozen=True, eq=False)
@@ -201,8 +201,8 @@ def _constant_block(an, p: BlockPlan, kin: Kinematics, rhs: dict):
     if not p.signed:
         return r @ p.Ainv[0].T, np.zeros((N, 0))
 
-    def solve_pattern(k, idx):
-        return (r if idx.size == N else r[idx]) @ p.Ainv[k].T
+    def solve_pattern(signs, idx):
+        return (r if idx.size == N else r[idx]) @ p.Ainv[pattern_index(signs)].T
 
     scale = 1.0 + np.abs(r).max(axis=1)
     return resolve_signs(solve_pattern, len(p.signed), [int(p.offs[gi]) for gi in p.signed], N, scale, p.names)

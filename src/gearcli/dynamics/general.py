@@ -10,7 +10,7 @@ import numpy as np
 
 from ..analysis.schedule import UnknownGroup, unknown_groups
 from .equations import Columns
-from .signs import resolve_signs, sign_patterns
+from .signs import resolve_signs
 
 
 def is_geared(an, g: UnknownGroup) -> bool:
@@ -62,10 +62,7 @@ def solve_general(an, cols: Columns, groups, links, rhs: np.ndarray):
                 plus, minus = mid[:, rows, offs[i]], cols.group(groups[i], L, -1.0)[:, :, 0]
                 half[i][:, rows] = 0.5 * (plus - minus)
                 mid[:, rows, offs[i]] = 0.5 * (plus + minus)
-    patterns = sign_patterns(len(signed))
-
-    def solve_pattern(k, idx):
-        pat = patterns[k]
+    def solve_pattern(pat, idx):
         A = mid[idx]                       # (fancy indexing copies)
         if signed:
             for i, s in zip(signed, pat):

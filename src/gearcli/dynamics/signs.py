@@ -40,7 +40,15 @@ def sign_patterns(m: int) -> list[tuple[float, ...]]:
     return list(itertools.product((1.0, -1.0), repeat=m))
 
 
-def resolve_signs(solve_pattern: Callable[[int, np.ndarray], np.ndarray], m: int,
+MAX_EXHAUSTIVE = 16   # meshes in one block up to which every sign pattern may be tried
+
+
+def pattern_index(signs) -> int:
+    """Position of the sign vector ``signs`` (m,) in :func:`sign_patterns`."""
+    return int(sum(1 << (len(signs) - 1 - i) for i, s in enumerate(signs) if s < 0))
+
+
+def resolve_signs(solve_pattern: Callable[[np.ndarray, np.ndarray], np.ndarray], m: int,
                   t_cols: list[int], N: int, scale: np.ndarray,
                   mesh_names: list[str]) -> tuple[np.ndarray, np.ndarray]:
     """Solution of every sample with a sign pattern consistent with it.
@@ -48,14 +56,14 @@ def resolve_signs(solve_pattern: Callable[[int, np.ndarray], np.ndarray], m: int
     The search: start every sample with all t positive; a sample whose solution disagrees
     with its pattern retries with the signs of that solution (m + 1 rounds at most, which
     settles almost every sample at once); the samples left try every pattern in the order
-    of :func:`sign_patterns`.  A sample is accepted by the first pattern whose solution's t
-    agree with it (t of the wrong sign up to ``TOL_SIGN * scale`` counts as zero).
+    of :func:`sign_patterns` (up to ``MAX_EXHAUSTIVE`` meshes).  A sample is accepted by the
+    first pattern whose solution's t agree with it (t of the wrong sign up to
+    ``TOL_SIGN * scale`` counts as zero).
 
     Parameters
     ----------
-    solve_pattern : callable(k, idx) -> (len(idx), n)
-        Solution of the samples ``idx`` (index array) with sign pattern ``k`` of
-        :func:`sign_patterns`.
+    solve_pattern : callable(signs, idx) -> (len(idx), n)
+        Solution of the samples ``idx`` (index array) with the signs ``signs`` (m,) of t.
     m : number of geared meshes (signed unknowns).
     t_cols : the column of each signed t in the solution.
     N : number of samples.
@@ -71,40 +79,44 @@ def resolve_signs(solve_pattern: Callable[[int, np.ndarray], np.ndarray], m: int
     SignError
         naming the first sample for which no pattern is consistent.
     """
-    patterns = np.array(sign_patterns(m)).reshape(2 ** m, m)
-    weights = 2 ** np.arange(m - 1, -1, -1)          # pattern index from its minus signs
     x = None
-    pick = np.full(N, -1)
-    todo, k_of = np.arange(N), np.zeros(N, int)
+    used = np.ones((N, m))
+    todo = np.arange(N)
 
-    def attempt(idx, k):
+    def attempt(idx, signs):
         nonlocal x
-        xs = solve_pattern(k, idx)
-        if x is None:
-            x = np.empty((N, xs.shape[1]))
+        xs = solve_pattern(signs, idx)
         t = xs[:, t_cols]
-        ok = np.all(-patterns[k] * t <= (TOL_SIGN * scale[idx])[:, None], axis=1)
+        ok = np.all(-signs * t <= (TOL_SIGN * scale[idx])[:, None], axis=1)
+        if x is None:
+            if ok.all():                              # the usual case: done in one solve
+                x = xs
+                return idx[:0], t[:0]
+            x = np.empty((N, xs.shape[1]))
         x[idx[ok]] = xs[ok]
-        pick[idx[ok]] = k
-        return idx[~ok], ((t[~ok] < 0) * weights).sum(axis=1)
+        used[idx[ok]] = signs
+        return idx[~ok], np.where(t[~ok] < 0, -1.0, 1.0)
 
-    for _ in range(m + 1):                            # retry with the solution's own signs
+    todo, trial = attempt(todo, np.ones(m))
+    for _ in range(m):                                # retry with the solution's own signs
         if todo.size == 0:
             break
+        uniq, which = np.unique(trial, axis=0, return_inverse=True)
+        which = which.reshape(-1)
         left, nxt = [], []
-        for k in np.unique(k_of[todo]):
-            bad, kk = attempt(todo[k_of[todo] == k], int(k))
+        for u, signs in enumerate(uniq):
+            bad, own = attempt(todo[which == u], signs)
             left.append(bad)
-            nxt.append(kk)
-        todo = np.concatenate(left)
-        k_of[todo] = np.concatenate(nxt)
-    for k in range(len(patterns)):                    # the rest: every pattern in order
-        if todo.size == 0:
-            break
-        todo, _ = attempt(todo, k)
+            nxt.append(own)
+        todo, trial = np.concatenate(left), np.concatenate(nxt)
+    if todo.size and m <= MAX_EXHAUSTIVE:             # the rest: every pattern in order
+        for signs in sign_patterns(m):
+            if todo.size == 0:
+                break
+            todo, _ = attempt(todo, np.array(signs))
     if todo.size:
         raise SignError(int(todo[0]), mesh_names)
-    return x, patterns[pick]
+    return x, used
 
 
 def sign_violation(t: np.ndarray, signs: np.ndarray, scale: np.ndarray) -> float:
