@@ -7,7 +7,7 @@ device, a missing directory, a symlink, an empty name; a disk that fills after a
 number of bytes; a failing rename) must give:
 
 * exit status 0 or 2, never a traceback (status 1 with an exception), never a hang;
-* on status 2, at least one line on stderr;
+* on status 2, at least one line on stderr; no ``RuntimeWarning`` leaks;
 * no NaN or infinity in any file written;
 * no stray file in the directory (temporary or partial outputs);
 * inputs unchanged.
@@ -30,6 +30,7 @@ import shutil
 import signal
 import tempfile
 import time
+import warnings
 from pathlib import Path
 
 import pytest
@@ -121,7 +122,12 @@ def run_cli(args) -> tuple[object, bool]:
     old = signal.signal(signal.SIGALRM, _alarm)
     signal.alarm(HANG_SECONDS)
     try:
-        return CliRunner().invoke(app, [str(a) for a in args]), False
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            result = CliRunner().invoke(app, [str(a) for a in args])
+        result.leaked = [f"{w.category.__name__}: {w.message}" for w in caught
+                         if issubclass(w.category, RuntimeWarning)]
+        return result, False
     except Hang:
         return None, True
     finally:
@@ -143,6 +149,8 @@ def problems(result, hung: bool, work: Path, inputs: dict, allowed_outputs=()) -
         detail = "".join(__import__("traceback").format_exception(*exc))[-1500:] if exc else result.stderr[-500:]
         out.append(f"{kind}: exit {result.exit_code}: {detail}")
     text = result.stdout + result.stderr
+    if result.leaked:
+        out.append(f"warning leaked to stderr: {result.leaked[0]}")
     if "Traceback" in text:
         out.append("traceback text in output")
     if result.exit_code == 2 and not result.stderr.strip():

@@ -20,6 +20,7 @@ import json
 import os
 import signal
 import sys
+import warnings
 from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Iterator
@@ -105,7 +106,10 @@ def bad_input_exits() -> Iterator[None]:
     status 130; SIGTERM: one line, status 143 (temporary files are removed first).
     """
     try:
-        with _sigterm_raises():
+        with _sigterm_raises(), warnings.catch_warnings():
+            # numpy's overflow/invalid-value warnings are not for users: every number
+            # written is checked finite, and a non-finite one is an error
+            warnings.simplefilter("ignore", RuntimeWarning)
             yield
             sys.stdout.flush()
     except GearcliError as exc:
