@@ -1,0 +1,136 @@
+"""Gear pairs: carriers, fundamental circuits (theta_j,c = e_kj theta_k,c) and mesh geometry."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import Collector
+from ..model.gears import GearGeometry, gear_geometry
+from ..model.mechanism import Mechanism
+from .context import Home
+from .tree import Tree
+from .types import Circuit, CoaxialGroup
+
+
+def groups_of(groups: list[CoaxialGroup], x: int) -> list[CoaxialGroup]:
+    return [g for g in groups if x in g.members]
+
+
+def relative_rotation(h: Home, canon: np.ndarray, x: int, c: int, g: CoaxialGroup):
+    """Rotation of link ``x`` relative to link ``c`` about x's axis, both in coaxial group
+    ``g``: its row (J,) over real joint angles (rad per rad), and that axis (3,) in the
+    world frame at home (c's axis if x is the group's carrier)."""
+    zw, jin = h.zw, h.jin
+    ref = zw[jin[g.members[1]]]
+
+    def phi(m):
+        return np.zeros(h.J) if m == g.carrier else canon[m] * float(zw[jin[m]] @ ref)
+    z = zw[jin[x]] if x != g.carrier else zw[jin[c]]
+    return (phi(x) - phi(c)) * float(z @ ref), z
+
+
+def circuits(h: Home, groups: list[CoaxialGroup], canon: np.ndarray, col: Collector) -> list[Circuit]:
+    """Fundamental circuit of each gear pair and joint coupling, in ``mech.gears`` order
+    (pairs with a problem are reported to ``col`` and left out)."""
+    circuits: list[Circuit] = []
+    for gi, gp in enumerate(h.mech.gears):
+        j, k = h.idx[gp.j], h.idx[gp.k]
+        if gp.joints is not None and gp.mesh_point is None:
+            circ = joint_coupling(h.mech, h.tree, h.jidx, gi, gp, col)
+        else:
+            circ = gear_circuit(h, groups, canon, gi, gp, j, k, col)
+        if circ is not None:
+            circuits.append(circ)
+    return circuits
+
+
+def gear_circuit(h: Home, groups, canon, gi: int, gp, j: int, k: int, col: Collector) -> Circuit | None:
+    """Circuit of gear pair ``gp`` between links j and k: theta_{j,c} - e theta_{k,c} = 0,
+    with the ratio e given or derived from the mesh geometry."""
+    found = gear_carrier(h, groups, gp, j, k, col)
+    if found is None:
+        return None
+    c, gj, gk = found
+    row_j, zj_w = relative_rotation(h, canon, j, c, gj)
+    row_k, zk_w = relative_rotation(h, canon, k, c, gk)
+    Rc = h.kin.R[c]
+    geom = None
+    ratio = gp.ratio
+    if gp.mesh_point is not None:
+        geom = mesh_geometry(h, gp, j, k, c, gj, gk, zj_w, zk_w, col)
+        if geom is None:
+            return None
+        ratio = geom.ratio
+    if ratio is None:
+        return None
+    return Circuit(gi, j, k, c, float(ratio), row_j - ratio * row_k, Rc.T @ zj_w, Rc.T @ zk_w, geom)
+
+
+def gear_carrier(h: Home, groups, gp, j: int, k: int, col: Collector):
+    """Carrier c of gear pair ``gp``: a link sharing a coaxial group with each gear (both
+    gear axes fixed in it), given or unique.  Returns (c, group of j, group of k), or None
+    with an issue."""
+    cands = {}
+    for gj in groups_of(groups, j):
+        for gk in groups_of(groups, k):
+            if gj is gk:
+                continue
+            for c in set(gj.members) & set(gk.members) - {j, k}:
+                cands[c] = (gj, gk)
+    names = h.tree.links
+    if gp.carrier is not None:
+        c = h.idx[gp.carrier]
+        if c not in cands:
+            col.add(f"{gp.path}.carrier", f"'{gp.carrier}' cannot carry gears '{gp.j}' and '{gp.k}': "
+                    f"both gear axes must be fixed in the carrier"
+                    + (f" (possible carrier: {', '.join(names[x] for x in sorted(cands))})" if cands else ""))
+            return None
+    elif len(cands) == 1:
+        c = next(iter(cands))
+    elif not cands:
+        col.add(f"{gp.path}.links", f"gears '{gp.j}' and '{gp.k}' share no carrier: no link holds both "
+                "gear axes fixed (each gear must turn about a line fixed in the carrier)")
+        return None
+    else:
+        col.add(f"{gp.path}", f"gears '{gp.j}' and '{gp.k}' have several possible carriers "
+                f"({', '.join(names[x] for x in sorted(cands))}): give carrier")
+        return None
+    return (c, *cands[c])
+
+
+def mesh_geometry(h: Home, gp, j, k, c, gj, gk, zj_w, zk_w, col: Collector) -> GearGeometry | None:
+    """Gear geometry of ``gp`` from its mesh point, with both gear axes (points, m, and
+    directions) expressed in the carrier frame of c; None (with issues) if inconsistent."""
+    Rc, oc = h.kin.R[c], h.kin.o[c]
+    ow, jin = h.ow, h.jin
+    pj = ow[jin[j]] if j != gj.carrier else ow[jin[c]]
+    pk = ow[jin[k]] if k != gk.carrier else ow[jin[c]]
+    geom, probs = gear_geometry(gp.kind, gp.mesh_point, Rc.T @ (pj - oc), Rc.T @ zj_w,
+                                Rc.T @ (pk - oc), Rc.T @ zk_w, gp.teeth, gp.ratio,
+                                gp.cone_angles, (gp.j, gp.k))
+    for fld, msg in probs:
+        col.add(f"{gp.path}.{fld}", msg)
+    return geom
+
+
+def joint_coupling(mech: Mechanism, tree: Tree, jidx: dict, gi: int, gp, col: Collector) -> Circuit | None:
+    """Circuit of an ideal coupling of two joint coordinates, q_B = ratio * q_A."""
+    ok = True
+    for name in gp.joints:
+        if name not in jidx:
+            col.add(f"{gp.path}.joints", f"coupling '{gp.name}' names unknown joint '{name}'")
+            ok = False
+    if not ok:
+        return None
+    b, a = (jidx[name] for name in gp.joints)
+    if a == b:
+        col.add(f"{gp.path}.joints", f"coupling '{gp.name}' couples joint '{gp.joints[0]}' to itself")
+        return None
+    if gp.ratio is None or gp.ratio == 0:
+        col.add(f"{gp.path}.ratio", f"coupling '{gp.name}' needs a nonzero ratio")
+        return None
+    row = np.zeros(len(mech.joints))
+    row[b] = 1.0
+    row[a] -= gp.ratio
+    jb, ja = mech.joints[b], mech.joints[a]
+    return Circuit(gi, tree.index[jb.child], tree.index[ja.child], tree.index[jb.parent], float(gp.ratio),
+                   row, jb.R_pj[:, 2].copy(), ja.R_pj[:, 2].copy(), None, joints=(b, a))

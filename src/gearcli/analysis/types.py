@@ -1,0 +1,111 @@
+"""The results of the graph analysis: coaxial groups, fundamental circuits, the Analysis."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model.gears import GearGeometry
+from ..model.mechanism import Mechanism
+from .tree import Tree
+
+
+TOL_LINE = 1e-9
+
+
+@dataclass(frozen=True)
+class CoaxialGroup:
+    """Links turning about one line relative to ``carrier`` (carrier included first)."""
+
+    carrier: int
+    label: str
+    members: tuple[int, ...]
+    direction: np.ndarray  # reference direction of the line, in the carrier frame
+
+
+@dataclass(frozen=True, eq=False)
+class Circuit:
+    """Fundamental circuit of gear pair ``gear`` (index into mech.gears): links j, k, carrier c.
+
+    ``row`` is the constraint theta_{j,c} - e theta_{k,c} = 0 as a row over real joints;
+    ``geometry`` is None for an ideal coupling without mesh point.
+    """
+
+    gear: int
+    j: int
+    k: int
+    carrier: int
+    ratio: float
+    row: np.ndarray
+    zj: np.ndarray  # axis of j relative to c, carrier frame
+    zk: np.ndarray
+    geometry: GearGeometry | None
+    # (B, A) real joint indices of a joint coupling q_B = ratio * q_A (GearPair.joints):
+    # row = e_B - ratio e_A; the ideal mesh torque acts on both joints, each joint's parent
+    # taking the reaction (``carrier`` is then B's parent, for display).
+    joints: tuple[int, int] | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class Analysis:
+    """Derived topology of a mechanism; computed once, never mutated."""
+
+    mech: Mechanism
+    tree: Tree
+    canonical_parent: tuple
+    label: tuple             # axis label of each link's canonical edge (None for base)
+    level: tuple
+    primary: tuple[int, ...]   # EOLC, base first
+    independent: tuple[int, ...]  # joint index (or -1) of each independent coordinate
+    independent_names: tuple[str, ...]
+    groups: tuple[CoaxialGroup, ...]
+    circuits: tuple[Circuit, ...]
+    canon_rows: np.ndarray     # (L, J): canonical angle of link i in real joint angles
+    S: np.ndarray              # (J, dof): q = S q_ind
+    motor_links: tuple[int, ...]
+    motor_stators: tuple[int, ...]
+    motor_rows: np.ndarray     # (M, J): motor input rotation in real joint angles
+    A: np.ndarray              # (dof, M) structure matrix: motor angles = A^T q_ind
+    transmission_lines: tuple[tuple[int, ...], ...]
+    pseudo_triangular: bool
+    schedule: tuple[tuple[int, ...], ...] = field(default=())
+    # per motor: ((joint index, coefficient), ...) for a transmission motor (Motor.joints),
+    # None for a motor acting between its link and stator; () when no motor has joints
+    motor_joints: tuple = ()
+    open_loop: str = "chain"   # "tree": primary links form a tree (Mechanism.open_loop)
+
+    @property
+    def dof(self) -> int:
+        return self.S.shape[1]
+
+    @property
+    def names(self):
+        return self.tree.links
+
+    def name_of(self, ids) -> list[str]:
+        return [self.tree.links[i] for i in ids]
+
+    @property
+    def secondary(self) -> list[int]:
+        return [i for i in self.tree.moving if i not in self.primary]
+
+    @property
+    def carriers(self) -> dict[str, str]:
+        return {self.names[i]: self.names[self.canonical_parent[i]] for i in self.secondary}
+
+
+def collinear(o1, z1, o2, z2, scale=1.0) -> bool:
+    if np.linalg.norm(np.cross(z1, z2)) > TOL_LINE:
+        return False
+    d = o2 - o1
+    return np.linalg.norm(d - (d @ z1) * z1) <= TOL_LINE * max(scale, 1.0)
+
+
+def first_collinear(O, Z, o, z, scale=1.0):
+    """Index of the first line (origins O (k, 3), unit directions Z (k, 3)) that coincides
+    with the line (o, z) as :func:`collinear` decides, or None."""
+    d = o - O
+    hit = ((np.linalg.norm(np.cross(Z, z), axis=1) <= TOL_LINE)
+           & (np.linalg.norm(d - np.sum(d * Z, axis=1)[:, None] * Z, axis=1) <= TOL_LINE * max(scale, 1.0)))
+    k = np.flatnonzero(hit)
+    return int(k[0]) if k.size else None
