@@ -227,3 +227,203 @@ def test_single_planet_is_fine(run_cli, tmp_path):
     path.write_text(planetary((0,), 10))
     res = run_cli("check", path)
     assert res.exit_code == 0, res.stderr
+
+
+# --------------------------------------------------------------------------------------
+# URDF
+# --------------------------------------------------------------------------------------
+ARM = (ROOT / "mechanisms" / "geared_arm.urdf").read_text()
+
+
+def urdf_with_doctype(doctype: str, text: str = ARM) -> str:
+    """``text`` with a DOCTYPE inserted after the XML declaration."""
+    head, rest = text.split("\n", 1)
+    assert head.startswith("<?xml")
+    return f"{head}\n{doctype}\n{rest}"
+
+
+def structure_matrix(run_cli, path) -> list:
+    import json
+    res = run_cli("graph", path, "--json")
+    assert res.exit_code == 0, res.stderr
+    assert res.stderr == ""
+    return json.loads(res.stdout)["structure_matrix"]
+
+
+def test_internal_entity_is_expanded(run_cli, tmp_path):
+    text = urdf_with_doctype('<!DOCTYPE robot [<!ENTITY red "50">]>',
+                             ARM.replace("<mechanicalReduction>50</mechanicalReduction>",
+                                         "<mechanicalReduction>&red;</mechanicalReduction>"))
+    text = text.replace("<mechanicalReduction>50</mechanicalReduction>", "")
+    plain, ent = tmp_path / "plain.urdf", tmp_path / "entity.urdf"
+    plain.write_text(ARM)
+    ent.write_text(text)
+    A = structure_matrix(run_cli, ent)
+    assert A == structure_matrix(run_cli, plain)
+    assert A[1][1] == 50.0
+
+
+def test_internal_entity_changes_the_value(run_cli, tmp_path):
+    """The entity's value is used (not a default): 40 instead of 50 shows in the matrix."""
+    text = urdf_with_doctype('<!DOCTYPE robot [<!ENTITY red "40">]>',
+                             ARM.replace("<mechanicalReduction>50</mechanicalReduction>",
+                                         "<mechanicalReduction>&red;</mechanicalReduction>"))
+    path = tmp_path / "entity40.urdf"
+    path.write_text(text)
+    assert structure_matrix(run_cli, path)[1][1] == 40.0
+
+
+@pytest.mark.parametrize("decl", ['<!ENTITY red SYSTEM "{target}">', '<!ENTITY red PUBLIC "-//x//y" "{target}">'])
+def test_external_entity_refused_and_not_read(tmp_path, decl):
+    """The entity points at a FIFO: reading it would block (the subprocess would time out)
+    or show its content; neither happens, and the message names the entity and its line."""
+    import os
+    fifo = tmp_path / "secret.fifo"
+    os.mkfifo(fifo)
+    text = urdf_with_doctype("<!DOCTYPE robot [\n" + decl.format(target=fifo) + "\n]>",
+                             ARM.replace("<mechanicalReduction>50</mechanicalReduction>",
+                                         "<mechanicalReduction>&red;</mechanicalReduction>"))
+    line = bad_subprocess(tmp_path, text, 3, "DOCTYPE", r"^external entity 'red'.* is refused: gearcli reads "
+                          "nothing but the file itself$", name="ext.urdf", timeout=60)
+    assert "secret" in line  # names the target path, which it did not open
+
+
+def test_external_entity_to_existing_file_not_read(run_cli, tmp_path):
+    secret = tmp_path / "secret.txt"
+    secret.write_text("TOP-SECRET-CONTENT\n")
+    text = urdf_with_doctype(f'<!DOCTYPE robot [<!ENTITY red SYSTEM "file://{secret}">]>',
+                             ARM.replace("<mechanicalReduction>50</mechanicalReduction>",
+                                         "<mechanicalReduction>&red;</mechanicalReduction>"))
+    line = bad(run_cli, tmp_path, text, 2, "DOCTYPE", "^external entity 'red'", name="ext.urdf")
+    assert "TOP-SECRET" not in line
+
+
+def test_external_entity_in_attribute_refused(run_cli, tmp_path):
+    secret = tmp_path / "secret.txt"
+    secret.write_text("TOP-SECRET-CONTENT\n")
+    text = urdf_with_doctype(f'<!DOCTYPE robot [<!ENTITY red SYSTEM "file://{secret}">]>',
+                             ARM.replace('<robot name="geared_arm"', '<robot name="&red;"'))
+    line = bad(run_cli, tmp_path, text, line_of(text, "&red;"), "",
+               "^malformed XML: Attribute references external entity 'red'$", name="ext.urdf")
+    assert "TOP-SECRET" not in line
+
+
+def test_external_parameter_entity_and_dtd_not_read(run_cli, tmp_path):
+    import os
+    fifo = tmp_path / "dtd.fifo"
+    os.mkfifo(fifo)
+    text = urdf_with_doctype(f'<!DOCTYPE robot SYSTEM "{fifo}" [<!ENTITY % p SYSTEM "{fifo}"> %p;]>')
+    bad_subprocess(tmp_path, text, 2, "DOCTYPE", "^external entity 'p'", name="pe.urdf", timeout=60)
+
+
+def test_xinclude_is_never_processed(run_cli, tmp_path):
+    """An <xi:include> of a file holding a link is ignored: the robot is unchanged."""
+    extra = tmp_path / "extra.xml"
+    extra.write_text('<link name="intruder"/>')
+    text = ARM.replace('<link name="base_link"/>', '<link name="base_link"/>\n  <xi:include '
+                       f'xmlns:xi="http://www.w3.org/2001/XInclude" href="{extra}"/>')
+    path = tmp_path / "xi.urdf"
+    path.write_text(text)
+    from gearcli import load_mechanism
+    assert "intruder" not in load_mechanism(path).link_names
+
+
+def test_entity_bomb(run_cli, tmp_path):
+    ents = '<!ENTITY a "lollollollollol">' + "".join(
+        f'<!ENTITY {c} "{("&" + p + ";") * 10}">' for p, c in zip("abcdefghi", "bcdefghij"))
+    text = urdf_with_doctype(f"<!DOCTYPE robot [{ents}]>", ARM.replace('<robot name="geared_arm"', '<robot name="&j;"'))
+    path = tmp_path / "bomb.urdf"
+    path.write_text(text)
+    res = run_cli("check", path)
+    assert res.exit_code == 2 and "Traceback" not in res.stderr
+    assert len(res.stderr.splitlines()) == 1 and res.stderr.startswith(f"{path}:")
+    assert len(res.stderr) < 600 + len(str(path))
+
+
+def test_undeclared_entity(run_cli, tmp_path):
+    text = ARM.replace('<robot name="geared_arm"', '<robot name="&nope;"')
+    bad(run_cli, tmp_path, text, line_of(text, "&nope;"), "", "malformed XML: Entity 'nope' not defined",
+        name="u.urdf")
+
+
+@pytest.mark.parametrize("old,new,place,reason", [
+    ('<axis xyz="0 0 1"/>\n  </joint>\n\n  <joint name="pinion_joint"',
+     '<axis xyz="1e308 0 0"/>\n  </joint>\n\n  <joint name="pinion_joint"', "joint 'shoulder'",
+     r'^xyz="1e308 0 0": 1e\+308 is out of range \(\|x\| <= 1e12 in SI units\)$'),
+    ('<origin xyz="0.4 0 0" rpy="0 0 0"/>', '<origin xyz="0.4 0 0" rpy="0 0 1e300"/>', "joint 'elbow'",
+     r'^rpy="0 0 1e300": 1e\+300 is out of range'),
+    ('pressure_angle_deg="20"', 'pressure_angle_deg="2e20"', "joint 'pinion_joint'.gearcli:gear",
+     r'^pressure_angle_deg="2e20": 2e\+20 is out of range'),
+    ('<mimic joint="shoulder" multiplier="-3"', '<mimic joint="shoulder" multiplier="-3e20"',
+     "joint 'pinion_joint'.mimic", r'^multiplier="-3e20": -3e\+20 is out of range'),
+    ("<mechanicalReduction>50</mechanicalReduction>", "<mechanicalReduction>5e20</mechanicalReduction>",
+     "transmission 'elbow_trans'", r"mechanicalReduction.* 5e\+20 is out of range"),
+    ("<mechanicalReduction>50</mechanicalReduction>", "<mechanicalReduction>1" + "0" * 400 + "</mechanicalReduction>",
+     "transmission 'elbow_trans'", r"mechanicalReduction.* must be a finite nonzero number"),
+])
+def test_urdf_number_out_of_range(run_cli, tmp_path, old, new, place, reason):
+    assert ARM.count(old) == 1, old
+    text = ARM.replace(old, new)
+    needle = {"joint 'shoulder'": "1e308", "joint 'elbow'": "1e300", "joint 'pinion_joint'.gearcli:gear": "2e20",
+              "joint 'pinion_joint'.mimic": "-3e20", "transmission 'elbow_trans'": '<transmission name="elbow_trans"'}
+    bad(run_cli, tmp_path, text, line_of(text, needle[place]), place, reason, name="n.urdf")
+
+
+def test_urdf_mass_out_of_range(run_cli, tmp_path):
+    text = ARM.replace('<mass value=', '<mass value="1e300" was=', 1)
+    bad(run_cli, tmp_path, text, line_of(text, 'value="1e300"'), "link 'upper_arm'.inertial",
+        r'^mass "1e300" 1e\+300 is out of range', name="m.urdf")
+
+
+def test_urdf_5000_root_links_not_echoed(run_cli, tmp_path):
+    links = "".join(f'<link name="orphan{i}"/>' for i in range(5000))
+    text = ARM.replace('<link name="base_link"/>', '<link name="base_link"/>' + links)
+    line = bad(run_cli, tmp_path, text, line_of(text, "<robot "), "",
+               r"^several root links \(base_link, orphan0, orphan1, orphan2, orphan3 and 4996 more\)", name="r.urdf")
+    assert "orphan4999" not in line
+
+
+def test_urdf_100kB_name_not_echoed(run_cli, tmp_path):
+    big = "n" * 100_000
+    text = ARM.replace('<mimic joint="shoulder"', f'<mimic joint="{big}"')
+    line = bad(run_cli, tmp_path, text, line_of(text, big), "joint 'pinion_joint'.mimic",
+               "^joint 'pinion_joint' mimics unknown joint 'nnnn", name="big.urdf")
+    assert big not in line
+
+
+def test_urdf_deep_nesting(run_cli, tmp_path):
+    text = ARM.replace('<link name="base_link"/>', '<link name="base_link"/>' + "<a>" * 5000 + "</a>" * 5000)
+    bad(run_cli, tmp_path, text, line_of(text, "<a><a>"), "", "^malformed XML: ", name="deep.urdf")
+
+
+def test_urdf_file_size_limit(run_cli, tmp_path):
+    text = ARM + "<!--" + "x" * (17 * 2**20) + "-->\n"
+    bad(run_cli, tmp_path, text, None, "", r"^file is larger than 16 MiB, the limit for a URDF file$", name="big.urdf")
+
+
+def test_yourdfpy_prints_nothing(tmp_path):
+    """A URDF that yourdfpy parses with its fallback (it logs 'Using different parsing
+    approach.') gives exactly gearcli's output, nothing stray."""
+    text = ARM.replace('<limit lower="-2.6" upper="2.6" effort="60" velocity="3"/>',
+                       '<limit lower="-2.6" upper="2.6" effort="60" velocity="3"/><calibration rising="x"/>')
+    path = tmp_path / "odd.urdf"
+    path.write_text(text)
+    res = subprocess.run([sys.executable, "-c", "import sys; sys.path.insert(0, sys.argv[1]); "
+                          "from gearcli.cli import app; sys.argv = ['gearcli', 'check', sys.argv[2]]; app()",
+                          str(ROOT / "src"), str(path)], capture_output=True, text=True, timeout=120)
+    assert "Traceback" not in res.stderr
+    lines = (res.stdout + res.stderr).splitlines()
+    assert len(lines) == 1 and lines[0].startswith(str(path)), lines
+
+
+def test_quiet_yourdfpy_silences_its_log_and_prints(capfd, caplog):
+    import logging
+
+    from gearcli.io.urdf_xml import quiet_yourdfpy
+    with quiet_yourdfpy():
+        logging.getLogger("yourdfpy.urdf").error("Using different parsing approach.")
+        print("stray")
+    out, err = capfd.readouterr()
+    assert out == "" and err == "" and not caplog.records
+    logging.getLogger("yourdfpy.urdf").error("visible again")
+    assert [r.getMessage() for r in caplog.records] == ["visible again"]

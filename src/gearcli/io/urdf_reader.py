@@ -40,79 +40,40 @@ around (unsupported transmissions, ignored friction) is listed in ``Mechanism.wa
 """
 from __future__ import annotations
 
-import io
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 from lxml import etree
 
 from ..errors import Collector, Issue, MechanismError
+from ..model.mechanism import Joint, Link, Mechanism
 from ..model.validate import check_inertia
-from ..model.mechanism import GEAR_KINDS, GearPair, Joint, Link, Mechanism, Motor
-from ..spatial import align_z, matrix_rpy, rot_z
+from ..spatial import align_z, matrix_rpy
+from .limits import read_bytes
 from .ratings_reader import attach_urdf_ratings
-from .urdf_transmissions import KINDS as TRANSMISSION_KINDS
-from .urdf_transmissions import read_transmissions
-
-NS = "https://gearcli.dev/urdf/1"
-"""XML namespace of gearcli's URDF extension elements (prefix ``gearcli``)."""
-
-JOINT_TYPES = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic"}
-INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-GEAR_ATTRS = ("name", "j", "k", "kind", "ratio", "teeth", "carrier", "mesh_point", "pressure_angle",
-              "pressure_angle_deg", "cone_angles", "cone_angles_deg", "derived")
-MIMIC_GEAR_ATTRS = ("name", "kind", "teeth", "carrier", "mesh_point", "pressure_angle",
-                    "pressure_angle_deg", "cone_angles", "cone_angles_deg")
-
-
-def q(tag: str) -> str:
-    """Qualified name of a gearcli extension element or attribute."""
-    return f"{{{NS}}}{tag}"
+from .urdf_extension import Extension
+from .urdf_mimic import Mimics
+from .urdf_structure import JOINT_TYPES, StructureChecks
+from .urdf_xml import NS, floats as _floats, load_yourdfpy, parse_xml, q, range_problem
 
 
 def load_urdf(path: str | Path) -> Mechanism:
     """Read a URDF file; raises :class:`~gearcli.errors.MechanismError` on bad input."""
-    path = Path(path)
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise MechanismError([Issue(str(path), "", None, f"cannot read file: {exc.strerror}")]) from None
-    return parse_urdf(data, str(path))
+    return parse_urdf(read_bytes(path, "URDF file"), str(path))
 
 
 def parse_urdf(text: str | bytes, file: str = "<string>") -> Mechanism:
     """Parse the text of a URDF (see the module docstring for the mapping)."""
     data = text.encode("utf-8") if isinstance(text, str) else text
-    parser = etree.XMLParser(remove_comments=True, resolve_entities=False, no_network=True)
-    try:
-        root = etree.fromstring(data, parser)
-    except etree.XMLSyntaxError as exc:
-        line = exc.lineno if getattr(exc, "lineno", None) else None
-        msg = str(exc.msg if getattr(exc, "msg", None) else exc)
-        msg = msg.split(", line ")[0]
-        raise MechanismError([Issue(file, "", line, f"malformed XML: {msg}")]) from None
+    root = parse_xml(data, file)
     return attach_urdf_ratings(_Reader(root, data, file).build(), root, file)
-
-
-def _floats(text: str | None, n: int | None = None) -> np.ndarray | None:
-    """Whitespace-separated finite numbers, or None if malformed (or the wrong count)."""
-    if text is None:
-        return None
-    try:
-        v = np.array([float(x) for x in text.split()], float)
-    except ValueError:
-        return None
-    if (n is not None and v.size != n) or not np.all(np.isfinite(v)):
-        return None
-    return v
 
 
 def _transform(origin) -> np.ndarray:
     return np.eye(4) if origin is None else np.asarray(origin, float)
 
 
-class _Reader:
+class _Reader(StructureChecks, Mimics, Extension):
     """One URDF being read: elements by name, issues and warnings with their lines."""
 
     def __init__(self, root, data: bytes, file: str):
@@ -139,7 +100,8 @@ class _Reader:
         v = _floats(text, n)
         if v is None:
             what = "a finite number" if n == 1 else f"{n} finite numbers"
-            self.add(path, f"{attr}=\"{text}\" is not {what}", el)
+            why = range_problem(text)
+            self.add(path, f"{attr}=\"{text}\": {why}" if why else f"{attr}=\"{text}\" is not {what}", el)
             return default
         return v
 
@@ -181,145 +143,10 @@ class _Reader:
             open_loop=open_loop, warnings=tuple(self.warnings),
         )
 
-    # -- structure (lxml): names, references, types, numbers, tree ---------------------------
-    def register(self, el, kind: str, seen: dict) -> str | None:
-        """Record a named <link>/<joint> in ``seen``; its path, or None (reported) when it has
-        no name or a duplicate one."""
-        name = el.get("name")
-        if not name:
-            self.add(kind, f"a <{kind}> has no name", el)
-            return None
-        path = f"{kind} '{name}'"
-        if name in seen:
-            self.add(path, f"duplicate {kind} name '{name}' (first at line {seen[name].sourceline})", el)
-            return None
-        seen[name] = el
-        self.lines[path] = el.sourceline
-        return path
-
-    def check_structure(self) -> None:
-        """Names, references, types and numbers of every <link> and <joint>, then that the
-        joints form one tree (sets ``self.base``)."""
-        self.link_el: dict[str, object] = {}
-        for el in self.root.findall("link"):
-            path = self.register(el, "link", self.link_el)
-            if path is not None:
-                self.check_inertial(el, path)
-        self.joint_el: dict[str, object] = {}
-        self.parent_of: dict[str, str] = {}   # link -> parent link
-        self.joint_into: dict[str, str] = {}  # link -> joint whose child it is
-        for el in self.root.findall("joint"):
-            path = self.register(el, "joint", self.joint_el)
-            if path is not None:
-                self.check_joint(el, path)
-        if self.col.issues:
-            return
-        self.check_tree()
-
-    def check_joint(self, el, path: str) -> None:
-        """Type, parent and child links (recorded in ``parent_of``/``joint_into``), origin,
-        axis and mimic numbers of one <joint>."""
-        jtype = el.get("type")
-        if jtype in ("floating", "planar"):
-            self.add(path, f"joint type '{jtype}' is not supported: gearcli analyses mechanisms on a "
-                     "fixed base with one-degree-of-freedom joints (revolute, continuous, prismatic, fixed)", el)
-        elif jtype not in JOINT_TYPES and jtype != "fixed":
-            self.add(path, f"unknown joint type '{jtype}' (expected revolute, continuous, prismatic or fixed)"
-                     if jtype else "the joint has no type", el)
-        self.check_joint_ends(el, path)
-        origin = el.find("origin")
-        self.vector(origin, "xyz", path)
-        self.vector(origin, "rpy", path)
-        axis_el = el.find("axis")
-        axis = self.vector(axis_el, "xyz", path)
-        if axis is not None and np.linalg.norm(axis) < 1e-12 and jtype in JOINT_TYPES:
-            self.add(path, "the joint axis is the zero vector", axis_el)
-        mimic = el.find("mimic")
-        if mimic is not None:
-            for attr in ("multiplier", "offset"):
-                self.vector(mimic, attr, f"{path}.mimic", n=1)
-
-    def check_joint_ends(self, el, path: str) -> None:
-        """The joint's <parent> and <child> links: known, distinct, one parent joint a link."""
-        ends = {}
-        for end in ("parent", "child"):
-            sub = el.find(end)
-            link = sub.get("link") if sub is not None else None
-            if not link:
-                self.add(path, f"the joint has no <{end} link=\"...\"/>", el)
-            elif link not in self.link_el:
-                self.add(path, f"unknown {end} link '{link}'", sub)
-            else:
-                ends[end] = link
-        if len(ends) == 2:
-            p, c = ends["parent"], ends["child"]
-            if p == c:
-                self.add(path, f"the joint connects link '{p}' to itself", el)
-            elif c in self.joint_into:
-                self.add(path, f"link '{c}' is already the child of joint '{self.joint_into[c]}' "
-                         "(a URDF is a tree: each link has one parent joint)", el)
-            else:
-                self.joint_into[c] = el.get("name")
-                self.parent_of[c] = p
-
-    def check_tree(self) -> None:
-        """One root link (the base, ``self.base``) from which every link hangs, no loop."""
-        root = self.root
-        roots = [n for n in self.link_el if n not in self.parent_of]
-        if not self.link_el:
-            self.add("", "the robot has no links", root)
-        elif not roots:
-            self.add("", "the joints form a loop: no link is the root (a URDF must be a tree)", root)
-        elif len(roots) > 1:
-            self.add("", f"several root links ({', '.join(roots)}): a URDF must be one tree hanging from "
-                     "one root link (the fixed base)", root)
-        else:
-            self.base = roots[0]
-            # a loop not through the root: some link does not reach the root
-            for link in self.link_el:
-                seen, x = set(), link
-                while x in self.parent_of and x not in seen:
-                    seen.add(x)
-                    x = self.parent_of[x]
-                if x != self.base:
-                    j = self.joint_into[link]
-                    self.add(f"joint '{j}'", f"the joints form a loop through link '{link}' (a URDF must be a tree)",
-                             self.joint_el[j])
-                    break
-
-    def check_inertial(self, el, path: str) -> None:
-        inertial = el.find("inertial")
-        if inertial is None:
-            return
-        self.vector(inertial.find("origin"), "xyz", f"{path}.inertial")
-        self.vector(inertial.find("origin"), "rpy", f"{path}.inertial")
-        mass = inertial.find("mass")
-        if mass is None or mass.get("value") is None:
-            self.add(f"{path}.inertial", "<inertial> has no <mass value=\"...\"/>", inertial)
-        else:
-            m = _floats(mass.get("value"), 1)
-            if m is None:
-                self.add(f"{path}.inertial", f"mass \"{mass.get('value')}\" is not a finite number", mass)
-            elif m[0] < 0:
-                self.add(f"{path}.inertial", f"mass must not be negative, got {m[0]:g} kg", mass)
-        inertia = inertial.find("inertia")
-        if inertia is None:
-            self.add(f"{path}.inertial", "<inertial> has no <inertia .../>", inertial)
-            return
-        missing = [k for k in INERTIA_KEYS if inertia.get(k) is None]
-        if missing:
-            self.add(f"{path}.inertial", f"<inertia> misses {', '.join(missing)}", inertia)
-        for k in INERTIA_KEYS:
-            if inertia.get(k) is not None and _floats(inertia.get(k), 1) is None:
-                self.add(f"{path}.inertial", f"{k}=\"{inertia.get(k)}\" is not a finite number", inertia)
-
     # -- values (yourdfpy) ----------------------------------------------------------------------
     def parse_values(self) -> None:
-        import yourdfpy  # noqa: PLC0415  (slow import, only for URDF)
-
         try:
-            urdf = yourdfpy.URDF.load(io.BytesIO(self.data), build_scene_graph=False, load_meshes=False,
-                                      build_collision_scene_graph=False, load_collision_meshes=False)
+            urdf = load_yourdfpy(self.root)
         except Exception as exc:  # noqa: BLE001  (yourdfpy raises bare KeyError/ValueError)
             self.add("", f"yourdfpy cannot read this URDF: {type(exc).__name__}: {exc}")
             return
@@ -429,341 +256,6 @@ class _Reader:
         self.movable = {j.name: j for j in joints}
         return joints
 
-    # -- mimic couplings ------------------------------------------------------------------------
-    def couplings(self) -> list[GearPair]:
-        """A GearPair(joints=(B, A)) per <mimic> of a movable joint; the offsets stay in
-        ``self.leader`` (absorbed into the joint frames later)."""
-        elements = self.mimic_leaders()
-        self.check_mimic_cycles(elements)
-        if self.col.issues:
-            return []
-        return [self.mimic_pair(b, a, m) for b, (a, m, c) in self.leader.items()]
-
-    def mimic_leaders(self) -> dict:
-        """``self.leader[B] = (A, multiplier, offset)`` for each valid <mimic> of a movable
-        joint B; returns the <mimic> elements by follower name."""
-        self.leader: dict[str, tuple[str, float, float]] = {}
-        elements = {}
-        for name in self.joint_order:
-            if name not in self.movable:
-                continue
-            el = self.joint_el[name].find("mimic")
-            if el is None or el.get(q("derived")) == "true":
-                continue
-            path = f"joint '{name}'.mimic"
-            self.lines[path] = el.sourceline
-            a = el.get("joint")
-            if not a:
-                self.add(path, "<mimic> has no joint attribute", el)
-                continue
-            if a not in self.joint_el:
-                self.add(path, f"joint '{name}' mimics unknown joint '{a}'", el)
-                continue
-            if a not in self.movable:
-                self.add(path, f"joint '{name}' mimics fixed joint '{a}'", el)
-                continue
-            m = float(self.yjoints[name].mimic.multiplier)
-            c = float(self.yjoints[name].mimic.offset)
-            if m == 0:
-                self.add(path, "mimic multiplier must not be zero (a joint locked at its offset is a fixed joint)", el)
-                continue
-            self.leader[name] = (a, m, c)
-            elements[name] = el
-        return elements
-
-    def check_mimic_cycles(self, elements: dict) -> None:
-        """Report each cycle of joints following one another (once, from its first joint)."""
-        reported: set[str] = set()
-        for start in self.leader:
-            seen, x = [], start
-            while x in self.leader and x not in seen:
-                seen.append(x)
-                x = self.leader[x][0]
-            if x in seen and x not in reported:
-                cyc = seen[seen.index(x):]
-                reported.update(cyc)
-                first = min(cyc, key=self.joint_order.index)
-                loop = cyc[cyc.index(first):] + cyc[:cyc.index(first)] + [first]
-                self.add(f"joint '{first}'.mimic", f"mimic cycle: {' -> '.join(loop)} "
-                         "(each joint follows the next; no joint leads)", elements[first])
-
-    def mimic_pair(self, b: str, a: str, m: float) -> GearPair:
-        """The coupling q_B = m q_A, with the mesh geometry of B's gearcli:gear if any."""
-        jb, ja = self.movable[b], self.movable[a]
-        gear = self.joint_el[b].find(q("gear"))
-        kw = {}
-        if gear is not None:
-            kw = self.gear_geometry(gear, f"joint '{b}'.gearcli:gear", MIMIC_GEAR_ATTRS)
-            if jb.parent != ja.parent:
-                self.add(f"joint '{b}'.gearcli:gear", f"gear geometry on a mimic needs both joints on one "
-                         f"carrier, but '{b}' hangs from '{jb.parent}' and '{a}' from '{ja.parent}' "
-                         "(give the pair as a top-level gearcli:gear)", gear)
-            kw.setdefault("carrier", jb.parent)
-        name = kw.pop("name", None) or f"mimic_{b}"
-        return GearPair(name, jb.child, ja.child, ratio=m, joints=(b, a), path=f"joint '{b}'.mimic", **kw)
-
-    def absorb_offsets(self, joints: list[Joint]) -> list[Joint]:
-        """q_B = m q_A + c: count B from its offset (B's joint frame turned, or slid, by the
-        total offset along its mimic chain), so that q_B' = m q_A' is linear."""
-        total: dict[str, float] = {}
-
-        def offset(name: str) -> float:
-            if name not in self.leader:
-                return 0.0
-            if name not in total:
-                a, m, c = self.leader[name]
-                total[name] = m * offset(a) + c
-            return total[name]
-
-        out = []
-        for jt in joints:
-            c = offset(jt.name)
-            if c == 0.0:
-                out.append(jt)
-            elif jt.type == "prismatic":
-                out.append(replace(jt, p_pj=jt.p_pj + c * jt.R_pj[:, 2]))
-            else:
-                out.append(replace(jt, R_pj=jt.R_pj @ rot_z(c)))
-        return out
-
-    # -- gearcli extension elements -----------------------------------------------------------------
-    def read_extension(self) -> dict:
-        ext = {"mechanism": None, "gears": [], "motors": []}
-        for el in self.root:
-            if not isinstance(el.tag, str) or etree.QName(el).namespace != NS:
-                continue
-            local = etree.QName(el).localname
-            if el.get(q("derived")) == "true" or el.get("derived") == "true":
-                continue
-            if local == "mechanism":
-                if ext["mechanism"] is not None:
-                    self.add("gearcli:mechanism", "only one gearcli:mechanism element is allowed", el)
-                ext["mechanism"] = el
-                self.unknown_attrs(el, ("end_effector", "gravity", "open_loop", "description"), "gearcli:mechanism")
-                if el.get("end_effector"):
-                    self.lines["end_effector"] = el.sourceline
-            elif local == "gear":
-                ext["gears"].append(el)
-            elif local == "motor":
-                ext["motors"].append(el)
-            elif local in ("motor_rating", "gear_rating"):
-                continue  # read by io.ratings_reader
-            else:
-                self.add(f"gearcli:{local}", f"unknown gearcli element gearcli:{local} (expected gearcli:mechanism, "
-                         "gearcli:gear or gearcli:motor)", el)
-        return ext
-
-    def unknown_attrs(self, el, allowed, path: str) -> None:
-        for attr in el.attrib:
-            local = etree.QName(attr).localname
-            if local not in allowed:
-                self.add(path, f"unknown attribute '{local}' (allowed: {', '.join(allowed)})", el)
-
-    def link_ref(self, name: str | None, path: str, el, what: str = "link"):
-        """The body of link ``name`` and the link frame in it, or None (with an issue)."""
-        if name is None:
-            return None
-        if name not in self.body_of:
-            self.add(path, f"unknown {what} '{name}'", el)
-            return None
-        return self.body_of[name]
-
-    def gear_geometry(self, el, path: str, allowed) -> dict:
-        """GearPair keyword arguments from a gearcli:gear element's geometry attributes."""
-        self.unknown_attrs(el, allowed, path)
-        kw: dict = {}
-        if el.get("name"):
-            kw["name"] = el.get("name")
-        kind = el.get("kind", "external")
-        if kind not in GEAR_KINDS:
-            self.add(path, f"unknown gear kind '{kind}' (expected {', '.join(GEAR_KINDS)})", el)
-        kw["kind"] = kind
-        if el.get("teeth") is not None:
-            t = self.vector(el, "teeth", path, n=2)
-            if t is not None:
-                if np.any(t <= 0) or np.any(t != np.round(t)):
-                    self.add(path, f"teeth must be two positive integers, got \"{el.get('teeth')}\"", el)
-                kw["teeth"] = (int(t[0]), int(t[1]))
-        carrier = None
-        if el.get("carrier") is not None:
-            ref = self.link_ref(el.get("carrier"), path, el, "carrier link")
-            if ref is not None:
-                carrier = ref
-                kw["carrier"] = ref[0]
-        if el.get("mesh_point") is not None:
-            P = self.vector(el, "mesh_point", path)
-            if P is not None:
-                if carrier is not None:  # the mesh point is in the carrier link's frame
-                    T = carrier[1]
-                    P = T[:3, :3] @ P + T[:3, 3]
-                kw["mesh_point"] = P
-        for key in ("pressure_angle", "cone_angles"):
-            n = 1 if key == "pressure_angle" else 2
-            if el.get(key) is not None and el.get(f"{key}_deg") is not None:
-                self.add(path, f"give either {key} (rad) or {key}_deg, not both", el)
-            v = self.vector(el, key, path, n=n)
-            if v is None:
-                v = self.vector(el, f"{key}_deg", path, n=n)
-                v = None if v is None else np.deg2rad(v)
-            if v is not None:
-                kw[key] = float(v[0]) if n == 1 else (float(v[0]), float(v[1]))
-        if "cone_angles" in kw and kind != "bevel":
-            self.add(path, f"cone angles are only for bevel gears, this pair is {kind}", el)
-        return kw
-
-    def extension_gears(self, ext) -> list[GearPair]:
-        gears = []
-        names = {}
-        for i, el in enumerate(ext["gears"]):
-            name = el.get("name") or f"{el.get('j')}-{el.get('k')}"
-            path = f"gearcli:gear '{name}'"
-            self.lines[path] = el.sourceline
-            if name in names:
-                self.add(path, f"duplicate gear pair name '{name}' (first at line {names[name]})", el)
-            names[name] = el.sourceline
-            kw = self.gear_geometry(el, path, GEAR_ATTRS)
-            kw.pop("name", None)
-            ends = []
-            for key in ("j", "k"):
-                if not el.get(key):
-                    self.add(path, f"gearcli:gear needs attribute {key} (a link name)", el)
-                else:
-                    ref = self.link_ref(el.get(key), path, el)
-                    if ref is not None:
-                        ends.append(ref[0])
-            ratio = None
-            if el.get("ratio") is not None:
-                r = self.vector(el, "ratio", path, n=1)
-                if r is not None:
-                    ratio = float(r[0])
-                    if ratio == 0:
-                        self.add(path, "gear ratio must not be zero", el)
-            if ratio is None and "teeth" not in kw:
-                self.add(path, "a gear pair needs a ratio or tooth counts (teeth)", el)
-            if ratio is None and "mesh_point" not in kw:
-                self.add(path, "a gear pair without mesh_point needs an explicit signed ratio", el)
-            if len(ends) == 2:
-                if ends[0] == ends[1]:
-                    self.add(path, "a gear pair needs two different links", el)
-                gears.append(GearPair(name, ends[0], ends[1], ratio=ratio, path=path, **kw))
-        return gears
-
-    # -- motors ------------------------------------------------------------------------------------
-    def motors(self, ext, has_gears: bool) -> list[Motor]:
-        """The gearcli:motor elements if any; else a motor per actuator of the usable
-        <transmission>s and (without gearcli:gear elements) a direct drive per joint that is
-        driven by none, in joint order."""
-        if ext["motors"]:
-            out = [self.extension_motor(el) for el in ext["motors"]]
-            plain = [t for t in self.root.findall("transmission") if t.get(q("derived")) != "true"]
-            if plain:
-                self.warn("", f"{len(plain)} <transmission> element(s) are ignored: the gearcli:motor "
-                          "elements define the motors")
-            return [m for m in out if m is not None]
-        driven: dict[str, str] = {}
-        acts = self.transmission_motors(self.usable_transmissions(), driven)
-        if not has_gears:
-            # a direct drive for every joint that leads no driven mimic group
-            led = {self.chain_leader(j) for j in driven}
-            for name, jt in self.movable.items():
-                if name not in self.leader and name not in led:
-                    acts.append((self.joint_order.index(name), 0, Motor(name, jt.child, jt.parent, f"joint '{name}'")))
-        acts.sort(key=lambda t: (t[0], t[1]))
-        motors = [m for _, _, m in acts]
-        seen: dict[str, str] = {}
-        for m in motors:
-            if m.name in seen:
-                self.add(m.path, f"duplicate motor (actuator) name '{m.name}' (also in {seen[m.name]})")
-            seen[m.name] = m.path
-        return motors
-
-    def usable_transmissions(self) -> list:
-        """(spec, element) of each <transmission> that names known, movable joints and has a
-        supported type; the others are reported (errors) or ignored (warnings)."""
-        specs = read_transmissions(self.root)
-        elements = self.root.findall("transmission")
-        kept = []
-        for spec, el in zip(specs, elements):
-            if el.get(q("derived")) == "true":
-                continue
-            path = spec.path
-            self.lines[path] = spec.line
-            missing = [j for j in spec.joints if j not in self.joint_el]
-            for j in missing:
-                self.add(path, f"transmission '{spec.name}' names unknown joint '{j}'", el)
-            if missing:
-                continue
-            for p in spec.problems:
-                self.add(path, p, el)
-            if spec.problems:
-                continue
-            if spec.kind not in TRANSMISSION_KINDS:
-                self.warn(path, f"transmission type '{spec.kind or '?'}' is not supported and is ignored "
-                          f"(supported: {', '.join(TRANSMISSION_KINDS)}); its joints are driven directly", el)
-                continue
-            fixed = [j for j in spec.joints if j not in self.movable]
-            if fixed:
-                self.warn(path, f"transmission '{spec.name}' drives fixed joint(s) {', '.join(fixed)}: ignored", el)
-                continue
-            kept.append((spec, el))
-        return kept
-
-    def transmission_motors(self, kept: list, driven: dict) -> list:
-        """(first joint position, order, Motor) per actuator of the transmissions ``kept``;
-        ``driven[joint]`` = name of the transmission that drives it.  A transmission on a mimic
-        follower is dropped when its leader has its own actuator."""
-        acts: list[tuple[int, int, Motor]] = []
-        own = {j for spec, _ in kept for j in spec.joints if j not in self.leader}
-        for spec, el in kept:
-            followers = [j for j in spec.joints if j in self.leader]
-            if followers and all(self.chain_leader(j) in own for j in followers):
-                self.warn(spec.path, f"transmission '{spec.name}' drives joint(s) {', '.join(followers)}, which "
-                          "follow another joint through <mimic> whose actuator drives them: ignored", el)
-                continue
-            clash = [j for j in spec.joints if j in driven]
-            if clash:
-                self.add(spec.path, f"joint '{clash[0]}' is driven by transmissions '{driven[clash[0]]}' and "
-                         f"'{spec.name}'", el)
-                continue
-            for j in spec.joints:
-                driven[j] = spec.name
-            for k, act in enumerate(spec.actuators):
-                first = self.movable[act.joints[0][0]]
-                pos = min(self.joint_order.index(j) for j, _ in act.joints)
-                acts.append((pos, k, Motor(act.name, first.child, first.parent, spec.path,
-                                           joints=tuple((j, float(c)) for j, c in act.joints))))
-        return acts
-
-    def chain_leader(self, name: str) -> str:
-        while name in self.leader:
-            name = self.leader[name][0]
-        return name
-
-    def extension_motor(self, el) -> Motor | None:
-        name = el.get("name")
-        path = f"gearcli:motor '{name}'"
-        self.lines[path] = el.sourceline
-        self.unknown_attrs(el, ("name", "link", "stator", "joints", "coefficients"), path)
-        if not name or not el.get("link"):
-            self.add(path, "gearcli:motor needs attributes name and link", el)
-            return None
-        link = self.link_ref(el.get("link"), path, el)
-        stator = self.link_ref(el.get("stator"), path, el, "stator link") if el.get("stator") else None
-        joints: tuple = ()
-        if el.get("joints") is not None:
-            names = el.get("joints").split()
-            coefs = self.vector(el, "coefficients", path, n=len(names))
-            if coefs is None:
-                self.add(path, "gearcli:motor with joints needs as many coefficients", el)
-                return None
-            for j in names:
-                if j not in self.movable:
-                    self.add(path, f"motor '{name}' drives unknown joint '{j}'", el)
-            joints = tuple(zip(names, map(float, coefs)))
-        if link is None:
-            return None
-        return Motor(name, link[0], stator[0] if stator else None, path, joints=joints)
-
     # -- end effector ------------------------------------------------------------------------------
     def end_effector(self, mech_el) -> tuple[str, str]:
         open_loop = "tree"
@@ -791,6 +283,7 @@ class _Reader:
         return best, open_loop
 
 
+
 def _lump(parts) -> tuple[float, np.ndarray, np.ndarray]:
     """Mass, centre of mass and inertia about it (body axes) of rigidly joined parts, each
     (mass, centre of mass, inertia about its centre in body axes)."""
@@ -808,4 +301,5 @@ def _lump(parts) -> tuple[float, np.ndarray, np.ndarray]:
     return M, com, 0.5 * (I + I.T)
 
 
-__all__ = ["NS", "load_urdf", "parse_urdf"]
+__all__ = ["NS", "load_urdf", "parse_urdf", "q"]
+

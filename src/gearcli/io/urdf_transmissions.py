@@ -30,6 +30,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from ..model.validate import number_problem
+
 KINDS = ("SimpleTransmission", "DifferentialTransmission", "WristTransmission")
 
 
@@ -68,6 +70,10 @@ def _number(text: str | None, what: str, problems: list[str], default: float = 1
         return default
     if value == 0 or value != value or abs(value) == float("inf"):
         problems.append(f"{what} must be a finite nonzero number, got {text.strip()}")
+        return default
+    why = number_problem(value)
+    if why:
+        problems.append(f"{what} {why}")
         return default
     return value
 

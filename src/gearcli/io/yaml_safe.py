@@ -4,7 +4,7 @@ The file is parsed by libyaml's event parser when PyYAML has it (pure-Python PyY
 otherwise), and the node graph is composed here, iteratively, so that hostile files fail
 fast and small with one located message:
 
-* a file larger than :data:`MAX_BYTES`;
+* a file larger than :data:`~gearcli.io.limits.MAX_BYTES`;
 * nesting deeper than :data:`MAX_DEPTH` (``[[[[...``), more than :data:`MAX_NODES` nodes;
 * an alias to a node that contains it (``a: &a [*a]``);
 * aliases that expand the document beyond ``ALIAS_FACTOR`` times its own node count plus
@@ -28,8 +28,8 @@ from yaml.events import (AliasEvent, MappingEndEvent, MappingStartEvent, ScalarE
 from yaml.nodes import MappingNode, ScalarNode, SequenceNode
 
 from ..errors import Collector, Issue, MechanismError
+from .limits import read_bytes
 
-MAX_BYTES = 16 * 2**20
 MAX_DEPTH = 64
 MAX_NODES = 2_000_000
 MAX_INT_DIGITS = 4000   # Python refuses to convert longer ones (sys.int_info)
@@ -63,16 +63,8 @@ def _fail(file: str, mark, message: str):
 
 def read_text(path: str | Path, kind: str = "mechanism file") -> str:
     """The UTF-8 text of ``path``; raises MechanismError (one located line) when the file
-    cannot be read, is larger than :data:`MAX_BYTES` or is not UTF-8."""
-    path = Path(path)
-    try:
-        with open(path, "rb") as fh:
-            data = fh.read(MAX_BYTES + 1)
-    except OSError as exc:
-        raise MechanismError([Issue(str(path), "", None, f"cannot read file: {exc.strerror}")]) from None
-    if len(data) > MAX_BYTES:
-        raise MechanismError([Issue(str(path), "", None, f"file is larger than {MAX_BYTES // 2**20} MiB, "
-                                    f"the limit for a {kind}")])
+    cannot be read, is larger than :data:`~gearcli.io.limits.MAX_BYTES` or is not UTF-8."""
+    data = read_bytes(path, kind)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
