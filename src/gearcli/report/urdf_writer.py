@@ -77,17 +77,37 @@ def _sources(mech: Mechanism) -> list[str]:
 
 def to_element(an: Analysis):
     """The ``<robot>`` element of the URDF of analysed mechanism ``an``."""
-    import yourdfpy  # noqa: PLC0415
+    mech = an.mech
+    corr = _frame_corrections(mech)
+    body = _urdf_body(mech, corr)
+    root = etree.Element("robot", attrib={"name": mech.name}, nsmap={"gearcli": NS})
+    root.append(etree.Comment(f" written by gearcli export from {mech.source}; exact gear, motor and "
+                              f"mechanism data in the gearcli elements (namespace {NS}) "))
+    for el in list(body):
+        root.append(el)
+    jel = {el.get("name"): el for el in root.findall("joint")}
+    _add_mimics(an, jel, corr)
+    _add_transmissions(an, root)
+    _add_extension(an, root, corr)
+    return root
 
-    mech, tree = an.mech, an.tree
-    # URDF frame of every link in its gearcli frame: (R, t)
+
+def _frame_corrections(mech: Mechanism) -> dict:
+    """URDF frame (R, t) of every link in its gearcli frame."""
     corr = {mech.base: (np.eye(3), np.zeros(3))}
     for jt in mech.joints:
         corr[jt.child] = frame_correction(jt)
+    return corr
 
-    def to_urdf(link: str, x):
-        R, t = corr[link]
-        return R.T @ (np.asarray(x, float) - t)
+
+def _to_urdf(corr: dict, link: str, x) -> np.ndarray:
+    """Point ``x`` of ``link``'s gearcli frame in its URDF frame, m."""
+    R, t = corr[link]
+    return R.T @ (np.asarray(x, float) - t)
+
+
+def _urdf_links(mech: Mechanism, corr: dict) -> list:
+    import yourdfpy  # noqa: PLC0415
 
     links = []
     for link in mech.links:
@@ -95,40 +115,46 @@ def to_element(an: Analysis):
         inertial = None
         if link.mass > 0 or np.any(link.inertia != 0):
             T = np.eye(4)
-            T[:3, 3] = to_urdf(link.name, link.com)
+            T[:3, 3] = _to_urdf(corr, link.name, link.com)
             inertial = yourdfpy.Inertial(origin=T, mass=float(link.mass), inertia=R.T @ link.inertia @ R)
         links.append(yourdfpy.Link(name=link.name, inertial=inertial))
-    joints = []
-    for jt in mech.joints:
-        Rc, _ = frame_correction(jt)
-        Rp, tp = corr[jt.parent]
-        a = jt.R_jc.T[:, 2]
-        T = np.eye(4)
-        T[:3, :3] = Rp.T @ jt.R_pj @ align_z(a).T
-        T[:3, 3] = Rp.T @ (jt.p_pj - tp)
-        limit = None
-        lim = jt.source.get("limit") if isinstance(jt.source, dict) else None
-        if jt.type == "prismatic":
-            jtype = "prismatic"
-            limit = yourdfpy.Limit(**lim) if lim else yourdfpy.Limit(
-                effort=1e6, velocity=1e3, lower=-PRISMATIC_LIMIT, upper=PRISMATIC_LIMIT)
-        elif lim and jt.source.get("urdf_type") == "revolute":
-            jtype, limit = "revolute", yourdfpy.Limit(**lim)
-        else:
-            jtype = "continuous"
-        joints.append(yourdfpy.Joint(name=jt.name, type=jtype, parent=jt.parent, child=jt.child,
-                                     origin=T, axis=np.array([float(x) + 0.0 for x in a]), limit=limit))
-    robot = yourdfpy.Robot(name=mech.name, links=links, joints=joints)
-    body = yourdfpy.URDF(robot=robot, build_scene_graph=False, load_meshes=False).write_xml().getroot()
+    return links
 
-    root = etree.Element("robot", attrib={"name": mech.name}, nsmap={"gearcli": NS})
-    root.append(etree.Comment(f" written by gearcli export from {mech.source}; exact gear, motor and "
-                              f"mechanism data in the gearcli elements (namespace {NS}) "))
-    for el in list(body):
-        root.append(el)
-    jel = {el.get("name"): el for el in root.findall("joint")}
 
-    # --- couplings and derived mimics -------------------------------------------------
+def _urdf_joint(jt, corr: dict):
+    import yourdfpy  # noqa: PLC0415
+
+    Rp, tp = corr[jt.parent]
+    a = jt.R_jc.T[:, 2]
+    T = np.eye(4)
+    T[:3, :3] = Rp.T @ jt.R_pj @ align_z(a).T
+    T[:3, 3] = Rp.T @ (jt.p_pj - tp)
+    limit = None
+    lim = jt.source.get("limit") if isinstance(jt.source, dict) else None
+    if jt.type == "prismatic":
+        jtype = "prismatic"
+        limit = yourdfpy.Limit(**lim) if lim else yourdfpy.Limit(
+            effort=1e6, velocity=1e3, lower=-PRISMATIC_LIMIT, upper=PRISMATIC_LIMIT)
+    elif lim and jt.source.get("urdf_type") == "revolute":
+        jtype, limit = "revolute", yourdfpy.Limit(**lim)
+    else:
+        jtype = "continuous"
+    return yourdfpy.Joint(name=jt.name, type=jtype, parent=jt.parent, child=jt.child,
+                          origin=T, axis=np.array([float(x) + 0.0 for x in a]), limit=limit)
+
+
+def _urdf_body(mech: Mechanism, corr: dict):
+    """Links, inertials and the joint tree, written by yourdfpy."""
+    import yourdfpy  # noqa: PLC0415
+
+    robot = yourdfpy.Robot(name=mech.name, links=_urdf_links(mech, corr),
+                           joints=[_urdf_joint(jt, corr) for jt in mech.joints])
+    return yourdfpy.URDF(robot=robot, build_scene_graph=False, load_meshes=False).write_xml().getroot()
+
+
+def _add_mimics(an: Analysis, jel: dict, corr: dict) -> None:
+    """Joint couplings as <mimic> (with their gear geometry), derived mimics, axis labels."""
+    mech, tree = an.mech, an.tree
     coupled = set()
     for gi, gp in enumerate(mech.gears):
         if gp.joints is None:
@@ -140,7 +166,7 @@ def to_element(an: Analysis):
             circ = next(c for c in an.circuits if c.gear == gi)
             carrier = tree.links[circ.carrier]
             g = etree.SubElement(jel[b], q("gear"), name=gp.name, kind=gp.kind, carrier=carrier)
-            _gear_attrs(g, gp, to_urdf(carrier, gp.mesh_point))
+            _gear_attrs(g, gp, _to_urdf(corr, carrier, gp.mesh_point))
     for ji, jt in enumerate(mech.joints):
         if jt.name in coupled or ji in an.independent:
             continue
@@ -153,7 +179,10 @@ def to_element(an: Analysis):
         if jt.label is not None:
             etree.SubElement(jel[jt.name], q("joint"), label=str(jt.label))
 
-    # --- derived transmissions (for other tools) ---------------------------------------
+
+def _add_transmissions(an: Analysis, root) -> None:
+    """Derived <transmission> elements (for other tools) of motors acting on one joint."""
+    mech, tree = an.mech, an.tree
     for mi, m in enumerate(mech.motors):
         x, s = an.motor_links[mi], an.motor_stators[mi]
         if m.joints:
@@ -171,7 +200,10 @@ def to_element(an: Analysis):
         act = etree.SubElement(t, "actuator", name=m.name)
         etree.SubElement(act, "mechanicalReduction").text = _num(n)
 
-    # --- gearcli extension elements ---------------------------------------------------------
+
+def _add_extension(an: Analysis, root, corr: dict) -> None:
+    """The gearcli extension elements: mechanism, gear pairs, motors."""
+    mech, tree = an.mech, an.tree
     mattrs = {"end_effector": mech.end_effector, "gravity": _vec(mech.gravity)}
     if an.open_loop == "tree":
         mattrs["open_loop"] = "tree"
@@ -184,13 +216,12 @@ def to_element(an: Analysis):
         g = etree.SubElement(root, q("gear"), name=gp.name, j=gp.j, k=gp.k, kind=gp.kind, carrier=carrier)
         if gp.ratio is not None:
             g.set("ratio", _num(gp.ratio))
-        _gear_attrs(g, gp, None if gp.mesh_point is None else to_urdf(carrier, gp.mesh_point))
+        _gear_attrs(g, gp, None if gp.mesh_point is None else _to_urdf(corr, carrier, gp.mesh_point))
     for mi, m in enumerate(mech.motors):
         el = etree.SubElement(root, q("motor"), name=m.name, link=m.link, stator=tree.links[an.motor_stators[mi]])
         if m.joints:
             el.set("joints", " ".join(j for j, _ in m.joints))
             el.set("coefficients", _vec([c for _, c in m.joints]))
-    return root
 
 
 def _gear_attrs(el, gp, mesh_point) -> None:
