@@ -21,8 +21,8 @@ import numpy as np
 from ..errors import Collector
 from ..model.mechanism import GearPair, Joint, Link, Mechanism, Motor
 from .ratings_reader import attach_yaml_ratings
+from ..model.geometry import dh_transform, origin_axis_transform
 from ..model.validate import check_inertia, inertia_matrix, number_problem
-from ..spatial import align_z, rot_x, rot_z, rpy_matrix
 from .yaml_safe import read_text, yaml_lines
 
 
@@ -145,7 +145,7 @@ def joint_geometry(spec: dict, col: Collector, path: str):
         theta = _angle(dh, "theta", col, f"{path}.dh")
         alpha = _angle(dh, "alpha", col, f"{path}.dh")
         d, a = float(dh.get("d", 0.0)), float(dh.get("a", 0.0))
-        return rot_z(theta), np.array([0.0, 0.0, d]), rot_x(alpha), np.array([a, 0.0, 0.0])
+        return dh_transform(theta, d, a, alpha)
     origin = spec.get("origin", {})
     xyz = np.asarray(origin.get("xyz", [0.0, 0.0, 0.0]), float)
     if "rpy" in origin and "rpy_deg" in origin:
@@ -155,8 +155,7 @@ def joint_geometry(spec: dict, col: Collector, path: str):
     if np.linalg.norm(axis) < 1e-12:
         col.add(f"{path}.axis", "joint axis must not be the zero vector")
         axis = np.array([0.0, 0.0, 1.0])
-    A = align_z(axis)
-    return rpy_matrix(rpy) @ A, xyz, A.T, np.zeros(3)
+    return origin_axis_transform(xyz, rpy, axis)
 
 
 def _build(data: dict, col: Collector, file: str, lines: dict) -> Mechanism:
