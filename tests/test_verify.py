@@ -229,3 +229,52 @@ def test_readme_documents_every_manifest_key():
             yield from keys(v)
     missing = sorted({k for k in keys(design_schema()) if not re.search(rf"`[^`\n]*\b{k}\b[^`\n]*`", readme)})
     assert not missing, f"README lacks manifest keys {missing}"
+
+
+def test_unreachable_dask_scheduler_is_bad_input(run_cli, tmp_path, monkeypatch):
+    pytest.importorskip("dask.distributed")
+    from gearcli.batch import runner
+
+    monkeypatch.setattr(runner, "DASK_TIMEOUT", 0.5)
+    r = run_cli("verify", DESIGNS / "ci_example.yaml", "--dask", "tcp://127.0.0.1:9")
+    assert r.exit_code == 2
+    assert r.stderr.startswith("--dask: cannot connect to the scheduler at 'tcp://127.0.0.1:9'")
+
+
+def test_bevel_tooth_stresses_of_the_rated_wrist_by_hand(run_cli, tmp_path, mech_dir):
+    # Pair 5-6: 25:25 bevel gears, pitch radius 25 mm at the mesh point, cone angles 45 deg,
+    # m = 2 mm, b = 8 mm, 20 deg.  Tredgold's virtual spur gears: z_v = 25 / cos 45 = 35.36,
+    # d_v = 50 mm / cos 45.  Lewis Y(35.36) interpolated in Shigley's Table 14-2 between
+    # 34 (0.371) and 38 (0.384); Hertz from the radii of curvature r = d_v sin(phi) / 2.
+    from gearcli import analyse, load_mechanism, named_columns, solve
+    from gearcli.io.trajectory import read_trajectory
+
+    js = tmp_path / "r.json"
+    assert run_cli("verify", DESIGNS / "ci_example.yaml", "--json", js, "-j", "1").exit_code == 0
+    checks = by_name(json.loads(js.read_text()))
+    an = analyse(load_mechanism(mech_dir / "bendix_wrist_rated.yaml"))
+    tr = read_trajectory(mech_dir / "bendix_wrist_traj.csv", an.independent_names)
+    t_peak = np.abs(named_columns(an, solve(an, tr.q, tr.qd, tr.qdd), tr.t)["gear:5-6:t"]).max()
+    zv = 25 / math.cos(math.pi / 4)
+    Y = 0.371 + (zv - 34) / (38 - 34) * (0.384 - 0.371)
+    sigma_F = t_peak / (0.008 * 0.002 * Y)
+    assert checks[("wrist_motion", "gear 5-6", "bending safety")]["value"] == pytest.approx(2e8 / sigma_F, rel=1e-9)
+    phi = math.radians(20)
+    r_v = 0.05 / math.cos(math.pi / 4) * math.sin(phi) / 2
+    ZE = math.sqrt(1 / (math.pi * 2 * (1 - 0.3**2) / 206e9))      # steel on steel, Z_E by definition
+    sigma_H = ZE * math.sqrt(t_peak / (0.008 * math.cos(phi)) * (2 / r_v))
+    assert checks[("wrist_motion", "gear 5-6", "contact safety")]["value"] == pytest.approx(9e8 / sigma_H, rel=2e-3)
+
+
+def test_degrees_case_gives_the_radian_results(run_cli, tmp_path):
+    case = write_rotor_case(tmp_path, "[{name: x, position: 0, C: 3000, C0: 3000, type: ball}]")
+    data = np.loadtxt(tmp_path / "rotor.csv", delimiter=",", skiprows=1)
+    data[:, 1:] = np.degrees(data[:, 1:])
+    np.savetxt(tmp_path / "rotor_deg.csv", data, delimiter=",", header="t,q:J,qd:J,qdd:J", comments="")
+    _, rad = run_json(run_cli, tmp_path, "cases:\n" + case)
+    deg_case = case.replace("[rotor.csv]", "[rotor_deg.csv]").replace("cycles_per_hour", "degrees: true, cycles_per_hour")
+    _, deg = run_json(run_cli, tmp_path, "cases:\n" + deg_case)
+    for a, b in zip(rad["checks"], deg["checks"]):
+        assert (a["component"], a["quantity"]) == (b["component"], b["quantity"])
+        assert b["value"] == pytest.approx(a["value"], rel=1e-9)
+    assert by_name(rad)[("rotor", "motor m", "speed")]["value"] == pytest.approx(W, rel=1e-12)

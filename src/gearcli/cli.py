@@ -350,7 +350,7 @@ def verify(
     manifest = load_manifest(design)
     err = Console(stderr=True, markup=False, highlight=False)
     progress = Progress(TextColumn("verifying"), BarColumn(), TextColumn("{task.completed}/{task.total} trajectories"),
-                        console=err, transient=True)
+                        console=err, transient=True, disable=not err.is_terminal)
     task = progress.add_task("verify", total=count_jobs(manifest))
     with progress:
         outcome = run_verify(design, jobs=jobs, dask_address=dask, junit=junit, json_path=json_out,

@@ -19,7 +19,7 @@ import numpy as np
 from ..design.checks import build_checks
 from ..design.evaluate import Samples, Verdict, combine, partials, signal
 from ..dynamics.solve import solve
-from ..errors import Collector
+from ..errors import Collector, GearcliError
 from ..io import load_mechanism
 from ..io.trajectory import read_trajectory
 from ..pipeline import analyse, prismatic_independent
@@ -113,13 +113,29 @@ def _run_local(todo: list[Job], workers: int, progress) -> dict:
     return results
 
 
+DASK_TIMEOUT = 10.0
+"""s to wait for the Dask scheduler before reporting it unreachable."""
+
+
+def _dask_client(address: str):
+    try:
+        from dask.distributed import Client  # noqa: PLC0415 (optional dependency)
+    except ImportError:
+        raise GearcliError("--dask needs dask.distributed: pip install 'gearcli[design]'") from None
+    try:
+        return Client(address, set_as_default=False, timeout=DASK_TIMEOUT)
+    except (OSError, TimeoutError, ValueError, TypeError) as exc:
+        raise GearcliError(f"--dask: cannot connect to the scheduler at '{address}': "
+                           f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__}") from None
+
+
 def _run_dask(todo: list[Job], address: str, progress) -> dict:
-    from dask.distributed import Client, as_completed as dask_completed  # noqa: PLC0415 (optional)
+    from dask.distributed import as_completed as dask_completed  # noqa: PLC0415 (optional)
 
     results = {}
-    with Client(address, set_as_default=False) as client:
+    with _dask_client(address) as client:
         futures = {client.submit(run_job, job, pure=False): job for job in todo}
-        for fut in dask_completed(list(futures)):
+        for fut in dask_completed(list(futures), loop=client.loop):
             job = futures[fut]
             results[(job.case, job.trajectory)] = fut.result()
             if progress:

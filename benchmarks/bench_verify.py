@@ -1,0 +1,83 @@
+"""Wall time of `gearcli verify` run serially, in processes and on Dask (prints figures; not a test).
+
+    python benchmarks/bench_verify.py [--trajectories 8] [--samples 20000] [--repeat 3]
+
+Builds a manifest over the rated Bendix wrist with --trajectories trajectory files of
+--samples samples each (a 1 Hz / 0.7 Hz / 1.3 Hz multi-sine), then reports the median
+wall time over --repeat runs of: -j 1 (this process), -j 2 (process pool) and a Dask
+LocalCluster with 2 worker processes (cluster start-up excluded), their ratios, and that
+the three JSON reports are identical.  The load average is printed with the figures: the
+machine is shared, so compare the ratios rather than single numbers.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from gearcli.batch.verify import run_verify
+from gearcli.io.trajectory import write_trajectory
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def make_manifest(d: Path, n_traj: int, n: int) -> Path:
+    t = np.linspace(0, n / 1000, n)
+    for k in range(n_traj):
+        a = 1 + 0.1 * k
+        q = np.column_stack([a * np.sin(2 * np.pi * t), 0.5 * np.sin(2 * np.pi * 0.7 * t),
+                             0.8 * np.cos(2 * np.pi * 1.3 * t)])
+        write_trajectory(d / f"traj_{k:02d}.csv", ["J1", "J2", "J3"], t, q)
+    man = d / "design.yaml"
+    man.write_text(f"cases:\n  - name: wrist\n    mechanism: {ROOT / 'mechanisms' / 'bendix_wrist_rated.yaml'}\n"
+                   "    trajectories: traj_*.csv\n    cycles_per_hour: 60\n    bearing_life_h: 20000\n")
+    return man
+
+
+def timed(fn, repeat: int) -> tuple[float, object]:
+    times, out = [], None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times), out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--trajectories", type=int, default=8)
+    ap.add_argument("--samples", type=int, default=20_000)
+    ap.add_argument("--repeat", type=int, default=3)
+    args = ap.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        d = Path(tmp)
+        man = make_manifest(d, args.trajectories, args.samples)
+
+        def run(name, **kw):
+            out = d / f"{name}.json"
+            run_verify(man, json_path=out, **kw)
+            return json.loads(out.read_text())
+
+        serial_t, serial = timed(lambda: run("serial", jobs=1), args.repeat)
+        pool_t, pool = timed(lambda: run("pool", jobs=2), args.repeat)
+        from dask.distributed import LocalCluster
+
+        with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl:
+            dask_t, dask = timed(lambda: run("dask", dask_address=cl.scheduler_address), args.repeat)
+    total = args.trajectories * args.samples
+    print(f"gearcli verify: {args.trajectories} trajectories x {args.samples:,} samples "
+          f"({len(serial['checks'])} checks), medians of {args.repeat}; load average {os.getloadavg()[0]:.2f}")
+    print(f"  -j 1 (serial)       {serial_t:7.2f} s  {total / serial_t:10,.0f} samples/s")
+    print(f"  -j 2 (processes)    {pool_t:7.2f} s  {total / pool_t:10,.0f} samples/s  speed-up {serial_t / pool_t:.2f}x")
+    print(f"  --dask (2 workers)  {dask_t:7.2f} s  {total / dask_t:10,.0f} samples/s  speed-up {serial_t / dask_t:.2f}x")
+    print(f"  identical reports: {serial == pool == dask}")
+
+
+if __name__ == "__main__":
+    main()
