@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 from lxml import etree
 
-from ..model.mechanism import GEAR_KINDS, GearPair, Motor
+from ..model.mechanism import GearPair, Motor
+from ..model.validate import gear_pair_problems
 from .urdf_transmissions import KINDS as TRANSMISSION_KINDS
 from .urdf_transmissions import read_transmissions
 from .urdf_xml import NS, q
@@ -68,8 +69,6 @@ class Extension:
         if el.get("name"):
             kw["name"] = el.get("name")
         kind = el.get("kind", "external")
-        if kind not in GEAR_KINDS:
-            self.add(path, f"unknown gear kind '{kind}' (expected {', '.join(GEAR_KINDS)})", el)
         kw["kind"] = kind
         if el.get("teeth") is not None:
             t = self.vector(el, "teeth", path, n=2)
@@ -100,9 +99,15 @@ class Extension:
                 v = None if v is None else np.deg2rad(v)
             if v is not None:
                 kw[key] = float(v[0]) if n == 1 else (float(v[0]), float(v[1]))
-        if "cone_angles" in kw and kind != "bevel":
-            self.add(path, f"cone angles are only for bevel gears, this pair is {kind}", el)
         return kw
+
+    def check_gear_pair(self, el, path: str, j: str | None, k: str | None, kw: dict, ratio) -> None:
+        """The checks every gear pair declaration gets (:func:`gearcli.model.validate.gear_pair_problems`);
+        ``j``/``k`` None when unknown (already reported)."""
+        same = j is not None and j == k
+        for _, message in gear_pair_problems("j", "j" if same else "k", kw["kind"], ratio, "teeth" in kw,
+                                             "mesh_point" in kw, "cone_angles" in kw):
+            self.add(path, message, el)
 
     def extension_gears(self, ext) -> list[GearPair]:
         gears = []
@@ -127,17 +132,9 @@ class Extension:
             ratio = None
             if el.get("ratio") is not None:
                 r = self.vector(el, "ratio", path, n=1)
-                if r is not None:
-                    ratio = float(r[0])
-                    if ratio == 0:
-                        self.add(path, "gear ratio must not be zero", el)
-            if ratio is None and "teeth" not in kw:
-                self.add(path, "a gear pair needs a ratio or tooth counts (teeth)", el)
-            if ratio is None and "mesh_point" not in kw:
-                self.add(path, "a gear pair without mesh_point needs an explicit signed ratio", el)
+                ratio = None if r is None else float(r[0])
+            self.check_gear_pair(el, path, *(ends if len(ends) == 2 else (None, None)), kw, ratio)
             if len(ends) == 2:
-                if ends[0] == ends[1]:
-                    self.add(path, "a gear pair needs two different links", el)
                 gears.append(GearPair(name, ends[0], ends[1], ratio=ratio, path=path, **kw))
         return gears
 

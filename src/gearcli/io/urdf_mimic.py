@@ -80,6 +80,7 @@ class Mimics:
         kw = {}
         if gear is not None:
             kw = self.gear_geometry(gear, f"joint '{b}'.gearcli:gear", MIMIC_GEAR_ATTRS)
+            self.check_gear_pair(gear, f"joint '{b}'.gearcli:gear", jb.child, ja.child, kw, m)
             if jb.parent != ja.parent:
                 self.add(f"joint '{b}'.gearcli:gear", f"gear geometry on a mimic needs both joints on one "
                          f"carrier, but '{b}' hangs from '{jb.parent}' and '{a}' from '{ja.parent}' "

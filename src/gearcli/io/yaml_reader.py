@@ -22,7 +22,7 @@ from ..errors import Collector
 from ..model.mechanism import GearPair, Joint, Link, Mechanism, Motor
 from .ratings_reader import attach_yaml_ratings
 from ..model.geometry import dh_transform, origin_axis_transform
-from ..model.validate import check_inertia, inertia_matrix, number_problem
+from ..model.validate import check_inertia, gear_pair_problems, inertia_matrix, number_problem
 from .yaml_safe import read_text, yaml_lines
 
 
@@ -158,19 +158,49 @@ def joint_geometry(spec: dict, col: Collector, path: str):
     return origin_axis_transform(xyz, rpy, axis)
 
 
+class _Names:
+    """Names declared in one list of the file (links, joints, ...): first path of each,
+    duplicates and unknown references reported."""
+
+    def __init__(self, col: Collector, what: str):
+        self.col, self.what, self.first = col, what, {}
+
+    def declare(self, name: str, path: str) -> None:
+        if name in self.first:
+            self.col.add(f"{path}.name", f"duplicate {self.what} name '{name}' (first at {self.first[name]})")
+        self.first[name] = path
+
+    def ref(self, value: str, path: str, what: str = "link") -> None:
+        if value not in self.first:
+            self.col.add(path, f"unknown {what} '{value}'")
+
+
 def _build(data: dict, col: Collector, file: str, lines: dict) -> Mechanism:
-    base = data["base"]
-    links: list[Link] = []
-    names: dict[str, str] = {}
+    """The Mechanism of validated ``data``: links, joints, gears and motors in turn, each
+    checked for names, references and values."""
+    links, link_list = _links(data, col)
+    for key in ("base", "end_effector"):
+        links.ref(data[key], key)
+    return Mechanism(
+        name=data["name"], base=data["base"], end_effector=data["end_effector"],
+        links=tuple(link_list), joints=tuple(_joints(data, col, links)),
+        gears=tuple(_gears(data, col, links)), motors=tuple(_motors(data, col, links)),
+        gravity=np.asarray(data.get("gravity", [0.0, 0.0, -9.81]), float),
+        source=file, lines=dict(lines),
+    )
+
+
+def _links(data: dict, col: Collector) -> tuple[_Names, list[Link]]:
+    """The link names (declared) and the links, masses and inertias checked."""
+    names = _Names(col, "link")
+    out: list[Link] = []
     for i, spec in enumerate(data["links"]):
         path = f"links[{i}]"
         name = spec["name"]
-        if name in names:
-            col.add(f"{path}.name", f"duplicate link name '{name}' (first at {names[name]})")
-        names[name] = path
+        names.declare(name, path)
         mass = float(spec.get("mass", 0.0))
         I = inertia_matrix(spec["inertia"]) if "inertia" in spec else np.zeros((3, 3))
-        if name != base:
+        if name != data["base"]:
             if "mass" not in spec:
                 col.add(path, f"link '{name}' has no mass")
             elif mass <= 0:
@@ -178,59 +208,48 @@ def _build(data: dict, col: Collector, file: str, lines: dict) -> Mechanism:
             why = check_inertia(I, mass)
             if why:
                 col.add(f"{path}.inertia", why)
-        links.append(Link(name, mass, np.asarray(spec.get("com", [0, 0, 0]), float), I, path))
+        out.append(Link(name, mass, np.asarray(spec.get("com", [0, 0, 0]), float), I, path))
+    return names, out
 
-    def ref(value: str, path: str, what: str = "link") -> None:
-        if value not in names:
-            col.add(path, f"unknown {what} '{value}'")
 
-    for key in ("base", "end_effector"):
-        ref(data[key], key)
-
+def _joints(data: dict, col: Collector, links: _Names) -> list[Joint]:
     joints: list[Joint] = []
-    jnames: dict[str, str] = {}
+    names = _Names(col, "joint")
     for i, spec in enumerate(data["joints"]):
         path = f"joints[{i}]"
-        if spec["name"] in jnames:
-            col.add(f"{path}.name", f"duplicate joint name '{spec['name']}' (first at {jnames[spec['name']]})")
-        jnames[spec["name"]] = path
-        ref(spec["parent"], f"{path}.parent")
-        ref(spec["child"], f"{path}.child")
+        names.declare(spec["name"], path)
+        links.ref(spec["parent"], f"{path}.parent")
+        links.ref(spec["child"], f"{path}.child")
         if spec["parent"] == spec["child"]:
             col.add(f"{path}.child", "a joint cannot connect a link to itself")
         R_pj, p_pj, R_jc, p_jc = joint_geometry(spec, col, path)
         source = {k: spec[k] for k in ("dh", "origin", "axis") if k in spec}
         joints.append(Joint(spec["name"], spec["parent"], spec["child"], R_pj, p_pj, R_jc, p_jc,
                             spec.get("type", "revolute"), spec.get("label"), source, path))
+    return joints
 
+
+_GEAR_FIELD = {"": "", "links": ".links", "kind": ".kind", "ratio": ".ratio", "cone_angles": ".cone_angles_deg"}
+
+
+def _gears(data: dict, col: Collector, links: _Names) -> list[GearPair]:
     gears: list[GearPair] = []
-    gnames: dict[str, str] = {}
+    names = _Names(col, "gear pair")
     for i, spec in enumerate(data.get("gears", [])):
         path = f"gears[{i}]"
         j, k = spec["links"]
-        ref(j, f"{path}.links[0]")
-        ref(k, f"{path}.links[1]")
-        if j == k:
-            col.add(f"{path}.links", "a gear pair needs two different links")
-        name = spec.get("name", f"{j}-{k}")
-        if name in gnames:
-            col.add(f"{path}.name", f"duplicate gear pair name '{name}' (first at {gnames[name]})")
-        gnames[name] = path
+        links.ref(j, f"{path}.links[0]")
+        links.ref(k, f"{path}.links[1]")
+        names.declare(spec.get("name", f"{j}-{k}"), path)
         if "carrier" in spec:
-            ref(spec["carrier"], f"{path}.carrier")
-        if "ratio" not in spec and "teeth" not in spec:
-            col.add(path, "a gear pair needs a ratio or tooth counts (teeth)")
-        if spec.get("ratio", 1.0) == 0:
-            col.add(f"{path}.ratio", "gear ratio must not be zero")
-        if "mesh_point" not in spec and "ratio" not in spec:
-            col.add(path, "a gear pair without mesh_point needs an explicit signed ratio")
-        kind = spec.get("kind", "external")
-        cones = spec.get("cone_angles_deg")
-        if cones is not None and kind != "bevel":
-            col.add(f"{path}.cone_angles_deg", f"cone angles are only for bevel gears, this pair is {kind}")
+            links.ref(spec["carrier"], f"{path}.carrier")
+        kind, cones = spec.get("kind", "external"), spec.get("cone_angles_deg")
+        ratio = float(spec["ratio"]) if "ratio" in spec else None
+        for field, message in gear_pair_problems(j, k, kind, ratio, "teeth" in spec, "mesh_point" in spec,
+                                                 cones is not None):
+            col.add(path + _GEAR_FIELD[field], message)
         gears.append(GearPair(
-            name, j, k, kind,
-            float(spec["ratio"]) if "ratio" in spec else None,
+            spec.get("name", f"{j}-{k}"), j, k, kind, ratio,
             tuple(spec["teeth"]) if "teeth" in spec else None,
             np.asarray(spec["mesh_point"], float) if "mesh_point" in spec else None,
             spec.get("carrier"),
@@ -238,22 +257,17 @@ def _build(data: dict, col: Collector, file: str, lines: dict) -> Mechanism:
             tuple(np.deg2rad(cones)) if cones is not None else None,
             path,
         ))
+    return gears
 
+
+def _motors(data: dict, col: Collector, links: _Names) -> list[Motor]:
     motors: list[Motor] = []
-    mnames: dict[str, str] = {}
+    names = _Names(col, "motor")
     for i, spec in enumerate(data.get("motors", [])):
         path = f"motors[{i}]"
-        if spec["name"] in mnames:
-            col.add(f"{path}.name", f"duplicate motor name '{spec['name']}' (first at {mnames[spec['name']]})")
-        mnames[spec["name"]] = path
-        ref(spec["link"], f"{path}.link")
+        names.declare(spec["name"], path)
+        links.ref(spec["link"], f"{path}.link")
         if "stator" in spec:
-            ref(spec["stator"], f"{path}.stator")
+            links.ref(spec["stator"], f"{path}.stator")
         motors.append(Motor(spec["name"], spec["link"], spec.get("stator"), path))
-
-    return Mechanism(
-        name=data["name"], base=base, end_effector=data["end_effector"],
-        links=tuple(links), joints=tuple(joints), gears=tuple(gears), motors=tuple(motors),
-        gravity=np.asarray(data.get("gravity", [0.0, 0.0, -9.81]), float),
-        source=file, lines=dict(lines),
-    )
+    return motors

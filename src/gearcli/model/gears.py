@@ -51,70 +51,92 @@ def gear_geometry(kind: str, P, oj, zj, ok, zk, teeth=None, ratio=None, cones=No
                   names=("j", "k")) -> tuple[GearGeometry | None, list[tuple[str, str]]]:
     """Geometry of a pair from the pitch point and the two axis lines (carrier frame).
 
+    Steps: the radial feet of P on both axes; the pitch element and cone angles of parallel
+    (:func:`_parallel`) or intersecting (:func:`_intersecting`) axes; the contact directions
+    and the geometric ratio (:func:`_contact`); the given ratio, tooth counts and cone angles
+    against the geometry (:func:`_given_values`).
+
     Returns the geometry and a list of (field, problem) pairs; the geometry is None when a
     problem makes it meaningless.
     """
     P, oj, zj, ok, zk = (np.asarray(x, float) for x in (P, oj, zj, ok, zk))
     zj, zk = zj / np.linalg.norm(zj), zk / np.linalg.norm(zk)
-    problems: list[tuple[str, str]] = []
-    nj, nk = names
     rad_j, r_j = _foot(P, oj, zj)
     rad_k, r_k = _foot(P, ok, zk)
     scale = max(1.0, r_j, r_k)
-    for r, n in ((r_j, nj), (r_k, nk)):
-        if r < TOL_GEOM * scale:
-            problems.append(("mesh_point", f"mesh point lies on the axis of gear '{n}'"))
+    problems = [("mesh_point", f"mesh point lies on the axis of gear '{n}'")
+                for r, n in ((r_j, names[0]), (r_k, names[1])) if r < TOL_GEOM * scale]
     if problems:
         return None, problems
-    parallel = np.linalg.norm(np.cross(zj, zk)) < TOL_GEOM
-    ring = None
-    if parallel:
-        if np.linalg.norm(np.cross(rad_j, rad_k)) > 1e-6:
-            problems.append(("mesh_point", "mesh point is not on the line of centres of the two parallel axes"))
-            return None, problems
-        same_side = rad_j @ rad_k > 0
-        if kind == "bevel":
-            problems.append(("kind", "bevel gears need intersecting axes, these axes are parallel"))
-        elif kind == "external" and same_side:
-            problems.append(("kind", "external pair, but the mesh point lies on the same side of both "
-                             "axes (that is an internal/ring pair)"))
-        elif kind == "internal" and not same_side:
-            problems.append(("kind", "internal pair, but the mesh point lies between the two axes "
-                             "(that is an external pair)"))
-        if kind == "internal":
-            ring = 0 if r_j > r_k else 1
-        element = zj
-        cone_j = cone_k = 0.0
+    if np.linalg.norm(np.cross(zj, zk)) < TOL_GEOM:
+        pitch = _parallel(kind, zj, rad_j, rad_k, r_j, r_k, problems)
     else:
-        # closest points of the two axis lines
-        n = np.cross(zj, zk)
-        n /= np.linalg.norm(n)
-        gap = abs((ok - oj) @ n)
-        if gap > TOL_GEOM * scale:
-            problems.append(("mesh_point", f"the gear axes are skew (they miss each other by {gap:.4g} m): "
-                             "only parallel (spur) and intersecting (bevel) axes are supported"))
-            return None, problems
-        # apex: oj + s zj = ok + u zk
-        M = np.stack([zj, -zk], axis=1)
-        s, u = np.linalg.lstsq(M, ok - oj, rcond=None)[0]
-        apex = oj + s * zj
-        if abs((P - apex) @ n) > 1e-6 * scale:
-            problems.append(("mesh_point", "mesh point is not in the plane of the two gear axes"))
-            return None, problems
-        if kind != "bevel":
-            problems.append(("kind", f"{kind} gears need parallel axes, these axes intersect (use kind: bevel)"))
-        element = (P - apex) / np.linalg.norm(P - apex)
-        cone_j = float(np.arccos(np.clip(abs(element @ zj), 0, 1)))
-        cone_k = float(np.arccos(np.clip(abs(element @ zk), 0, 1)))
+        pitch = _intersecting(kind, P, oj, zj, ok, zk, scale, problems)
+    if pitch is None:
+        return None, problems
+    element, cone_j, cone_k, ring = pitch
+    ut, us, e = _contact(zj, zk, rad_j, rad_k, r_j, r_k, element, ring)
+    problems += _given_values(ratio, teeth, cones, e, r_j, r_k, cone_j, cone_k, names)
+    return GearGeometry(P, zj, zk, rad_j, rad_k, ut, us, r_j, r_k, e, cone_j, cone_k, ring), problems
+
+
+def _parallel(kind, zj, rad_j, rad_k, r_j, r_k, problems):
+    """Spur pair (parallel axes): (pitch element, cone_j, cone_k, ring), or None when the
+    mesh point is off the line of centres; ``problems`` gets the kind contradictions."""
+    if np.linalg.norm(np.cross(rad_j, rad_k)) > 1e-6:
+        problems.append(("mesh_point", "mesh point is not on the line of centres of the two parallel axes"))
+        return None
+    same_side = rad_j @ rad_k > 0
+    if kind == "bevel":
+        problems.append(("kind", "bevel gears need intersecting axes, these axes are parallel"))
+    elif kind == "external" and same_side:
+        problems.append(("kind", "external pair, but the mesh point lies on the same side of both "
+                         "axes (that is an internal/ring pair)"))
+    elif kind == "internal" and not same_side:
+        problems.append(("kind", "internal pair, but the mesh point lies between the two axes "
+                         "(that is an external pair)"))
+    ring = (0 if r_j > r_k else 1) if kind == "internal" else None
+    return zj, 0.0, 0.0, ring
+
+
+def _intersecting(kind, P, oj, zj, ok, zk, scale, problems):
+    """Bevel pair (intersecting axes): (pitch element from the apex to P, cone_j, cone_k,
+    None), or None when the axes are skew or P is off their plane."""
+    n = np.cross(zj, zk)
+    n /= np.linalg.norm(n)
+    gap = abs((ok - oj) @ n)
+    if gap > TOL_GEOM * scale:
+        problems.append(("mesh_point", f"the gear axes are skew (they miss each other by {gap:.4g} m): "
+                         "only parallel (spur) and intersecting (bevel) axes are supported"))
+        return None
+    # apex: oj + s zj = ok + u zk
+    s, _ = np.linalg.lstsq(np.stack([zj, -zk], axis=1), ok - oj, rcond=None)[0]
+    apex = oj + s * zj
+    if abs((P - apex) @ n) > 1e-6 * scale:
+        problems.append(("mesh_point", "mesh point is not in the plane of the two gear axes"))
+        return None
+    if kind != "bevel":
+        problems.append(("kind", f"{kind} gears need parallel axes, these axes intersect (use kind: bevel)"))
+    element = (P - apex) / np.linalg.norm(P - apex)
+    cone_j = float(np.arccos(np.clip(abs(element @ zj), 0, 1)))
+    cone_k = float(np.arccos(np.clip(abs(element @ zk), 0, 1)))
+    return element, cone_j, cone_k, None
+
+
+def _contact(zj, zk, rad_j, rad_k, r_j, r_k, element, ring):
+    """Tangential and separating unit vectors on gear j (ut, us) and the ratio e_kj from
+    rolling at the pitch point."""
     ut = np.cross(zj, rad_j)
     tk = np.cross(zk, rad_k)
-    c_j = r_j * (ut @ ut)
-    c_k = r_k * (tk @ ut)
-    e = c_k / c_j
+    e = (r_k * (tk @ ut)) / (r_j * (ut @ ut))
     us = -rad_j + (rad_j @ element) * element
     us /= np.linalg.norm(us)
-    if ring == 0:
-        us = -us
+    return ut, (-us if ring == 0 else us), e
+
+
+def _given_values(ratio, teeth, cones, e, r_j, r_k, cone_j, cone_k, names) -> list[tuple[str, str]]:
+    """(field, problem) for a ratio, tooth counts or cone angles that contradict the geometry."""
+    problems = []
     if ratio is not None and abs(ratio - e) > RTOL_RATIO * abs(e):
         problems.append(("ratio", f"ratio {ratio:g} contradicts the mesh geometry: pitch radii "
                          f"{r_j:.6g} m and {r_k:.6g} m give e = {e:.6g}"))
@@ -124,8 +146,8 @@ def gear_geometry(kind: str, P, oj, zj, ok, zk, teeth=None, ratio=None, cones=No
             problems.append(("teeth", f"tooth counts {teeth[0]}:{teeth[1]} give |ratio| {te:.6g}, but the "
                              f"mesh geometry gives {abs(e):.6g}"))
     if cones is not None:
-        for i, (given, geo, n) in enumerate(((cones[0], cone_j, nj), (cones[1], cone_k, nk))):
+        for i, (given, geo, n) in enumerate(((cones[0], cone_j, names[0]), (cones[1], cone_k, names[1]))):
             if abs(given - geo) > TOL_ANGLE:
                 problems.append((f"cone_angles_deg[{i}]", f"cone angle {np.rad2deg(given):.6g} deg of gear "
                                  f"'{n}' contradicts the geometry ({np.rad2deg(geo):.6g} deg)"))
-    return GearGeometry(P, zj, zk, rad_j, rad_k, ut, us, r_j, r_k, e, cone_j, cone_k, ring), problems
+    return problems

@@ -9,6 +9,8 @@ import math
 
 import numpy as np
 
+from .mechanism import GEAR_KINDS
+
 
 def inertia_matrix(spec) -> np.ndarray:
     """Inertia tensor from ``[Ixx, Iyy, Izz]`` or ``{ixx, iyy, izz, ixy, ixz, iyz}``."""
@@ -51,3 +53,24 @@ def number_problem(x) -> str | None:
         limit = f"{MAX_ABS:.0e}".replace("e+", "e")
         return f"{text} is out of range (|x| <= {limit} in SI units)"
     return None
+
+
+def gear_pair_problems(j: str, k: str, kind: str, ratio: float | None, has_teeth: bool,
+                       has_mesh_point: bool, has_cones: bool) -> list[tuple[str, str]]:
+    """Problems of a gear pair's declaration, whatever file it comes from: (field, message)
+    with field ``""`` (the pair), ``"links"``, ``"kind"``, ``"ratio"`` or ``"cone_angles"``;
+    ``ratio`` None when not given.  (The geometric checks are in :mod:`gearcli.model.gears`.)"""
+    out: list[tuple[str, str]] = []
+    if kind not in GEAR_KINDS:
+        out.append(("kind", f"unknown gear kind '{kind}' (expected {', '.join(GEAR_KINDS)})"))
+    if j == k:
+        out.append(("links", "a gear pair needs two different links"))
+    if ratio is None and not has_teeth:
+        out.append(("", "a gear pair needs a ratio or tooth counts (teeth)"))
+    if ratio == 0:
+        out.append(("ratio", "gear ratio must not be zero"))
+    if ratio is None and not has_mesh_point:
+        out.append(("", "a gear pair without mesh_point needs an explicit signed ratio"))
+    if has_cones and kind != "bevel":
+        out.append(("cone_angles", f"cone angles are only for bevel gears, this pair is {kind}"))
+    return out
