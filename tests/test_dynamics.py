@@ -19,7 +19,8 @@ import pytest
 from factories import PAPER_2DOF_PARAMS, paper_2dof_variant, planetary_2dof, spatial_3dof
 from gearcli.dynamics.solve import joint_space, solve
 from gearcli import analyse
-from gearcli.dynamics.kinematics import forward, velocities
+from gearcli.dynamics.kinematics import forward
+from gearcli.spatial import cross
 from gearcli import load_mechanism, parse_mechanism
 from metrics import rel_err
 
@@ -29,6 +30,32 @@ TOL = 1e-9
 
 
 # --- mechanisms under test ------------------------------------------------------------------
+
+def velocities(mech, tree, kin, qd: np.ndarray):
+    """Angular velocity and velocity of the origin of every link (world): a velocity recursion
+    of the test's own, separate from gearcli's forward kinematics (which it reuses only for
+    the joint frames)."""
+    N = qd.shape[0]
+    L = len(tree.links)
+    w = [None] * L
+    v = [None] * L
+    w[tree.base] = np.zeros((N, 3))
+    v[tree.base] = np.zeros((N, 3))
+    for ji in tree.order:
+        jt = mech.joints[ji]
+        c = tree.index[jt.child]
+        p = tree.parent[c]
+        z = kin.Rj[ji][:, :, 2]
+        r = kin.oj[ji] - kin.o[p]
+        vj = v[p] + cross(w[p], r)
+        if jt.type == "prismatic":
+            w[c] = w[p]
+            vj = vj + z * qd[:, ji:ji + 1]
+        else:
+            w[c] = w[p] + z * qd[:, ji:ji + 1]
+        v[c] = vj + cross(w[c], kin.o[c] - kin.oj[ji])
+    return w, v
+
 
 @lru_cache(maxsize=None)
 def analysis(key: str):

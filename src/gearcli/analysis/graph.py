@@ -64,8 +64,8 @@ def analyse(mech: Mechanism) -> Analysis:
     tlines, pseudo = transmission_lines(h, circuits, ind.primary, ind.chain, mot.links)
 
     an = Analysis(mech, tree, tuple(cparent), tuple(label), tuple(level), tuple(ind.primary),
-                  ind.independent, ind.independent_names, tuple(groups), tuple(circuits), canon,
-                  ind.S, tuple(mot.links), tuple(mot.stators), mot.rows, A, tuple(tlines), pseudo,
+                  ind.independent, ind.independent_names, tuple(groups), tuple(circuits),
+                  ind.S, tuple(mot.links), tuple(mot.stators), A, tuple(tlines), pseudo,
                   motor_joints=tuple(mot.joints) if any(x is not None for x in mot.joints) else (),
                   open_loop=ind.open_loop)
     blocks = solution_schedule(an, col)

@@ -60,11 +60,9 @@ class Analysis:
     independent_names: tuple[str, ...]
     groups: tuple[CoaxialGroup, ...]
     circuits: tuple[Circuit, ...]
-    canon_rows: np.ndarray     # (L, J): canonical angle of link i in real joint angles
     S: np.ndarray              # (J, dof): q = S q_ind
     motor_links: tuple[int, ...]
     motor_stators: tuple[int, ...]
-    motor_rows: np.ndarray     # (M, J): motor input rotation in real joint angles
     A: np.ndarray              # (dof, M) structure matrix: motor angles = A^T q_ind
     transmission_lines: tuple[tuple[int, ...], ...]
     pseudo_triangular: bool

@@ -111,27 +111,3 @@ def _turn_z(R0: np.ndarray, q: np.ndarray) -> np.ndarray:
     out[:, :, 1] = c * R0[:, :, 1] - s * R0[:, :, 0]
     out[:, :, 2] = R0[:, :, 2]
     return out
-
-
-def velocities(mech: Mechanism, tree: Tree, kin: Kinematics, qd: np.ndarray):
-    """Angular velocity and velocity of the origin of every link (world), for power checks."""
-    N = qd.shape[0]
-    L = len(tree.links)
-    w = [None] * L
-    v = [None] * L
-    w[tree.base] = np.zeros((N, 3))
-    v[tree.base] = np.zeros((N, 3))
-    for ji in tree.order:
-        jt = mech.joints[ji]
-        c = tree.index[jt.child]
-        p = tree.parent[c]
-        z = kin.Rj[ji][:, :, 2]
-        r = kin.oj[ji] - kin.o[p]
-        vj = v[p] + cross(w[p], r)
-        if jt.type == "prismatic":
-            w[c] = w[p]
-            vj = vj + z * qd[:, ji:ji + 1]
-        else:
-            w[c] = w[p] + z * qd[:, ji:ji + 1]
-        v[c] = vj + cross(w[c], kin.o[c] - kin.oj[ji])
-    return w, v
