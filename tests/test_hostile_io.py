@@ -519,3 +519,24 @@ def test_every_module_imports_and_no_private_atomic_writer_is_left():
         if path.name != "output.py":
             text = path.read_text()
             assert "mkstemp" not in text and "AtomicWriter" not in text and "os.replace" not in text, path
+
+
+@pytest.mark.parametrize("text, parts", [
+    (HEADER + "0,0,0\n1,0,0\n", ("2 samples with positions only", "at least 3")),
+    ("t,q:J1,q:J2,qdd:J1,qdd:J2\n0,0,0,0,0\n", ("1 sample with positions only", "at least 2")),
+    ("t,q:J1,q:J2,qd:J1,qd:J2\n0,0,0,0,0\n", ("1 sample with no qdd: columns", "at least 2")),
+    (HEADER, ("no samples",)),
+])
+def test_stdout_check_refuses_short_files_before_writing(run_cli, work, text, parts):
+    (work / "traj.csv").write_text(text)
+    r = run_cli("solve", work / "mech.yaml", work / "traj.csv", "-o", "-")
+    one_line_error(r, "traj.csv: ", *parts)
+    assert r.stdout == ""
+
+
+def test_check_counts_every_sample(tmp_path):
+    from gearcli.io.trajectory import TrajectoryReader
+
+    p = tmp_path / "t.csv"
+    p.write_text(rows(np.arange(500) * 1e-3, np.zeros(500)))
+    assert TrajectoryReader(p, ["J1", "J2"], chunk=200).check() == 500

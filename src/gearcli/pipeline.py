@@ -112,8 +112,7 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
     if out_path is None:
         run(None)
     elif out is None:
-        for _ in reader:   # read and check the whole trajectory before streaming
-            pass
+        reader.check()   # read and check the whole trajectory before streaming
         run(sys.stdout)
     else:
         with atomic_output(out, (mech_path, traj_path)) as f:

@@ -292,6 +292,18 @@ class TrajectoryReader:
                 last_t = si[-1, c_t]
                 yield si, np.asarray(linenos)
 
+    def check(self) -> int:
+        """Read and check every row (cells, ranges, time) without deriving rates; the
+        number of samples.  Raises like iteration would for the rows and for too few
+        samples."""
+        n = sum(len(data) for data, _ in self._raw())
+        if n == 0:
+            raise _fail(self.file, None, "", "no samples after the header")
+        need = 1 + (self.cols["qd"] is None) + (self.cols["qdd"] is None)
+        if n < need:
+            raise self._too_few(n, need, "q" if self.cols["qd"] is None else "qd")
+        return n
+
     def __iter__(self):
         prev = None   # rows of the previous chunk (for the spline pad)
         pending = None
@@ -322,14 +334,16 @@ class TrajectoryReader:
         sl = slice(a, a + len(cur[0]))
         return Trajectory(t[sl], q[sl], qd[sl], qdd[sl], lines[sl])
 
+    def _too_few(self, n: int, need: int, kind: str) -> TrajectoryError:
+        given = "positions only" if kind == "q" else "no qdd: columns"
+        return _fail(self.file, None, "", f"{n} sample{'s' if n != 1 else ''} with {given}: rates and "
+                     f"accelerations are derived by spline, which needs at least {need} samples (or "
+                     "give the qd: and qdd: columns)")
+
     def _derive(self, t, y, order: int, lines, kind: str) -> list[np.ndarray]:
         """Spline derivatives, with a clear error when too few samples or not finite."""
-        need = order + 1
-        if len(t) < need:
-            given = "positions only" if kind == "q" else "no qdd: columns"
-            raise _fail(self.file, None, "", f"{len(t)} sample{'s' if len(t) != 1 else ''} with {given}: rates and accelerations "
-                        f"are derived by spline, which needs at least {need} samples (or give the "
-                        "qd: and qdd: columns)")
+        if len(t) < order + 1:
+            raise self._too_few(len(t), order + 1, kind)
         try:
             with np.errstate(all="ignore"), warnings.catch_warnings():
                 warnings.simplefilter("ignore")
