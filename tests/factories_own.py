@@ -5,7 +5,8 @@ built from the same parameters by the test's own transforms, never from what gea
 
 * :data:`PUMA_YAML` -- a literal D-H table with twists of +-90 deg and theta offsets.
 * :func:`dh_geared` -- a random three-dof D-H arm with non-zero twists alpha and offsets
-  theta, a base pinion driving link 1 (external spur pair, carrier 0) and a pinion carried
+  theta, a base pinion (even seeds) or ring gear (odd seeds: internal pair whose gear j is
+  the ring) driving link 1 (carrier 0) and a pinion carried
   by link 1 driving link 2 (carrier 1), the third joint driven directly; full inertia
   tensors, off-axis centres of mass, an arbitrary gravity direction.
 * :func:`urdf_prismatic_chain` -- a URDF revolute / prismatic / revolute chain on skewed
@@ -71,10 +72,15 @@ def dh_geared(seed: int) -> tuple[str, OwnMech]:
     rows = [tuple(float(x) for x in (u(-np.pi, np.pi), u(-0.2, 0.2), u(0.15, 0.5), sgn[i] * u(0.3, 2.8))) for i in range(3)]
     links, link_specs = _random_links(rng, ["1", "2", "3", "4", "5"])
     ez = np.array([0.0, 0, 1])
-    # pinion 4 on the base, axis parallel to J1's (z0), meshing with link 1's gear of radius r1
+    # gear 4 on the base, axis parallel to J1's (z0), meshing with link 1's gear of radius r1:
+    # a pinion (external pair) for even seeds, a ring around link 1's gear (internal pair,
+    # the ring is gear j) for odd seeds
+    ring = seed % 2 == 1
     r1, r4, phi, h4, yaw4 = u(0.06, 0.12), u(0.015, 0.04), u(-np.pi, np.pi), u(-0.1, 0.1), u(-np.pi, np.pi)
+    if ring:
+        r4 = u(0.15, 0.25)
     dir4 = np.array([np.cos(phi), np.sin(phi), 0.0])
-    o4, P41 = (r1 + r4) * dir4 + h4 * ez, r1 * dir4 + h4 * ez
+    o4, P41 = (r1 + (-r4 if ring else r4)) * dir4 + h4 * ez, r1 * dir4 + h4 * ez
     e41 = rolling_ratio(P41, o4, ez, np.zeros(3), ez)
     # pinion 5 carried by link 1, axis parallel to J2's (z1), meshing with link 2's gear of radius r2
     r2, r5, beta, h5 = u(0.05, 0.1), u(0.015, 0.03), u(-np.pi, np.pi), u(-0.1, 0.1)
@@ -93,7 +99,7 @@ def dh_geared(seed: int) -> tuple[str, OwnMech]:
     gravity = 9.81 * unit(rng.normal(size=3))
     doc = {"name": f"dh_geared_{seed}", "gravity": fl(gravity), "base": "0", "end_effector": "3",
            "links": [{"name": "0"}] + link_specs, "joints": jspecs,
-           "gears": [{"name": "4-1", "links": ["4", "1"], "kind": "external", "ratio": e41,
+           "gears": [{"name": "4-1", "links": ["4", "1"], "kind": "internal" if ring else "external", "ratio": e41,
                       "mesh_point": fl(P41), "pressure_angle_deg": pa[0]},
                      {"name": "5-2", "links": ["5", "2"], "kind": "external", "ratio": e52,
                       "mesh_point": fl(P52), "pressure_angle_deg": pa[1]}],
@@ -104,8 +110,12 @@ def dh_geared(seed: int) -> tuple[str, OwnMech]:
                OwnJoint("J5", "1", "5", X_pj=homog(None, o5))]
     S = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [e41, 0, 0], [0, e52, 0]], float)
     motors = {"motor4": ("J4", S[3]), "motor5": ("J5", S[4]), "motor3": ("J3", S[2])}
-    gears = {"4-1": dict(j="4", k="1", carrier="0", P=P41, oj=o4, zj=ez, ok=np.zeros(3), zk=ez, phi_deg=pa[0]),
-                "5-2": dict(j="5", k="2", carrier="1", P=P52, oj=o5, zj=ez, ok=np.zeros(3), zk=ez, phi_deg=pa[1])}
+    # us_j: the separating force on j points along us_j * (j's outward radial direction):
+    # outwards for a ring, towards its own axis otherwise
+    gears = {"4-1": dict(j="4", k="1", carrier="0", P=P41, oj=o4, zj=ez, ok=np.zeros(3), zk=ez, phi_deg=pa[0],
+                         us_j=1.0 if ring else -1.0),
+             "5-2": dict(j="5", k="2", carrier="1", P=P52, oj=o5, zj=ez, ok=np.zeros(3), zk=ez, phi_deg=pa[1],
+                         us_j=-1.0)}
     return dump(doc), OwnMech("0", links, joints, S, gravity, motors, gears)
 
 

@@ -103,7 +103,8 @@ def test_joint_frames_of_base_joints(key):
 # --- 2. Pinocchio on a model built from the test's own D-H product -------------------------------
 
 @pytest.mark.parametrize("key", DH + ["urdf_chain:0"])
-def test_own_pinocchio_rnea(key):
+@pytest.mark.parametrize("method", ["block", "full"])
+def test_own_pinocchio_rnea(key, method):
     """RNEA of the own model, projected by virtual work (tau_ind = S^T tau_all with the
     factory's own S), gives gearcli's equivalent torques; motor torques follow from the own
     structure matrix."""
@@ -111,7 +112,7 @@ def test_own_pinocchio_rnea(key):
     an, om = case(key)
     traj = SineTrajectory(an.dof, seed=3)
     q, qd, qdd = traj(np.linspace(0.0, 2.0, 30))
-    res = solve(an, q, qd, qdd)
+    res = solve(an, q, qd, qdd, method=method)
     tau_all, f = OwnPinocchio(om).rnea(q @ om.S.T, qd @ om.S.T, qdd @ om.S.T)
     tau_ind = tau_all @ om.S
     assert rel_err(res.tau, tau_ind) < TOL
@@ -124,12 +125,13 @@ def test_own_pinocchio_rnea(key):
 
 # --- 3. power and momentum balances on differentiated positions ------------------------------------
 
-def fd_case(key):
+@lru_cache(maxsize=None)
+def fd_case(key, method="block"):
     an, om = case(key)
     traj = SineTrajectory(an.dof, seed=11)
     t = np.linspace(0.0, 3.0, 40)
     q, qd, qdd = traj(t)
-    return an, om, q, qd, qdd, solve(an, q, qd, qdd), fd_motion(om, traj, t)
+    return an, om, q, qd, qdd, solve(an, q, qd, qdd, method=method), fd_motion(om, traj, t)
 
 
 @pytest.mark.parametrize("key", ALL)
@@ -144,13 +146,14 @@ def test_power_balance_own_kinematics(key):
 
 
 @pytest.mark.parametrize("key", BASE_FRAMES_KNOWN)
-def test_momentum_balance_own_kinematics(key):
+@pytest.mark.parametrize("method", ["block", "full"])
+def test_momentum_balance_own_kinematics(key, method):
     """The base acts on the moving links through its bearings and the motor stators it
     holds (no gear is fixed to it here).  With the reactions rotated by the own joint frames,
     their resultant plus gravity equals the rate of change of the total linear momentum, and
     their moment about the world origin that of the angular momentum, both differentiated
     from the own link poses."""
-    an, om, q, qd, qdd, res, st = fd_case(key)
+    an, om, q, qd, qdd, res, st = fd_case(key, method)
     q_all = q @ om.S.T
     F = joint_frames(om, q_all)
     g = np.asarray(om.gravity, float)
@@ -177,9 +180,10 @@ def test_momentum_balance_own_kinematics(key):
 
 @pytest.mark.parametrize("key", ["dh_geared:0", "dh_geared:1"])
 def test_tooth_force_own_geometry(key):
-    """For the external spur pairs: rebuild the force on gear j from the reported t,
-    radial and axial components along the test's own directions (pitch point and axes moved
-    with the own carrier pose).  Its separating component, towards j's own axis, is
+    """For the spur pairs (external; internal with the ring as gear j for odd seeds):
+    rebuild the force on gear j from the reported t, radial and axial components along the
+    test's own directions (pitch point and axes moved with the own carrier pose).  Its
+    separating component, towards j's own axis (outwards for a ring), is
     |t| tan(phi) with phi as written in the file (degrees); the sep column says the same; it
     has no component along the axes; and the components reported on gear k are those of
     -g along k's own radial direction and axis."""
@@ -205,7 +209,7 @@ def test_tooth_force_own_geometry(key):
         g = t[:, None] * np.cross(zj, rj) + res.gear_radial[:, gi, 0, None] * rj + res.gear_axial[:, gi, 0, None] * zj
         sep = np.abs(t) * np.tan(np.radians(gm["phi_deg"]))
         assert np.max(t) > 0 > np.min(t)     # both signs of |t| exercised
-        assert rel_err(np.sum(g * -rj, axis=1), sep) < TOL
+        assert rel_err(np.sum(g * (gm["us_j"] * rj), axis=1), sep) < TOL
         assert rel_err(res.gear_sep[:, gi], sep) < TOL
         assert np.max(np.abs(np.sum(g * zj, axis=1))) < TOL * np.max(np.abs(t))
         assert rel_err(res.gear_radial[:, gi, 1], -np.sum(g * rk, axis=1)) < TOL

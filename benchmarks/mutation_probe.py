@@ -1,0 +1,215 @@
+"""Mutation probe: do the independent tests catch deliberate physics bugs?
+
+For every mutation in :data:`MUTATIONS` (file under ``src/gearcli``, exact old snippet, new
+snippet, description) the probe copies ``src/`` to a temporary directory, applies the
+edits, and runs the independent tests (:data:`TESTS`, stop at the first failure) with
+``PYTHONPATH`` pointing at the copy.  It prints a table: caught / missed and the test that
+caught each bug.
+
+Usage (from the repository root, test extra installed)::
+
+    python benchmarks/mutation_probe.py              # all mutations
+    python benchmarks/mutation_probe.py -k alpha     # those whose name contains "alpha"
+    python benchmarks/mutation_probe.py -x --tests "tests --ignore=tests/test_independent.py"
+
+Exit status 0 when every mutation is caught, 1 when one is missed, 2 when a snippet is not
+found exactly once in the current source (the list must be kept in sync with ``src/``) or
+when the unmutated copy fails the tests.  Consistency checks that share gearcli's own
+kinematics or equation assembly (block vs full solve, the Newton-Euler residual of the
+solution, balances on gearcli's kinematics) are deliberately not in :data:`TESTS`.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+# Independent tests only, the fastest and most telling first.
+TESTS = [
+    "tests/test_independent.py",
+    "tests/test_dynamics.py::test_paper_closed_form",
+    "tests/test_dynamics.py::test_paper_static_weight_on_vertical_bearings",
+    "tests/test_dynamics.py::test_spatial_gear_constraints",
+    "tests/test_dynamics.py::test_separating_force",
+    "tests/test_dynamics.py::test_planetary_structure",
+    "tests/test_dynamics.py::test_ring_pair_is_exercised",
+    "tests/test_dynamics.py::test_pinocchio_rnea",
+    "tests/test_dynamics.py::test_pinocchio_bearing_reactions",
+    "tests/test_dynamics.py::test_pinocchio_joint_reaction_of_gearless_subtree",
+]
+
+
+@dataclass(frozen=True)
+class Mutation:
+    name: str
+    description: str
+    edits: tuple   # ((path under src/gearcli, old snippet, new snippet), ...)
+
+
+MUTATIONS = [
+    Mutation("dh-alpha-sign", "D-H twist alpha read with the wrong sign (Rx(-alpha))",
+             (("io/yaml_reader.py",
+               "return rot_z(theta), np.array([0.0, 0.0, d]), rot_x(alpha), np.array([a, 0.0, 0.0])",
+               "return rot_z(theta), np.array([0.0, 0.0, d]), rot_x(-alpha), np.array([a, 0.0, 0.0])"),)),
+    Mutation("joint-rotation-transposed", "joint rotation R0 Rz(q) applied as R0 Rz(q)^T",
+             (("dynamics/kinematics.py",
+               "out[:, :, 0] = c * R0[:, :, 0] + s * R0[:, :, 1]\n    out[:, :, 1] = c * R0[:, :, 1] - s * R0[:, :, 0]",
+               "out[:, :, 0] = c * R0[:, :, 0] - s * R0[:, :, 1]\n    out[:, :, 1] = c * R0[:, :, 1] + s * R0[:, :, 0]"),)),
+    Mutation("drop-w-x-z-qd", "angular acceleration without the w_parent x z qd term",
+             (("dynamics/kinematics.py",
+               "dw[c] = dw[p] + z * qdd_j + cross(w[p], z) * qd_j",
+               "dw[c] = dw[p] + z * qdd_j"),)),
+    Mutation("gravity-sign", "gravity vector used with the wrong sign in the inertia loads",
+             (("dynamics/loads.py", "    g = mech.gravity\n", "    g = -mech.gravity\n"),)),
+    Mutation("inertia-about-origin", "CoM inertia used as if about the link origin (parallel-axis terms dropped)",
+             (("dynamics/loads.py",
+               "out[L] = np.concatenate([F, mv(R, Nb) + cross(rc, F)], axis=1)",
+               "out[L] = np.concatenate([F, mv(R, Nb) + cross(rc, link.mass * (kin.a[L] - g))], axis=1)"),)),
+    Mutation("separating-force-sign", "separating force pulls the gears together",
+             (("model/gears.py",
+               "us = -rad_j + (rad_j @ element) * element",
+               "us = rad_j - (rad_j @ element) * element"),)),
+    Mutation("tan-to-sin", "separating force abs(t) sin(phi) instead of abs(t) tan(phi) (equations and columns)",
+             (("dynamics/loads.py",
+               "self.tan_phi[ci] = float(np.tan(an.mech.gears[c.gear].pressure_angle))",
+               "self.tan_phi[ci] = float(np.sin(an.mech.gears[c.gear].pressure_angle))"),
+              ("dynamics/solve.py",
+               "s = np.abs(t) * np.tan(mech.gears[c.gear].pressure_angle)",
+               "s = np.abs(t) * np.sin(mech.gears[c.gear].pressure_angle)"))),
+    Mutation("gear-ratio-inverted", "circuit equation theta_j = theta_k / e instead of theta_j = e theta_k",
+             (("analysis/graph.py", "row_j - ratio * row_k,", "ratio * row_j - row_k,"),)),
+    Mutation("moment-cross-order", "moment of a force as f x r instead of r x f",
+             (("dynamics/loads.py",
+               "return np.concatenate([d, cross(point - origin, d)], axis=1)",
+               "return np.concatenate([d, cross(d, point - origin)], axis=1)"),)),
+    Mutation("coriolis-factor-2", "prismatic Coriolis acceleration w x v instead of 2 w x v",
+             (("dynamics/kinematics.py",
+               "a_j = a_j + 2 * cross(w[p], z * qd_j)",
+               "a_j = a_j + cross(w[p], z * qd_j)"),)),
+    # further bugs, beyond the list of issue 7
+    Mutation("drop-centripetal", "child origin acceleration without w x (w x r)",
+             (("dynamics/kinematics.py",
+               "a[c] = a_j + cross(dw[c], rc) + cross(w[c], cross(w[c], rc))",
+               "a[c] = a_j + cross(dw[c], rc)"),)),
+    Mutation("inertia-world-axes", "inertia tensor (link axes) applied to world-frame w",
+             (("dynamics/loads.py", "wb = mtv(R, w)", "wb = w"),)),
+    Mutation("no-stator-reaction", "motor torque not reacted on the stator",
+             (("dynamics/loads.py", "sign = 1.0 if L == x else -1.0", "sign = 1.0 if L == x else 0.0"),)),
+    Mutation("ring-as-gear-j", "ring gear j of an internal pair pushed inwards",
+             (("model/gears.py", "    if ring == 0:\n        us = -us\n", ""),)),
+    Mutation("bevel-sep-radial", "bevel separating force along the radius, not normal to the pitch element",
+             (("model/gears.py",
+               "us = -rad_j + (rad_j @ element) * element",
+               "us = -rad_j + 0.0 * element"),)),
+]
+
+
+class SnippetError(Exception):
+    pass
+
+
+def copy_source(dest: Path) -> Path:
+    """Copy src/ (and the schemas/ it reads at run time) under ``dest``; returns dest/src."""
+    shutil.copytree(ROOT / "src", dest / "src", ignore=shutil.ignore_patterns("__pycache__"))
+    if (ROOT / "schemas").is_dir():
+        shutil.copytree(ROOT / "schemas", dest / "schemas")
+    return dest / "src"
+
+
+def apply(src: Path, m: Mutation) -> None:
+    """Apply m's edits to the copy ``src`` (…/gearcli); each old snippet must occur once."""
+    for rel, old, new in m.edits:
+        path = src / rel
+        if not path.is_file():
+            raise SnippetError(f"{m.name}: file src/gearcli/{rel} does not exist")
+        text = path.read_text()
+        n = text.count(old)
+        if n != 1:
+            raise SnippetError(f"{m.name}: snippet found {n} times (expected once) in src/gearcli/{rel}:\n  {old!r}")
+        path.write_text(text.replace(old, new))
+
+
+def run_tests(src_root: Path, tests, stop_first: bool) -> tuple[bool, list, int, float]:
+    """(passed, failing tests, tests run, seconds) with gearcli imported from src_root."""
+    env = dict(os.environ, PYTHONPATH=str(src_root), PYTHONDONTWRITEBYTECODE="1")
+    cmd = [sys.executable, "-m", "pytest", "-o", "addopts=", "-q", "-rfE", "-p", "no:cacheprovider", *tests]
+    if stop_first:
+        cmd.insert(3, "-x")
+    t0 = time.perf_counter()
+    out = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True)
+    dt = time.perf_counter() - t0
+    failing = re.findall(r"^(?:FAILED|ERROR) (\S+)", out.stdout, re.M)
+    counts = {k: int(n) for n, k in re.findall(r"(\d+) (passed|failed|error|errors)\b", out.stdout)}
+    total = sum(counts.values())
+    if out.returncode not in (0, 1) and not failing:
+        failing = [f"pytest exit {out.returncode}: {out.stdout[-300:]}"]
+    return out.returncode == 0, failing, total, dt
+
+
+def check_import(src_root: Path) -> None:
+    env = dict(os.environ, PYTHONPATH=str(src_root))
+    got = subprocess.run([sys.executable, "-c", "import gearcli; print(gearcli.__file__)"], env=env,
+                         capture_output=True, text=True).stdout.strip()
+    if not got.startswith(str(src_root)):
+        raise SystemExit(f"mutation_probe: gearcli imported from {got!r}, not from the copy {src_root}")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("-k", default="", help="only mutations whose name contains this")
+    ap.add_argument("-x", action="store_true", help="stop each run at the first failing test (faster)")
+    ap.add_argument("--tests", default=" ".join(TESTS), help="pytest arguments selecting the tests to run, "
+                    "one string (default: the independent tests)")
+    args = ap.parse_args(argv)
+    todo = [m for m in MUTATIONS if args.k in m.name]
+    rows, missed = [], 0
+    with tempfile.TemporaryDirectory(prefix="gearcli-mut-") as tmp:
+        base = copy_source(Path(tmp) / "clean")
+        check_import(base)
+        for m in todo:            # every snippet first: fail loudly before spending minutes
+            scratch = Path(tmp) / "check"
+            try:
+                apply(copy_source(scratch) / "gearcli", m)
+            except SnippetError as e:
+                print(f"mutation_probe: {e}", file=sys.stderr)
+                return 2
+            finally:
+                shutil.rmtree(scratch)
+        ok, failing, total, dt = run_tests(base, shlex.split(args.tests), False)
+        if not ok:
+            print(f"mutation_probe: the unmutated source fails {failing}", file=sys.stderr)
+            return 2
+        print(f"unmutated source: {total} tests pass ({dt:.1f} s)", flush=True)
+        for m in todo:
+            copy = copy_source(Path(tmp) / m.name)
+            apply(copy / "gearcli", m)
+            passed, failing, _, dt = run_tests(copy, shlex.split(args.tests), args.x)
+            missed += passed
+            status = "MISSED" if passed else ("caught" if args.x else f"caught by {len(failing)} of {total}")
+            first = failing[0] if failing else ""
+            rows.append((m, status, first))
+            print(f"  {m.name}: {status} {first} ({dt:.1f} s)", flush=True)
+            shutil.rmtree(copy.parent)
+    print()
+    print("| mutation | bug | in | result | first failing test |")
+    print("|---|---|---|---|---|")
+    for m, status, first in rows:
+        where = ", ".join(sorted({e[0] for e in m.edits}))
+        first = first.replace("tests/", "", 1)
+        print(f"| `{m.name}` | {m.description} | {where} | {status} | {'`' + first + '`' if first else '-'} |")
+    print(f"\n{len(rows) - missed} of {len(rows)} mutations caught")
+    return 1 if missed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
