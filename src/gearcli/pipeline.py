@@ -53,6 +53,9 @@ def prismatic_independent(an: Analysis) -> list[str]:
 
 @dataclass
 class SolveReport:
+    """What :func:`solve_file` did: the analysis, the number of samples, the load summary,
+    the worst residual (with ``verify``) and the output path (None: stdout or nothing)."""
+
     analysis: Analysis
     samples: int
     summary: Summary

@@ -34,6 +34,9 @@ class UnknownGroup:
 
 
 def unknown_groups(an) -> list[UnknownGroup]:
+    """The unknowns of the load equations, grouped: 5 per revolute joint reaction (3 forces,
+    2 moments), 1 per gear mesh (the tangential force t), 1 per motor; each with the moving
+    links whose balance it enters."""
     mech, tree = an.mech, an.tree
     b = tree.base
     out = []

@@ -24,6 +24,15 @@ from ..analysis.tree import Tree
 
 @dataclass
 class Kinematics:
+    """Kinematics of every link and joint along N samples, all in the base frame.
+
+    Per link i (lists indexed by link id): ``R[i]`` (N, 3, 3) orientation R_0i of its frame;
+    ``o[i]`` (N, 3) origin, m; ``w[i]`` (N, 3) angular velocity omega_i, rad/s; ``dw[i]``
+    (N, 3) angular acceleration, rad/s^2; ``a[i]`` (N, 3) acceleration of the origin, m/s^2.
+    Per real joint j (indexed as ``mech.joints``): ``Rj[j]`` (N, 3, 3) joint frame (z = axis)
+    and ``oj[j]`` (N, 3) its origin, m.
+    """
+
     R: list
     o: list
     w: list
@@ -34,6 +43,7 @@ class Kinematics:
 
     @property
     def n(self) -> int:
+        """Number of samples N."""
         return self.oj[0].shape[0]
 
 

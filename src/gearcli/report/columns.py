@@ -31,6 +31,9 @@ from ..dynamics.solve import Result
 
 
 def column_names(an) -> list[str]:
+    """Names of the output columns of ``an``, in the stable order of the CSV (README,
+    "Output columns"): t, motors, equivalent joint torques, gear meshes, joint reactions,
+    then the appended motor speed and power columns."""
     mech = an.mech
     cols = ["t"]
     cols += [f"motor:{m.name}" for m in mech.motors]
@@ -94,6 +97,8 @@ def column_unit(name: str) -> str:
 
 @dataclass
 class Stat:
+    """Peak magnitude, time of the peak and running RMS of one load column (SI unit ``unit``)."""
+
     name: str
     unit: str
     peak: float = 0.0
@@ -128,6 +133,7 @@ class Summary:
 
     @classmethod
     def for_mechanism(cls, an) -> "Summary":
+        """An empty summary of every motor, gear mesh and bearing load of ``an``."""
         names = column_names(an)
         ideal_unit = {an.mech.gears[c.gear].name: _ideal_unit(an, c) for c in an.circuits if c.geometry is None}
         pick = []
@@ -149,6 +155,7 @@ class Summary:
         return cls([p[0] for p in pick], [Stat(p[1], p[2]) for p in pick])
 
     def add(self, tab: np.ndarray) -> None:
+        """Accumulate a chunk ``tab`` (N, columns) of the output table (column 0 is t, s)."""
         t = tab[:, 0]
         X = np.abs(tab[:, self.columns])
         imax = np.argmax(X, axis=0)
