@@ -278,3 +278,13 @@ def test_degrees_case_gives_the_radian_results(run_cli, tmp_path):
         assert (a["component"], a["quantity"]) == (b["component"], b["quantity"])
         assert b["value"] == pytest.approx(a["value"], rel=1e-9)
     assert by_name(rad)[("rotor", "motor m", "speed")]["value"] == pytest.approx(W, rel=1e-12)
+
+
+def test_unwritable_reports_are_refused_before_running(run_cli, tmp_path):
+    (tmp_path / "file").write_text("x")
+    r = run_cli("verify", DESIGNS / "ci_example.yaml", "--plots", tmp_path / "file")
+    assert r.exit_code == 2 and "--plots: cannot create the directory" in r.stderr
+    r = run_cli("verify", DESIGNS / "ci_example.yaml", "--junit", tmp_path / "no" / "r.xml")
+    assert r.exit_code == 2 and len(r.stderr.strip().splitlines()) == 1
+    r = run_cli("verify", DESIGNS / "ci_example.yaml", "--json", DESIGNS / "ci_example.yaml")
+    assert r.exit_code == 2 and "Design checks" not in r.stdout

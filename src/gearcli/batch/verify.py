@@ -5,6 +5,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..errors import GearcliError
 from ..io.output import output_target
 from ..report.plots import plot_check
 from .manifest import load_manifest
@@ -39,6 +40,8 @@ def run_verify(manifest_path, *, jobs: int | None = None, dask_address: str | No
     and write the requested reports; ``progress(total=..)`` once, then ``progress()`` per job."""
     manifest = manifest or load_manifest(manifest_path)
     check_outputs(manifest, junit, json_path, markdown_path)
+    if plots_dir:
+        make_plot_dir(Path(plots_dir))
     results = run_manifest(manifest, jobs=jobs, dask_address=dask_address, progress=progress)
     rows = rows_of(results)
     suite = manifest.name
@@ -60,6 +63,14 @@ def check_outputs(manifest, *paths) -> None:
             output_target(p, inputs)
 
 
+def make_plot_dir(directory: Path) -> None:
+    """Create the ``--plots`` directory (before any work); problems are bad input."""
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise GearcliError(f"{directory}: --plots: cannot create the directory: {exc.strerror}") from None
+
+
 def _slug(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_")
 
@@ -67,7 +78,6 @@ def _slug(text: str) -> str:
 def write_plots(results, directory: Path) -> list[Path]:
     """One PNG per failing or tight (< 10 % margin) check: its quantity along the worst
     trajectory with the level that just meets the limit."""
-    directory.mkdir(parents=True, exist_ok=True)
     out = []
     for r in results:
         for v in r.verdicts:
