@@ -119,3 +119,17 @@ def test_yaml_rating_errors(run_cli, tmp_path, edit, message):
     r = run_cli("check", path)
     assert r.exit_code == 2
     assert message in r.stderr, r.stderr
+
+
+def test_export_keeps_every_rating(tmp_path, mech_dir):
+    from gearcli.report.urdf_writer import export_urdf
+
+    mech = load_mechanism(mech_dir / "bendix_wrist_rated.yaml")
+    path = tmp_path / "w.urdf"
+    export_urdf(mech, path)
+    back = load_mechanism(path)
+    for a, b in zip(mech.joints, back.joints):
+        assert a.name == b.name and a.bearings == b.bearings and b.bearings
+    assert [m.rating for m in back.motors] == [m.rating for m in mech.motors]
+    by_name = {g.name: g.rating for g in back.gears}
+    assert all(by_name[g.name] == g.rating for g in mech.gears)

@@ -7,7 +7,7 @@ to None; the checks live in :mod:`gearcli.design`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 STEEL_ELASTIC_COEFFICIENT = 189.8e3
 """Z_E of steel on steel (E = 206 GPa, nu = 0.3), sqrt(Pa) (ISO 6336-2): the default."""
@@ -34,7 +34,7 @@ class MotorRating:
     rms_torque: float
     max_speed: float
     max_power: float | None = None
-    path: str = ""
+    path: str = field(default="", compare=False)   # where it was read (for messages)
 
 
 @dataclass(frozen=True)
@@ -60,7 +60,7 @@ class BearingRating:
     Y0: float
     locating: bool = True
     M: float | None = None
-    path: str = ""
+    path: str = field(default="", compare=False)   # where it was read (for messages)
 
 
 @dataclass(frozen=True)
@@ -69,7 +69,7 @@ class JointLimit:
 
     effort: float | None
     velocity: float | None
-    path: str = ""
+    path: str = field(default="", compare=False)   # where it was read (for messages)
 
 
 @dataclass(frozen=True)
@@ -89,4 +89,4 @@ class GearRating:
     elastic_coefficient: float
     application_factor: float = 1.0
     load_sharing_factor: float = 1.0
-    path: str = ""
+    path: str = field(default="", compare=False)   # where it was read (for messages)

@@ -32,6 +32,7 @@ from ..model.mechanism import Mechanism
 from ..spatial import align_z
 from ..io.output import output_target, write_text
 from ..io.urdf_reader import NS, q
+from .urdf_ratings import add_rating_elements
 
 PRISMATIC_LIMIT = 1000.0  # m, placeholder +- limits of a prismatic joint without known limits
 
@@ -89,6 +90,7 @@ def to_element(an: Analysis):
     _add_mimics(an, jel, corr)
     _add_transmissions(an, root)
     _add_extension(an, root, corr)
+    add_rating_elements(mech, root, jel)
     return root
 
 
