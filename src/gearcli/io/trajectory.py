@@ -33,7 +33,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.interpolate import make_interp_spline
 
 from ..errors import Issue, TrajectoryError
 
@@ -74,6 +73,8 @@ def derivatives(t: np.ndarray, y: np.ndarray, order: int = 2) -> list[np.ndarray
     k = min(5, n - 1)
     if k < order:
         raise ValueError(f"{n} samples allow a spline of degree {k} < {order}")
+    from scipy.interpolate import make_interp_spline  # noqa: PLC0415  (only when rates are missing; keeps `check` fast)
+
     spl = make_interp_spline(t, y, k=k)
     return [spl.derivative(i)(t) for i in range(1, order + 1)]
 
