@@ -83,7 +83,7 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
         output_target(out_path, (mech_path, traj_path))   # refuse a bad -o before any work
     an = analysis or analyse(load_mechanism(mech_path))
     reader = TrajectoryReader(traj_path, an.independent_names, degrees=degrees, chunk=chunk,
-                              linear=prismatic_independent(an))
+                              linear=prismatic_independent(an), loads=an.mech.loads)
     if progress is not None:
         progress(total=reader.count())
     summary = Summary.for_mechanism(an)
@@ -98,7 +98,8 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
         for part in reader:
             with np.errstate(all="ignore"), warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                res = solve(an, part.q, part.qd, part.qdd, method=method, chunk=chunk, verify=verify)
+                res = solve(an, part.q, part.qd, part.qdd, method=method, chunk=chunk, verify=verify,
+                            loads=part.loads)
                 tab = table(an, part.t, res)
             _check_loads(reader, part, tab, names)
             if verify:

@@ -148,7 +148,7 @@ def _prepare_case(spec: dict, where: str, base: Path, col: Collector, issues: li
     for tp in trajs:
         try:
             read_trajectory(tp, an.independent_names, degrees=spec.get("degrees", False),
-                            linear=prismatic_independent(an))
+                            linear=prismatic_independent(an), loads=an.mech.loads)
         except GearcliError as exc:
             issues += exc.lines()
     name = spec.get("name", Path(spec["mechanism"]).stem)

@@ -51,8 +51,9 @@ def case_analysis(mech_path: str | Path):
 
 def solve_samples(an, traj_path, degrees: bool) -> Samples:
     """Solve a trajectory file: times, every output column, and every real joint's rate."""
-    tr = read_trajectory(traj_path, an.independent_names, degrees=degrees, linear=prismatic_independent(an))
-    res = solve(an, tr.q, tr.qd, tr.qdd)
+    tr = read_trajectory(traj_path, an.independent_names, degrees=degrees, linear=prismatic_independent(an),
+                         loads=an.mech.loads)
+    res = solve(an, tr.q, tr.qd, tr.qdd, loads=tr.loads)
     return Samples(tr.t, named_columns(an, res, tr.t), tr.qd @ an.S.T)
 
 

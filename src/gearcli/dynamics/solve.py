@@ -27,6 +27,7 @@ from ..analysis.schedule import unknown_groups
 from .blocks import make_plans, solve_blocks
 from .equations import Columns
 from .general import is_geared, solve_full
+from .external import external_wrenches, load_values, subtract_external
 from .inertia import inertia_load
 from .kinematics import forward
 from .signs import SignError, sign_violation
@@ -102,16 +103,18 @@ class Solver:
         self.plans = make_plans(an)
 
     def solve(self, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK,
-              verify: bool = False) -> Result:
+              verify: bool = False, loads: dict | None = None) -> Result:
         """See :func:`solve`."""
         q, qd, qdd = _check_shapes(self.an, q, qd, qdd)
         if method not in ("block", "full"):
             raise ValueError(f"unknown method '{method}' (expected 'block' or 'full')")
+        values = load_values(self.an.mech, q.shape[0], loads)
         parts = []
         for s in range(0, q.shape[0], chunk):
             sl = slice(s, s + chunk)
             try:
-                parts.append(self._chunk(q[sl], qd[sl], qdd[sl], method, verify))
+                parts.append(self._chunk(q[sl], qd[sl], qdd[sl], method, verify,
+                                         {k: v[sl] for k, v in values.items()}))
             except SignError as exc:
                 raise SignError(exc.sample + s, exc.meshes) from None
         if len(parts) == 1:
@@ -123,11 +126,12 @@ class Solver:
         res.motor_speed = qd @ self.an.A
         return res
 
-    def _chunk(self, q_ind, qd_ind, qdd_ind, method, verify) -> Result:
+    def _chunk(self, q_ind, qd_ind, qdd_ind, method, verify, values) -> Result:
         an = self.an
         q, qd, qdd = joint_space(an, q_ind, qd_ind, qdd_ind)
         kin = forward(an.mech, an.tree, q, qd, qdd)
         b = inertia_load(an, kin)
+        subtract_external(b, external_wrenches(an, kin, values))
         cols = Columns(an, kin) if (method == "full" or verify) else None
         if method == "block":
             x, sig = solve_blocks(an, self.plans, kin, b, q)
@@ -150,7 +154,8 @@ def solver_for(an) -> Solver:
     return sol
 
 
-def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, verify: bool = False) -> Result:
+def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, verify: bool = False,
+          loads: dict | None = None) -> Result:
     """Inverse dynamics along a trajectory.
 
     Parameters
@@ -167,13 +172,19 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
     verify : bool
         Also compute the worst Newton-Euler residual of any link (``Result.residual``,
         relative to the largest load of the sample) and check the sign of every t.
+    loads : dict, optional
+        ``{load name: array (N, 6) or (6,)}``: [fx, fy, fz, mx, my, mz] of an external load
+        of ``an.mech.loads`` (N, N*m about the load point, in the load's frame: base or
+        link), overriding the constant of the mechanism file; loads not given keep it.
 
     Raises
     ------
     SignError
         when no sign pattern of the tooth forces is consistent at some sample (named).
+    ValueError
+        for bad shapes, an unknown load name or a load value that is not finite.
     """
-    return solver_for(an).solve(q, qd, qdd, method=method, chunk=chunk, verify=verify)
+    return solver_for(an).solve(q, qd, qdd, method=method, chunk=chunk, verify=verify, loads=loads)
 
 
 def residual(an, groups, cols, b, x_all, sig) -> float:

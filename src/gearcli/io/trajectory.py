@@ -4,7 +4,8 @@ Format: a header row, then one row per sample.  Columns ``t`` (s), ``q:<joint>``
 for every independent joint (the joints of the equivalent open-loop chain, named as in
 the mechanism file), optionally ``qd:<joint>`` (rad/s) and ``qdd:<joint>`` (rad/s^2).
 With ``degrees=True`` every angle column (q, qd, qdd) is in degrees (deg, deg/s, deg/s^2);
-columns of prismatic joints (``linear``) are in m, m/s, m/s^2 either way.
+columns of prismatic joints (``linear``) are in m, m/s, m/s^2 either way.  Optional
+``load:<name>:fx`` ... ``mz`` columns override external loads per sample (:mod:`.load_columns`).
 
 Missing rates/accelerations are derived from the positions with a quintic interpolating
 spline (:func:`scipy.interpolate.make_interp_spline`, k = 5, not-a-knot ends): for a smooth
@@ -35,6 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import Issue, TrajectoryError
+from .load_columns import load_columns, load_samples
 
 PAD = 64
 MAX_ABS = 1e12        # largest |value| accepted, SI units (s, rad, m and their rates)
@@ -47,13 +49,15 @@ _NUMBER = re.compile(r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)
 @dataclass
 class Trajectory:
     """Samples of the independent joints: ``t`` (N,), ``q``, ``qd``, ``qdd`` (N, dof);
-    ``line`` (N,) the file line of every sample (None for arrays not read from a file)."""
+    ``line`` (N,) the file line of every sample (None for arrays not read from a file);
+    ``loads`` {load name: (N, 6)} for the external loads with ``load:`` columns."""
 
     t: np.ndarray
     q: np.ndarray
     qd: np.ndarray
     qdd: np.ndarray
     line: np.ndarray | None = None
+    loads: dict | None = None
 
 
 def show(text: str, limit: int = 40) -> str:
@@ -115,14 +119,17 @@ def _expected(names: list[str]) -> str:
     return "expected t, " + ", ".join(qs) + " and optional qd:/qdd: columns, separated by ',', ';' or tab"
 
 
-def _columns(header: list[str], names: list[str], file: str) -> dict:
-    """Map of column kind -> list of column indices (or None) per independent joint."""
+def _columns(header: list[str], names: list[str], file: str, loads=()) -> dict:
+    """Map of column kind -> list of column indices (or None) per independent joint, and
+    ``"load"`` -> the load columns (:func:`~.load_columns.load_columns`)."""
     pos: dict[str, int] = {}
     for i, h in enumerate(header):
         if h in pos:
             raise _fail(file, 1, _place(header, i), "duplicate column")
         pos[h] = i
+    lcols = load_columns(pos, loads, file)
     known = {"t"} | {f"{p}:{n}" for p in ("q", "qd", "qdd") for n in names}
+    known |= {h for h in pos if h.startswith("load:")}
     for h, i in pos.items():
         if h not in known:
             what = "empty column name" if not h else "unknown column"
@@ -132,7 +139,7 @@ def _columns(header: list[str], names: list[str], file: str) -> dict:
     for n in names:
         if f"q:{n}" not in pos:
             raise _fail(file, 1, "", f"missing column 'q:{show(n)}' (independent joint '{show(n)}', rad)")
-    out = {"t": pos["t"]}
+    out = {"t": pos["t"], "load": lcols}
     for p in ("q", "qd", "qdd"):
         cols = [pos.get(f"{p}:{n}") for n in names]
         if p != "q" and any(c is None for c in cols) and any(c is not None for c in cols):
@@ -211,13 +218,16 @@ class TrajectoryReader:
 
     Iterating yields :class:`Trajectory` chunks in SI units.  ``names`` are the independent
     joint names (``Analysis.independent_names``); ``linear`` names those of prismatic joints,
-    which ``degrees`` leaves alone.  Every problem raises
+    which ``degrees`` leaves alone; ``loads`` the mechanism's external loads
+    (:class:`~gearcli.model.loads.Load`), whose ``load:`` columns override them per sample
+    (never scaled by ``degrees``).  Every problem raises
     :class:`~gearcli.errors.TrajectoryError` with an :class:`~gearcli.errors.Issue`.
     """
 
     def __init__(self, path: str | Path, names, degrees: bool = False, chunk: int = 100_000,
-                 linear=()):
+                 linear=(), loads=()):
         self.path, self.names, self.degrees = Path(path), list(names), degrees
+        self.loads = tuple(loads)
         self.linear = set(linear)
         self.chunk = max(int(chunk), 2 * PAD + 1)
         self.file = str(path)
@@ -229,7 +239,7 @@ class TrajectoryReader:
         _check_utf8(self.file, [head], [1])
         self.sep = next((s for s in SEPARATORS if s in head), ",")
         self.header = _split(head, self.sep)
-        self.cols = _columns(self.header, self.names, self.file)
+        self.cols = _columns(self.header, self.names, self.file, self.loads)
         self.scale = self._column_scale()
 
     def _open(self):
@@ -333,7 +343,8 @@ class TrajectoryReader:
         elif qdd is None:
             (qdd,) = self._derive(t, qd, 1, lines, "qd")
         sl = slice(a, a + len(cur[0]))
-        return Trajectory(t[sl], q[sl], qd[sl], qdd[sl], lines[sl])
+        loads = load_samples(cur[0], c["load"], self.loads)
+        return Trajectory(t[sl], q[sl], qd[sl], qdd[sl], lines[sl], loads)
 
     def _too_few(self, n: int, need: int, kind: str) -> TrajectoryError:
         given = "positions only" if kind == "q" else "no qdd: columns"
@@ -361,9 +372,9 @@ class TrajectoryReader:
         return out
 
 
-def read_trajectory(path, names, degrees: bool = False, linear=()) -> Trajectory:
+def read_trajectory(path, names, degrees: bool = False, linear=(), loads=()) -> Trajectory:
     """Read a whole trajectory CSV into memory (see :class:`TrajectoryReader`)."""
-    parts = list(TrajectoryReader(path, names, degrees, chunk=1 << 62, linear=linear))
+    parts = list(TrajectoryReader(path, names, degrees, chunk=1 << 62, linear=linear, loads=loads))
     return parts[0]
 
 

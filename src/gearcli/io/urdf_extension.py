@@ -1,5 +1,5 @@
 """gearcli URDF extension elements (``gearcli:mechanism``, ``gearcli:gear``,
-``gearcli:motor``) and the motors of a URDF (extension motors, ``<transmission>``
+``gearcli:motor``; ``gearcli:load`` is read by :mod:`gearcli.io.loads_reader`) and the motors of a URDF (extension motors, ``<transmission>``
 actuators, direct drives).  A mixin of the reader in :mod:`gearcli.io.urdf_reader`."""
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ class Extension:
     ``leader`` and ``chain_leader``."""
 
     def read_extension(self) -> dict:
-        ext = {"mechanism": None, "gears": [], "motors": []}
+        ext = {"mechanism": None, "gears": [], "motors": [], "loads": []}
         for el in self.root:
             if not isinstance(el.tag, str) or etree.QName(el).namespace != NS:
                 continue
@@ -40,11 +40,13 @@ class Extension:
                 ext["gears"].append(el)
             elif local == "motor":
                 ext["motors"].append(el)
+            elif local == "load":
+                ext["loads"].append(el)
             elif local in ("motor_rating", "gear_rating"):
                 continue  # read by io.ratings_reader
             else:
                 self.add(f"gearcli:{local}", f"unknown gearcli element gearcli:{local} (expected gearcli:mechanism, "
-                         "gearcli:gear or gearcli:motor)", el)
+                         "gearcli:gear, gearcli:motor or gearcli:load)", el)
         return ext
 
     def unknown_attrs(self, el, allowed, path: str) -> None:

@@ -24,7 +24,8 @@ What each URDF element becomes (README, "URDF in and out", has the table with ex
   has ``gearcli:gear`` elements, whose motors must then be listed);
 * extension elements in the namespace :data:`NS` (other URDF tools ignore them):
   ``<gearcli:mechanism end_effector= gravity= open_loop=/>``, ``<gearcli:gear .../>``
-  (a full gear pair, attributes as in the YAML format), ``<gearcli:motor .../>``, and,
+  (a full gear pair, attributes as in the YAML format), ``<gearcli:motor .../>``,
+  ``<gearcli:load .../>`` (an external load, :mod:`gearcli.io.loads_reader`), and,
   inside a ``<joint>``, ``<gearcli:joint label=/>`` and ``<gearcli:gear .../>`` (the mesh
   geometry of that joint's mimic coupling).  Elements and attributes marked
   ``gearcli:derived="true"`` were written by :mod:`gearcli.urdf_export` for other tools and
@@ -51,6 +52,7 @@ from ..model.validate import check_inertia
 from ..spatial import align_z, matrix_rpy
 from .limits import read_bytes
 from .ratings_reader import attach_urdf_ratings
+from .loads_reader import UrdfLoads
 from .urdf_extension import Extension
 from .urdf_mimic import Mimics
 from .urdf_structure import JOINT_TYPES, StructureChecks
@@ -73,7 +75,7 @@ def _transform(origin) -> np.ndarray:
     return np.eye(4) if origin is None else np.asarray(origin, float)
 
 
-class _Reader(StructureChecks, Mimics, Extension):
+class _Reader(StructureChecks, Mimics, Extension, UrdfLoads):
     """One URDF being read: elements by name, issues and warnings with their lines."""
 
     def __init__(self, root, data: bytes, file: str):
@@ -129,6 +131,7 @@ class _Reader(StructureChecks, Mimics, Extension):
         self.col.raise_if_any()
         joints = self.absorb_offsets(joints)
         motors = self.motors(ext, bool(ext["gears"]))
+        loads = self.extension_loads(ext["loads"])
         self.col.raise_if_any()
         mech_el = ext["mechanism"]
         end_effector, open_loop = self.end_effector(mech_el)
@@ -140,7 +143,7 @@ class _Reader(StructureChecks, Mimics, Extension):
             name=root.get("name") or Path(self.file).stem, base=self.base, end_effector=end_effector,
             links=tuple(links), joints=tuple(joints), gears=tuple(gears), motors=tuple(motors),
             gravity=np.asarray(gravity, float), source=self.file, lines=dict(self.lines),
-            open_loop=open_loop, warnings=tuple(self.warnings),
+            open_loop=open_loop, warnings=tuple(self.warnings), loads=loads,
         )
 
     # -- values (yourdfpy) ----------------------------------------------------------------------

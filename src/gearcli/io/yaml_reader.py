@@ -20,6 +20,7 @@ import numpy as np
 
 from ..errors import Collector
 from ..model.mechanism import GearPair, Joint, Link, Mechanism, Motor
+from .loads_reader import yaml_loads
 from .ratings_reader import attach_yaml_ratings
 from ..model.geometry import dh_transform, origin_axis_transform
 from ..model.validate import check_inertia, gear_pair_problems, inertia_matrix, number_problem
@@ -176,7 +177,7 @@ class _Names:
 
 
 def _build(data: dict, col: Collector, file: str, lines: dict) -> Mechanism:
-    """The Mechanism of validated ``data``: links, joints, gears and motors in turn, each
+    """The Mechanism of validated ``data``: links, joints, gears, motors and loads in turn, each
     checked for names, references and values."""
     links, link_list = _links(data, col)
     for key in ("base", "end_effector"):
@@ -186,7 +187,7 @@ def _build(data: dict, col: Collector, file: str, lines: dict) -> Mechanism:
         links=tuple(link_list), joints=tuple(_joints(data, col, links)),
         gears=tuple(_gears(data, col, links)), motors=tuple(_motors(data, col, links)),
         gravity=np.asarray(data.get("gravity", [0.0, 0.0, -9.81]), float),
-        source=file, lines=dict(lines),
+        source=file, lines=dict(lines), loads=yaml_loads(data, col, set(links.first), data["base"]),
     )
 
 

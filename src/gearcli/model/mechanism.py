@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .loads import Load
 from .ratings import BearingRating, GearRating, JointLimit, MotorRating
 
 
@@ -125,6 +126,7 @@ class Mechanism:
     # first link j of a gear pair or coupling (a branched robot, e.g. a URDF humanoid).
     open_loop: str = "chain"
     warnings: tuple[str, ...] = ()  # input problems that were worked around (e.g. URDF)
+    loads: tuple[Load, ...] = ()    # external loads on links (model.loads)
 
     def link(self, name: str) -> Link:
         for link in self.links:

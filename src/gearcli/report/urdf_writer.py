@@ -17,8 +17,8 @@ write):
   gearcli:derived="true">`` (both for other tools; gearcli ignores them on reading);
 * the exact gearcli data in extension elements (namespace :data:`gearcli.urdf.NS`):
   ``gearcli:mechanism`` (end effector, gravity, open loop), ``gearcli:gear`` (full gear
-  geometry; angles in rad), ``gearcli:motor`` (link, stator, transmission coefficients) and
-  ``gearcli:joint`` (axis labels).
+  geometry; angles in rad), ``gearcli:motor`` (link, stator, transmission coefficients),
+  ``gearcli:load`` (external loads, in the URDF link frame) and ``gearcli:joint`` (axis labels).
 """
 from __future__ import annotations
 
@@ -224,6 +224,16 @@ def _add_extension(an: Analysis, root, corr: dict) -> None:
         if m.joints:
             el.set("joints", " ".join(j for j, _ in m.joints))
             el.set("coefficients", _vec([c for _, c in m.joints]))
+    _add_loads(mech, root, corr)
+
+
+def _add_loads(mech: Mechanism, root, corr: dict) -> None:
+    """One gearcli:load per external load, re-expressed in its link's URDF frame."""
+    for ld in mech.loads:
+        R, _ = corr[ld.link]
+        f, m = (R.T @ ld.force, R.T @ ld.moment) if ld.frame == "link" else (ld.force, ld.moment)
+        etree.SubElement(root, q("load"), name=ld.name, link=ld.link, frame=ld.frame,
+                         point=_vec(_to_urdf(corr, ld.link, ld.point)), force=_vec(f), moment=_vec(m))
 
 
 def _gear_attrs(el, gp, mesh_point) -> None:
