@@ -41,6 +41,7 @@ class GearcliError(Exception):
     """Base class of the errors gearcli reports as bad input (exit status 2)."""
 
     def lines(self) -> list[str]:
+        """One line per problem, ``file:line: place: what is wrong``."""
         return [str(self)]
 
 
@@ -52,6 +53,7 @@ class MechanismError(GearcliError):
         super().__init__("\n".join(str(i) for i in self.issues))
 
     def lines(self) -> list[str]:
+        """One line per problem, ``file:line: place: what is wrong``."""
         return [str(i) for i in self.issues]
 
 
@@ -83,8 +85,10 @@ class Collector:
         return self.lines.get("", None)
 
     def add(self, path: str, message: str) -> None:
+        """Record a problem at YAML/element ``path`` (its line looked up)."""
         self.issues.append(Issue(self.file, path, self.line_of(path), message))
 
     def raise_if_any(self) -> None:
+        """Raise a :class:`MechanismError` with every problem recorded so far, if any."""
         if self.issues:
             raise MechanismError(self.issues)

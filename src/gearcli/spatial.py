@@ -8,16 +8,19 @@ import numpy as np
 
 
 def rot_x(a: float) -> np.ndarray:
+    """Rotation matrix (3, 3) by ``a`` rad about x."""
     c, s = np.cos(a), np.sin(a)
     return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
 
 
 def rot_y(a: float) -> np.ndarray:
+    """Rotation matrix (3, 3) by ``a`` rad about y."""
     c, s = np.cos(a), np.sin(a)
     return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
 def rot_z(a: float) -> np.ndarray:
+    """Rotation matrix (3, 3) by ``a`` rad about z."""
     c, s = np.cos(a), np.sin(a)
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
@@ -50,6 +53,7 @@ def align_z(axis) -> np.ndarray:
 
 
 def skew(v) -> np.ndarray:
+    """Cross-product matrix [v]x (3, 3) of ``v`` (3,): [v]x u = v x u."""
     x, y, z = v
     return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
 

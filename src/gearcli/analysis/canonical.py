@@ -112,6 +112,7 @@ def coaxial_groups(h: Home, cparent: list, label: list) -> list[CoaxialGroup]:
 
 
 def auto_label(i: int) -> str:
+    """Axis label of the i-th distinct axis: a, b, ..., z, a1, b1, ..."""
     s = ""
     i += 1
     while i:

@@ -12,6 +12,7 @@ from .types import Circuit, CoaxialGroup
 
 
 def groups_of(groups: list[CoaxialGroup], x: int) -> list[CoaxialGroup]:
+    """The coaxial groups that link ``x`` belongs to."""
     return [g for g in groups if x in g.members]
 
 

@@ -32,10 +32,12 @@ class Home:
 
     @property
     def L(self) -> int:
+        """Number of links (base included)."""
         return len(self.tree.links)
 
     @property
     def J(self) -> int:
+        """Number of real joints."""
         return len(self.mech.joints)
 
     def collinear(self, a: int, b: int) -> bool:

@@ -27,6 +27,7 @@ class Tree:
 
     @property
     def moving(self) -> list[int]:
+        """Ids of every link but the base, in link order."""
         return [i for i in range(len(self.links)) if i != self.base]
 
     def path_up(self, i: int, stop: int) -> list[int]:

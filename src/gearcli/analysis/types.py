@@ -74,25 +74,31 @@ class Analysis:
 
     @property
     def dof(self) -> int:
+        """Degrees of freedom: the number of independent coordinates."""
         return self.S.shape[1]
 
     @property
     def names(self):
+        """Link names, indexed by link id."""
         return self.tree.links
 
     def name_of(self, ids) -> list[str]:
+        """Names of the links ``ids``."""
         return [self.tree.links[i] for i in ids]
 
     @property
     def secondary(self) -> list[int]:
+        """Secondary links (gears and shafts carried by a primary link), ids."""
         return [i for i in self.tree.moving if i not in self.primary]
 
     @property
     def carriers(self) -> dict[str, str]:
+        """Carrier (canonical parent) of every secondary link, by name."""
         return {self.names[i]: self.names[self.canonical_parent[i]] for i in self.secondary}
 
 
 def collinear(o1, z1, o2, z2, scale=1.0) -> bool:
+    """True if the lines (o1, z1) and (o2, z2) coincide (unit directions; tolerance TOL_LINE, lengths scaled by ``scale``, m)."""
     if np.linalg.norm(np.cross(z1, z2)) > TOL_LINE:
         return False
     d = o2 - o1

@@ -108,6 +108,7 @@ class Columns:
         return sign * _moment(z)
 
     def motor(self, mi: int, L: int) -> np.ndarray:
+        """(N, 6, 1) column of motor ``mi``'s torque on link L: about the input link's joint axis on the input link, reversed on the stator (a transmission motor: its joints' generalised forces)."""
         an, kin = self.an, self.kin
         if an.motor_joints and an.motor_joints[mi] is not None:
             return sum(coef * self.axial(ji, L) for ji, coef in an.motor_joints[mi])[:, :, None]

@@ -30,6 +30,7 @@ class SignError(GearcliError):
         self.meshes = meshes
 
     def lines(self) -> list[str]:
+        """The one-line message of this error."""
         return [f"sample {self.sample}: no sign pattern of the tangential tooth forces of "
                 f"{', '.join(self.meshes)} agrees with its own solution (paper Eq. 14); "
                 "the equations have no consistent solution there"]

@@ -129,6 +129,7 @@ class Mechanism:
     loads: tuple[Load, ...] = ()    # external loads on links (model.loads)
 
     def link(self, name: str) -> Link:
+        """The link called ``name``."""
         for link in self.links:
             if link.name == name:
                 return link
@@ -136,4 +137,5 @@ class Mechanism:
 
     @property
     def link_names(self) -> list[str]:
+        """Names of every link, in file order."""
         return [link.name for link in self.links]
