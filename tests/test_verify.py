@@ -288,3 +288,17 @@ def test_unwritable_reports_are_refused_before_running(run_cli, tmp_path):
     assert r.exit_code == 2 and len(r.stderr.strip().splitlines()) == 1
     r = run_cli("verify", DESIGNS / "ci_example.yaml", "--json", DESIGNS / "ci_example.yaml")
     assert r.exit_code == 2 and "Design checks" not in r.stdout
+
+
+def test_bad_trajectory_rows_are_listed_with_the_other_problems(run_cli, tmp_path):
+    case = write_rotor_case(tmp_path, "[{name: x, position: 0, C: 3000, C0: 3000, type: ball}]")
+    lines = (tmp_path / "rotor.csv").read_text().splitlines()
+    lines[5] = lines[5].replace(",", ",x", 1)
+    (tmp_path / "rotor.csv").write_text("\n".join(lines) + "\n")
+    man = tmp_path / "design.yaml"
+    man.write_text("cases:\n" + case.replace("min_static_safety: 1.5", "min_static_safety: 1.5, limits: [{column: nope, max_abs: 1}]"))
+    r = run_cli("verify", man)
+    assert r.exit_code == 2
+    err = r.stderr.strip().splitlines()
+    assert any(x.startswith(f"{tmp_path / 'rotor.csv'}:6:") for x in err), err
+    assert any("unknown output column 'nope'" in x for x in err), err

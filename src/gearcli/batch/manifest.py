@@ -19,7 +19,7 @@ import jsonschema
 from ..design.checks import Check, Requirements, build_checks
 from ..errors import Collector, GearcliError, Issue, MechanismError
 from ..io import load_mechanism
-from ..io.trajectory import read_trajectory
+from ..io.trajectory import TrajectoryReader
 from ..io.yaml_reader import yaml_lines
 from ..pipeline import analyse, prismatic_independent
 
@@ -147,8 +147,8 @@ def _prepare_case(spec: dict, where: str, base: Path, col: Collector, issues: li
         col.add(f"{where}.mechanism", f"nothing to check: '{spec['mechanism']}' has no ratings and the case no limits")
     for tp in trajs:
         try:
-            read_trajectory(tp, an.independent_names, degrees=spec.get("degrees", False),
-                            linear=prismatic_independent(an), loads=an.mech.loads)
+            TrajectoryReader(tp, an.independent_names, degrees=spec.get("degrees", False),
+                             linear=prismatic_independent(an), loads=an.mech.loads).check()   # rows only, no spline
         except GearcliError as exc:
             issues += exc.lines()
     name = spec.get("name", Path(spec["mechanism"]).stem)
