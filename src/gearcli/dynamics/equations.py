@@ -31,14 +31,19 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model.gears import helical_terms
 from ..spatial import cross, mv
 from .kinematics import Kinematics
 
 
-def tooth_force_direction(ut: np.ndarray, us: np.ndarray, sigma, tan_phi: float) -> np.ndarray:
+def tooth_force_direction(ut: np.ndarray, us: np.ndarray, sigma, tan_phi: float,
+                          axial: np.ndarray | None = None) -> np.ndarray:
     """Tooth force on gear j per unit of tangential force t (paper Eq. 14, ERRATA 7).
 
-    g_jk = t ut + |t| tan(phi) us = t (ut + sigma tan(phi) us), sigma = sign(t).
+    g_jk = t ut + |t| tan(phi) us = t (ut + sigma tan(phi) us), sigma = sign(t); for a
+    helical pair phi is the transverse pressure angle and the axial thrust t a is added,
+    a = -+tan(beta) z_j for a right-/left-hand gear j
+    (:func:`gearcli.model.gears.helical_terms`).
 
     Parameters
     ----------
@@ -46,9 +51,11 @@ def tooth_force_direction(ut: np.ndarray, us: np.ndarray, sigma, tan_phi: float)
     us : (N, 3) unit separating direction on j (away from the mesh partner, perpendicular to
         the pitch element), base frame.
     sigma : (N,) or scalar, sign of t.
-    tan_phi : tangent of the pressure angle.
+    tan_phi : tangent of the (transverse) pressure angle.
+    axial : (N, 3) axial thrust per unit of t, base frame (None: spur).
     """
-    return ut + (np.asarray(sigma, float).reshape(-1, 1) * tan_phi) * us
+    d = ut + (np.asarray(sigma, float).reshape(-1, 1) * tan_phi) * us
+    return d if axial is None else d + axial
 
 
 def _force_at(d: np.ndarray, point: np.ndarray, origin: np.ndarray) -> np.ndarray:
@@ -75,9 +82,11 @@ class Columns:
             if c.joints is not None:
                 continue  # joint coupling: see axial()
             if c.geometry is not None:
-                gm = c.geometry
-                self.world[ci] = dict(P=oc + mv(Rc, gm.P), ut=mv(Rc, gm.ut), us=mv(Rc, gm.us))
-                self.tan_phi[ci] = float(np.tan(an.mech.gears[c.gear].pressure_angle))
+                gm, gp = c.geometry, an.mech.gears[c.gear]
+                tan_t, a = helical_terms(gm, gp.pressure_angle, gp.helix_angle, gp.hand)
+                self.world[ci] = dict(P=oc + mv(Rc, gm.P), ut=mv(Rc, gm.ut), us=mv(Rc, gm.us),
+                                      ax=mv(Rc, a) if gp.helix_angle else None)
+                self.tan_phi[ci] = tan_t
             else:
                 self.world[ci] = dict(zj=mv(Rc, c.zj), zk=mv(Rc, c.zk))
 
@@ -132,7 +141,7 @@ class Columns:
         o = self.kin.o[L]
         if c.geometry is not None:
             sign = 1.0 if L == c.j else -1.0
-            d = tooth_force_direction(wv["ut"], wv["us"], sigma, self.tan_phi[ci])
+            d = tooth_force_direction(wv["ut"], wv["us"], sigma, self.tan_phi[ci], wv["ax"])
             return sign * _force_at(d, wv["P"], o)[:, :, None]
         col = 0.0
         if L == c.j:

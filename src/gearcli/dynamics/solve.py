@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..analysis.schedule import unknown_groups
+from ..model.gears import helical_terms
 from .blocks import make_plans, solve_blocks
 from .equations import Columns
 from .general import is_geared, solve_full
@@ -49,7 +50,8 @@ class Result:
     motor torque is reported in ``motor``.
     ``gear_t`` (N, G): tangential tooth force on gear j by gear k, N, positive when it turns
     j in j's positive sense (for an ideal coupling: the mesh torque on j, N*m).
-    ``gear_sep`` (N, G): separating force magnitude |t| tan(phi), N.
+    ``gear_sep`` (N, G): separating force magnitude |t| tan(phi), N (phi_t = the transverse
+    pressure angle, tan(phi_n) / cos(beta), for a helical pair).
     ``gear_radial``, ``gear_axial`` (N, G, 2): components of the tooth force on gear j and on
     gear k along each gear's own outward radial direction (towards the pitch point) and its
     positive axis, N.
@@ -229,13 +231,15 @@ def _result(an, groups, x_all) -> Result:
         gt[:, ci] = t
         if c.geometry is None:
             continue
-        gm = c.geometry
-        s = np.abs(t) * np.tan(mech.gears[c.gear].pressure_angle)
+        gm, gp = c.geometry, mech.gears[c.gear]
+        tan_t, a = helical_terms(gm, gp.pressure_angle, gp.helix_angle, gp.hand)
+        s = np.abs(t) * tan_t
         sep[:, ci] = s
-        # g = t ut + s us (on j); -g on k; ut is perpendicular to both radial directions
-        rad[:, ci, 0] = s * (gm.us @ gm.rad_j)
-        ax[:, ci, 0] = t * (gm.ut @ gm.zj) + s * (gm.us @ gm.zj)
-        rad[:, ci, 1] = -(t * (gm.ut @ gm.rad_k) + s * (gm.us @ gm.rad_k))
-        ax[:, ci, 1] = -(t * (gm.ut @ gm.zk) + s * (gm.us @ gm.zk))
+        # g = t (ut + a) + s us (on j); -g on k; ut is perpendicular to both radial directions
+        ua = gm.ut + a
+        rad[:, ci, 0] = t * (ua @ gm.rad_j) + s * (gm.us @ gm.rad_j)
+        ax[:, ci, 0] = t * (ua @ gm.zj) + s * (gm.us @ gm.zj)
+        rad[:, ci, 1] = -(t * (ua @ gm.rad_k) + s * (gm.us @ gm.rad_k))
+        ax[:, ci, 1] = -(t * (ua @ gm.zk) + s * (gm.us @ gm.zk))
     tau = motor @ an.A.T
     return Result(motor, tau, joint, gt, sep, rad, ax)

@@ -13,7 +13,8 @@ from .urdf_transmissions import read_transmissions
 from .urdf_xml import NS, q
 
 GEAR_ATTRS = ("name", "j", "k", "kind", "ratio", "teeth", "carrier", "mesh_point", "pressure_angle",
-              "pressure_angle_deg", "cone_angles", "cone_angles_deg", "derived")
+              "pressure_angle_deg", "cone_angles", "cone_angles_deg", "helix_angle", "helix_angle_deg", "hand",
+              "derived")
 
 
 class Extension:
@@ -91,8 +92,10 @@ class Extension:
                     T = carrier[1]
                     P = T[:3, :3] @ P + T[:3, 3]
                 kw["mesh_point"] = P
-        for key in ("pressure_angle", "cone_angles"):
-            n = 1 if key == "pressure_angle" else 2
+        if el.get("hand") is not None:
+            kw["hand"] = el.get("hand")
+        for key in ("pressure_angle", "cone_angles", "helix_angle"):
+            n = 2 if key == "cone_angles" else 1
             if el.get(key) is not None and el.get(f"{key}_deg") is not None:
                 self.add(path, f"give either {key} (rad) or {key}_deg, not both", el)
             v = self.vector(el, key, path, n=n)
@@ -108,7 +111,8 @@ class Extension:
         ``j``/``k`` None when unknown (already reported)."""
         same = j is not None and j == k
         for _, message in gear_pair_problems("j", "j" if same else "k", kw["kind"], ratio, "teeth" in kw,
-                                             "mesh_point" in kw, "cone_angles" in kw):
+                                             "mesh_point" in kw, "cone_angles" in kw, kw.get("helix_angle"),
+                                             kw.get("hand")):
             self.add(path, message, el)
 
     def extension_gears(self, ext) -> list[GearPair]:

@@ -230,7 +230,8 @@ def _joints(data: dict, col: Collector, links: _Names) -> list[Joint]:
     return joints
 
 
-_GEAR_FIELD = {"": "", "links": ".links", "kind": ".kind", "ratio": ".ratio", "cone_angles": ".cone_angles_deg"}
+_GEAR_FIELD = {"": "", "links": ".links", "kind": ".kind", "ratio": ".ratio", "cone_angles": ".cone_angles_deg",
+               "helix_angle": ".helix_angle_deg", "hand": ".hand"}
 
 
 def _gears(data: dict, col: Collector, links: _Names) -> list[GearPair]:
@@ -246,8 +247,9 @@ def _gears(data: dict, col: Collector, links: _Names) -> list[GearPair]:
             links.ref(spec["carrier"], f"{path}.carrier")
         kind, cones = spec.get("kind", "external"), spec.get("cone_angles_deg")
         ratio = float(spec["ratio"]) if "ratio" in spec else None
+        helix = float(np.deg2rad(spec["helix_angle_deg"])) if "helix_angle_deg" in spec else None
         for field, message in gear_pair_problems(j, k, kind, ratio, "teeth" in spec, "mesh_point" in spec,
-                                                 cones is not None):
+                                                 cones is not None, helix, spec.get("hand")):
             col.add(path + _GEAR_FIELD[field], message)
         gears.append(GearPair(
             spec.get("name", f"{j}-{k}"), j, k, kind, ratio,
@@ -256,7 +258,7 @@ def _gears(data: dict, col: Collector, links: _Names) -> list[GearPair]:
             spec.get("carrier"),
             float(np.deg2rad(spec.get("pressure_angle_deg", 20.0))),
             tuple(np.deg2rad(cones)) if cones is not None else None,
-            path,
+            path, helix_angle=helix or 0.0, hand=spec.get("hand"),
         ))
     return gears
 

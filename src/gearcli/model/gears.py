@@ -151,3 +151,21 @@ def _given_values(ratio, teeth, cones, e, r_j, r_k, cone_j, cone_k, names) -> li
                 problems.append((f"cone_angles_deg[{i}]", f"cone angle {np.rad2deg(given):.6g} deg of gear "
                                  f"'{n}' contradicts the geometry ({np.rad2deg(geo):.6g} deg)"))
     return problems
+
+
+def helical_terms(gm: GearGeometry, pressure_angle: float, helix_angle: float = 0.0,
+                  hand: str | None = None) -> tuple[float, np.ndarray]:
+    """(tan phi_t, a): the tooth force on gear j is ``g = t (ut + a) + |t| tan(phi_t) us``.
+
+    For a spur pair (beta = 0) phi_t is the pressure angle and a = 0.  For a helical pair
+    ``pressure_angle`` is the normal one phi_n: tan(phi_t) = tan(phi_n) / cos(beta), and the
+    contact force is normal to the tooth line.  On a right-hand gear j the tooth line
+    advances like a right-hand screw, along cos(beta) z_j + sin(beta) ut (whichever way z_j
+    points), so a force perpendicular to it with tangential part t ut has the axial part
+    a t = -t tan(beta) z_j; on a left-hand gear j, +t tan(beta) z_j.  (3,) carrier frame.
+    """
+    tan_t = float(np.tan(pressure_angle) / np.cos(helix_angle))
+    if not helix_angle:
+        return tan_t, np.zeros(3)
+    sign = -1.0 if hand == "right" else 1.0
+    return tan_t, sign * float(np.tan(helix_angle)) * gm.zj

@@ -88,6 +88,11 @@ class GearPair:
     # coupling acting on the two joints (torque pair, reactions on each joint's parent).
     joints: tuple[str, str] | None = None
     rating: GearRating | None = None   # tooth rating (design checks)
+    # Helical parallel-axis pair: helix angle beta (rad; pressure_angle is then the normal
+    # one) and the hand of gear j ("right"/"left"; gear k: opposite for an external pair,
+    # the same for an internal one).  See model.gears.helical_terms.
+    helix_angle: float = 0.0
+    hand: str | None = None
 
 
 @dataclass(frozen=True, eq=False)

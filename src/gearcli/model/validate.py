@@ -56,11 +56,13 @@ def number_problem(x) -> str | None:
 
 
 def gear_pair_problems(j: str, k: str, kind: str, ratio: float | None, has_teeth: bool,
-                       has_mesh_point: bool, has_cones: bool) -> list[tuple[str, str]]:
+                       has_mesh_point: bool, has_cones: bool, helix: float | None = None,
+                       hand: str | None = None) -> list[tuple[str, str]]:
     """Problems of a gear pair's declaration, whatever file it comes from: (field, message)
-    with field ``""`` (the pair), ``"links"``, ``"kind"``, ``"ratio"`` or ``"cone_angles"``;
-    ``ratio`` None when not given.  (The geometric checks are in :mod:`gearcli.model.gears`.)"""
-    out: list[tuple[str, str]] = []
+    with field ``""`` (the pair), ``"links"``, ``"kind"``, ``"ratio"``, ``"cone_angles"``,
+    ``"helix_angle"`` or ``"hand"``; ``ratio`` and ``helix`` (rad) None when not given.
+    (The geometric checks are in :mod:`gearcli.model.gears`.)"""
+    out: list[tuple[str, str]] = _helix_problems(kind, has_mesh_point, helix, hand)
     if kind not in GEAR_KINDS:
         out.append(("kind", f"unknown gear kind '{kind}' (expected {', '.join(GEAR_KINDS)})"))
     if j == k:
@@ -73,4 +75,22 @@ def gear_pair_problems(j: str, k: str, kind: str, ratio: float | None, has_teeth
         out.append(("", "a gear pair without mesh_point needs an explicit signed ratio"))
     if has_cones and kind != "bevel":
         out.append(("cone_angles", f"cone angles are only for bevel gears, this pair is {kind}"))
+    return out
+
+
+def _helix_problems(kind: str, has_mesh_point: bool, helix: float | None, hand: str | None) -> list:
+    out = []
+    if helix is not None and not 0.0 <= helix < 1.0471975511965979:
+        out.append(("helix_angle", f"helix angle must be in [0, 60) degrees, got {np.degrees(helix):g}"))
+    if helix and kind not in ("external", "internal"):
+        out.append(("helix_angle", f"a helix angle is only for external and internal parallel-axis pairs, "
+                    f"this pair is {kind}"))
+    elif helix and not has_mesh_point:
+        out.append(("helix_angle", "a helix angle needs the tooth geometry (mesh_point)"))
+    if hand is not None and hand not in ("right", "left"):
+        out.append(("hand", f"hand must be 'right' or 'left', got '{hand}'"))
+    if hand is not None and not helix:
+        out.append(("hand", "hand given without a (non-zero) helix angle"))
+    if helix and hand is None:
+        out.append(("hand", "a helical pair needs the hand of gear j: right or left"))
     return out

@@ -244,3 +244,6 @@ def _gear_attrs(el, gp, mesh_point) -> None:
     el.set("pressure_angle", _num(gp.pressure_angle))
     if gp.cone_angles is not None:
         el.set("cone_angles", _vec(gp.cone_angles))
+    if gp.helix_angle:
+        el.set("helix_angle", _num(gp.helix_angle))
+        el.set("hand", str(gp.hand))
