@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from .dynamics.solve import solve
 from .analysis.graph import Analysis
@@ -38,9 +39,10 @@ def analyse(mech: Mechanism) -> Analysis:
     load equations (:func:`gearcli.dynamics.determinacy.check_determinate`).  Raises
     :class:`~gearcli.errors.MechanismError` listing every problem.
     """
-    an = analyse_graph(mech)
-    col = Collector(mech.source, mech.lines)
-    check_determinate(an, col)
+    with threadpool_limits(limits=1, user_api="blas"):   # small matrices: threads only contend
+        an = analyse_graph(mech)
+        col = Collector(mech.source, mech.lines)
+        check_determinate(an, col)
     col.raise_if_any()
     return an
 

@@ -22,6 +22,7 @@ import weakref
 from dataclasses import dataclass
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from ..analysis.schedule import unknown_groups
 from ..model.gears import helical_terms
@@ -112,13 +113,16 @@ class Solver:
             raise ValueError(f"unknown method '{method}' (expected 'block' or 'full')")
         values = load_values(self.an.mech, q.shape[0], loads)
         parts = []
-        for s in range(0, q.shape[0], chunk):
-            sl = slice(s, s + chunk)
-            try:
-                parts.append(self._chunk(q[sl], qd[sl], qdd[sl], method, verify,
-                                         {k: v[sl] for k, v in values.items()}))
-            except SignError as exc:
-                raise SignError(exc.sample + s, exc.meshes) from None
+        # the operands are 3x3 to 48x48 matrices: BLAS threads only contend (2-3x slower
+        # with a busy second core), so one BLAS thread, whatever the environment says
+        with threadpool_limits(limits=1, user_api="blas"):
+            for s in range(0, q.shape[0], chunk):
+                sl = slice(s, s + chunk)
+                try:
+                    parts.append(self._chunk(q[sl], qd[sl], qdd[sl], method, verify,
+                                             {k: v[sl] for k, v in values.items()}))
+                except SignError as exc:
+                    raise SignError(exc.sample + s, exc.meshes) from None
         if len(parts) == 1:
             res = parts[0]
         else:
