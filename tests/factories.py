@@ -308,7 +308,14 @@ def spatial_3dof(seed: int = 20240607, j5_parent: str = "1") -> tuple[str, dict]
                    {"name": "motor3", "link": "3", "stator": "2"}],
     }
     info = dict(ratios={"4-1": e41, "5-6": e56, "6-2": e62}, ring=("4-1", 1), gravity=gravity,
-                home=W, axes=axes, parents=parents, links=links)   # for the tests' own kinematics
+                home=W, axes=axes, parents=parents, links=links,   # for the tests' own kinematics
+                gears_home={   # world frame at home; us_j: separating force on j along +-(radial of j)
+                    "4-1": dict(j="4", k="1", carrier="0", P=P41, oj=o4, zj=-a1, ok=O1, zk=a1, apex=None,
+                                phi_deg=20.0, us_j=-1.0),
+                    "5-6": dict(j="5", k="6", carrier="1", P=P56, oj=W["5"][1], zj=a1, ok=W["6"][1], zk=d2,
+                                apex=apex, phi_deg=22.5, us_j=-1.0),
+                    "6-2": dict(j="6", k="2", carrier="1", P=P62, oj=W["6"][1], zj=d2, ok=O2, zk=-d2, apex=None,
+                                phi_deg=25.0, us_j=-1.0)})
     return dump(doc), info
 
 

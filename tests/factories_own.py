@@ -169,7 +169,15 @@ def spatial_own() -> tuple[str, OwnMech]:
     S = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [e["4-1"], 0, 0], [1, e["5-6"] * e["6-2"], 0],
                   [0, e["6-2"], 0]], float)
     motors = {"motor4": ("J4", S[3]), "motor5": ("J5", S[4]), "motor3": ("J3", S[2])}
-    return text, OwnMech("0", links, _ordered(joints), S, info["gravity"], motors)
+    gears = {}
+    for name, gh in info["gears_home"].items():   # world at home -> carrier frame
+        Rc, oc = W[gh["carrier"]]
+        gm = dict(gh)
+        for key in ("P", "oj", "ok", "apex"):
+            gm[key] = None if gh[key] is None else Rc.T @ (gh[key] - oc)
+        gm["zj"], gm["zk"] = Rc.T @ gh["zj"], Rc.T @ gh["zk"]
+        gears[name] = gm
+    return text, OwnMech("0", links, _ordered(joints), S, info["gravity"], motors, gears)
 
 
 def _tensor(spec) -> np.ndarray:

@@ -178,14 +178,16 @@ def test_momentum_balance_own_kinematics(key, method):
 
 # --- 4. the tooth force of Eq. (14) in the test's own geometry -------------------------------------
 
-@pytest.mark.parametrize("key", ["dh_geared:0", "dh_geared:1"])
+@pytest.mark.parametrize("key", ["dh_geared:0", "dh_geared:1", "spatial"])
 def test_tooth_force_own_geometry(key):
-    """For the spur pairs (external; internal with the ring as gear j for odd seeds):
-    rebuild the force on gear j from the reported t, radial and axial components along the
-    test's own directions (pitch point and axes moved with the own carrier pose).  Its
-    separating component, towards j's own axis (outwards for a ring), is
-    |t| tan(phi) with phi as written in the file (degrees); the sep column says the same; it
-    has no component along the axes; and the components reported on gear k are those of
+    """Spur pairs (external; internal with the ring as gear j for odd dh_geared seeds, as
+    gear k in spatial) and a bevel pair (spatial): rebuild the force on gear j from the
+    reported t, radial and axial components along the test's own directions (pitch point,
+    axes and cone apex moved with the own carrier pose).  Per ERRATA 7 its separating
+    component is perpendicular to the pitch element (the axis for spur gears, apex -> pitch
+    point for bevel gears), towards j's own axis (outwards for a ring), of size |t| tan(phi)
+    with phi as written in the file (degrees); the sep column says the same; the force has
+    no other component off the tangent; and the components reported on gear k are those of
     -g along k's own radial direction and axis."""
     an, om = case(key)
     rng = np.random.default_rng(5)
@@ -198,6 +200,8 @@ def test_tooth_force_own_geometry(key):
         Tc = T[gm["carrier"]]
         Rc, oc = Tc[:, :3, :3], Tc[:, :3, 3]
         P = Rc @ gm["P"] + oc
+        e = Rc @ gm["zj"] if gm.get("apex") is None else P - (Rc @ gm["apex"] + oc)
+        e = e / np.linalg.norm(e, axis=1, keepdims=True)          # pitch element
         basis = []
         for o, z in ((gm["oj"], gm["zj"]), (gm["ok"], gm["zk"])):
             zw = Rc @ z
@@ -209,8 +213,10 @@ def test_tooth_force_own_geometry(key):
         g = t[:, None] * np.cross(zj, rj) + res.gear_radial[:, gi, 0, None] * rj + res.gear_axial[:, gi, 0, None] * zj
         sep = np.abs(t) * np.tan(np.radians(gm["phi_deg"]))
         assert np.max(t) > 0 > np.min(t)     # both signs of |t| exercised
-        assert rel_err(np.sum(g * (gm["us_j"] * rj), axis=1), sep) < TOL
+        us = rj - np.sum(rj * e, axis=1, keepdims=True) * e
+        us = gm["us_j"] * us / np.linalg.norm(us, axis=1, keepdims=True)
+        assert rel_err(np.sum(g * us, axis=1), sep) < TOL
         assert rel_err(res.gear_sep[:, gi], sep) < TOL
-        assert np.max(np.abs(np.sum(g * zj, axis=1))) < TOL * np.max(np.abs(t))
+        assert np.max(np.abs(np.sum(g * e, axis=1))) < TOL * np.max(np.abs(t))
         assert rel_err(res.gear_radial[:, gi, 1], -np.sum(g * rk, axis=1)) < TOL
         assert np.max(np.abs(res.gear_axial[:, gi, 1] + np.sum(g * zk, axis=1))) < TOL * np.max(np.abs(t))
