@@ -388,3 +388,70 @@ def test_urdf_bad_loads(run_cli, tmp_path, attrs, pattern):
                                                          if "gearcli:load" in ln))
     assert lines[0].startswith(f"{path}:{lineno}: gearcli:load 'x': "), lines[0]
     assert pattern in lines[0]
+
+
+# --- real URDF arms: Pinocchio built from the same file (pin.buildModelFromUrdf) ----------------------
+
+def _urdf_cases():
+    from test_urdf import ERD, GEARED_ARM
+    cases = [(GEARED_ARM, "tool", "upper_arm")]
+    if ERD is not None:
+        cases.append((ERD / "ur_description/urdf/ur5_robot.urdf", "tool0", "forearm_link"))
+    return cases
+
+
+@pytest.mark.parametrize("path,tip,mid", _urdf_cases(), ids=lambda x: getattr(x, "name", x))
+def test_real_urdf_arm_with_fext_matches_pinocchio(tmp_path, path, tip, mid):
+    """A link-frame wrench on the tip link (fixed to its parent joint's body in both files)
+    and a base-frame one on a middle link; Pinocchio gets them as fext in its joint frames,
+    placed by its own frame placements and joint poses."""
+    pin = pytest.importorskip("pinocchio")
+    from test_urdf import trajectory
+    tip_w, mid_w, p_tip, p_mid = [3.0, -7.0, 12.0, 0.4, -0.2, 0.3], [-5.0, 2.0, 4.0, 0.1, 0.6, -0.2], \
+        np.array([0.02, -0.03, 0.05]), np.array([0.1, 0.02, -0.01])
+    el = "".join(f'<gearcli:load name="{n}" link="{lk}" frame="{fr}" point="{" ".join(map(str, p))}" '
+                 f'force="{" ".join(map(str, w[:3]))}" moment="{" ".join(map(str, w[3:]))}"/>'
+                 for n, lk, fr, p, w in (("tcp", tip, "link", p_tip, tip_w), ("push", mid, "base", p_mid, mid_w)))
+    text = path.read_text()
+    if "xmlns:gearcli" not in text:
+        text = text.replace("<robot ", '<robot xmlns:gearcli="https://gearcli.dev/urdf/1" ', 1)
+    loaded = tmp_path / path.name
+    loaded.write_text(text.replace("</robot>", el + "\n</robot>"))
+    an = analyse(load_mechanism(loaded))
+    assert [ld.name for ld in an.mech.loads] == ["tcp", "push"]
+    q, qd, qdd = trajectory(an.dof, n=12)
+    res = solve(an, q, qd, qdd)
+    q_all, qd_all, qdd_all = q @ an.S.T, qd @ an.S.T, qdd @ an.S.T
+    model = pin.buildModelFromUrdf(str(path))
+    data = model.createData()
+    ids = [model.getJointId(jt.name) for jt in an.mech.joints]
+    tau = np.zeros_like(q_all)
+    for s in range(q_all.shape[0]):
+        qp, vp, ap = pin.neutral(model), np.zeros(model.nv), np.zeros(model.nv)
+        for ji, jid in enumerate(ids):
+            jm = model.joints[jid]
+            if jm.nq == 2:
+                qp[jm.idx_q:jm.idx_q + 2] = np.cos(q_all[s, ji]), np.sin(q_all[s, ji])
+            else:
+                qp[jm.idx_q] = q_all[s, ji]
+            vp[jm.idx_v], ap[jm.idx_v] = qd_all[s, ji], qdd_all[s, ji]
+        pin.forwardKinematics(model, data, qp)
+        fext = pin.StdVec_Force()
+        for _ in range(model.njoints):
+            fext.append(pin.Force.Zero())
+        for link, frame, p, w in ((tip, "link", p_tip, tip_w), (mid, "base", p_mid, mid_w)):
+            fr = model.frames[model.getFrameId(link)]
+            X = fr.placement                                # link frame in its joint's frame
+            Rj = data.oMi[fr.parentJoint].rotation
+            f, m = np.asarray(w[:3]), np.asarray(w[3:])
+            if frame == "link":
+                f, m = X.rotation @ f, X.rotation @ m
+            else:
+                f, m = Rj.T @ f, Rj.T @ m
+            arm = X.rotation @ p + X.translation
+            fext[fr.parentJoint] = fext[fr.parentJoint] + pin.Force(f, m + np.cross(arm, f))
+        t = pin.rnea(model, data, qp, vp, ap, fext)
+        tau[s] = [t[model.joints[jid].idx_v] for jid in ids]
+    assert rel_err(res.tau, tau @ an.S, tiny=1.0) < TOL
+    bare = solve(an, q, qd, qdd, loads={"tcp": np.zeros(6), "push": np.zeros(6)})
+    assert rel_err(bare.tau, tau @ an.S, tiny=1.0) > 1e-3
