@@ -171,10 +171,10 @@ def problems(result, hung: bool, work: Path, inputs: dict, allowed_outputs=()) -
     return out
 
 
-def verdict(target: str, problems_found: list[str], files: dict) -> None:
+def verdict(target: str, problems_found: list[str], files: dict, exit_code=None) -> None:
     """Fail the example, or record it (GEARCLI_FUZZ_RECORD)."""
     if RECORD:
-        row = {"target": target, "problems": problems_found}
+        row = {"target": target, "exit": exit_code, "problems": problems_found}
         if problems_found:
             row["files"] = {k: base64.b64encode(v).decode() for k, v in files.items()}
         with open(RECORD, "a") as f:
@@ -189,7 +189,7 @@ def run_case(target: str, files: dict, args_of, outputs=("out.csv",)) -> None:
         for name, data in files.items():
             (work / name).write_bytes(data)
         result, hung = run_cli(args_of(work))
-        verdict(target, problems(result, hung, work, files, outputs), files)
+        verdict(target, problems(result, hung, work, files, outputs), files, None if hung else result.exit_code)
 
 
 # --- targets ----------------------------------------------------------------------------
@@ -245,7 +245,7 @@ def test_fuzz_trajectory(name, muts, n, degrees, to_stdout):
             found = problems(result, hung, work, files)
             if not hung and NON_FINITE.search(result.stdout.encode()):
                 found.append("non-finite number written to stdout")
-            verdict("csv", found, files)
+            verdict("csv", found, files, None if hung else result.exit_code)
     else:
         run_case("csv", files, args)
 
@@ -321,4 +321,4 @@ def test_fuzz_output_faults(fault, command, budget, tmpfile):
             found.append(f"fault {fault} not refused (exit {result.exit_code})")
         if fault in ("symlink", "dangling") and not (work / ("link" if fault == "symlink" else "dangle")).is_symlink():
             found.append("symlink replaced by a file")
-        verdict("output", found, files)
+        verdict("output", found, files, None if hung else result.exit_code)
