@@ -8,10 +8,7 @@ problems of the manifest and of every file it names are reported together (one l
 from __future__ import annotations
 
 import glob
-import json
 from dataclasses import dataclass
-from functools import lru_cache
-from importlib import resources
 from pathlib import Path
 
 import jsonschema
@@ -22,19 +19,15 @@ from ..io import load_mechanism
 from ..io.trajectory import TrajectoryReader
 from ..io.yaml_reader import yaml_lines
 from ..pipeline import analyse, prismatic_independent
+from ..io.schemas import packaged_schema
 
 REQUIREMENT_KEYS = ("cycles_per_hour", "bearing_life_h", "min_static_safety", "min_bending_safety",
                     "min_contact_safety")
 
 
-@lru_cache(maxsize=1)
 def design_schema() -> dict:
     """The JSON Schema of design manifests (``schemas/design.schema.json``)."""
-    try:
-        text = resources.files("gearcli").joinpath("schemas/design.schema.json").read_text()
-    except (FileNotFoundError, ModuleNotFoundError, OSError):
-        text = (Path(__file__).resolve().parents[3] / "schemas" / "design.schema.json").read_text()
-    return json.loads(text)
+    return packaged_schema("design.schema.json")
 
 
 class ManifestError(GearcliError):

@@ -10,9 +10,6 @@ nothing below this module knows about them.
 from __future__ import annotations
 
 import difflib
-import json
-from functools import lru_cache
-from importlib import resources
 from pathlib import Path
 
 import jsonschema
@@ -25,16 +22,12 @@ from .ratings_reader import attach_yaml_ratings
 from ..model.geometry import dh_transform, origin_axis_transform
 from ..model.validate import check_inertia, gear_pair_problems, inertia_matrix, number_problem
 from .yaml_safe import read_text, yaml_lines
+from .schemas import packaged_schema
 
 
-@lru_cache(maxsize=1)
 def mechanism_schema() -> dict:
     """The JSON Schema of mechanism files (``schemas/mechanism.schema.json``)."""
-    try:
-        text = resources.files("gearcli").joinpath("schemas/mechanism.schema.json").read_text()
-    except (FileNotFoundError, ModuleNotFoundError, OSError):
-        text = (Path(__file__).resolve().parents[3] / "schemas" / "mechanism.schema.json").read_text()
-    return json.loads(text)
+    return packaged_schema("mechanism.schema.json")
 
 
 def load_yaml(path: str | Path) -> Mechanism:
