@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass
+from functools import cached_property
 
 from ..errors import Collector
 from ..model.mechanism import Mechanism
@@ -25,10 +26,10 @@ class Tree:
     parent: tuple
     order: tuple[int, ...]
 
-    @property
-    def moving(self) -> list[int]:
-        """Ids of every link but the base, in link order."""
-        return [i for i in range(len(self.links)) if i != self.base]
+    @cached_property
+    def moving(self) -> tuple[int, ...]:
+        """Ids of every link but the base, in link order (computed once: read in loops)."""
+        return tuple(i for i in range(len(self.links)) if i != self.base)
 
     def path_up(self, i: int, stop: int) -> list[int]:
         """Joint indices from link ``i`` up to (not beyond) ancestor ``stop``."""
