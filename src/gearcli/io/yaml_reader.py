@@ -12,6 +12,8 @@ from __future__ import annotations
 import difflib
 from pathlib import Path
 
+from functools import lru_cache
+
 import jsonschema
 import numpy as np
 
