@@ -102,11 +102,9 @@ def resolve_signs(solve_pattern: Callable[[np.ndarray, np.ndarray], np.ndarray],
     for _ in range(m):                                # retry with the solution's own signs
         if todo.size == 0:
             break
-        uniq, which = np.unique(trial, axis=0, return_inverse=True)
-        which = which.reshape(-1)
         left, nxt = [], []
-        for u, signs in enumerate(uniq):
-            bad, own = attempt(todo[which == u], signs)
+        for rows in _same_rows(trial):
+            bad, own = attempt(todo[rows], trial[rows[0]])
             left.append(bad)
             nxt.append(own)
         todo, trial = np.concatenate(left), np.concatenate(nxt)
@@ -118,6 +116,19 @@ def resolve_signs(solve_pattern: Callable[[np.ndarray, np.ndarray], np.ndarray],
     if todo.size:
         raise SignError(int(todo[0]), mesh_names)
     return x, used
+
+
+def _same_rows(signs: np.ndarray) -> list[np.ndarray]:
+    """Indices of the rows of ``signs`` (n, m) of +-1 grouped by equal rows."""
+    m = signs.shape[1]
+    if m > 60:                                       # too many bits for an integer key
+        _, which = np.unique(signs, axis=0, return_inverse=True)
+        which = which.reshape(-1)
+        return [np.flatnonzero(which == u) for u in range(which.max() + 1)]
+    key = (signs < 0) @ (1 << np.arange(m, dtype=np.int64))
+    order = np.argsort(key, kind="stable")
+    cuts = np.flatnonzero(np.diff(key[order])) + 1
+    return np.split(order, cuts)
 
 
 def sign_violation(t: np.ndarray, signs: np.ndarray, scale: np.ndarray) -> float:
