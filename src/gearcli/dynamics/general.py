@@ -63,11 +63,11 @@ def solve_general(an, cols: Columns, groups, links, rhs: np.ndarray):
                 half[i][:, rows] = 0.5 * (plus - minus)
                 mid[:, rows, offs[i]] = 0.5 * (plus + minus)
     def solve_pattern(pat, idx):
-        A = mid[idx]                       # (fancy indexing copies)
-        if signed:
-            for i, s in zip(signed, pat):
-                A[:, :, offs[i]] += s * half[i][idx]
-        return np.linalg.solve(A, rhs[idx][:, :, None])[:, :, 0]
+        every = idx.size == N
+        A = mid.copy() if every else mid[idx]          # (fancy indexing copies too)
+        for i, s in zip(signed, pat):
+            A[:, :, offs[i]] += s * (half[i] if every else half[i][idx])
+        return np.linalg.solve(A, (rhs if every else rhs[idx])[:, :, None])[:, :, 0]
 
     scale = 1.0 + np.max(np.abs(rhs), axis=1)
     x, signs = resolve_signs(solve_pattern, len(signed), [int(offs[i]) for i in signed], N, scale,
