@@ -1,4 +1,5 @@
 """`gearcli solve`: the CSV contract, agreement with the library, and bad input."""
+from schema_keys import schema_keys
 import io
 import re
 import json
@@ -120,15 +121,7 @@ def test_readme_documents_every_schema_key_and_output_column():
     readme = (ROOT / "README.md").read_text()
     schema = mechanism_schema()
 
-    def keys(node):
-        for k, v in node.get("properties", {}).items():
-            yield k
-            yield from keys(v)
-        for v in node.get("$defs", {}).values():
-            yield from keys(v)
-        for v in node.get("oneOf", []):
-            yield from keys(v)
-    missing = sorted({k for k in keys(schema) if not re.search(rf"`[^`\n]*\b{k}\b[^`\n]*`", readme)})
+    missing = sorted({k for k in schema_keys(schema) if not re.search(rf"`[^`\n]*\b{k}\b[^`\n]*`", readme)})
     assert not missing, f"README reference table lacks {missing}"
     an = analyse(load_mechanism(ROOT / "mechanisms" / "paper_2dof.yaml"))
     for c in column_names(an):

@@ -1,4 +1,5 @@
 """`gearcli verify`: verdicts against hand statics, exit codes, reports, batch execution."""
+from schema_keys import schema_keys
 import json
 import math
 import xml.etree.ElementTree as ET
@@ -221,13 +222,7 @@ def test_readme_documents_every_manifest_key():
 
     readme = (ROOT / "README.md").read_text()
 
-    def keys(node):
-        for k, v in node.get("properties", {}).items():
-            yield k
-            yield from keys(v)
-        for v in node.get("$defs", {}).values():
-            yield from keys(v)
-    missing = sorted({k for k in keys(design_schema()) if not re.search(rf"`[^`\n]*\b{k}\b[^`\n]*`", readme)})
+    missing = sorted({k for k in schema_keys(design_schema()) if not re.search(rf"`[^`\n]*\b{k}\b[^`\n]*`", readme)})
     assert not missing, f"README lacks manifest keys {missing}"
 
 

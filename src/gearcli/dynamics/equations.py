@@ -160,16 +160,17 @@ class Columns:
             return self.motor(g.index, L)
         return self.mesh(g.index, L, sigma)
 
-    def balance(self, groups, L: int, signs: dict | None = None) -> np.ndarray:
+    def balance(self, groups, L: int, signs: dict | None = None, out: np.ndarray | None = None) -> np.ndarray:
         """Left-hand side of link L's balance (Eqs. 15-16 primary, 19-20 secondary).
 
         Returns the (N, 6, n) matrix whose columns are the wrenches on L of the unknowns of
         ``groups`` (n scalars in their order; zero for a group not acting on L); ``signs``
-        maps ``(kind, index)`` of a geared mesh to sign(t), (N,) (default +1).
+        maps ``(kind, index)`` of a geared mesh to sign(t), (N,) (default +1).  ``out``, a
+        zeroed (N, 6, n) array (or view) to fill, saves the allocation.
         """
         signs = signs or {}
-        n = sum(g.size for g in groups)
-        out = np.zeros((self.kin.n, 6, n))
+        if out is None:
+            out = np.zeros((self.kin.n, 6, sum(g.size for g in groups)))
         c0 = 0
         for g in groups:
             if L in g.links:

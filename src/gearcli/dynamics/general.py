@@ -26,13 +26,9 @@ def mesh_names(an, groups, signed) -> list[str]:
 def assemble(cols: Columns, groups, links) -> np.ndarray:
     """Matrix (N, 6 * len(links), n) of the balances of ``links`` (Eqs. 15-16, 19-20, one
     :meth:`~.equations.Columns.balance` per link, stacked), every t taken positive."""
-    row = {L: 6 * r for r, L in enumerate(links)}
-    offs = np.cumsum([0] + [g.size for g in groups])
-    A = np.zeros((cols.kin.n, 6 * len(links), offs[-1]))
-    for g, c0, c1 in zip(groups, offs[:-1], offs[1:]):
-        for L in g.links:
-            if L in row:
-                A[:, row[L]:row[L] + 6, c0:c1] = cols.group(g, L, 1.0)
+    A = np.zeros((cols.kin.n, 6 * len(links), sum(g.size for g in groups)))
+    for r, L in enumerate(links):
+        cols.balance(groups, L, out=A[:, 6 * r:6 * r + 6, :])
     return A
 
 
