@@ -46,6 +46,10 @@ TESTS = [
     "tests/test_dynamics.py::test_pinocchio_rnea",
     "tests/test_dynamics.py::test_pinocchio_bearing_reactions",
     "tests/test_dynamics.py::test_pinocchio_joint_reaction_of_gearless_subtree",
+    "tests/test_rack.py::test_static_rack_by_hand",
+    "tests/test_rack.py::test_rack_sign_from_geometry",
+    "tests/test_rack.py::test_power_balance_along_bundled_trajectory",
+    "tests/test_helical.py::test_static_helical_by_hand",
 ]
 
 
@@ -108,6 +112,11 @@ MUTATIONS = [
              (("model/gears.py",
                "us = -rad_j + (rad_j @ element) * element",
                "us = -rad_j + 0.0 * element"),)),
+    # issue 9: racks and helical gears
+    Mutation("rack-sign", "rack displacement x = -r theta where the geometry gives x = +r theta",
+             (("model/gears.py", "e = 1.0 / (r_j * np.sign(along))", "e = -1.0 / (r_j * np.sign(along))"),)),
+    Mutation("helical-hand", "axial thrust of a helical gear with the hand reversed",
+             (("model/gears.py", 'sign = -1.0 if hand == "right" else 1.0', 'sign = 1.0 if hand == "right" else -1.0'),)),
 ]
 
 

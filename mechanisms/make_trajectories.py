@@ -1,11 +1,13 @@
 """Regenerate the bundled example trajectories (run from the repository root).
 
 paper_2dof_traj.csv: positions only (the solver derives rates and accelerations by spline);
-bendix_wrist_traj.csv: positions, rates and accelerations of an analytic motion.
+bendix_wrist_traj.csv: positions, rates and accelerations of an analytic motion;
+rack_axis_traj.csv (m) and helical_reduction_traj.csv (rad): analytic, with rates and
+accelerations.
 """
 import numpy as np
 
-from gearcli.trajectory import write_trajectory
+from gearcli.io.trajectory import write_trajectory
 
 t = np.linspace(0.0, 2.0, 2001)          # 2 s at 1 kHz
 w = np.pi
@@ -28,3 +30,18 @@ write_trajectory("mechanisms/bendix_wrist_traj.csv", ["J1", "J2", "J3"], t, q, q
 # unit rule applies to revolute joints; a prismatic joint's q is in m)
 q = np.column_stack([0.8 * np.sin(w * t), 0.6 * np.sin(1.5 * w * t + 0.3), 0.01 + 0.005 * np.sin(2 * w * t)])
 write_trajectory("mechanisms/geared_arm_traj.csv", ["shoulder", "elbow", "finger_left_joint"], t, q)
+
+# rack_axis: the carriage's slide Jx (m): a 0.15 m stroke out and back with a superposed
+# faster wiggle (speeds to 0.6 m/s, accelerations to 4 m/s^2)
+q = 0.15 * np.sin(w * t) + 0.01 * np.sin(4 * w * t)
+qd = 0.15 * w * np.cos(w * t) + 0.04 * w * np.cos(4 * w * t)
+qdd = -0.15 * w**2 * np.sin(w * t) - 0.16 * w**2 * np.sin(4 * w * t)
+write_trajectory("mechanisms/rack_axis_traj.csv", ["Jx"], t, q[:, None], qd[:, None], qdd[:, None])
+
+# helical_reduction: the output shaft Jout (rad), forwards and back against the constant
+# resisting torque
+q = 1.5 * np.sin(w * t) * (1 + 0.2 * np.cos(2 * w * t))
+qd = 1.5 * w * (np.cos(w * t) * (1 + 0.2 * np.cos(2 * w * t)) - 0.4 * np.sin(w * t) * np.sin(2 * w * t))
+qdd = 1.5 * w**2 * (-np.sin(w * t) * (1 + 0.2 * np.cos(2 * w * t)) - 0.8 * np.cos(w * t) * np.sin(2 * w * t)
+                    - 0.8 * np.sin(w * t) * np.cos(2 * w * t))
+write_trajectory("mechanisms/helical_reduction_traj.csv", ["Jout"], t, q[:, None], qd[:, None], qdd[:, None])

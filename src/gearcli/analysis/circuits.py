@@ -51,6 +51,8 @@ def gear_circuit(h: Home, groups, canon, gi: int, gp, j: int, k: int, col: Colle
     if found is None:
         return None
     c, gj, gk = found
+    if not joint_types_fit(h, gp, c, gj, gk, col):
+        return None
     row_j, zj_w = relative_rotation(h, canon, j, c, gj)
     row_k, zk_w = relative_rotation(h, canon, k, c, gk)
     Rc = h.kin.R[c]
@@ -64,6 +66,27 @@ def gear_circuit(h: Home, groups, canon, gi: int, gp, j: int, k: int, col: Colle
     if ratio is None:
         return None
     return Circuit(gi, j, k, c, float(ratio), row_j - ratio * row_k, Rc.T @ zj_w, Rc.T @ zk_w, geom)
+
+
+def joint_types_fit(h: Home, gp, c: int, gj: CoaxialGroup, gk: CoaxialGroup, col: Collector) -> bool:
+    """True if gear j turns and gear k turns (slides, for a rack) relative to the carrier;
+    otherwise an issue naming the pair's link."""
+    types = [h.mech.joints[h.jin[g.members[1]]].type for g in (gj, gk)]
+    want = ["revolute", "prismatic" if gp.kind == "rack" else "revolute"]
+    ok = True
+    for i, (name, got, need) in enumerate(zip((gp.j, gp.k), types, want)):
+        if got == need:
+            continue
+        ok = False
+        if gp.kind == "rack":
+            what = ("the pinion of a rack pair must turn on a revolute joint" if i == 0
+                    else "the rack of a rack pair must slide on a prismatic joint")
+            col.add(f"{gp.path}.links[{i}]", f"'{name}' {'slides' if got == 'prismatic' else 'turns'} relative "
+                    f"to the carrier '{h.tree.links[c]}': {what} (links: [pinion, rack])")
+        else:
+            col.add(f"{gp.path}.links[{i}]", f"'{name}' slides on a prismatic joint relative to the carrier: "
+                    f"a {gp.kind} gear must turn (for a rack and pinion use kind: rack, links: [pinion, rack])")
+    return ok
 
 
 def gear_carrier(h: Home, groups, gp, j: int, k: int, col: Collector):

@@ -245,7 +245,7 @@ def _joints(data: dict, col: Collector, links: _Names) -> list[Joint]:
 
 
 _GEAR_FIELD = {"": "", "links": ".links", "kind": ".kind", "ratio": ".ratio", "cone_angles": ".cone_angles_deg",
-               "helix_angle": ".helix_angle_deg", "hand": ".hand"}
+               "helix_angle": ".helix_angle_deg", "hand": ".hand", "teeth": ".teeth"}
 
 
 def _gears(data: dict, col: Collector, links: _Names) -> list[GearPair]:

@@ -62,6 +62,8 @@ def gear_geometry(kind: str, P, oj, zj, ok, zk, teeth=None, ratio=None, cones=No
     P, oj, zj, ok, zk = (np.asarray(x, float) for x in (P, oj, zj, ok, zk))
     zj, zk = zj / np.linalg.norm(zj), zk / np.linalg.norm(zk)
     rad_j, r_j = _foot(P, oj, zj)
+    if kind == "rack":
+        return rack_geometry(P, zj, zk, rad_j, r_j, ratio, names)
     rad_k, r_k = _foot(P, ok, zk)
     scale = max(1.0, r_j, r_k)
     problems = [("mesh_point", f"mesh point lies on the axis of gear '{n}'")
@@ -78,6 +80,35 @@ def gear_geometry(kind: str, P, oj, zj, ok, zk, teeth=None, ratio=None, cones=No
     ut, us, e = _contact(zj, zk, rad_j, rad_k, r_j, r_k, element, ring)
     problems += _given_values(ratio, teeth, cones, e, r_j, r_k, cone_j, cone_k, names)
     return GearGeometry(P, zj, zk, rad_j, rad_k, ut, us, r_j, r_k, e, cone_j, cone_k, ring), problems
+
+
+def rack_geometry(P, zj, zk, rad_j, r_j, ratio, names):
+    """Rack and pinion: pinion j turning about (oj, zj), rack k sliding along zk.
+
+    The rack's pitch line passes through the pitch point P along zk; it must be tangent to
+    the pinion's pitch circle there: zk = +-ut with ut = zj x rad_j.  Rolling without
+    slip, x_k = r_j (ut . zk) theta_j, so e_kj = theta_j / x_k = 1 / (r_j (ut . zk)) (rad/m).
+    The separating force on the pinion, us = -rad_j, is normal to the pitch line (and to
+    the rack's pitch plane, spanned by zk and zj), pushing the pinion away from the rack;
+    the rack receives the opposite.  ``rad_k`` = -rad_j (from the rack towards P, as for
+    an external pair), ``r_k`` = inf.
+    """
+    if r_j < TOL_GEOM * max(1.0, float(np.linalg.norm(P))):
+        return None, [("mesh_point", f"mesh point lies on the axis of pinion '{names[0]}'")]
+    ut = np.cross(zj, rad_j)
+    along = float(ut @ zk)
+    if abs(abs(along) - 1.0) > 1e-9:
+        return None, [("mesh_point", f"the axis of rack '{names[1]}' is not tangent to the pitch circle of "
+                       f"pinion '{names[0]}' at the mesh point (it must be perpendicular to the pinion axis "
+                       f"and to the pinion radius through the mesh point; angle to the tangent "
+                       f"{np.degrees(np.arccos(min(1.0, abs(along)))):.4g} deg)")]
+    e = 1.0 / (r_j * np.sign(along))
+    problems = []
+    if ratio is not None and abs(ratio - e) > RTOL_RATIO * abs(e):
+        problems.append(("ratio", f"ratio {ratio:g} rad/m contradicts the mesh geometry: pinion pitch radius "
+                         f"{r_j:.6g} m and the rack direction give e = {e:.6g} rad/m"))
+    return GearGeometry(P, zj, zk, rad_j, -rad_j, ut, -rad_j, r_j, float("inf"), float(e), 0.0, 0.0,
+                        None), problems
 
 
 def _parallel(kind, zj, rad_j, rad_k, r_j, r_k, problems):

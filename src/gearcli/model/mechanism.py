@@ -59,7 +59,7 @@ class Joint:
     limit: JointLimit | None = None                     # URDF <limit effort velocity>
 
 
-GEAR_KINDS = ("external", "internal", "bevel")
+GEAR_KINDS = ("external", "internal", "bevel", "rack")
 
 
 @dataclass(frozen=True, eq=False)
@@ -69,7 +69,9 @@ class GearPair:
     Fundamental circuit equation (paper Eq. 8): theta_{j,c} = ratio * theta_{k,c}, with c
     the carrier and the angles measured about each joint's positive axis.  ``mesh_point``
     is the pitch point in the carrier frame (m); ``None`` means an ideal coupling with no
-    tooth geometry.
+    tooth geometry.  ``kind == "rack"``: j is a pinion turning on a revolute joint and k a
+    rack sliding on a prismatic joint relative to the carrier, q_{k,c} the rack's
+    displacement along its axis (m), ``ratio`` = theta_j / x_k = +-1/r_j (rad/m).
     """
 
     name: str

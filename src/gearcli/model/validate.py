@@ -60,21 +60,33 @@ def gear_pair_problems(j: str, k: str, kind: str, ratio: float | None, has_teeth
                        hand: str | None = None) -> list[tuple[str, str]]:
     """Problems of a gear pair's declaration, whatever file it comes from: (field, message)
     with field ``""`` (the pair), ``"links"``, ``"kind"``, ``"ratio"``, ``"cone_angles"``,
-    ``"helix_angle"`` or ``"hand"``; ``ratio`` and ``helix`` (rad) None when not given.
+    ``"helix_angle"``, ``"hand"`` or ``"teeth"``; ``ratio`` and ``helix`` (rad) None when not given.
     (The geometric checks are in :mod:`gearcli.model.gears`.)"""
     out: list[tuple[str, str]] = _helix_problems(kind, has_mesh_point, helix, hand)
     if kind not in GEAR_KINDS:
         out.append(("kind", f"unknown gear kind '{kind}' (expected {', '.join(GEAR_KINDS)})"))
     if j == k:
         out.append(("links", "a gear pair needs two different links"))
-    if ratio is None and not has_teeth:
+    if kind == "rack":
+        out += _rack_problems(has_teeth, has_mesh_point)
+    elif ratio is None and not has_teeth:
         out.append(("", "a gear pair needs a ratio or tooth counts (teeth)"))
     if ratio == 0:
         out.append(("ratio", "gear ratio must not be zero"))
-    if ratio is None and not has_mesh_point:
+    if ratio is None and not has_mesh_point and kind != "rack":
         out.append(("", "a gear pair without mesh_point needs an explicit signed ratio"))
     if has_cones and kind != "bevel":
         out.append(("cone_angles", f"cone angles are only for bevel gears, this pair is {kind}"))
+    return out
+
+
+def _rack_problems(has_teeth: bool, has_mesh_point: bool) -> list[tuple[str, str]]:
+    out = []
+    if not has_mesh_point:
+        out.append(("", "a rack pair needs its mesh_point (the pitch point on the rack's pitch line)"))
+    if has_teeth:
+        out.append(("teeth", "a rack pair takes no tooth counts (the pinion's pitch radius comes from "
+                    "the mesh point; give a rating's module for the stress checks)"))
     return out
 
 

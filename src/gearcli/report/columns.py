@@ -145,7 +145,7 @@ class Summary:
                 pick.append((i, f"motor {n.split(':')[1]} {last}",
                              "W" if last == "power" else ("m/s" if lin else "rad/s")))
             elif kind == "motor":
-                pick.append((i, f"motor {n[6:]}", "N·m"))
+                pick.append((i, f"motor {n[6:]}", "N" if _motor_linear(an, n[6:]) else "N·m"))
             elif kind == "gear" and last in ("t", "torque"):
                 pair = n[5:-len(last) - 1]
                 pick.append((i, f"gear {pair} {'tangential' if last == 't' else 'torque'}",

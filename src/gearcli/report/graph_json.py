@@ -47,4 +47,7 @@ def _equation(mech: Mechanism, n, c: Circuit) -> str:
     if c.joints is not None:
         b, a = (mech.joints[x].name for x in c.joints)
         return f"q_{b} = {c.ratio:.6g} * q_{a}"
+    if mech.gears[c.gear].kind == "rack":   # x of the rack (m) = r theta of the pinion
+        return (f"theta_{n[c.j]},{n[c.carrier]} = {c.ratio:.6g} * x_{n[c.k]},{n[c.carrier]}"
+                f" (x = {1 / c.ratio:.6g} m * theta)")
     return f"theta_{n[c.j]},{n[c.carrier]} = {c.ratio:.6g} * theta_{n[c.k]},{n[c.carrier]}"
