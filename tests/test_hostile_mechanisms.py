@@ -191,35 +191,58 @@ def test_file_size_limit(run_cli, tmp_path):
 
 
 # --------------------------------------------------------------------------------------
-# redundant planets: statically indeterminate (the pairs named), never "0 degrees of freedom"
+# redundant planets: load shared by mesh stiffness (the pairs named in a note), 1 dof
+# whatever their number, never "0 degrees of freedom"; planets that do not fit: refused
 # --------------------------------------------------------------------------------------
-def planetary(angles_deg, digits: int) -> str:
+def planetary(angles_deg, digits: int, planet_teeth=None) -> str:
     """Sun S and carrier C on the base axis, planets on C meshing S and a ring fixed to the
-    base; coordinates rounded to ``digits`` decimals (as a designer writes them)."""
+    base; coordinates rounded to ``digits`` decimals (as a designer writes them).  Module
+    2 mm: planet i has ``planet_teeth[i]`` = (teeth meshing the sun, teeth meshing the ring),
+    a stepped planet unless they are equal (default (10, 10), the one that fits)."""
     rs, rp = 0.02, 0.01
-    rc, rr = rs + rp, rs + 2 * rp
+    rr = rs + 2 * rp
     links = ["  - {name: '0'}", "  - {name: S, mass: 0.2, inertia: [0.0001, 0.0001, 0.0001]}",
              "  - {name: C, mass: 0.5, inertia: [0.001, 0.001, 0.001]}"]
     joints = ["  - {name: JS, parent: '0', child: S}", "  - {name: JC, parent: '0', child: C, origin: {xyz: [0, 0, 0.01]}}"]
     gears = []
     for i, deg in enumerate(angles_deg):
+        zs, zr = (10, 10) if planet_teeth is None else planet_teeth[i]
+        rc = rs + zs * rp / 10
         c, s = (round(f(math.radians(deg)), digits) for f in (math.cos, math.sin))
         links.append(f"  - {{name: P{i}, mass: 0.05, inertia: [0.00001, 0.00001, 0.00001]}}")
         joints.append(f"  - {{name: JP{i}, parent: C, child: P{i}, origin: {{xyz: [{rc * c}, {rc * s}, 0]}}}}")
-        gears.append(f"  - {{name: S-P{i}, links: [S, P{i}], teeth: [20, 10], mesh_point: [{rs * c}, {rs * s}, -0.01]}}")
-        gears.append(f"  - {{name: P{i}-R, links: [P{i}, '0'], kind: internal, teeth: [10, 40], "
+        gears.append(f"  - {{name: S-P{i}, links: [S, P{i}], teeth: [20, {zs}], mesh_point: [{rs * c}, {rs * s}, -0.01]}}")
+        gears.append(f"  - {{name: P{i}-R, links: [P{i}, '0'], kind: internal, teeth: [{zr}, 40], "
                      f"mesh_point: [{rr * c}, {rr * s}, -0.01]}}")
     return ("name: planetary\nbase: '0'\nend_effector: C\nlinks:\n" + "\n".join(links) + "\njoints:\n"
             + "\n".join(joints) + "\ngears:\n" + "\n".join(gears) + "\nmotors:\n  - {name: M, link: S}\n")
 
 
-@pytest.mark.parametrize("angles", [(0, 120), (0, 120, 240)])
+@pytest.mark.parametrize("angles", [(0, 120), (0, 120, 240), (0, 90, 180, 270)])
 @pytest.mark.parametrize("digits", [10, 12])
 def test_redundant_planets(run_cli, tmp_path, angles, digits):
-    text = planetary(angles, digits)
-    pairs = ", ".join(f"'S-P{i}' \\(gears\\[{2 * i}\\]\\), 'P{i}-R' \\(gears\\[{2 * i + 1}\\]\\)" for i in range(len(angles)))
-    bad(run_cli, tmp_path, text, line_of(text, "gears:"), "gears",
-        "^redundant gear pairs make the loads statically indeterminate: " + pairs + "$")
+    path = tmp_path / "planets.yaml"
+    path.write_text(planetary(angles, digits))
+    res = run_cli("check", path)
+    assert res.exit_code == 0, res.stderr
+    lines = res.stdout.splitlines()
+    assert lines[0] == f"{path}: OK (1 dof, {3 + len(angles)} links, {2 * len(angles)} gear pairs, 1 motors)"
+    pairs = ", ".join(f"'S-P{i}', 'P{i}-R'" for i in range(len(angles)))
+    assert lines[1:] == [f"note: redundant gear set {pairs}: load shared by mesh stiffness, min sum t^2/k "
+                         "(equal stiffness)"]
+
+
+@pytest.mark.parametrize("wrong", [(11, 9), (9, 11), (12, 8)])
+def test_planet_that_does_not_fit(run_cli, tmp_path, wrong):
+    """The third planet is stepped (each of its pairs fits its own geometry), so its ratio
+    sun -> carrier differs from the others': the closure equations contradict (the train
+    locks); refused, naming the pairs."""
+    text = planetary((0, 120, 240), 12, planet_teeth=((10, 10), (10, 10), wrong))
+    line = bad(run_cli, tmp_path, text, line_of(text, "gears:"), "gears",
+               r"^gear pairs 'S-P0' \(gears\[0\]\), .*'P2-R' \(gears\[5\]\) form a redundant set whose "
+               r"closure equations contradict \(teeth or mesh radii do not fit, relative misfit [0-9.e-]+\): "
+               r"the gear trains lock$")
+    assert "'S-P2'" in line
 
 
 def test_single_planet_is_fine(run_cli, tmp_path):

@@ -1,5 +1,14 @@
 """Degrees of freedom and independent coordinates: the map q = S q_ind from the independent
-(equivalent open-loop chain) joint coordinates to every real joint coordinate."""
+(equivalent open-loop chain) joint coordinates to every real joint coordinate.
+
+The degrees of freedom are J minus the rank of the circuit rows: a kinematically consistent
+redundant gear set (N planets between one sun and one ring, a duplicated pair) adds rows
+that depend on the others and takes no freedom away.  Its loads are shared by the mesh
+stiffness model of :mod:`gearcli.dynamics.general`; the sets are reported in
+``Analysis.redundant``.  An inconsistent set (closure equations that contradict each other:
+planets whose teeth or radii do not fit) locks the gear train and is refused, naming the
+pairs.
+"""
 from __future__ import annotations
 
 from typing import NamedTuple
@@ -9,6 +18,8 @@ import numpy as np
 from ..errors import Collector
 from .context import Home
 from .types import Circuit
+
+RTOL_RANK = 1e-6   # rows dependent within the ratio tolerance (as ratios are checked) are redundant
 
 
 class Independent(NamedTuple):
@@ -20,33 +31,51 @@ class Independent(NamedTuple):
     S: np.ndarray          # (J, dof): every real joint angle from the independent ones
     independent: tuple     # (dof,) joint id of each coordinate, -1 for a canonical angle
     independent_names: tuple
+    redundant: tuple = ()  # circuit positions of each redundant (load-sharing) gear set
+
+
+class CircuitRank(NamedTuple):
+    """The circuit rows Gam (G, J), their numerical rank, a basis of independent rows
+    (positions) and the singular values / left singular vectors of the scaled rows."""
+
+    Gam: np.ndarray
+    rank: int
+    basis: list[int]
+    sv: np.ndarray
+    U: np.ndarray
 
 
 def independent_coordinates(h: Home, cparent: list, canon: np.ndarray, primary: list[int],
-                             circuits: list[Circuit], col: Collector) -> Independent:
-    """Degrees of freedom (J - G), the independent coordinates and S (J, dof) solving the
-    circuit rows Gam q = 0 together with q_ind = B q (canonical angles of the EOLC, or the
-    free joints of a tree)."""
-    G, J = len(circuits), h.J
-    Gam = circuit_matrix(h, circuits, col)
-    dof = J - G
+                            circuits: list[Circuit], col: Collector) -> Independent:
+    """Degrees of freedom (J - rank of the circuit rows), the independent coordinates and
+    S (J, dof) solving the independent circuit rows Gam_b q = 0 together with q_ind = B q
+    (canonical angles of the EOLC, or the free joints of a tree)."""
+    J = h.J
+    cr = circuit_rank(h, circuits)
     open_loop = "tree" if h.mech.open_loop == "tree" else "chain"
     if open_loop == "tree":
-        primary, chain, B = tree_coordinates(h, circuits, dof, col)
+        dependent = {c.j for c in circuits}
+        chain = [h.idx[jt.child] for jt in h.mech.joints if h.idx[jt.child] not in dependent]
+        primary = [h.tree.base] + chain
     else:
         chain = primary[1:]
-        if len(chain) != dof:
-            col.add("end_effector", f"the mechanism has {dof} degrees of freedom ({J} joints - {G} gear pairs) "
-                    f"but its equivalent open-loop chain {' -> '.join(h.tree.links[i] for i in primary)} has "
-                    f"{len(chain)} joints")
-            col.raise_if_any()
+    dof = J - cr.rank
+    if len(chain) > dof:
+        _contradiction(h, circuits, cr, len(chain) - dof, col)
+    elif len(chain) != dof:
+        _dof_mismatch(h, primary, chain, dof, cr.rank, open_loop, col)
+    if open_loop == "tree":
+        B = np.zeros((dof, J))
+        for r, c in enumerate(chain):
+            B[r, h.jin[c]] = 1.0
+    else:
         B = canon[chain]
-    Mfull = np.vstack([Gam, B])
+    Mfull = np.vstack([cr.Gam[cr.basis], B])
     if np.linalg.matrix_rank(Mfull) < J:
         col.add("gears", "the gear trains lock the equivalent open-loop chain: its joint angles do not "
                 "determine the motion of every link")
         col.raise_if_any()
-    S = np.linalg.solve(Mfull, np.vstack([np.zeros((G, dof)), np.eye(dof)]))
+    S = np.linalg.solve(Mfull, np.vstack([np.zeros((cr.rank, dof)), np.eye(dof)]))
     S[np.abs(S) < 1e-15] = 0.0
     independent = []
     for c in chain:
@@ -54,43 +83,88 @@ def independent_coordinates(h: Home, cparent: list, canon: np.ndarray, primary: 
         independent.append(jt if open_loop == "tree" or h.idx[h.mech.joints[jt].parent] == cparent[c] else -1)
     names = tuple(h.mech.joints[jt].name if jt >= 0 else f"{h.tree.links[cparent[c]]}-{h.tree.links[c]}"
                   for jt, c in zip(independent, chain))
-    return Independent(primary, chain, open_loop, S, tuple(independent), names)
+    return Independent(primary, chain, open_loop, S, tuple(independent), names, redundant_sets(cr))
 
 
-def circuit_matrix(h: Home, circuits: list[Circuit], col: Collector) -> np.ndarray:
-    """(G, J) matrix Gam of the circuit rows; raises if it is rank deficient (redundant
-    gear pairs, whose loads would be statically indeterminate)."""
+def circuit_rank(h: Home, circuits: list[Circuit]) -> CircuitRank:
+    """Rank of the circuit rows, judged on rows scaled to unit length with the ratio
+    tolerance RTOL_RANK (rounded mesh points must not turn two redundant planets into
+    "0 degrees of freedom"), and a basis of independent rows taken in file order."""
     G = len(circuits)
     Gam = np.array([c.row for c in circuits]).reshape(G, h.J)
-    # rows scaled to unit length; a pair redundant within the ratio tolerance (1e-6, as
-    # ratios are checked against the geometry) is redundant: rounded mesh points must not
-    # turn two redundant planets into "0 degrees of freedom"
+    if G == 0:
+        return CircuitRank(Gam, 0, [], np.zeros(0), np.zeros((0, 0)))
     Gn = Gam / np.maximum(np.linalg.norm(Gam, axis=1, keepdims=True), 1e-300)
-    sv = np.linalg.svd(Gn, compute_uv=False) if G else np.zeros(0)
-    rank = int(np.sum(sv > 1e-6 * sv[0])) if G else 0
-    if rank < G:
-        _, sv, Vt = np.linalg.svd(Gn.T)
-        null = Vt[rank:]  # left null vectors of Gam
-        involved = sorted({i for v in null for i in np.flatnonzero(np.abs(v) > 1e-8)})
-        gears = h.mech.gears
-        col.add("gears", "redundant gear pairs make the loads statically indeterminate: "
-                + ", ".join(f"'{gears[circuits[i].gear].name}' ({gears[circuits[i].gear].path})"
-                            for i in involved))
-        col.raise_if_any()
-    return Gam
+    U, sv, _ = np.linalg.svd(Gn)
+    rank = int(np.sum(sv > RTOL_RANK * sv[0]))
+    basis: list[int] = []
+    for i in range(G):                      # greedy: a row joins if it adds to the rank
+        trial = Gn[basis + [i]]
+        if len(basis) < rank and np.linalg.svd(trial, compute_uv=False)[-1] > RTOL_RANK * sv[0]:
+            basis.append(i)
+    return CircuitRank(Gam, rank, basis, sv, U)
 
 
-def tree_coordinates(h: Home, circuits: list[Circuit], dof: int, col: Collector):
-    """Open-loop tree (``open_loop: tree``): every link whose own joint is not made dependent
-    by a pair (its first link j) is primary.  Returns (primary, chain, B (dof, J))."""
-    dependent = {c.j for c in circuits}
-    chain = [h.idx[jt.child] for jt in h.mech.joints if h.idx[jt.child] not in dependent]
-    primary = [h.tree.base] + chain
-    if len(chain) != dof:
-        col.add("gears", f"the mechanism has {dof} degrees of freedom ({h.J} joints - {len(circuits)} gear pairs "
-                f"and couplings) but {len(chain)} joints are not made dependent by a pair")
-        col.raise_if_any()
-    B = np.zeros((dof, h.J))
-    for r, c in enumerate(chain):
-        B[r, h.jin[c]] = 1.0
-    return primary, chain, B
+def redundant_sets(cr: CircuitRank) -> tuple[tuple[int, ...], ...]:
+    """Circuit positions of each redundant gear set: the supports of a sparse basis of the
+    left null space of the rows (reduced row echelon form), merged where they overlap."""
+    G = cr.Gam.shape[0]
+    if cr.rank == G:
+        return ()
+    null = _rref(cr.U[:, cr.rank:].T)
+    sets: list[set[int]] = []
+    for v in null:
+        s = set(np.flatnonzero(np.abs(v) > 1e-8 * np.abs(v).max()).tolist())
+        for other in [o for o in sets if o & s]:
+            s |= other
+            sets.remove(other)
+        sets.append(s)
+    return tuple(tuple(sorted(s)) for s in sorted(sets, key=min))
+
+
+def _rref(M: np.ndarray) -> np.ndarray:
+    """Reduced row echelon form of M (rows independent), partial pivoting."""
+    M = M.copy()
+    r = 0
+    for c in range(M.shape[1]):
+        if r == M.shape[0]:
+            break
+        p = r + int(np.argmax(np.abs(M[r:, c])))
+        if abs(M[p, c]) < 1e-10:
+            continue
+        M[[r, p]] = M[[p, r]]
+        M[r] /= M[r, c]
+        for i in range(M.shape[0]):
+            if i != r:
+                M[i] -= M[i, c] * M[r]
+        r += 1
+    return M
+
+
+def _pairs(h: Home, circuits: list[Circuit], which) -> str:
+    gears = h.mech.gears
+    return ", ".join(f"'{gears[circuits[i].gear].name}' ({gears[circuits[i].gear].path})" for i in which)
+
+
+def _contradiction(h: Home, circuits: list[Circuit], cr: CircuitRank, excess: int, col: Collector) -> None:
+    """Refuse gear pairs whose closure equations contradict: the ``excess`` smallest nonzero
+    singular directions of the rows name the pairs involved."""
+    U = cr.U[:, cr.rank - excess:cr.rank]
+    involved = sorted({i for v in U.T for i in np.flatnonzero(np.abs(v) > 1e-8)})
+    misfit = cr.sv[cr.rank - 1] / cr.sv[0]
+    col.add("gears", "gear pairs " + _pairs(h, circuits, involved) + " form a redundant set whose closure "
+            f"equations contradict (teeth or mesh radii do not fit, relative misfit {misfit:.2g}): "
+            "the gear trains lock")
+    col.raise_if_any()
+
+
+def _dof_mismatch(h: Home, primary, chain, dof: int, rank: int, open_loop: str, col: Collector) -> None:
+    G = len(chain)
+    if open_loop == "tree":
+        col.add("gears", f"the mechanism has {dof} degrees of freedom ({h.J} joints - {rank} independent "
+                f"gear pairs and couplings) but {G} joints are not made dependent by a pair")
+    else:
+        col.add("end_effector", f"the mechanism has {dof} degrees of freedom ({h.J} joints - {rank} "
+                f"independent gear pairs) but its equivalent open-loop chain "
+                f"{' -> '.join(h.tree.links[i] for i in primary)} has {G} joints")
+    col.raise_if_any()

@@ -67,7 +67,7 @@ def analyse(mech: Mechanism) -> Analysis:
                   ind.independent, ind.independent_names, tuple(groups), tuple(circuits),
                   ind.S, tuple(mot.links), tuple(mot.stators), A, tuple(tlines), pseudo,
                   motor_joints=tuple(mot.joints) if any(x is not None for x in mot.joints) else (),
-                  open_loop=ind.open_loop)
+                  open_loop=ind.open_loop, redundant=ind.redundant)
     blocks = solution_schedule(an, col)
     col.raise_if_any()
     return replace(an, schedule=blocks)

@@ -80,7 +80,7 @@ def solution_schedule(an, col: Collector | None = None) -> tuple[tuple[int, ...]
     groups = unknown_groups(an)
     nrow = 6 * len(moving)
     ncol = sum(g.size for g in groups)
-    if ncol != nrow:
+    if ncol < nrow or (ncol > nrow and not an.redundant):
         if col is not None:
             col.add("", f"{nrow} equations for {ncol} unknowns: the loads are not statically determinate")
         return ()
@@ -134,14 +134,35 @@ class _Network:
     def blocks(self):
         """Strong components of the link dependency graph (link a after link b when a's
         equations contain an unknown matched to b's) and, per component, the set of
-        components it comes after."""
+        components it comes after.  The links of the under-determined part (more unknowns
+        than equations: a redundant gear set) form one block per connected piece."""
         dep = (self.inc @ self.used.T).tocoo()  # dep[a, b] > 0: a uses an unknown solved with b
         _, comp = connected_components(dep.tocsr(), directed=True, connection="strong")
+        H = self.horizontal()
+        if H.any():
+            inc_h = self.inc[H]
+            _, piece = connected_components((inc_h @ inc_h.T).tocsr(), directed=False)
+            comp[H] = comp.max() + 1 + piece
         after: dict[int, set[int]] = {int(k): set() for k in comp}
         for a, b in zip(comp[dep.row], comp[dep.col]):
             if a != b:
                 after[int(a)].add(int(b))
         return comp, after
+
+    def horizontal(self) -> np.ndarray:
+        """(L,) mask of the links in the under-determined (horizontal) part of the
+        Dulmage-Mendelsohn decomposition: those whose equations reach an unmatched unknown
+        by an alternating path, i.e. the links that reach the sink in the residual network.
+        No other link's equations contain their unknowns, so their blocks come after the
+        blocks they depend on."""
+        residual = (self.cap - self.flow).tocsr()
+        residual.data = (residual.data > 0).astype(np.int32)
+        residual.eliminate_zeros()
+        sink = self.L + self.G + 1
+        order = breadth_first_order(residual.T.tocsr(), sink, directed=True, return_predecessors=False)
+        mask = np.zeros(self.L, bool)
+        mask[[int(v) - 1 for v in order if 1 <= v <= self.L]] = True
+        return mask
 
     def overdetermined_links(self) -> list[int]:
         """Positions (in ``moving``) of the links whose equations cannot all be matched:

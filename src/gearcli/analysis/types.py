@@ -71,6 +71,9 @@ class Analysis:
     # None for a motor acting between its link and stator; () when no motor has joints
     motor_joints: tuple = ()
     open_loop: str = "chain"   # "tree": primary links form a tree (Mechanism.open_loop)
+    # positions in ``circuits`` of each redundant gear set (kinematically consistent pairs
+    # beyond the rank of the circuit rows): loads shared by mesh stiffness, min sum t^2/k
+    redundant: tuple[tuple[int, ...], ...] = ()
 
     @property
     def dof(self) -> int:

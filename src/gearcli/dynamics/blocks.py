@@ -11,15 +11,17 @@ sample.  Blocks with no such frame fall back to the general (world-frame) solve.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..analysis.schedule import unknown_groups
 from ..spatial import cross
+from .coaxial_frames import coaxial_links, turn_row
 from .equations import Columns
 from .general import is_geared, mesh_names, solve_general
 from .kinematics import Kinematics, forward
+from .sharing import least_load_map, mesh_weights
 from .signs import pattern_index, resolve_signs, sign_patterns
 
 
@@ -33,10 +35,14 @@ class BlockPlan:
     signed: list[int]       # positions in groups of signed mesh unknowns
     offs: np.ndarray        # column offsets of the groups
     patterns: list          # sign patterns
-    Ainv: list              # inverse matrix per pattern, (n, 6*len(links))
+    Ainv: list              # inverse matrix per pattern, (n, 6*len(links)); rectangular
+                            # (n > 6*len(links)) for a redundant gear set: least-t^2/k map
     names: list             # gear pair names of the signed unknowns (messages)
     C: dict                 # group position -> (C_plus (6,size), C_sep (6,size)) in F about o_F, primary side
-    parent_side: dict       # group position -> True when a joint basis is its parent's (rotate by -q)
+    parent_side: dict       # group position -> True when a joint basis is not its child's (rotate by -q)
+    # group position -> (J,) row: a joint basis carried by a third coaxial link F
+    # (:mod:`.coaxial_frames`), turned to the child's by -(q_all @ row) instead of -q
+    turn: dict = field(default_factory=dict)
 
 
 def _spread(an, g) -> bool:
@@ -58,7 +64,7 @@ def _fixed_in(an, g) -> set[int]:
     if g.kind == "joint":
         jt = mech.joints[g.index]
         c = tree.index[jt.child]
-        return {c} if jt.type == "prismatic" else {tree.index[jt.parent], c}
+        return {c} if jt.type == "prismatic" else {tree.index[jt.parent], c} | coaxial_links(an, g.index)
     if g.kind == "motor":
         x, s = an.motor_links[g.index], an.motor_stators[g.index]
         if mech.joints[tree.parent_joint[x]].type == "prismatic":
@@ -89,7 +95,10 @@ def _owned_groups(an, groups) -> dict[int, list]:
 
 
 def _constant_matrices(an, blk, gs, offs, signed, to_F, cols) -> list[np.ndarray]:
-    """Inverse of the block matrix in F about o_F, for each sign pattern."""
+    """Inverse of the block matrix in F about o_F, for each sign pattern; for a redundant
+    block (more unknowns than equations) the rectangular (n, 6B) map to the solution that
+    minimises sum t^2 / k (:func:`.sharing.least_load_map`)."""
+    w = mesh_weights(an, gs) if offs[-1] > 6 * len(blk) else None
     Ainv = []
     for pat in sign_patterns(len(signed)):
         sig = dict(zip(signed, pat))
@@ -99,7 +108,7 @@ def _constant_matrices(an, blk, gs, offs, signed, to_F, cols) -> list[np.ndarray
                 if L in blk:
                     r0 = 6 * blk.index(L)
                     A[r0:r0 + 6, offs[gi]:offs[gi + 1]] = to_F(cols.group(g, L, sig.get(gi, 1.0)), L)
-        Ainv.append(np.linalg.inv(A))
+        Ainv.append(np.linalg.inv(A) if w is None else least_load_map(A, w))
     return Ainv
 
 
@@ -120,6 +129,22 @@ def _propagation_columns(an, F, gs, signed, to_F, cols) -> tuple[dict, dict]:
     return C, parent_side
 
 
+def _frame(an, gs, common: set) -> tuple[int | None, dict]:
+    """The frame link F of a block among the ``common`` candidates (the base first: no
+    rotation; then links that carry every joint basis as its parent or child) and the turn
+    rows of the joints whose basis F carries as a third coaxial link ({} if none)."""
+    tree = an.tree
+
+    def third(F):
+        return [gi for gi, g in enumerate(gs) if g.kind == "joint" and F not in
+                (tree.index[an.mech.joints[g.index].parent], tree.index[an.mech.joints[g.index].child])]
+    for F in sorted(common, key=lambda x: (x != tree.base, len(third(x)), x)):
+        turn = {gi: turn_row(an, gs[gi].index, F) for gi in third(F)}
+        if all(row is not None for row in turn.values()):
+            return F, turn
+    return None, {}
+
+
 def make_plans(an) -> tuple[BlockPlan, ...]:
     """Block plans of ``an.schedule`` (computed once per analysis, owned by the solver)."""
     tree = an.tree
@@ -133,10 +158,13 @@ def make_plans(an) -> tuple[BlockPlan, ...]:
         signed = [i for i, g in enumerate(gs) if is_geared(an, g)]
         names = mesh_names(an, gs, signed)
         common = set.intersection(*[_fixed_in(an, g) for g in gs]) if gs else set()
-        if not common or offs[-1] != 6 * len(blk):
+        if not common or offs[-1] < 6 * len(blk):
             plans.append(BlockPlan(tuple(blk), gs, None, signed, offs, [], [], names, {}, {}))
             continue
-        F = min(common, key=lambda x: (x != tree.base, x))  # prefer the base: no rotation
+        F, turn = _frame(an, gs, common)
+        if F is None:
+            plans.append(BlockPlan(tuple(blk), gs, None, signed, offs, [], [], names, {}, {}))
+            continue
         RF, oF = home.R[F][0], home.o[F][0]
 
         def to_F(col, L):
@@ -148,7 +176,7 @@ def make_plans(an) -> tuple[BlockPlan, ...]:
         Ainv = _constant_matrices(an, blk, gs, offs, signed, to_F, cols)
         C, parent_side = _propagation_columns(an, F, gs, signed, to_F, cols)
         plans.append(BlockPlan(tuple(blk), gs, F, signed, offs, sign_patterns(len(signed)), Ainv, names,
-                               C, parent_side))
+                               C, parent_side, turn))
     return tuple(plans)
 
 
@@ -247,5 +275,7 @@ def solve_blocks(an, plans, kin: Kinematics, b: dict, q_all: np.ndarray):
                     _subtract(rhs[L], 1.0 if L == P else -1.0, w, kin.o[p.F], kin.o[L])
             if gi in p.signed:
                 sig_all[(g.kind, g.index)] = signs[:, p.signed.index(gi)]
-            x_all[(g.kind, g.index)] = _child_basis(xg, q_all[:, g.index]) if p.parent_side.get(gi) else xg
+            if p.parent_side.get(gi):
+                xg = _child_basis(xg, q_all @ p.turn[gi] if gi in p.turn else q_all[:, g.index])
+            x_all[(g.kind, g.index)] = xg
     return x_all, sig_all

@@ -7,6 +7,7 @@ from ..analysis.schedule import unknown_groups
 from ..errors import Collector
 from .kinematics import forward
 from .equations import Columns
+from .sharing import mesh_weights, null_directions_without_t
 
 _RTOL = 1e-10
 
@@ -57,6 +58,10 @@ def check_determinate(an, col: Collector) -> None:
     rank, total = 0, 0
     for blk, groups in zip(an.schedule, owned):
         n = sum(g.size for g in groups)
+        if n > 6 * len(blk):              # a redundant gear set: load sharing must be unique
+            _check_sharing(an, cols, blk, groups, col)
+            rank, total = rank + 6 * len(blk), total + 6 * len(blk)
+            continue
         best = 0
         for c in cols:
             A = _block_matrix(c, blk, groups)
@@ -67,3 +72,17 @@ def check_determinate(an, col: Collector) -> None:
     if rank < total or total != 6 * len(an.tree.moving):
         col.add("", f"the loads are statically indeterminate: the equations of the moving links are "
                 f"singular (rank {rank} of {total}); check the gear geometry and the motors")
+
+
+def _check_sharing(an, cols: list, blk: tuple, groups: list, col: Collector) -> None:
+    """A redundant block: its equations must be independent (full row rank) and every
+    redundancy must change some tooth force, else the mesh-stiffness model cannot share it."""
+    w = mesh_weights(an, groups)
+    names = ", ".join(f"'{an.tree.links[x]}'" for x in blk)
+    found = [null_directions_without_t(_block_matrix(c, blk, groups), w) for c in cols]
+    if all(r < 6 * len(blk) for r, _ in found):
+        col.add("", f"the loads are statically indeterminate: the equations of links {names} are "
+                "singular; check the gear geometry and the motors")
+    elif all(k > 0 for _, k in found):
+        col.add("", f"the loads of links {names} are statically indeterminate beyond the mesh-stiffness "
+                "model: a redundancy changes only bearing reactions or motor torques, no tooth force")

@@ -10,6 +10,7 @@ import numpy as np
 
 from ..analysis.schedule import UnknownGroup, unknown_groups
 from .equations import Columns
+from .sharing import least_load_solve, mesh_weights
 from .signs import resolve_signs
 
 
@@ -43,11 +44,16 @@ def solve_general(an, cols: Columns, groups, links, rhs: np.ndarray):
     Returns
     -------
     x : (N, n) unknowns in the order of ``groups``; signs : {(kind, index): (N,) sign of t}.
+
+    With more unknowns than equations (a redundant gear set) x is the solution that
+    minimises sum t^2 / k (:mod:`.sharing`).
     """
     N = rhs.shape[0]
     offs = np.cumsum([0] + [g.size for g in groups])
     signed = [i for i, g in enumerate(groups) if is_geared(an, g)]
     mid = assemble(cols, groups, links)
+    shared = offs[-1] > 6 * len(links)
+    w = mesh_weights(an, groups) if shared else None
     row = {L: 6 * r for r, L in enumerate(links)}
     half = {}
     for i in signed:                       # column = mid + sign(t) * half (Eq. 14)
@@ -63,7 +69,10 @@ def solve_general(an, cols: Columns, groups, links, rhs: np.ndarray):
         A = mid.copy() if every else mid[idx]          # (fancy indexing copies too)
         for i, s in zip(signed, pat):
             A[:, :, offs[i]] += s * (half[i] if every else half[i][idx])
-        return np.linalg.solve(A, (rhs if every else rhs[idx])[:, :, None])[:, :, 0]
+        r = rhs if every else rhs[idx]
+        if shared:
+            return least_load_solve(A, r, w)
+        return np.linalg.solve(A, r[:, :, None])[:, :, 0]
 
     scale = 1.0 + np.max(np.abs(rhs), axis=1)
     x, signs = resolve_signs(solve_pattern, len(signed), [int(offs[i]) for i in signed], N, scale,

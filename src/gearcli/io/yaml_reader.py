@@ -272,9 +272,19 @@ def _gears(data: dict, col: Collector, links: _Names) -> list[GearPair]:
             spec.get("carrier"),
             float(np.deg2rad(spec.get("pressure_angle_deg", 20.0))),
             tuple(np.deg2rad(cones)) if cones is not None else None,
-            path, helix_angle=helix or 0.0, hand=spec.get("hand"),
+            path, helix_angle=helix or 0.0, hand=spec.get("hand"), stiffness=_stiffness(spec, col, path),
         ))
     return gears
+
+
+def _stiffness(spec: dict, col: Collector, path: str) -> float | None:
+    """``gears[].stiffness`` (N/m), which must be positive (finite: checked before)."""
+    if "stiffness" not in spec:
+        return None
+    k = float(spec["stiffness"])
+    if not k > 0:
+        col.add(f"{path}.stiffness", f"mesh stiffness must be positive, got {k:g} N/m")
+    return k
 
 
 def _motors(data: dict, col: Collector, links: _Names) -> list[Motor]:

@@ -95,6 +95,9 @@ class GearPair:
     # the same for an internal one).  See model.gears.helical_terms.
     helix_angle: float = 0.0
     hand: str | None = None
+    # Mesh stiffness k, N/m (N*m/rad for an ideal coupling): the weight 1/k of the pair's
+    # tooth force in a redundant gear set's load sharing (min sum t^2/k); None: equal.
+    stiffness: float | None = None
 
 
 @dataclass(frozen=True, eq=False)

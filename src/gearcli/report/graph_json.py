@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from ..analysis.graph import Analysis, Circuit
 from ..model.mechanism import Mechanism
+from .sharing import sharing_sets
 
 
 def analysis_dict(an: Analysis) -> dict:
@@ -40,6 +41,7 @@ def analysis_dict(an: Analysis) -> dict:
         "structure_matrix": an.A.tolist(),
         "pseudo_triangular": an.pseudo_triangular,
         "solve_order": [[n[i] for i in block] for block in an.schedule],
+        "load_sharing": sharing_sets(an),
     } | ({"open_loop": "tree"} if an.open_loop == "tree" else {})
 
 

@@ -11,6 +11,8 @@ from typing import TYPE_CHECKING
 from rich.console import Console
 from rich.table import Table
 
+from .sharing import sharing_notes
+
 if TYPE_CHECKING:  # pragma: no cover
     from ..analysis.graph import Analysis
 
@@ -121,6 +123,8 @@ def print_graph_tables(an: Analysis, console: Console) -> None:
     console.print(structure_table(an))
     console.print(f"Pseudo-triangular: {'yes' if an.pseudo_triangular else 'no'}")
     console.print("Solve order: " + format_blocks([an.name_of(b) for b in an.schedule]))
+    for line in sharing_notes(an):
+        console.print(line, markup=False)
 
 
 def summary_table(report) -> Table:
