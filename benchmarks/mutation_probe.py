@@ -50,6 +50,10 @@ TESTS = [
     "tests/test_rack.py::test_rack_sign_from_geometry",
     "tests/test_rack.py::test_power_balance_along_bundled_trajectory",
     "tests/test_helical.py::test_static_helical_by_hand",
+    "tests/test_helical_bundled.py::test_static_reduction_by_hand",
+    "tests/test_helical_bundled.py::test_bearing_radial_and_axial_loads_by_hand",
+    "tests/test_helical_bundled.py::test_power_balance_along_bundled_trajectory",
+    "tests/test_helical_bundled.py::test_pinocchio_rnea_per_shaft_with_tooth_forces",
 ]
 
 
