@@ -2,8 +2,8 @@
 
 paper_2dof_traj.csv: positions only (the solver derives rates and accelerations by spline);
 bendix_wrist_traj.csv: positions, rates and accelerations of an analytic motion;
-rack_axis_traj.csv (m) and helical_reduction_traj.csv (rad): analytic, with rates and
-accelerations.
+rack_axis_traj.csv (m), helical_reduction_traj.csv and planetary_3p_traj.csv (rad): analytic,
+with rates and accelerations.
 """
 import numpy as np
 
@@ -45,3 +45,10 @@ qd = 1.5 * w * (np.cos(w * t) * (1 + 0.2 * np.cos(2 * w * t)) - 0.4 * np.sin(w *
 qdd = 1.5 * w**2 * (-np.sin(w * t) * (1 + 0.2 * np.cos(2 * w * t)) - 0.8 * np.cos(w * t) * np.sin(2 * w * t)
                     - 0.8 * np.sin(w * t) * np.cos(2 * w * t))
 write_trajectory("mechanisms/helical_reduction_traj.csv", ["Jout"], t, q[:, None], qd[:, None], qdd[:, None])
+
+# planetary_3p: the carrier JC (rad), two turns out and back with a superposed faster
+# oscillation (sun = 3.5 x carrier: to ~40 rad/s at the motor)
+q = 2.0 * np.pi * np.sin(0.5 * w * t) + 0.3 * np.sin(3 * w * t)
+qd = np.pi**2 * np.cos(0.5 * w * t) + 0.9 * w * np.cos(3 * w * t)
+qdd = -0.5 * np.pi**3 * np.sin(0.5 * w * t) - 2.7 * w**2 * np.sin(3 * w * t)
+write_trajectory("mechanisms/planetary_3p_traj.csv", ["JC"], t, q[:, None], qd[:, None], qdd[:, None])

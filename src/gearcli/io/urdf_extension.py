@@ -14,7 +14,7 @@ from .urdf_xml import NS, q
 
 GEAR_ATTRS = ("name", "j", "k", "kind", "ratio", "teeth", "carrier", "mesh_point", "pressure_angle",
               "pressure_angle_deg", "cone_angles", "cone_angles_deg", "helix_angle", "helix_angle_deg", "hand",
-              "derived")
+              "stiffness", "derived")
 
 
 class Extension:
@@ -94,6 +94,12 @@ class Extension:
                 kw["mesh_point"] = P
         if el.get("hand") is not None:
             kw["hand"] = el.get("hand")
+        if el.get("stiffness") is not None:
+            k = self.vector(el, "stiffness", path, n=1)
+            if k is not None and not k[0] > 0:
+                self.add(path, f"mesh stiffness must be positive, got {k[0]:g} N/m", el)
+            elif k is not None:
+                kw["stiffness"] = float(k[0])
         for key in ("pressure_angle", "cone_angles", "helix_angle"):
             n = 2 if key == "cone_angles" else 1
             if el.get(key) is not None and el.get(f"{key}_deg") is not None:

@@ -20,6 +20,7 @@ import numpy as np
 from ..errors import Collector
 from ..model.mechanism import GearPair, Joint, Link, Mechanism, Motor
 from .loads_reader import yaml_loads
+from .planets import expand_planets, item_path
 from .ratings_reader import attach_yaml_ratings
 from ..model.geometry import dh_transform, origin_axis_transform
 from ..model.validate import check_inertia, gear_pair_problems, inertia_matrix, number_problem
@@ -137,6 +138,8 @@ def parse_mechanism(text: str, file: str = "<string>") -> Mechanism:
     _number_issues(data, col)
     _schema_issues(data, col, {i.path for i in col.issues})
     col.raise_if_any()
+    data = expand_planets(data, joint_geometry, col)
+    col.raise_if_any()
     mech = attach_yaml_ratings(_build(data, col, file, lines), data, col)
     col.raise_if_any()
     return mech
@@ -210,7 +213,7 @@ def _links(data: dict, col: Collector) -> tuple[_Names, list[Link]]:
     names = _Names(col, "link")
     out: list[Link] = []
     for i, spec in enumerate(data["links"]):
-        path = f"links[{i}]"
+        path = item_path(data, "links", i)
         name = spec["name"]
         names.declare(name, path)
         mass = float(spec.get("mass", 0.0))
@@ -231,7 +234,7 @@ def _joints(data: dict, col: Collector, links: _Names) -> list[Joint]:
     joints: list[Joint] = []
     names = _Names(col, "joint")
     for i, spec in enumerate(data["joints"]):
-        path = f"joints[{i}]"
+        path = item_path(data, "joints", i)
         names.declare(spec["name"], path)
         links.ref(spec["parent"], f"{path}.parent")
         links.ref(spec["child"], f"{path}.child")
@@ -252,7 +255,7 @@ def _gears(data: dict, col: Collector, links: _Names) -> list[GearPair]:
     gears: list[GearPair] = []
     names = _Names(col, "gear pair")
     for i, spec in enumerate(data.get("gears", [])):
-        path = f"gears[{i}]"
+        path = item_path(data, "gears", i)
         j, k = spec["links"]
         links.ref(j, f"{path}.links[0]")
         links.ref(k, f"{path}.links[1]")

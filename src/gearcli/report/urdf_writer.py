@@ -247,3 +247,5 @@ def _gear_attrs(el, gp, mesh_point) -> None:
     if gp.helix_angle:
         el.set("helix_angle", _num(gp.helix_angle))
         el.set("hand", str(gp.hand))
+    if gp.stiffness is not None:
+        el.set("stiffness", _num(gp.stiffness))

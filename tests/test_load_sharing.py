@@ -1,0 +1,297 @@
+"""Redundant gear sets (issue 9): a planetary with N planets shares its load by the mesh
+stiffness model (min sum t^2/k subject to every Newton-Euler equation).
+
+The checks are independent of the solver's minimisation:
+
+* symmetry and an equivalent determinate mechanism: with equal stiffness each of the N
+  planets carries exactly 1/N of the tooth force of ONE planet with N times the mass and
+  inertia (the determinate mechanism solved by the ordinary square solve; same total
+  carrier-axis inertia, since sum (I_zz + m r^2) over the planets = N I_zz + (N m) r^2);
+* a static hand calculation with unequal stiffness (t_i proportional to k_i);
+* block schedule (constant frame, rectangular map) against the full world-frame solve;
+* the Newton-Euler residual of every link (``--verify``).
+"""
+from __future__ import annotations
+
+import dataclasses
+import re
+
+import numpy as np
+import pytest
+import yaml
+
+from gearcli import analyse, load_mechanism
+from gearcli.dynamics.blocks import make_plans
+from gearcli.dynamics.sharing import SharingError, least_load_map, null_directions_without_t
+from gearcli.dynamics.solve import solve
+from gearcli.io.trajectory import read_trajectory
+from gearcli.io.yaml_reader import parse_mechanism
+
+TOL = 1e-12
+
+
+@pytest.fixture(scope="module")
+def bundled(mech_dir):
+    return (mech_dir / "planetary_3p.yaml").read_text()
+
+
+def variant(text: str, edit) -> object:
+    """Analysis of the bundled planetary's YAML after ``edit(data)``."""
+    data = yaml.safe_load(text)
+    edit(data)
+    return analyse(parse_mechanism(yaml.safe_dump(data), "variant.yaml"))
+
+
+def with_planets(n: int):
+    def edit(data):
+        next(j for j in data["joints"] if j["name"] == "JP")["planets"] = n
+    return edit
+
+
+def lumped(n: int):
+    """One planet with n times the planet's mass and inertia (from the file's own data)."""
+    def edit(data):
+        jp = next(j for j in data["joints"] if j["name"] == "JP")
+        del jp["planets"]
+        planet = next(x for x in data["links"] if x["name"] == "planet")
+        planet["mass"] = n * planet["mass"]
+        planet["inertia"] = [n * v for v in planet["inertia"]]
+    return edit
+
+
+def trajectory(mech_dir, an):
+    traj = read_trajectory(mech_dir / "planetary_3p_traj.csv", an.independent_names)
+    return traj.q[::20], traj.qd[::20], traj.qdd[::20]
+
+
+def gear_index(an, name: str) -> int:
+    return next(ci for ci, c in enumerate(an.circuits) if an.mech.gears[c.gear].name == name)
+
+
+def close(a, b, tol=TOL):
+    scale = max(np.max(np.abs(a)), np.max(np.abs(b)), 1e-300)
+    np.testing.assert_allclose(a, b, rtol=0, atol=tol * scale)
+
+
+# --- the bundled planetary: names, notes, equal sharing, one-planet equivalent ----------------------
+
+def test_expanded_names_and_note(run_cli, mech_dir):
+    res = run_cli("graph", mech_dir / "planetary_3p.yaml", "--json")
+    assert res.exit_code == 0, res.stderr
+    import json
+
+    d = json.loads(res.stdout)
+    assert d["dof"] == 1
+    assert d["secondary"] == ["sun", "planet1", "planet2", "planet3"]
+    assert d["carriers"] == {"sun": "housing", "planet1": "carrier", "planet2": "carrier", "planet3": "carrier"}
+    pairs = ["sun-planet1", "sun-planet2", "sun-planet3", "planet-ring1", "planet-ring2", "planet-ring3"]
+    assert d["load_sharing"] == [{"pairs": pairs, "model": "load shared by mesh stiffness, min sum t^2/k",
+                                  "stiffness": [3.0e8] * 3 + [3.5e8] * 3}]
+    text = run_cli("graph", mech_dir / "planetary_3p.yaml").stdout
+    assert "JP2: carrier -> planet2" in text
+    assert text.splitlines()[-1].startswith("note: redundant gear set 'sun-planet1', ")
+
+
+def test_planets_equally_spaced(mech_dir):
+    """The expanded pins sit at 0, 120 and 240 degrees on the 21 mm circle (carrier frame)."""
+    mech = load_mechanism(mech_dir / "planetary_3p.yaml")
+    pins = {j.name: j.p_pj for j in mech.joints if j.name.startswith("JP")}
+    for k, name in enumerate(("JP1", "JP2", "JP3")):
+        a = 2 * np.pi * k / 3
+        close(pins[name], [0.021 * np.cos(a), 0.021 * np.sin(a), -0.01], 1e-15)
+    sun_mesh = {g.name: g.mesh_point for g in mech.gears}
+    close(sun_mesh["sun-planet3"], [0.012 * np.cos(4 * np.pi / 3), 0.012 * np.sin(4 * np.pi / 3), -0.01], 1e-15)
+
+
+@pytest.mark.parametrize("n", [2, 3, 4])
+def test_each_planet_carries_one_nth_of_the_lumped_planet(mech_dir, bundled, n):
+    an = variant(bundled, with_planets(n))
+    one = variant(bundled, lumped(n))
+    assert an.dof == one.dof == 1
+    assert len(an.redundant) == 1 and not one.redundant
+    q, qd, qdd = trajectory(mech_dir, an)
+    res, ref = solve(an, q, qd, qdd), solve(one, q, qd, qdd)
+    close(res.motor, ref.motor)
+    for pair in ("sun-planet", "planet-ring"):
+        t_ref = ref.gear_t[:, gear_index(one, pair)]
+        sep_ref = ref.gear_sep[:, gear_index(one, pair)]
+        for i in range(1, n + 1):
+            ci = gear_index(an, f"{pair}{i}")
+            close(res.gear_t[:, ci], t_ref / n)
+            close(res.gear_sep[:, ci], sep_ref / n)
+    assert np.min(np.abs(ref.gear_t[:, 0])) > 1.0     # the comparison is not between zeros
+
+
+def test_every_planet_bearing_loaded(mech_dir):
+    an = analyse(load_mechanism(mech_dir / "planetary_3p.yaml"))
+    res = solve(an, *trajectory(mech_dir, an))
+    names = [j.name for j in an.mech.joints]
+    radial = [np.hypot(res.joint[:, names.index(f"JP{i}"), 0], res.joint[:, names.index(f"JP{i}"), 1])
+              for i in (1, 2, 3)]
+    t = np.abs(res.gear_t[:, gear_index(an, "sun-planet1")])
+    for r in radial:
+        assert np.all(r > 1.5 * t)          # the pin carries both tooth forces (about 2 t)
+        close(r, radial[0], 1e-12)
+
+
+def test_block_equals_full_and_rectangular_plan(mech_dir):
+    an = analyse(load_mechanism(mech_dir / "planetary_3p.yaml"))
+    plans = make_plans(an)
+    assert len(plans) == 1                   # sun, carrier and planets: one redundant block
+    p = plans[0]
+    assert an.names[p.F] == "carrier"       # a constant frame: the least-t^2/k map is constant
+    assert p.Ainv[0].shape == (int(p.offs[-1]), 6 * len(p.links)) and p.offs[-1] == 6 * len(p.links) + 2
+    q, qd, qdd = trajectory(mech_dir, an)
+    blk = solve(an, q, qd, qdd, method="block", verify=True)
+    full = solve(an, q, qd, qdd, method="full", verify=True)
+    for f in ("motor", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial"):
+        close(getattr(blk, f), getattr(full, f), 1e-11)
+    assert blk.residual < 1e-13 and full.residual < 1e-13
+
+
+def test_cli_verify_residual_at_rounding_level(run_cli, mech_dir, tmp_path):
+    out = tmp_path / "loads.csv"
+    res = run_cli("solve", mech_dir / "planetary_3p.yaml", mech_dir / "planetary_3p_traj.csv", "-o", out, "--verify")
+    assert res.exit_code == 0, res.stderr
+    worst = float(re.search(r"Worst Newton-Euler residual \(relative\): (\S+)", res.stdout).group(1))
+    assert worst < 1e-13
+    assert "note: redundant gear set 'sun-planet1', 'sun-planet2', 'sun-planet3', 'planet-ring1', " in res.stdout
+
+
+# --- unequal stiffness: static hand check -----------------------------------------------------------
+
+@pytest.mark.parametrize("k", [(1.0e8, 2.0e8, 3.0e8), (5.0e8, 1.0e8, 1.0e8)])
+def test_unequal_stiffness_shares_in_proportion(mech_dir, k):
+    """At rest (gravity along the axis) a resisting torque M on the carrier needs the motor
+    torque M / 3.5 (ratio 1 + 60/24); the sun's torque balance: sum t_i = (M / 3.5) / r_sun.
+    Each planet path i has both its meshes of stiffness k_i; the planets at rest carry equal
+    sun and ring forces t_i, and min sum 2 t_i^2 / k_i subject to sum t_i = T gives
+    t_i = T k_i / sum k (Lagrange).  Weights ignored would give T / 3 each."""
+    mech = load_mechanism(mech_dir / "planetary_3p.yaml")
+    M = 3.5
+    stiff = {f"{pair}{i + 1}": k[i] for i in range(3) for pair in ("sun-planet", "planet-ring")}
+    loads = (dataclasses.replace(mech.loads[0], force=np.zeros(3), moment=np.array([0.0, 0.0, -M])),)
+    mech = dataclasses.replace(mech, gears=tuple(dataclasses.replace(g, stiffness=stiff[g.name]) for g in mech.gears),
+                               loads=loads)
+    an = analyse(mech)
+    z = np.zeros((1, 1))
+    for method in ("block", "full"):
+        res = solve(an, z, z, z, method=method, verify=True)
+        assert res.residual < 1e-13
+        assert res.motor[0, 0] == pytest.approx(M / 3.5, rel=1e-12)
+        T = (M / 3.5) / 0.012
+        for i in range(3):
+            for pair in ("sun-planet", "planet-ring"):
+                t = res.gear_t[0, gear_index(an, f"{pair}{i + 1}")]
+                assert abs(t) == pytest.approx(T * k[i] / sum(k), rel=1e-12)
+
+
+def test_default_stiffness_is_equal_sharing(mech_dir, bundled):
+    """Without stiffness (default equal) the symmetric planetary shares equally too, and the
+    note says which stiffness applied."""
+    def edit(data):
+        for g in data["gears"]:
+            g.pop("stiffness")
+    an = variant(bundled, edit)
+    res = solve(an, *trajectory(mech_dir, an))
+    t = res.gear_t[:, [gear_index(an, f"sun-planet{i}") for i in (1, 2, 3)]]
+    close(t[:, 1], t[:, 0])
+    close(t[:, 2], t[:, 0])
+
+
+# --- the sharing map itself, and what it refuses ------------------------------------------------------
+
+def test_least_load_map_two_parallel_springs():
+    """x = (t1, t2, R): t1 + t2 = T, R = 5 (a reaction): min t1^2/k1 + t2^2/k2 -> t_i = T k_i / (k1 + k2)."""
+    A = np.array([[1.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    k1, k2 = 2.0, 6.0
+    X = least_load_map(A, np.array([1 / k1, 1 / k2, 0.0]))
+    x = X @ np.array([8.0, 5.0])
+    np.testing.assert_allclose(x, [2.0, 6.0, 5.0], rtol=1e-14)
+
+
+def test_redundancy_without_tooth_force_is_refused():
+    """x = (R1, R2, t): R1 + R2 = F, t = T: the split of R1, R2 changes no tooth force."""
+    A = np.array([[1.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    w = np.array([0.0, 0.0, 1.0])
+    assert null_directions_without_t(A, w) == (2, 1)
+    with pytest.raises(SharingError):
+        least_load_map(A, w)
+
+
+# --- export round trip ------------------------------------------------------------------------------
+
+def test_export_round_trip(run_cli, mech_dir, tmp_path):
+    out = tmp_path / "p3.urdf"
+    res = run_cli("export", mech_dir / "planetary_3p.yaml", "-o", out)
+    assert res.exit_code == 0, res.stderr
+    assert 'stiffness="300000000.0"' in out.read_text()
+    a = analyse(load_mechanism(mech_dir / "planetary_3p.yaml"))
+    b = analyse(load_mechanism(out))
+    assert [g.name for g in b.mech.gears] == [g.name for g in a.mech.gears]
+    assert [g.stiffness for g in b.mech.gears] == [g.stiffness for g in a.mech.gears]
+    assert [[b.mech.gears[b.circuits[i].gear].name for i in s] for s in b.redundant] == \
+           [[a.mech.gears[a.circuits[i].gear].name for i in s] for s in a.redundant]
+    q, qd, qdd = trajectory(mech_dir, a)
+    ra, rb = solve(a, q, qd, qdd), solve(b, q, qd, qdd)
+    close(rb.gear_t, ra.gear_t, 1e-9)
+    close(rb.motor, ra.motor, 1e-9)
+    check = run_cli("check", out)
+    assert check.exit_code == 0 and "note: redundant gear set 'sun-planet1'" in check.stdout
+
+
+def test_urdf_stiffness_not_positive(run_cli, mech_dir, tmp_path):
+    out = tmp_path / "p3.urdf"
+    run_cli("export", mech_dir / "planetary_3p.yaml", "-o", out)
+    text = out.read_text().replace('stiffness="300000000.0"', 'stiffness="-1"', 1)
+    bad = tmp_path / "bad.urdf"
+    bad.write_text(text)
+    res = run_cli("check", bad)
+    assert res.exit_code == 2 and "Traceback" not in res.stderr
+    lines = res.stderr.splitlines()
+    assert len(lines) == 1 and re.search(r"bad\.urdf:\d+: gearcli:gear 'sun-planet1': mesh stiffness must be "
+                                         r"positive, got -1 N/m$", lines[0]), lines
+
+
+# --- joints[].planets: bad input ------------------------------------------------------------------
+
+def _line(text: str, needle: str) -> int:
+    return next(i + 1 for i, s in enumerate(text.splitlines()) if needle in s)
+
+
+@pytest.mark.parametrize("old, new, needle, place, reason", [
+    ("    planets: 3", "    planets: 1", "planets: 1", "joints[2].planets", "1 is less than the minimum of 2"),
+    ("    planets: 3", "    planets: 2.5", "planets: 2.5", "joints[2].planets", "2.5 is not of type 'integer'"),
+    ("  - {name: motor, link: sun}", "  - {name: motor, link: planet}", "    planets: 3", "joints[2].planets",
+     r"^planet link 'planet' cannot be used by motors\[0\]: only its joint on the carrier and its gear pairs "
+     r"are copied$"),
+    ("    parent: carrier\n    child: planet\n    origin: {xyz: [0.021, 0, -0.01]}\n    axis: [0, 0, 1]",
+     "    parent: carrier\n    child: planet\n    dh: {d: -0.01, a: 0.021}", "    planets: 3", "joints[2].planets",
+     r"^planets need a revolute joint given by origin/axis \(not dh\)$"),
+    ("    parent: carrier\n    child: planet", "    parent: housing\n    child: planet", "    planets: 3",
+     "joints[2].planets", r"^the planets' carrier 'housing' turns on no joint"),
+])
+def test_planets_bad_input(run_cli, tmp_path, bundled, old, new, needle, place, reason):
+    assert bundled.count(old) == 1
+    text = bundled.replace(old, new)
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    res = run_cli("check", path)
+    assert res.exit_code == 2 and res.stdout == "" and "Traceback" not in res.stderr
+    lines = res.stderr.splitlines()
+    assert len(lines) == 1, lines
+    prefix = f"{path}:{_line(text, needle)}: {place}: "
+    assert lines[0].startswith(prefix), (lines[0], prefix)
+    assert re.search(reason, lines[0][len(prefix):]), lines[0]
+
+
+def test_planet_copy_error_points_at_the_original(run_cli, tmp_path, bundled):
+    """A problem in a copied pair is reported at the pair the user wrote (its YAML path and
+    line), naming the copy."""
+    text = bundled.replace("    teeth: [18, 60]", "    teeth: [18, 61]")
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    res = run_cli("check", path)
+    assert res.exit_code == 2
+    lines = res.stderr.splitlines()
+    assert lines and all(ln.startswith(f"{path}:{_line(text, '[18, 61]')}: gears[1].teeth: ") for ln in lines), lines
