@@ -298,11 +298,12 @@ def test_full_disk_leaves_nothing(run_cli, work, monkeypatch, no_tmpfile, comman
 
     monkeypatch.setattr(output.os, "fdopen", fdopen)
     (work / "traj.csv").write_text(SMOOTH)
-    (work / "out.x").write_text("previous\n")
+    name = "out.csv" if command == "solve" else "out.x"   # solve's format comes from the extension
+    (work / name).write_text("previous\n")
     before = snapshot(work)
     args = [work / "mech.yaml"] + ([work / "traj.csv"] if command == "solve" else [])
-    r = run_cli(command, *args, "-o", work / "out.x")
-    one_line_error(r, "out.x: -o: cannot write: No space left on device")
+    r = run_cli(command, *args, "-o", work / name)
+    one_line_error(r, f"{name}: -o: cannot write: No space left on device")
     assert snapshot(work) == before
 
 

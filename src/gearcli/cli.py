@@ -233,9 +233,11 @@ TRAJ_HELP = ("Trajectory CSV: header t,q:<joint>,... for every independent joint
 def solve(
     mech: Path = typer.Argument(..., metavar="MECH", help=MECH_HELP, show_default=False),
     traj: Path = typer.Argument(..., metavar="TRAJ.csv", help=TRAJ_HELP, show_default=False),
-    output: str = typer.Option(None, "-o", "--output", metavar="OUT.csv",
-                               help="Loads CSV to write, one row per sample ('-' for stdout). "
-                                    "Default: TRAJ.loads.csv beside the trajectory."),
+    output: str = typer.Option(None, "-o", "--output", metavar="OUT.csv|parquet|feather|npz",
+                               help="Loads table to write, one row per sample, format by extension "
+                                    "('-': CSV to stdout). Default: TRAJ.loads.csv beside the trajectory."),
+    precision: int = typer.Option(None, "--precision", metavar="N", help="Significant digits of CSV "
+                                  "values, 1..17 (default 9; 17 round-trips float64)."),
     degrees: bool = typer.Option(False, "--degrees", help="Angle columns of the trajectory are in "
                                  "degrees (deg, deg/s, deg/s^2)."),
     method: str = typer.Option("block", "--method", help="'block': the level-by-level schedule "
@@ -278,7 +280,7 @@ def solve(
 
     try:
         report = solve_file(mech, traj, out, degrees=degrees, method=method, verify=verify,
-                            chunk=chunk, progress=tick, analysis=an)
+                            chunk=chunk, progress=tick, analysis=an, precision=precision)
     finally:
         if started:
             progress.stop()
@@ -375,12 +377,13 @@ def verify(
 @app.command()
 @reports_bad_input
 def plot(
-    loads: Path = typer.Argument(..., metavar="LOADS.csv", show_default=False, help="A CSV written by gearcli solve."),
+    loads: Path = typer.Argument(..., metavar="LOADS", show_default=False,
+                                 help="A loads file written by gearcli solve (.csv, .parquet, .feather, .npz)."),
     columns: list[str] = typer.Argument(..., metavar="COLUMN_OR_GLOB...", show_default=False,
                                         help="Column names or shell patterns, e.g. 'motor:*' 'gear:5-1:t'."),
     output: Path = typer.Option(..., "-o", "--output", metavar="FIG.png|svg|pdf", help="Figure to write."),
 ) -> None:
-    """Draw columns of a loads CSV over time (one axis per unit: N, N*m, rad/s, W)."""
+    """Draw columns of a loads file over time (one axis per unit: N, N*m, rad/s, W)."""
     from .report.plots import plot_loads_csv  # noqa: PLC0415
 
     n = plot_loads_csv(loads, columns, output)

@@ -19,12 +19,14 @@ from .dynamics.solve import solve
 from .analysis.graph import Analysis
 from .analysis.graph import analyse as analyse_graph
 from .dynamics.determinacy import check_determinate
-from .errors import Collector, Issue, TrajectoryError
+from . import __version__
+from .errors import Collector, GearcliError, Issue, TrajectoryError
 from .io import load_mechanism
-from .io.output import atomic_output, output_target
+from .io.output import OutputError, atomic_output, output_target
 from .io.trajectory import TrajectoryReader
 from .model.mechanism import Mechanism
-from .report.columns import Summary, column_names, first_non_finite, format_rows, table
+from .report.columns import Summary, column_names, column_units, first_non_finite, table
+from .report.table_files import CONVENTIONS, FORMATS, format_of, open_table
 
 VERIFY_TOLERANCE = 1e-8
 """``--verify`` fails when the worst relative Newton-Euler residual exceeds this (or is
@@ -66,37 +68,51 @@ class SolveReport:
 
 
 def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, method: str = "block",
-               verify: bool = False, chunk: int = 20_000, progress=None, analysis: Analysis | None = None) -> SolveReport:
-    """Solve a trajectory file and write the loads CSV (see :mod:`gearcli.report`).
+               verify: bool = False, chunk: int = 20_000, progress=None, analysis: Analysis | None = None,
+               precision: int | None = None) -> SolveReport:
+    """Solve a trajectory file and write the loads table (see :mod:`gearcli.report`).
 
-    ``progress(total=None, advance=None)`` is called with ``total`` once (number of
-    samples) and with ``advance`` after each chunk.  The output is written atomically
-    (:func:`gearcli.io.output.atomic_output`: nothing is written unless everything
-    succeeded); ``out_path="-"`` writes to stdout after the whole trajectory was read and
-    checked, streaming the loads (a non-finite load or a failed ``verify`` found while
-    streaming stops the output with an error); ``None`` writes nothing (summary only).
+    The format of ``out_path`` follows its extension (:mod:`gearcli.report.table_files`:
+    ``.csv`` or none, ``.parquet``, ``.feather``, ``.npz``; another one is an
+    :class:`~gearcli.io.output.OutputError`); ``precision`` (1..17 significant digits,
+    default 9) applies to CSV only.  ``progress(total=None, advance=None)`` is called with
+    ``total`` once (number of samples) and with ``advance`` after each chunk.  The output
+    is written atomically (:func:`gearcli.io.output.atomic_output`: nothing is written
+    unless everything succeeded); ``out_path="-"`` writes CSV to stdout after the whole
+    trajectory was read and checked, streaming the loads (a non-finite load or a failed
+    ``verify`` found while streaming stops the output with an error); ``None`` writes
+    nothing (summary only).
 
     Every output sample is checked finite before it is written
     (:class:`~gearcli.errors.TrajectoryError` naming the first bad sample and column);
     with ``verify`` the worst residual of every chunk must be finite and at most
     :data:`VERIFY_TOLERANCE`.
     """
-    if out_path is not None:
-        output_target(out_path, (mech_path, traj_path))   # refuse a bad -o before any work
+    fmt = _output_format(out_path, (mech_path, traj_path), precision)   # refuse a bad -o before any work
     an = analysis or analyse(load_mechanism(mech_path))
     reader = TrajectoryReader(traj_path, an.independent_names, degrees=degrees, chunk=chunk,
                               linear=prismatic_independent(an), loads=an.mech.loads)
+    to_stdout = out_path is not None and str(out_path) == "-"
+    rows = reader.check() if to_stdout or fmt == "npz" else reader.count()   # exact count first
     if progress is not None:
-        progress(total=reader.count())
+        progress(total=rows)
     summary = Summary.for_mechanism(an)
     names = column_names(an)
     worst = 0.0
     n = 0
 
-    def run(f):
+    def run(table_file):
+        try:
+            solve_chunks(table_file)
+        except BaseException:
+            if table_file is not None:
+                table_file.abort()
+            raise
+        if table_file is not None:
+            table_file.close()
+
+    def solve_chunks(table_file):
         nonlocal worst, n
-        if f is not None:
-            f.write(",".join(names) + "\n")
         for part in reader:
             with np.errstate(all="ignore"), warnings.catch_warnings():
                 warnings.simplefilter("ignore")
@@ -108,22 +124,43 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
                 _check_residual(reader, part, res.residual)
                 worst = max(worst, res.residual)
             summary.add(tab)
-            if f is not None:
-                f.write(format_rows(tab))
+            if table_file is not None:
+                table_file.write(tab)
             n += len(part.t)
             if progress is not None:
                 progress(advance=len(part.t))
 
-    out = None if out_path is None or str(out_path) == "-" else Path(out_path)
+    def opened(f):
+        meta = {"gearcli_version": __version__, "mechanism": str(mech_path), "trajectory": str(traj_path),
+                "conventions": CONVENTIONS}
+        return open_table(fmt, f, names, column_units(an), meta, precision=precision or 9, rows=rows)
+
+    out = None if out_path is None or to_stdout else Path(out_path)
     if out_path is None:
         run(None)
     elif out is None:
-        reader.check()   # read and check the whole trajectory before streaming
-        run(sys.stdout)
+        run(opened(sys.stdout))
     else:
-        with atomic_output(out, (mech_path, traj_path)) as f:
-            run(f)
+        with atomic_output(out, (mech_path, traj_path), binary=fmt != "csv") as f:
+            run(opened(f))
     return SolveReport(an, n, summary, worst if verify else None, out)
+
+
+def _output_format(out_path, inputs, precision: int | None) -> str:
+    """The format of ``out_path`` (``csv`` when None); raises for a bad target, an unknown
+    extension or a bad ``precision``."""
+    if precision is not None and not (isinstance(precision, int) and 1 <= precision <= 17):
+        raise GearcliError(f"--precision: expected 1 to 17 significant digits, got {precision}")
+    if out_path is None:
+        return "csv"
+    output_target(out_path, inputs)
+    fmt = format_of(str(out_path))
+    if fmt is None:
+        raise OutputError(str(out_path), f"unknown output format '{Path(out_path).suffix}' (the extension "
+                          f"chooses it: {', '.join(FORMATS)})")
+    if precision is not None and fmt != "csv":
+        raise OutputError(str(out_path), f"--precision applies to CSV output only, not {fmt}")
+    return fmt
 
 
 def _sample_line(reader: TrajectoryReader, part, i: int) -> int | None:

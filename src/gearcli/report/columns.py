@@ -84,7 +84,8 @@ def named_columns(an, res: Result, t: np.ndarray | None = None) -> dict[str, np.
 
 
 def column_unit(name: str) -> str:
-    """SI unit of an output column (rotary joints; see the README's column table)."""
+    """SI unit of an output column from its name alone (the README's column table; a
+    prismatic input or joint changes some: :func:`column_units`)."""
     last = name.rsplit(":", 1)[-1]
     if name.startswith("motor:"):
         return {"speed": "rad/s", "power": "W"}.get(last, "N·m") if name.count(":") == 2 else "N·m"
@@ -93,6 +94,28 @@ def column_unit(name: str) -> str:
     if name.startswith("tau:") or last in ("torque", "mx", "my", "mz", "bending"):
         return "N·m"
     return "N"
+
+
+def column_units(an) -> list[str]:
+    """SI unit of every output column of ``an``, in the order of :func:`column_names`:
+    :func:`column_unit`, with N (and m/s) where a motor drives a prismatic input
+    directly, an independent joint slides or an ideal pair's driven joint slides."""
+    linear = {m.name for m in an.mech.motors if _motor_linear(an, m.name)}
+    sliding = {n for n, ji in zip(an.independent_names, an.independent)
+               if ji >= 0 and an.mech.joints[ji].type == "prismatic"}
+    ideal = {an.mech.gears[c.gear].name: _ideal_unit(an, c) for c in an.circuits if c.geometry is None}
+    units = []
+    for name in column_names(an):
+        kind, _, rest = name.partition(":")
+        unit = column_unit(name)
+        if kind == "motor" and rest.split(":")[0] in linear:
+            unit = {"speed": "m/s", "power": "W"}.get(rest.split(":")[-1], "N") if ":" in rest else "N"
+        elif kind == "tau" and rest in sliding:
+            unit = "N"
+        elif kind == "gear" and name.endswith(":torque"):
+            unit = ideal[rest[:-len(":torque")]]
+        units.append(unit)
+    return units
 
 
 @dataclass
@@ -134,24 +157,19 @@ class Summary:
     @classmethod
     def for_mechanism(cls, an) -> "Summary":
         """An empty summary of every motor, gear mesh and bearing load of ``an``."""
-        names = column_names(an)
-        ideal_unit = {an.mech.gears[c.gear].name: _ideal_unit(an, c) for c in an.circuits if c.geometry is None}
         pick = []
-        for i, n in enumerate(names):
+        for i, (n, unit) in enumerate(zip(column_names(an), column_units(an))):
             kind = n.split(":")[0]
             last = n.rsplit(":", 1)[-1]
             if kind == "motor" and last in ("speed", "power") and n.count(":") == 2:
-                lin = _motor_linear(an, n.split(":")[1])
-                pick.append((i, f"motor {n.split(':')[1]} {last}",
-                             "W" if last == "power" else ("m/s" if lin else "rad/s")))
+                pick.append((i, f"motor {n.split(':')[1]} {last}", unit))
             elif kind == "motor":
-                pick.append((i, f"motor {n[6:]}", "N" if _motor_linear(an, n[6:]) else "N·m"))
+                pick.append((i, f"motor {n[6:]}", unit))
             elif kind == "gear" and last in ("t", "torque"):
                 pair = n[5:-len(last) - 1]
-                pick.append((i, f"gear {pair} {'tangential' if last == 't' else 'torque'}",
-                             "N" if last == "t" else ideal_unit[pair]))
+                pick.append((i, f"gear {pair} {'tangential' if last == 't' else 'torque'}", unit))
             elif kind == "joint" and last in ("radial", "axial", "bending"):
-                pick.append((i, f"bearing {n[6:-len(last) - 1]} {last}", "N·m" if last == "bending" else "N"))
+                pick.append((i, f"bearing {n[6:-len(last) - 1]} {last}", unit))
         return cls([p[0] for p in pick], [Stat(p[1], p[2]) for p in pick])
 
     def add(self, tab: np.ndarray) -> None:
@@ -191,7 +209,8 @@ def first_non_finite(tab: np.ndarray) -> tuple[int, int] | None:
 
 
 def format_rows(tab: np.ndarray, fmt: str = "%.9g") -> str:
-    """CSV text of the rows of ``tab``."""
+    """CSV text of the rows of ``tab`` (Python's ``%`` formatting; the reference of
+    :func:`gearcli.report.csv_text.format_rows`, which writes the same bytes faster)."""
     n, m = tab.shape
     line = ",".join([fmt] * m) + "\n"
     return (line * n) % tuple((tab + 0.0).ravel().tolist())   # + 0.0: no negative zeros

@@ -7,6 +7,7 @@ Files are written through a temporary file and renamed; the format follows the e
 from __future__ import annotations
 
 import fnmatch
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,7 @@ import numpy as np
 from ..errors import GearcliError
 from ..io.output import atomic_output, output_target
 from .columns import column_unit
+from .table_files import format_of
 
 FORMATS = (".png", ".svg", ".pdf")
 
@@ -133,12 +135,44 @@ def _is_float(text: str) -> bool:
         return False
 
 
+def read_loads(path) -> tuple[list[str], np.ndarray, dict]:
+    """Header, (N, ncol) data and units (column -> unit) of a loads file written by
+    ``gearcli solve``: CSV (units from the column names), Parquet, Feather or NPZ (units
+    from the file's metadata)."""
+    fmt = format_of(str(path))
+    if fmt in (None, "csv"):
+        header, data = read_loads_csv(path)
+        return header, data, {n: column_unit(n) for n in header}
+    try:
+        if fmt == "npz":
+            with np.load(path, allow_pickle=False) as z:
+                header, data, units = [str(c) for c in z["columns"]], z["loads"], [str(u) for u in z["units"]]
+        else:
+            header, data, units = _read_arrow(path, fmt)
+    except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
+        raise GearcliError(f"{path}: cannot read the {fmt} file: {getattr(exc, 'strerror', None) or exc}") from None
+    if not header or header[0] != "t" or data.ndim != 2 or data.shape[1] != len(header):
+        raise GearcliError(f"{path}: not a loads table written by gearcli solve (first column 't')")
+    return header, data, dict(zip(header, (u.replace("*", "·") for u in units)))
+
+
+def _read_arrow(path, fmt: str):
+    import pyarrow.feather as feather  # noqa: PLC0415
+    import pyarrow.parquet as pq  # noqa: PLC0415
+
+    t = pq.read_table(path) if fmt == "parquet" else feather.read_table(path)
+    units = [(f.metadata or {}).get(b"unit", b"").decode() for f in t.schema]
+    data = np.column_stack([t.column(i).to_numpy() for i in range(t.num_columns)]) if t.num_columns else np.zeros((0, 0))
+    return t.column_names, data.astype(float), units
+
+
 def plot_loads_csv(path, patterns: list[str], out) -> int:
-    """Plot the columns of a loads CSV matching ``patterns`` into ``out``; returns their count."""
+    """Plot the columns of a loads file (CSV, Parquet, Feather, NPZ) matching
+    ``patterns`` into ``out``; returns their count."""
     out = check_output_path(out)
     output_target(out, [path])
-    header, data = read_loads_csv(path)
+    header, data, units = read_loads(path)
     names = select_columns(header, patterns, str(path))
     series = {n: data[:, header.index(n)] for n in names}
-    plot_columns(data[:, 0], series, {n: column_unit(n) for n in names}, out, title=Path(path).name)
+    plot_columns(data[:, 0], series, {n: units[n] for n in names}, out, title=Path(path).name)
     return len(names)
