@@ -244,12 +244,11 @@ def solve(
                                "(fast); 'full': all equations simultaneously (cross-check)."),
     verify: bool = typer.Option(False, "--verify", help="Compute every link's Newton-Euler "
                                 "residual from the solved forces and print the worst (relative)."),
-    chunk: int = typer.Option(20_000, "--chunk", min=100, help="Samples processed at once "
-                              "(bounds memory)."),
+    chunk: int = typer.Option(20_000, "--chunk", min=100, help="Samples processed at once (bounds memory)."),
 ) -> None:
     """Motor torques (N*m), bearing reaction wrenches (N, N*m, parent on child, joint frame)
-    and gear tooth forces (N) at every sample of a trajectory.  Writes a CSV (columns in the
-    README) and prints, for every motor, gear mesh and bearing, the peak, RMS and time of
+    and gear tooth forces (N) at every sample of a trajectory.  Writes a table (CSV, Parquet,
+    Feather or NPZ; columns in the README) and prints, for every motor, gear mesh and bearing, the peak, RMS and time of
     the peak."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn  # noqa: PLC0415
 
