@@ -14,12 +14,13 @@ and how the samples of a duty cycle are reduced to the value compared with the l
 from __future__ import annotations
 
 import difflib
+import math
 from dataclasses import dataclass, field
 
 from ..errors import Collector
 from ..report.columns import column_names, column_unit
 from .bearings import LIFE_EXPONENT
-from .gears import lewis_form_factor, virtual_spur
+from .gears import lewis_form_factor, virtual_helical_teeth, virtual_spur
 
 MODULE_RTOL = 0.01
 """Relative tolerance of module * teeth / 2 against the pitch radius from the geometry."""
@@ -108,11 +109,13 @@ def _gear_checks(an, req: Requirements, col: Collector) -> list[Check]:
         if r is None or c.geometry is None:
             continue
         g = c.geometry
-        teeth = gp.teeth if gp.teeth is not None else (2 * g.r_j / r.module, 2 * g.r_k / r.module)
+        mt = r.module / math.cos(gp.helix_angle)    # transverse module (helical: module is the normal one)
+        teeth = gp.teeth if gp.teeth is not None else (2 * g.r_j / mt, 2 * g.r_k / mt)
         if gp.teeth is not None:
             for link, z, rad in zip((gp.j, gp.k), gp.teeth, (g.r_j, g.r_k)):
-                if abs(r.module * z / 2 - rad) > MODULE_RTOL * rad:
-                    col.add(f"{r.path}.module", f"module {r.module:g} m x {z} teeth / 2 = {r.module * z / 2:g} m "
+                if abs(mt * z / 2 - rad) > MODULE_RTOL * rad:
+                    what = "module" if not gp.helix_angle else "normal module / cos(helix angle)"
+                    col.add(f"{r.path}.module", f"{what} {mt:g} m x {z} teeth / 2 = {mt * z / 2:g} m "
                             f"disagrees with the pitch radius {rad:g} m of gear '{link}' from the mesh geometry")
         try:
             stress = _stress_factors(gp, g, teeth, r)
@@ -128,17 +131,20 @@ def _gear_checks(an, req: Requirements, col: Collector) -> list[Check]:
 
 
 def _stress_factors(gp, g, teeth, r) -> dict:
-    """Lewis and Hertz constants of a pair: sigma_F = kF |t|, sigma_H = kH sqrt(|t|).
+    """Lewis and Hertz constants of a pair (:mod:`gearcli.design.gears`).
 
-    Bevel gears use their virtual spur gears (:func:`gearcli.design.gears.virtual_spur`).
+    Bevel gears use their virtual spur gears (:func:`gearcli.design.gears.virtual_spur`);
+    helical gears the Lewis factor of their virtual tooth counts z / cos^3(beta) with the
+    normal module, and the helical zone and helix angle factors (``beta``).
     """
     zj, dj = virtual_spur(teeth[0], 2 * g.r_j, g.cone_j)
     zk, dk = virtual_spur(teeth[1], 2 * g.r_k, g.cone_k)
+    beta = gp.helix_angle
     K = r.application_factor * r.load_sharing_factor
-    Y = min(lewis_form_factor(zj), lewis_form_factor(zk))
+    Y = min(lewis_form_factor(virtual_helical_teeth(z, beta)) for z in (zj, zk))
     d1, u = min(dj, dk), max(dj, dk) / min(dj, dk)
     return {"K": K, "Y": Y, "d1": d1, "u": u, "alpha": gp.pressure_angle, "internal": g.ring is not None,
-            "module": r.module, "b": r.face_width, "ZE": r.elastic_coefficient}
+            "module": r.module, "b": r.face_width, "ZE": r.elastic_coefficient, "beta": beta}
 
 
 def _joint_limit_checks(an) -> list[Check]:

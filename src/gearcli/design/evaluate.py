@@ -64,7 +64,8 @@ def signal(check: Check, s: Samples, mech) -> np.ndarray:
     if kind == "bending":
         return lewis_bending_stress(ft, x["module"], x["b"], x["Y"], x["K"])
     if kind == "contact":
-        return hertz_contact_stress(ft, x["d1"], x["b"], x["u"], x["alpha"], x["ZE"], x["K"], x["internal"])
+        return hertz_contact_stress(ft, x["d1"], x["b"], x["u"], x["alpha"], x["ZE"], x["K"], x["internal"],
+                                    x.get("beta", 0.0))
     raise ValueError(f"unknown signal {check.signal!r}")
 
 

@@ -13,6 +13,18 @@ Sources
   sigma_H = Z_H Z_E sqrt(K Ft (u + 1) / (d1 b u)), zone factor Z_H = sqrt(2 / (sin a cos a)),
   u = z2 / z1 >= 1 (u + 1 -> u - 1 for an internal pair), elastic coefficient Z_E
   (189.8 sqrt(N/mm^2) for steel on steel).  Shigley Eq. 14-14 is the same stress.
+* Helical gears (helix angle beta, normal pressure angle a_n, ``module`` = the normal module
+  m_n): the transverse tangential force Ft (the ``gear:<pair>:t`` column) is used
+  throughout.  Bending: the Lewis equation on the normal section, the load Ft / cos(beta)
+  spread over the tooth length b / cos(beta), sigma_F = K Ft / (b m_n Y(z_v)), with Y
+  taken at the virtual (formative) tooth count z_v = z / cos^3(beta) (Shigley's *Mechanical
+  Engineering Design*, helical gears: the virtual number of teeth N / cos^3(psi); the
+  helical tooth is rated as the spur tooth of its normal section).  Contact: ISO 6336-2:2019, zone factor for helical gears without
+  profile shift Z_H = sqrt(2 cos(beta_b) / (cos^2(a_t) tan(a_t))), tan(a_t) = tan(a_n) /
+  cos(beta), tan(beta_b) = tan(beta) cos(a_t), and helix angle factor Z_beta =
+  1 / sqrt(cos(beta)); the contact ratio factor Z_eps is taken as 1 (its upper bound: a
+  nominal, conservative value).  Both reduce to the spur formulas at beta = 0.
+* A rack (z -> inf) has the Lewis factor 0.485 and u -> inf: (u + 1) / u -> 1.
 * Bevel gears are rated on their virtual spur gears (Tredgold's approximation, Shigley
   sec. 15-1, ISO 10300): virtual tooth count z / cos(delta), virtual pitch diameter
   d / cos(delta), delta the pitch cone angle, at the mean pitch point.
@@ -67,15 +79,28 @@ def lewis_bending_stress(Ft, module: float, face_width: float, Y: float, K: floa
     return K * np.abs(np.asarray(Ft, float)) / (face_width * module * Y)
 
 
-def zone_factor(pressure_angle: float) -> float:
-    """ISO 6336-2 zone factor of a spur pair without profile shift, sqrt(2 / (sin a cos a))."""
-    return math.sqrt(2.0 / (math.sin(pressure_angle) * math.cos(pressure_angle)))
+def zone_factor(pressure_angle: float, helix_angle: float = 0.0) -> float:
+    """ISO 6336-2 zone factor without profile shift, sqrt(2 cos(beta_b) / (cos^2(a_t) tan(a_t))):
+    sqrt(2 / (sin a cos a)) for a spur pair; ``pressure_angle`` is the normal one (rad)."""
+    at = math.atan(math.tan(pressure_angle) / math.cos(helix_angle))
+    bb = math.atan(math.tan(helix_angle) * math.cos(at))
+    return math.sqrt(2.0 * math.cos(bb) / (math.cos(at) ** 2 * math.tan(at)))
+
+
+def helix_angle_factor(helix_angle: float) -> float:
+    """ISO 6336-2:2019 helix angle factor Z_beta = 1 / sqrt(cos(beta)) (1 for spur gears)."""
+    return 1.0 / math.sqrt(math.cos(helix_angle))
+
+
+def virtual_helical_teeth(z: float, helix_angle: float) -> float:
+    """Virtual (formative) tooth count of a helical gear, z / cos^3(beta)."""
+    return z / math.cos(helix_angle) ** 3
 
 
 def hertz_contact_stress(Ft, d1: float, face_width: float, u: float, pressure_angle: float,
                          ZE: float = STEEL_ELASTIC_COEFFICIENT, K: float = 1.0,
-                         internal: bool = False) -> np.ndarray:
-    """Nominal contact stress at the pitch point, sigma_H = Z_H Z_E sqrt(K |Ft| (u +- 1) / (d1 b u)), Pa.
+                         internal: bool = False, helix_angle: float = 0.0) -> np.ndarray:
+    """Nominal contact stress at the pitch point, sigma_H = Z_H Z_E Z_beta sqrt(K |Ft| (u +- 1) / (d1 b u)), Pa.
 
     Parameters
     ----------
@@ -86,18 +111,21 @@ def hertz_contact_stress(Ft, d1: float, face_width: float, u: float, pressure_an
     face_width : float
         Face width b, m.
     u : float
-        Gear ratio z2 / z1 >= 1.
+        Gear ratio z2 / z1 >= 1 (inf for a rack).
     pressure_angle : float
-        rad.
+        Normal pressure angle, rad.
     ZE : float
         Elastic coefficient, sqrt(Pa).
     K : float
         Product of the load factors.
     internal : bool
         An internal (ring) pair: u + 1 becomes u - 1.
+    helix_angle : float
+        Helix angle beta, rad (0: spur); Ft is then the transverse tangential force.
     """
-    ratio = (u - 1.0 if internal else u + 1.0) / u
-    return zone_factor(pressure_angle) * ZE * np.sqrt(K * np.abs(np.asarray(Ft, float)) * ratio / (d1 * face_width))
+    ratio = 1.0 - 1.0 / u if internal else 1.0 + 1.0 / u
+    Z = zone_factor(pressure_angle, helix_angle) * helix_angle_factor(helix_angle) * ZE
+    return Z * np.sqrt(K * np.abs(np.asarray(Ft, float)) * ratio / (d1 * face_width))
 
 
 def virtual_spur(z: float, d: float, cone_angle: float) -> tuple[float, float]:
