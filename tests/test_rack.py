@@ -197,3 +197,29 @@ def test_bad_rack_input(run_cli, tmp_path, text, edit, place, pattern):
     assert re.search(pattern, first), first
     with pytest.raises(MechanismError):
         analyse(load_mechanism(path))
+
+
+def test_check_graph_and_solve_list_loads_racks_and_helical_pairs(run_cli, mech_dir, tmp_path):
+    rack, hel = mech_dir / "rack_axis.yaml", mech_dir / "helical_reduction.yaml"
+    r = run_cli("check", rack)
+    assert r.exit_code == 0
+    lines = r.stdout.splitlines()
+    assert lines[0] == f"{rack}: OK (1 dof, 3 links, 1 gear pairs, 1 motors)"
+    assert lines[1] == ("load 'payload' on link 'carriage' (frame base): force [-80, 0, -49.05] N, "
+                        "moment [0, 0, 0] N*m at [0.05, -0.04, 0.08] m (link frame)")
+    assert lines[2] == ("rack pair 'rack': pinion 'pinion' (pitch radius 0.024 m) drives rack 'carriage': "
+                        "x = 0.024 m/rad * theta")
+    r = run_cli("check", hel)
+    assert "helical pair 'stage1': helix angle 20 deg, 'input' right hand, 'intermediate' left hand" in r.stdout
+    assert "helical pair 'stage2': helix angle 15 deg, 'intermediate' left hand, 'output' right hand" in r.stdout
+    g = run_cli("graph", rack)
+    assert "rack pair 'rack'" in g.stdout and "load 'payload'" in g.stdout
+    assert "theta_pinion,frame = 41.6667 * x_carriage,frame (x = 0.024 m * theta)" in g.stdout
+    import json
+    doc = json.loads(run_cli("graph", "--json", hel).stdout)
+    assert doc["loads"] == [{"name": "resisting", "link": "output", "frame": "base", "point": [0, 0, 0.1],
+                             "force": [0, 0, 0], "moment": [0, 0, -20]}]
+    assert [p["hands"] for p in doc["helical_and_rack_pairs"]] == [
+        {"input": "right", "intermediate": "left"}, {"intermediate": "left", "output": "right"}]
+    s = run_cli("solve", rack, mech_dir / "rack_axis_traj.csv", "-o", tmp_path / "out.csv")
+    assert s.exit_code == 0 and "rack pair 'rack'" in s.stdout and "load 'payload'" in s.stdout

@@ -30,6 +30,7 @@ from rich.console import Console
 
 from . import __version__
 from .errors import GearcliError
+from .report.features import feature_notes
 from .report.sharing import sharing_notes
 from .report.tables import JSON_DIGITS, print_graph_tables, round_sig, stdout_console, summary_table
 
@@ -186,7 +187,7 @@ def check(mech: Path = typer.Argument(..., metavar="MECH", help=MECH_HELP, show_
     m = an.mech
     typer.echo(f"{mech}: OK ({an.dof} dof, {len(m.links)} links, {len(an.circuits)} gear pairs, "
                f"{len(m.motors)} motors)")
-    for line in sharing_notes(an):
+    for line in sharing_notes(an) + feature_notes(an):
         typer.echo(line)
 
 
@@ -288,8 +289,8 @@ def solve(
     ideal = [an.mech.gears[c.gear].name for c in an.circuits if c.geometry is None]
     if ideal:
         console.print("Ideal pairs (no mesh geometry; mesh torque instead of tooth forces): " + ", ".join(ideal))
-    for line in sharing_notes(an):
-        console.print(line)
+    for line in sharing_notes(an) + feature_notes(an):
+        console.print(line, markup=False)
     if verify:
         console.print(f"Worst Newton-Euler residual (relative): {report.residual:.3g}")
     if not to_stdout:

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from ..analysis.graph import Analysis, Circuit
 from ..model.mechanism import Mechanism
+from .features import load_dicts, pair_dicts
 from .sharing import sharing_sets
 
 
@@ -42,6 +43,8 @@ def analysis_dict(an: Analysis) -> dict:
         "pseudo_triangular": an.pseudo_triangular,
         "solve_order": [[n[i] for i in block] for block in an.schedule],
         "load_sharing": sharing_sets(an),
+        "loads": load_dicts(an),
+        "helical_and_rack_pairs": pair_dicts(an),
     } | ({"open_loop": "tree"} if an.open_loop == "tree" else {})
 
 

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 from rich.console import Console
 from rich.table import Table
 
+from .features import feature_notes
 from .sharing import sharing_notes
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -123,7 +124,7 @@ def print_graph_tables(an: Analysis, console: Console) -> None:
     console.print(structure_table(an))
     console.print(f"Pseudo-triangular: {'yes' if an.pseudo_triangular else 'no'}")
     console.print("Solve order: " + format_blocks([an.name_of(b) for b in an.schedule]))
-    for line in sharing_notes(an):
+    for line in sharing_notes(an) + feature_notes(an):
         console.print(line, markup=False)
 
 

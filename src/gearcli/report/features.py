@@ -1,0 +1,53 @@
+"""One-line notes on a mechanism's external loads, helical pairs and racks (``check``,
+``graph``, the ``solve`` summary) and their plain-data form (``graph --json``)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..analysis.graph import Analysis
+
+OPPOSITE = {"right": "left", "left": "right"}
+
+
+def _vec(x) -> str:
+    return "[" + ", ".join(f"{float(v):.6g}" for v in np.asarray(x, float)) + "]"
+
+
+def load_dicts(an: Analysis) -> list[dict]:
+    """Each external load: name, link, frame, point (m, link frame), force (N), moment (N*m)."""
+    return [{"name": ld.name, "link": ld.link, "frame": ld.frame, "point": np.asarray(ld.point, float).tolist(),
+             "force": np.asarray(ld.force, float).tolist(), "moment": np.asarray(ld.moment, float).tolist()}
+            for ld in an.mech.loads]
+
+
+def pair_dicts(an: Analysis) -> list[dict]:
+    """Each helical pair (helix angle, hands of j and k) and rack (pinion, rack, pitch
+    radius r and x_rack = x_per_rad * theta_pinion), in circuit order."""
+    out = []
+    for c in an.circuits:
+        gp = an.mech.gears[c.gear]
+        if gp.helix_angle:
+            k_hand = gp.hand if gp.kind == "internal" else OPPOSITE[gp.hand]
+            out.append({"pair": gp.name, "kind": "helical", "helix_angle_deg": math.degrees(gp.helix_angle),
+                        "hands": {gp.j: gp.hand, gp.k: k_hand}})
+        elif gp.kind == "rack" and c.geometry is not None:
+            out.append({"pair": gp.name, "kind": "rack", "pinion": gp.j, "rack": gp.k,
+                        "pitch_radius": c.geometry.r_j, "x_per_rad": 1.0 / c.ratio})
+    return out
+
+
+def feature_notes(an: Analysis) -> list[str]:
+    """Human-readable lines: ``load 'tip' on link '2' (frame base): force [..] N, moment [..]
+    N*m at [..] m``, ``helical pair ...``, ``rack pair ...``."""
+    lines = [f"load '{d['name']}' on link '{d['link']}' (frame {d['frame']}): force {_vec(d['force'])} N, "
+             f"moment {_vec(d['moment'])} N*m at {_vec(d['point'])} m (link frame)" for d in load_dicts(an)]
+    for d in pair_dicts(an):
+        if d["kind"] == "helical":
+            hands = ", ".join(f"'{k}' {v} hand" for k, v in d["hands"].items())
+            lines.append(f"helical pair '{d['pair']}': helix angle {d['helix_angle_deg']:.6g} deg, {hands}")
+        else:
+            lines.append(f"rack pair '{d['pair']}': pinion '{d['pinion']}' (pitch radius {d['pitch_radius']:.6g} m) "
+                         f"drives rack '{d['rack']}': x = {d['x_per_rad']:.6g} m/rad * theta")
+    return lines
