@@ -187,7 +187,7 @@ def check(mech: Path = typer.Argument(..., metavar="MECH", help=MECH_HELP, show_
     m = an.mech
     typer.echo(f"{mech}: OK ({an.dof} dof, {len(m.links)} links, {len(an.circuits)} gear pairs, "
                f"{len(m.motors)} motors)")
-    for line in sharing_notes(an) + feature_notes(an):
+    for line in feature_notes(an) + sharing_notes(an):
         typer.echo(line)
 
 
@@ -289,7 +289,7 @@ def solve(
     ideal = [an.mech.gears[c.gear].name for c in an.circuits if c.geometry is None]
     if ideal:
         console.print("Ideal pairs (no mesh geometry; mesh torque instead of tooth forces): " + ", ".join(ideal))
-    for line in sharing_notes(an) + feature_notes(an):
+    for line in feature_notes(an) + sharing_notes(an):
         console.print(line, markup=False)
     if verify:
         console.print(f"Worst Newton-Euler residual (relative): {report.residual:.3g}")

@@ -124,7 +124,7 @@ def print_graph_tables(an: Analysis, console: Console) -> None:
     console.print(structure_table(an))
     console.print(f"Pseudo-triangular: {'yes' if an.pseudo_triangular else 'no'}")
     console.print("Solve order: " + format_blocks([an.name_of(b) for b in an.schedule]))
-    for line in sharing_notes(an) + feature_notes(an):
+    for line in feature_notes(an) + sharing_notes(an):
         console.print(line, markup=False)
 
 
