@@ -54,6 +54,9 @@ TESTS = [
     "tests/test_helical_bundled.py::test_bearing_radial_and_axial_loads_by_hand",
     "tests/test_helical_bundled.py::test_power_balance_along_bundled_trajectory",
     "tests/test_helical_bundled.py::test_pinocchio_rnea_per_shaft_with_tooth_forces",
+    "tests/test_load_sharing.py::test_each_planet_carries_one_nth_of_the_lumped_planet",
+    "tests/test_load_sharing.py::test_unequal_stiffness_shares_in_proportion",
+    "tests/test_load_sharing.py::test_least_load_map_two_parallel_springs",
 ]
 
 
@@ -121,6 +124,11 @@ MUTATIONS = [
              (("model/gears.py", "e = 1.0 / (r_j * np.sign(along))", "e = -1.0 / (r_j * np.sign(along))"),)),
     Mutation("helical-hand", "axial thrust of a helical gear with the hand reversed",
              (("model/gears.py", 'sign = -1.0 if hand == "right" else 1.0', 'sign = 1.0 if hand == "right" else -1.0'),)),
+    # issue 9: load sharing in redundant gear sets
+    Mutation("sharing-weights-ignored", "mesh stiffness ignored: every mesh of a redundant set weighted alike",
+             (("dynamics/sharing.py", "w.append(scale.get(g.index, 1.0))", "w.append(1.0)"),)),
+    Mutation("sharing-weights-inverted", "min sum k t^2 instead of min sum t^2 / k",
+             (("dynamics/sharing.py", "else kmin / x for i, x", "else x / kmin for i, x"),)),
 ]
 
 

@@ -295,3 +295,44 @@ def test_planet_copy_error_points_at_the_original(run_cli, tmp_path, bundled):
     assert res.exit_code == 2
     lines = res.stderr.splitlines()
     assert lines and all(ln.startswith(f"{path}:{_line(text, '[18, 61]')}: gears[1].teeth: ") for ln in lines), lines
+
+
+# --- another topology: a duplicated mesh (two pinions' worth of teeth on one pair of gears) ---------
+
+@pytest.mark.parametrize("snippet", [
+    '  - {name: "5-1b", links: ["5", "1"], ratio: -3.0, mesh_point: [0.09, 0, -0.05], stiffness: 3.0e8}\n',
+    '  - {name: "5-1b", links: ["5", "1"], teeth: [20, 60], mesh_point: [0.09, 0, -0.06], stiffness: 3.0e8}\n',
+])
+def test_duplicated_mesh_splits_in_proportion_to_stiffness(mech_dir, snippet):
+    """The paper's arm with a second mesh between gears 5 and 1 (at the same pitch point, or
+    10 mm lower on the same teeth), stiffness 1e8 and 3e8 N/m: only the sum of the two
+    tangential forces is fixed (the torques on 5 and 1 about their axes; the rest goes into
+    the bearings), so t_b / t_a = k_b / k_a = 3 at every sample, whatever the motion and the
+    sign of t (random states exercise the sign resolution of Eq. 14)."""
+    text = (mech_dir / "paper_2dof.yaml").read_text()
+    text = text.replace('    ratio: -3.0   ', '    stiffness: 1.0e8\n    ratio: -3.0   ', 1)
+    an = analyse(parse_mechanism(text.replace("\nmotors:", "\n" + snippet + "motors:"), "dup.yaml"))
+    assert an.dof == 2 and len(an.redundant) == 1
+    a, b = gear_index(an, "5-1"), gear_index(an, "5-1b")
+    rng = np.random.default_rng(3)
+    q, qd, qdd = rng.uniform(-3, 3, (300, 2)), 3 * rng.normal(size=(300, 2)), 20 * rng.normal(size=(300, 2))
+    blk = solve(an, q, qd, qdd, verify=True)
+    full = solve(an, q, qd, qdd, method="full", verify=True)
+    assert np.any(blk.gear_t[:, a] > 0) and np.any(blk.gear_t[:, a] < 0)
+    close(blk.gear_t[:, b], 3.0 * blk.gear_t[:, a])
+    for f in ("motor", "joint", "gear_t", "gear_sep"):
+        close(getattr(blk, f), getattr(full, f), 1e-11)
+    assert blk.residual < 1e-12 and full.residual < 1e-12
+
+
+def test_stiffness_for_all_pairs_of_a_set_or_none(run_cli, tmp_path, bundled):
+    text = bundled.replace("    stiffness: 3.5e8\n", "")
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    res = run_cli("check", path)
+    assert res.exit_code == 2 and res.stdout == ""
+    lines = res.stderr.splitlines()
+    assert len(lines) == 1
+    assert lines[0].startswith(f"{path}:{_line(text, 'name: planet-ring')}: gears[1]: gear pair 'planet-ring1' has "
+                               "no stiffness but other pairs of its redundant gear set have: give stiffness for "
+                               "every pair of the set ('sun-planet1' (gears[0]), "), lines[0]

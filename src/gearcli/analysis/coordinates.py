@@ -83,7 +83,9 @@ def independent_coordinates(h: Home, cparent: list, canon: np.ndarray, primary: 
         independent.append(jt if open_loop == "tree" or h.idx[h.mech.joints[jt].parent] == cparent[c] else -1)
     names = tuple(h.mech.joints[jt].name if jt >= 0 else f"{h.tree.links[cparent[c]]}-{h.tree.links[c]}"
                   for jt, c in zip(independent, chain))
-    return Independent(primary, chain, open_loop, S, tuple(independent), names, redundant_sets(cr))
+    sets = redundant_sets(cr)
+    _stiffness_given_for_all_or_none(h, circuits, sets, col)
+    return Independent(primary, chain, open_loop, S, tuple(independent), names, sets)
 
 
 def circuit_rank(h: Home, circuits: list[Circuit]) -> CircuitRank:
@@ -120,6 +122,19 @@ def redundant_sets(cr: CircuitRank) -> tuple[tuple[int, ...], ...]:
             sets.remove(other)
         sets.append(s)
     return tuple(tuple(sorted(s)) for s in sorted(sets, key=min))
+
+
+def _stiffness_given_for_all_or_none(h: Home, circuits: list[Circuit], sets, col: Collector) -> None:
+    """The load sharing of a redundant set weighs its pairs by stiffness: either every pair
+    of the set gives ``stiffness`` or none does (equal sharing)."""
+    gears = h.mech.gears
+    for members in sets:
+        missing = [gears[circuits[i].gear] for i in members if gears[circuits[i].gear].stiffness is None]
+        if missing and len(missing) < len(members):
+            col.add(f"{missing[0].path}", f"gear pair '{missing[0].name}' has no stiffness but other pairs of its "
+                    f"redundant gear set have: give stiffness for every pair of the set "
+                    f"({_pairs(h, circuits, members)}) or for none (equal sharing)")
+    col.raise_if_any()
 
 
 def _rref(M: np.ndarray) -> np.ndarray:

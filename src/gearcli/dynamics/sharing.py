@@ -37,18 +37,24 @@ class SharingError(GearcliError):
 
 
 def mesh_weights(an, groups) -> np.ndarray:
-    """(n,) diagonal of D for the unknowns of ``groups``: 1/k of each mesh (tangential force
-    or ideal-coupling torque), scaled so that the largest is 1; 0 for joint reactions and
-    motor torques.  A mesh without ``stiffness`` counts as stiffness 1 (equal sharing)."""
+    """(n,) diagonal of D for the unknowns of ``groups``: for a mesh (tangential force or
+    ideal-coupling torque) of a redundant set ``an.redundant``, 1/k scaled by the set's
+    largest 1/k (1 for every mesh of a set without ``stiffness``: equal sharing); 1 for a
+    determinate mesh (its t is fixed by the equations: the weight does not matter, and a
+    weight of the sets' order keeps the KKT system well scaled); 0 for joint reactions and
+    motor torques.  The objective separates by set, so only ratios within a set matter."""
+    scale = {}
+    for members in an.redundant:
+        k = [an.mech.gears[an.circuits[i].gear].stiffness for i in members]
+        kmin = min((x for x in k if x is not None), default=None)
+        scale.update({i: 1.0 if kmin is None or x is None else kmin / x for i, x in zip(members, k)})
     w = []
     for g in groups:
         if g.kind == "mesh":
-            k = an.mech.gears[an.circuits[g.index].gear].stiffness
-            w.append(1.0 / (k if k is not None else 1.0))
+            w.append(scale.get(g.index, 1.0))
         else:
             w.extend([0.0] * g.size)
-    w = np.asarray(w, float)
-    return w / w.max() if w.size and w.max() > 0 else w
+    return np.asarray(w, float)
 
 
 def _kkt(A: np.ndarray, w: np.ndarray) -> np.ndarray:

@@ -18,6 +18,7 @@ from ..errors import Collector, Issue, MechanismError
 from ..model.mechanism import Mechanism
 from ..model.ratings import (BEARING_FACTOR_DEFAULTS, STEEL_ELASTIC_COEFFICIENT, BearingRating, GearRating,
                              JointLimit, MotorRating)
+from .planets import item_path
 
 NS = "https://gearcli.dev/urdf/1"
 MOTOR_KEYS = ("peak_torque", "rms_torque", "max_speed", "max_power")
@@ -80,14 +81,16 @@ def attach_yaml_ratings(mech: Mechanism, data: dict, col: Collector) -> Mechanis
     """``mech`` with the ratings of the (schema-valid) YAML ``data`` attached; issues to ``col``."""
     motors = tuple(replace(m, rating=motor_rating(s["rating"], f"motors[{i}].rating", col.add))
                    if "rating" in s else m for i, (m, s) in enumerate(zip(mech.motors, data.get("motors", []))))
-    joints = tuple(replace(j, bearings=bearing_ratings(s["bearings"], f"joints[{i}].bearings", col.add))
+    joints = tuple(replace(j, bearings=bearing_ratings(s["bearings"], f"{item_path(data, 'joints', i)}.bearings",
+                                                       col.add))
                    if "bearings" in s else j for i, (j, s) in enumerate(zip(mech.joints, data["joints"])))
     gears = []
     for i, (g, s) in enumerate(zip(mech.gears, data.get("gears", []))):
         if "rating" in s:
+            path = f"{item_path(data, 'gears', i)}.rating"   # a planet copy: its original's path
             if g.mesh_point is None:
-                col.add(f"gears[{i}].rating", "a gear rating needs the mesh geometry (mesh_point)")
-            g = replace(g, rating=gear_rating(s["rating"], f"gears[{i}].rating", col.add))
+                col.add(path, "a gear rating needs the mesh geometry (mesh_point)")
+            g = replace(g, rating=gear_rating(s["rating"], path, col.add))
         gears.append(g)
     return replace(mech, motors=motors, joints=joints, gears=tuple(gears))
 
