@@ -137,9 +137,13 @@ class Stat:
     def add_squares(self, x: np.ndarray) -> None:
         """Accumulate the squares of ``x`` (N,) >= 0, scaled as in LAPACK's dnrm2."""
         m = float(x.max()) if x.size else 0.0
+        if m != 0.0:
+            self.add_scaled(m, float(np.dot(x / m, x / m)))
+
+    def add_scaled(self, m: float, s: float) -> None:
+        """Accumulate squares whose largest is ``m**2`` > 0 and whose sum is ``s * m**2``."""
         if m == 0.0:
             return
-        s = float(np.dot(x / m, x / m))
         if m > self.scale:
             self.ssq = self.ssq * (self.scale / m) ** 2 + s
             self.scale = m
@@ -177,11 +181,14 @@ class Summary:
         t = tab[:, 0]
         X = np.abs(tab[:, self.columns])
         imax = np.argmax(X, axis=0)
+        peak = X[imax, np.arange(X.shape[1])]
+        Y = X / np.where(peak > 0.0, peak, 1.0)     # scaled columns (no overflow when squared)
+        ssq = np.einsum("ij,ij->j", Y, Y)
         for k, st in enumerate(self.stats):
-            v = X[imax[k], k]
+            v = peak[k]
             if v > st.peak or st.n == 0:
                 st.peak, st.t_peak = float(v), float(t[imax[k]])
-            st.add_squares(X[:, k])
+            st.add_scaled(float(v), float(ssq[k]))
             st.n += X.shape[0]
 
 

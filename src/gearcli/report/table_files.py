@@ -81,7 +81,7 @@ class ArrowTable:
         if kind == "parquet":
             import pyarrow.parquet as pq  # noqa: PLC0415
 
-            self.writer = pq.ParquetWriter(f, self.schema, compression="snappy")
+            self.writer = pq.ParquetWriter(f, self.schema, compression="snappy", use_dictionary=False)
         else:
             self.writer = pa.ipc.new_file(f, self.schema)
 
