@@ -223,3 +223,14 @@ def test_check_graph_and_solve_list_loads_racks_and_helical_pairs(run_cli, mech_
         {"input": "right", "intermediate": "left"}, {"intermediate": "left", "output": "right"}]
     s = run_cli("solve", rack, mech_dir / "rack_axis_traj.csv", "-o", tmp_path / "out.csv")
     assert s.exit_code == 0 and "rack pair 'rack'" in s.stdout and "load 'payload'" in s.stdout
+
+
+def test_bearings_on_a_prismatic_joint_are_refused(run_cli, tmp_path, text):
+    bad = text.replace("    type: prismatic\n", "    type: prismatic\n    bearings:\n"
+                       "      - {name: a, position: 0.0, C: 5400, C0: 2360, type: ball}\n")
+    path = tmp_path / "bad.yaml"
+    path.write_text(bad)
+    r = run_cli("check", path)
+    assert r.exit_code == 2
+    first = r.stderr.splitlines()[0]
+    assert re.match(rf"{re.escape(str(path))}:\d+: joints\[1\]\.bearings: rolling-bearing ratings", first), first

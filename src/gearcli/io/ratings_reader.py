@@ -77,6 +77,10 @@ def gear_rating(spec: dict, path: str, add) -> GearRating:
                       float(spec.get("application_factor", 1.0)), float(spec.get("load_sharing_factor", 1.0)), path)
 
 
+PRISMATIC_BEARINGS = ("rolling-bearing ratings (ISO 281 life in revolutions) are for revolute joints; "
+                      "a prismatic joint's linear guide is not rated")
+
+
 def attach_yaml_ratings(mech: Mechanism, data: dict, col: Collector) -> Mechanism:
     """``mech`` with the ratings of the (schema-valid) YAML ``data`` attached; issues to ``col``."""
     motors = tuple(replace(m, rating=motor_rating(s["rating"], f"motors[{i}].rating", col.add))
@@ -84,6 +88,9 @@ def attach_yaml_ratings(mech: Mechanism, data: dict, col: Collector) -> Mechanis
     joints = tuple(replace(j, bearings=bearing_ratings(s["bearings"], f"{item_path(data, 'joints', i)}.bearings",
                                                        col.add))
                    if "bearings" in s else j for i, (j, s) in enumerate(zip(mech.joints, data["joints"])))
+    for i, j in enumerate(joints):
+        if j.bearings and j.type == "prismatic":
+            col.add(f"joints[{i}].bearings", PRISMATIC_BEARINGS)
     gears = []
     for i, (g, s) in enumerate(zip(mech.gears, data.get("gears", []))):
         if "rating" in s:
@@ -180,6 +187,8 @@ def attach_urdf_ratings(mech: Mechanism, root, file: str) -> Mechanism:
             continue
         if len(specs) > 2:
             adder(el)(path, f"a joint has one or two bearings, got {len(specs)}")
+        elif specs and joints[name].type == "prismatic":
+            adder(el)(path, PRISMATIC_BEARINGS)
         elif specs and None not in specs:
             joints[name] = replace(joints[name], bearings=bearing_ratings(specs, f"{path}.gearcli:bearing", adder(el)))
         limit = _urdf_limit(el, path, warn)
