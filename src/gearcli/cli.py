@@ -246,6 +246,10 @@ def solve(
     verify: bool = typer.Option(False, "--verify", help="Compute every link's Newton-Euler "
                                 "residual from the solved forces and print the worst (relative)."),
     chunk: int = typer.Option(20_000, "--chunk", min=100, help="Samples processed at once (bounds memory)."),
+    jobs: int = typer.Option(None, "--jobs", "-j", min=1, help="Threads for the compiled kernel "
+                             "(default: every usable core); results do not depend on it."),
+    backend: str = typer.Option("auto", "--backend", help="'kernel': compiled per-sample kernel "
+                                "(numba); 'numpy': array reference; 'auto': the kernel when available."),
 ) -> None:
     """Motor torques (N*m), bearing reaction wrenches (N, N*m, parent on child, joint frame)
     and gear tooth forces (N) at every sample of a trajectory.  Writes a table (CSV, Parquet,
@@ -253,11 +257,10 @@ def solve(
     the peak."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn  # noqa: PLC0415
 
-    from .pipeline import solve_file  # noqa: PLC0415
+    from .pipeline import check_solve_options, solve_file  # noqa: PLC0415
 
-    if method not in ("block", "full"):
-        raise GearcliError(f"--method: expected 'block' or 'full', got '{method}'")
     an = load_analysis(mech)
+    check_solve_options(an, method, backend)
     out = output if output is not None else str(traj.with_suffix(".loads.csv"))
     err = Console(stderr=True, markup=False, highlight=False)
     if not err.is_terminal:
@@ -280,7 +283,8 @@ def solve(
 
     try:
         report = solve_file(mech, traj, out, degrees=degrees, method=method, verify=verify,
-                            chunk=chunk, progress=tick, analysis=an, precision=precision)
+                            chunk=chunk, progress=tick, analysis=an, precision=precision,
+                            backend=backend, jobs=jobs)
     finally:
         if started:
             progress.stop()

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from .dynamics.solve import solve
+from .dynamics.solve import BACKENDS, solve, solver_for
 from .analysis.graph import Analysis
 from .analysis.graph import analyse as analyse_graph
 from .dynamics.determinacy import check_determinate
@@ -67,9 +67,22 @@ class SolveReport:
     output: Path | None
 
 
+def check_solve_options(an: Analysis, method: str, backend: str) -> None:
+    """Raise :class:`GearcliError` for a bad ``--method`` or ``--backend`` (the kernel must be
+    available for the mechanism when asked for)."""
+    if method not in ("block", "full"):
+        raise GearcliError(f"--method: expected 'block' or 'full', got '{method}'")
+    if backend not in BACKENDS:
+        raise GearcliError(f"--backend: expected one of {', '.join(BACKENDS)}, got '{backend}'")
+    try:
+        solver_for(an).backend(method, backend)
+    except ValueError as exc:
+        raise GearcliError(f"--backend: {exc}") from None
+
+
 def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, method: str = "block",
                verify: bool = False, chunk: int = 20_000, progress=None, analysis: Analysis | None = None,
-               precision: int | None = None) -> SolveReport:
+               precision: int | None = None, backend: str = "auto", jobs: int | None = None) -> SolveReport:
     """Solve a trajectory file and write the loads table (see :mod:`gearcli.report`).
 
     The format of ``out_path`` follows its extension (:mod:`gearcli.report.table_files`:
@@ -86,7 +99,7 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
     Every output sample is checked finite before it is written
     (:class:`~gearcli.errors.TrajectoryError` naming the first bad sample and column);
     with ``verify`` the worst residual of every chunk must be finite and at most
-    :data:`VERIFY_TOLERANCE`.
+    :data:`VERIFY_TOLERANCE`.  ``backend`` and ``jobs`` as in :func:`~gearcli.dynamics.solve.solve`.
     """
     fmt = _output_format(out_path, (mech_path, traj_path), precision)   # refuse a bad -o before any work
     an = analysis or analyse(load_mechanism(mech_path))
@@ -117,7 +130,7 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
             with np.errstate(all="ignore"), warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 res = solve(an, part.q, part.qd, part.qdd, method=method, chunk=chunk, verify=verify,
-                            loads=part.loads)
+                            loads=part.loads, backend=backend, jobs=jobs)
                 tab = table(an, part.t, res)
             _check_loads(reader, part, tab, names)
             if verify:

@@ -114,7 +114,7 @@ def resolve_signs(solve_pattern: Callable[[np.ndarray, np.ndarray], np.ndarray],
                 break
             todo, _ = attempt(todo, np.array(signs))
     if todo.size:
-        raise SignError(int(todo[0]), mesh_names)
+        raise SignError(int(todo.min()), mesh_names)   # the first such sample
     return x, used
 
 

@@ -35,6 +35,7 @@ from .kinematics import forward
 from .signs import SignError, sign_violation
 
 DEFAULT_CHUNK = 20_000
+BACKENDS = ("auto", "kernel", "numpy")
 
 
 @dataclass
@@ -104,40 +105,99 @@ class Solver:
         self.an = an
         self.groups = unknown_groups(an)
         self.plans = make_plans(an)
+        self._program = None
+
+    def kernel_program(self):
+        """The compiled kernel's program of this mechanism (:mod:`.kernel_program`), or None
+        when numba does not import; built on first use."""
+        if self._program is None:
+            try:
+                from .kernel_program import build_program  # noqa: PLC0415  (imports numba)
+            except ImportError:
+                return None
+            self._program = build_program(self.an, self.plans)
+        return self._program
+
+    def backend(self, method: str = "block", backend: str = "auto") -> str:
+        """The path a solve takes: "kernel" or "numpy" (see :func:`solve`)."""
+        if backend not in BACKENDS:
+            raise ValueError(f"unknown backend '{backend}' (expected one of {', '.join(BACKENDS)})")
+        if backend == "numpy" or (backend == "auto" and method == "full"):
+            return "numpy"
+        if method == "full":
+            raise ValueError("backend 'kernel' solves method 'block' only")
+        prog = self.kernel_program()
+        if prog is not None and prog.covered:
+            return "kernel"
+        if backend == "kernel":
+            why = "numba does not import" if prog is None else "a block of this mechanism is not square"
+            raise ValueError(f"backend 'kernel' unavailable: {why}")
+        return "numpy"
 
     def solve(self, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK,
-              verify: bool = False, loads: dict | None = None) -> Result:
+              verify: bool = False, loads: dict | None = None, backend: str = "auto",
+              jobs: int | None = None) -> Result:
         """See :func:`solve`."""
         q, qd, qdd = _check_shapes(self.an, q, qd, qdd)
         if method not in ("block", "full"):
             raise ValueError(f"unknown method '{method}' (expected 'block' or 'full')")
+        if chunk < 1:
+            raise ValueError(f"chunk must be at least 1, got {chunk}")
+        path = self.backend(method, backend)
         values = load_values(self.an.mech, q.shape[0], loads)
-        parts = []
         # the operands are 3x3 to 48x48 matrices: BLAS threads only contend (2-3x slower
         # with a busy second core), so one BLAS thread, whatever the environment says
         with threadpool_limits(limits=1, user_api="blas"):
+            if path == "kernel":
+                res = self._by_kernel(q, qd, qdd, values, jobs, chunk, verify)
+            else:
+                res = self._by_numpy(q, qd, qdd, method, chunk, verify, values)
+        res.motor_speed = qd @ self.an.A
+        return res
+
+    def _by_kernel(self, q, qd, qdd, values, jobs, chunk, verify) -> Result:
+        from .kernel_driver import kernel_solve  # noqa: PLC0415  (imports numba)
+        x_all, sig = kernel_solve(self.kernel_program(), self.an, q, qd, qdd, values, jobs, chunk)
+        res = _result(self.an, self.groups, x_all)
+        if verify:
+            worst = 0.0
             for s in range(0, q.shape[0], chunk):
                 sl = slice(s, s + chunk)
-                try:
-                    parts.append(self._chunk(q[sl], qd[sl], qdd[sl], method, verify,
-                                             {k: v[sl] for k, v in values.items()}))
-                except SignError as exc:
-                    raise SignError(exc.sample + s, exc.meshes) from None
+                _, kin, b = self._loads(q[sl], qd[sl], qdd[sl], {k: v[sl] for k, v in values.items()})
+                worst = max(worst, residual(self.an, self.groups, Columns(self.an, kin), b,
+                                            {k: v[sl] for k, v in x_all.items()}, {k: v[sl] for k, v in sig.items()}))
+            res.residual = worst
+        return res
+
+    def _by_numpy(self, q, qd, qdd, method, chunk, verify, values) -> Result:
+        parts = []
+        for s in range(0, q.shape[0], chunk):
+            sl = slice(s, s + chunk)
+            try:
+                parts.append(self._chunk(q[sl], qd[sl], qdd[sl], method, verify,
+                                         {k: v[sl] for k, v in values.items()}))
+            except SignError as exc:
+                raise SignError(exc.sample + s, exc.meshes) from None
         if len(parts) == 1:
             res = parts[0]
         else:
             res = Result(*(np.concatenate([getattr(p, f) for p in parts]) for f in
                            ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial")))
             res.residual = max(p.residual for p in parts) if verify else None
-        res.motor_speed = qd @ self.an.A
         return res
 
-    def _chunk(self, q_ind, qd_ind, qdd_ind, method, verify, values) -> Result:
+    def _loads(self, q_ind, qd_ind, qdd_ind, values):
+        """Kinematics and right-hand sides (inertia and external loads) of some samples."""
         an = self.an
         q, qd, qdd = joint_space(an, q_ind, qd_ind, qdd_ind)
         kin = forward(an.mech, an.tree, q, qd, qdd)
         b = inertia_load(an, kin)
         subtract_external(b, external_wrenches(an, kin, values))
+        return q, kin, b
+
+    def _chunk(self, q_ind, qd_ind, qdd_ind, method, verify, values) -> Result:
+        an = self.an
+        q, kin, b = self._loads(q_ind, qd_ind, qdd_ind, values)
         cols = Columns(an, kin) if (method == "full" or verify) else None
         if method == "block":
             x, sig = solve_blocks(an, self.plans, kin, b, q)
@@ -161,7 +221,7 @@ def solver_for(an) -> Solver:
 
 
 def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, verify: bool = False,
-          loads: dict | None = None) -> Result:
+          loads: dict | None = None, backend: str = "auto", jobs: int | None = None) -> Result:
     """Inverse dynamics along a trajectory.
 
     Parameters
@@ -182,15 +242,25 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
         ``{load name: array (N, 6) or (6,)}``: [fx, fy, fz, mx, my, mz] of an external load
         of ``an.mech.loads`` (N, N*m about the load point, in the load's frame: base or
         link), overriding the constant of the mechanism file; loads not given keep it.
+    backend : {"auto", "kernel", "numpy"}
+        "kernel": the compiled per-sample kernel (:mod:`.kernel`, numba; method "block"
+        only); "numpy": the array implementation (the readable reference); "auto"
+        (default): the kernel when numba imports and it covers the mechanism (every block
+        square), else numpy.  Both give the same results to rounding (~1e-15 relative).
+    jobs : int, optional
+        Threads the kernel splits the samples over (contiguous ranges; results bitwise
+        identical for any number); None: every usable core.  The numpy path uses one.
 
     Raises
     ------
     SignError
         when no sign pattern of the tooth forces is consistent at some sample (named).
     ValueError
-        for bad shapes, an unknown load name or a load value that is not finite.
+        for bad shapes, an unknown load name or a load value that is not finite, an unknown
+        backend, or backend "kernel" where it is unavailable.
     """
-    return solver_for(an).solve(q, qd, qdd, method=method, chunk=chunk, verify=verify, loads=loads)
+    return solver_for(an).solve(q, qd, qdd, method=method, chunk=chunk, verify=verify, loads=loads,
+                                backend=backend, jobs=jobs)
 
 
 def residual(an, groups, cols, b, x_all, sig) -> float:

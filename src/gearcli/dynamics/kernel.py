@@ -1,0 +1,231 @@
+"""The compiled per-sample kernel: a sample's whole chain in registers and small arrays.
+
+For each sample: joint space, kinematics, inertia and external loads
+(:mod:`.kernel_links`), then the blocks of the schedule in order, exactly as
+:func:`.blocks.solve_blocks` does over arrays: a constant-frame block gathers its links'
+right-hand sides in its frame F, x = Ainv[pattern] r with the sign resolution of
+:func:`.signs.resolve_signs` (all t positive, then the solution's own signs m times, then
+every pattern in order), passes its wrenches on to the later links and turns joint
+reactions to their child's basis; a block without a constant frame is assembled in world
+axes from column terms (:mod:`.kernel_terms`) and solved by Gaussian elimination.
+
+Data-driven (:mod:`.kernel_program`): one compiled function serves every mechanism,
+compiled once and cached on disk (numba ``cache=True``).  No allocation per sample:
+:func:`run` allocates its scratch once per call (one call per thread).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from .kernel_links import INLINE, OPTS, cross, external, inertia, joint_space, kinematics, rot
+from .kernel_world import world_gather, world_propagate, world_solve
+from .signs import MAX_EXHAUSTIVE, TOL_SIGN
+
+
+@njit(**OPTS)
+def _gather(F, base, lk0, B, blinks, R, o, rhs, r):
+    """r (6B) = the block links' right-hand sides in F's axes about o_F."""
+    if F == base:            # the base: at rest, world axes, about the origin
+        for i in range(B):
+            L = blinks[lk0 + i]
+            e = cross(o[L, 0], o[L, 1], o[L, 2], rhs[L, 0], rhs[L, 1], rhs[L, 2])
+            for h in range(3):
+                r[6 * i + h] = rhs[L, h]
+                r[6 * i + 3 + h] = rhs[L, 3 + h] + e[h]
+        return
+    for i in range(B):
+        L = blinks[lk0 + i]
+        dx, dy, dz = o[L, 0] - o[F, 0], o[L, 1] - o[F, 1], o[L, 2] - o[F, 2]
+        e = cross(dx, dy, dz, rhs[L, 0], rhs[L, 1], rhs[L, 2])
+        for h in range(3):
+            r[6 * i + h] = R[F, 0, h] * rhs[L, 0] + R[F, 1, h] * rhs[L, 1] + R[F, 2, h] * rhs[L, 2]
+        m0, m1, m2 = rhs[L, 3] + e[0], rhs[L, 4] + e[1], rhs[L, 5] + e[2]
+        for h in range(3):
+            r[6 * i + 3 + h] = R[F, 0, h] * m0 + R[F, 1, h] * m1 + R[F, 2, h] * m2
+
+
+@njit(**OPTS)
+def _apply(ainv, off, n, nr, r, x):
+    """x (n) = Ainv r, Ainv (n, nr) row-major at ``off``."""
+    if nr == 6:
+        r0, r1, r2, r3, r4, r5 = r[0], r[1], r[2], r[3], r[4], r[5]
+        for i in range(n):
+            b = off + 6 * i
+            x[i] = (ainv[b] * r0 + ainv[b + 1] * r1 + ainv[b + 2] * r2
+                    + ainv[b + 3] * r3 + ainv[b + 4] * r4 + ainv[b + 5] * r5)
+        return
+    for i in range(n):
+        s = 0.0
+        b = off + i * nr
+        for j in range(0, nr, 6):   # unrolled by six: independent products, short chains
+            s += (ainv[b + j] * r[j] + ainv[b + j + 1] * r[j + 1] + ainv[b + j + 2] * r[j + 2]
+                  + ainv[b + j + 3] * r[j + 3] + ainv[b + j + 4] * r[j + 4] + ainv[b + j + 5] * r[j + 5])
+        x[i] = s
+
+
+@njit(**OPTS)
+def consistent(x, tcol, t0, m, sig, tol):
+    """True when every t agrees with its sign (up to tol; signs.resolve_signs)."""
+    for i in range(m):
+        if not (-sig[i] * x[tcol[t0 + i]] <= tol):
+            return False
+    return True
+
+
+@njit(**OPTS)
+def own_signs(x, tcol, t0, m, sig):
+    """sig = the signs of the solution's own t (zero counts as positive)."""
+    for i in range(m):
+        sig[i] = -1.0 if x[tcol[t0 + i]] < 0 else 1.0
+
+
+@njit(**OPTS)
+def pattern_signs(p, m, sig):
+    """sig = pattern p of :func:`.signs.sign_patterns` (bit m-1-i set: t_i negative)."""
+    for i in range(m):
+        sig[i] = -1.0 if (p >> (m - 1 - i)) & 1 else 1.0
+
+
+@njit(**OPTS)
+def _pattern(m, sig):
+    """Position of the signs in :func:`.signs.sign_patterns` (signs.pattern_index)."""
+    k = 0
+    for i in range(m):
+        if sig[i] < 0:
+            k += 1 << (m - 1 - i)
+    return k
+
+
+@njit(**OPTS)
+def _trial(ctx, world, a0, k0, nt, n, nr, r, x, m, sig):
+    """x = the block's solution for the signs ``sig`` (constant frame: Ainv[pattern] r)."""
+    ainv, trec, tflt, R, o, A = ctx
+    if world:
+        world_solve(k0, nt, trec, tflt, sig, R, o, nr, r, x, A)
+    else:
+        _apply(ainv, a0 + _pattern(m, sig) * n * nr, n, nr, r, x)
+
+
+@njit(**OPTS)
+def _resolve(ctx, world, a0, k0, nt, n, nr, r, x, tcol, t0, m, sig, tol):
+    """Solve a block with a consistent sign pattern (signs.resolve_signs); False if none."""
+    for i in range(m):
+        sig[i] = 1.0
+    _trial(ctx, world, a0, k0, nt, n, nr, r, x, m, sig)
+    if consistent(x, tcol, t0, m, sig, tol):
+        return True
+    for _ in range(m):
+        own_signs(x, tcol, t0, m, sig)
+        _trial(ctx, world, a0, k0, nt, n, nr, r, x, m, sig)
+        if consistent(x, tcol, t0, m, sig, tol):
+            return True
+    if m <= MAX_EXHAUSTIVE:
+        for p in range(1 << m):
+            pattern_signs(p, m, sig)
+            _trial(ctx, world, a0, k0, nt, n, nr, r, x, m, sig)
+            if consistent(x, tcol, t0, m, sig, tol):
+                return True
+    return False
+
+
+@njit(**OPTS)
+def _propagate(F, p0, np_, prec, cmat, later, R, o, x, rhs):
+    """rhs[L] -= the solved wrenches of the block's groups on their later links L."""
+    for e in range(p0, p0 + np_):
+        c0, size, signed, co, P, l0, nl = (prec[e, 0], prec[e, 1], prec[e, 2], prec[e, 3],
+                                           prec[e, 4], prec[e, 5], prec[e, 6])
+        wF0, wF1, wF2, wF3, wF4, wF5 = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        for j in range(size):
+            xj = x[c0 + j]
+            wF0 += cmat[co + j] * xj
+            wF1 += cmat[co + size + j] * xj
+            wF2 += cmat[co + 2 * size + j] * xj
+            wF3 += cmat[co + 3 * size + j] * xj
+            wF4 += cmat[co + 4 * size + j] * xj
+            wF5 += cmat[co + 5 * size + j] * xj
+            if signed == 1:
+                ax = abs(xj)
+                cs = co + 6 * size
+                wF0 += cmat[cs + j] * ax
+                wF1 += cmat[cs + size + j] * ax
+                wF2 += cmat[cs + 2 * size + j] * ax
+                wF3 += cmat[cs + 3 * size + j] * ax
+                wF4 += cmat[cs + 4 * size + j] * ax
+                wF5 += cmat[cs + 5 * size + j] * ax
+        f = rot(R, F, wF0, wF1, wF2)
+        mo = rot(R, F, wF3, wF4, wF5)
+        for i in range(nl):
+            L = later[l0 + i]
+            s = 1.0 if L == P else -1.0
+            e2 = cross(o[F, 0] - o[L, 0], o[F, 1] - o[L, 1], o[F, 2] - o[L, 2], f[0], f[1], f[2])
+            for h in range(3):
+                rhs[L, h] -= s * f[h]
+                rhs[L, 3 + h] -= s * (mo[h] + e2[h])
+
+
+@njit(**OPTS)
+def _store(n, b, brec, gcol, scol, cbrec, q, x, sig, X, SG):
+    """Write block b's solution (joint reactions in the child's basis) and signs."""
+    nloc, g0, m, t0, cb0, ncb = brec[b, 3], brec[b, 4], brec[b, 5], brec[b, 6], brec[b, 10], brec[b, 11]
+    for i in range(nloc):
+        X[n, gcol[g0 + i]] = x[i]
+    for e in range(cb0, cb0 + ncb):
+        c0 = cbrec[e, 0]
+        cq, sq = np.cos(q[cbrec[e, 1]]), np.sin(q[cbrec[e, 1]])
+        for h in (0, 3):
+            x0, x1 = x[c0 + h], x[c0 + h + 1]
+            X[n, gcol[g0 + c0 + h]] = cq * x0 + sq * x1
+            X[n, gcol[g0 + c0 + h + 1]] = -sq * x0 + cq * x1
+    for i in range(m):
+        SG[n, scol[t0 + i]] = sig[i]
+
+
+@njit(**OPTS)
+def _blocks(n, ints, flts, q, R, o, rhs, r, x, sig, A, X, SG, fail):
+    """Every block of the schedule in order, for sample n."""
+    jrec, brec, blinks, gcol, tcol, scol, prec, later, cbrec, moving, trec, meta = ints
+    jflt, lflt, S, g, ainv, cmat, tflt = flts
+    base = meta[0]
+    ctx = (ainv, trec, tflt, R, o, A)
+    for b in range(brec.shape[0]):
+        F, lk0, B, nloc, m, t0, a0, k0, nt = (brec[b, 0], brec[b, 1], brec[b, 2], brec[b, 3], brec[b, 5],
+                                              brec[b, 6], brec[b, 7], brec[b, 12], brec[b, 13])
+        nr = 6 * B
+        world = F < 0
+        if world:
+            world_gather(lk0, B, blinks, rhs, r)
+        else:
+            _gather(F, base, lk0, B, blinks, R, o, rhs, r)
+        big = 0.0
+        for i in range(nr):
+            big = max(big, abs(r[i]))
+        ok = _resolve(ctx, world, a0, k0, nt, nloc, nr, r, x, tcol, t0, m, sig, TOL_SIGN * (1.0 + big))
+        if not ok and fail[n] < 0:
+            fail[n] = b
+        if world:
+            world_propagate(k0, nt, trec, tflt, sig, R, o, x, rhs)
+        else:
+            _propagate(F, brec[b, 8], brec[b, 9], prec, cmat, later, R, o, x, rhs)
+        _store(n, b, brec, gcol, scol, cbrec, q, x, sig, X, SG)
+
+
+@njit(**OPTS)
+def run(ints, flts, ldrec, ldflt, vals, qi, qdi, qddi, start, stop, X, SG, fail, scratch):
+    """Solve samples start..stop-1 of qi, qdi, qddi (N, dof) into X (N, ncols) (every unknown, in
+    :func:`~gearcli.analysis.schedule.unknown_groups` order, joint reactions in the child's
+    basis), SG (N, signed meshes) the sign of each t used and fail (N,) the first block with
+    no consistent sign pattern (-1: none); ``fail`` must come filled with -1.  ``scratch``
+    from :func:`~.kernel_driver.scratch` (one per thread).  Compiled without numba's
+    reference counting (``_nrt=False``, which costs ~10 ns an array passed): nothing here
+    allocates."""
+    jrec, moving = ints[0], ints[9]
+    jflt, lflt, S, g = flts[0], flts[1], flts[2], flts[3]
+    R, o, w, dw, a, rhs, Rj, oj, q, qd, qdd, r, x, sig, A = scratch
+    for n in range(start, stop):
+        joint_space(S, qi, qdi, qddi, n, q, qd, qdd)
+        kinematics(jrec, jflt, q, qd, qdd, R, o, w, dw, a, Rj, oj)
+        for L in moving:
+            inertia(L, lflt, g, R, w, dw, a, rhs)
+        external(n, ldrec, ldflt, vals, R, rhs)
+        _blocks(n, ints, flts, q, R, o, rhs, r, x, sig, A, X, SG, fail)

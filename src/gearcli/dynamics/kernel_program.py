@@ -1,0 +1,172 @@
+"""The compiled kernel's "program": one analysed mechanism flattened into a few arrays.
+
+The kernel (:mod:`.kernel`) is data-driven: one compiled function serves every mechanism,
+reading what to do from the arrays built here once per analysis (from the
+:class:`~gearcli.analysis.graph.Analysis` and the block plans of :func:`.blocks.make_plans`):
+
+* ``jrec`` (J, 5) int: per real joint in tree order [joint index, parent link, child link,
+  1 if prismatic, flags: 1 parent is the base, 2 R_pj = I, 4 R_jc = I, 8 p_jc = 0]; ``jflt`` (J, 24): R_pj (row-major), p_pj, R_jc, p_jc;
+* ``lflt`` (L, 13): per link mass, inertia about the centre of mass (link axes, row-major),
+  centre of mass (link frame); ``moving`` the moving link ids;
+* ``ldrec`` (nloads, 4) int [link, 1 if in link axes, row offset in the values array,
+  1 if one row per sample]; ``ldflt`` (nloads, 3) the load point (link frame);
+* ``brec`` (B, 14) int per block (schedule order): [F, links offset, number of links,
+  unknowns n, column offset, signed meshes m, t offset, Ainv offset, propagation offset,
+  propagations, child-basis offset, child-basis count, term offset, term count]; ``blinks``
+  the links; ``gcol`` each block column's position in the solution row; ``tcol`` the
+  block columns of the signed t; ``scol`` their position in the signs row;
+* ``ainv`` every pattern's (n, 6B) inverse (row-major, patterns in
+  :func:`~.signs.sign_patterns` order: rectangular matrices are fine);
+* ``prec`` (P, 7) int per propagated group [first column, size, 1 if signed, cmat offset,
+  primary link, later-links offset, count]; ``cmat`` its C_plus (6, size) then C_sep;
+  ``later`` the later links;
+* ``cbrec`` (C, 2) int [first column, joint index]: joint reactions solved in the parent's
+  basis, turned by -q to the child's; ``meta`` [base link id].
+
+Blocks without a constant frame (F = -1 in ``brec``) are solved in world axes from the
+column terms of :mod:`.kernel_terms`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..analysis.schedule import unknown_groups
+from .blocks import _primary_side, make_plans
+from .kernel_terms import general_terms
+
+I64 = np.int64
+
+
+@dataclass(frozen=True, eq=False)
+class Program:
+    """A mechanism flattened for the kernel (see module docstring)."""
+
+    ints: tuple          # int64 arrays, in the kernel's order
+    flts: tuple          # float64 arrays, in the kernel's order
+    ncols: int           # unknowns per sample (every group, in unknown_groups order)
+    offsets: dict        # (kind, index) -> (first column, size)
+    signed: list         # (kind, index) of each signs column
+    names: list          # per block: names of its signed meshes (SignError)
+    covered: bool        # False: a block the kernel cannot solve (use the numpy path)
+
+
+def _joints(an):
+    mech, tree = an.mech, an.tree
+    rec, flt = [], []
+    for ji in tree.order:
+        jt = mech.joints[ji]
+        c = tree.index[jt.child]
+        eye = np.eye(3)
+        flags = (int(tree.parent[c] == tree.base) | 2 * int(np.array_equal(jt.R_pj, eye))
+                 | 4 * int(np.array_equal(jt.R_jc, eye)) | 8 * int(not np.any(jt.p_jc)))
+        rec.append([ji, tree.parent[c], c, int(jt.type == "prismatic"), flags])
+        flt.append(np.concatenate([np.ravel(jt.R_pj), jt.p_pj, np.ravel(jt.R_jc), jt.p_jc]))
+    return np.array(rec, I64).reshape(-1, 5), np.array(flt, float).reshape(-1, 24)
+
+
+def _links(an):
+    out = np.zeros((len(an.tree.links), 13))
+    for L in an.tree.moving:
+        link = an.mech.links[L]
+        out[L] = np.concatenate([[link.mass], np.ravel(link.inertia), link.com])
+    return out
+
+
+def _loads(an, values: dict, n: int):
+    """Load records and the stacked values: one row (constant) or n rows per load."""
+    rec, pts, rows = [], [], []
+    off = 0
+    for ld in an.mech.loads:
+        w = values[ld.name]
+        per = int(w.strides[0] != 0 and n > 1)
+        w = np.ascontiguousarray(w if per else w[:1], float)
+        rec.append([an.tree.index[ld.link], int(ld.frame == "link"), off, per])
+        pts.append(np.asarray(ld.point, float))
+        rows.append(w)
+        off += w.shape[0]
+    vals = np.concatenate(rows) if rows else np.zeros((1, 6))
+    return np.array(rec, I64).reshape(-1, 4), np.array(pts, float).reshape(-1, 3), vals
+
+
+def load_arrays(an, values: dict, n: int):
+    """(ldrec, ldflt, vals) of the loads of ``an`` for n samples (see module docstring)."""
+    return _loads(an, values, n)
+
+
+class _Builder:
+    """Accumulates the per-block arrays."""
+
+    def __init__(self):
+        self.brec, self.blinks, self.gcol, self.tcol, self.scol = [], [], [], [], []
+        self.ainv, self.prec, self.cmat, self.later, self.cbrec = [], [], [], [], []
+        self.ainv_len = self.cmat_len = 0
+
+    def add_floats(self, attr: str, arr) -> int:
+        arr = np.ascontiguousarray(arr, float).ravel()
+        off = getattr(self, attr + "_len")
+        getattr(self, attr).append(arr)
+        setattr(self, attr + "_len", off + arr.size)
+        return off
+
+    def propagation(self, an, p, gi, g, later) -> None:
+        Cp, Cs = p.C[gi]
+        off = self.add_floats("cmat", Cp)
+        if Cs is not None:
+            self.add_floats("cmat", Cs)
+        self.prec.append([int(p.offs[gi]), g.size, int(Cs is not None), off, _primary_side(an, g),
+                          len(self.later), len(later)])
+        self.later += later
+
+
+def _block(bd: _Builder, an, bi, p, block_of, offsets, sigcol, terms):
+    """Append block ``bi`` (plan ``p``) to the builder."""
+    n = int(p.offs[-1])
+    rec = [-1 if p.F is None else p.F, len(bd.blinks), len(p.links), n, len(bd.gcol), len(p.signed),
+           len(bd.tcol), bd.ainv_len, len(bd.prec), 0, len(bd.cbrec), 0, *terms.get(bi, (0, 0))]
+    bd.blinks += list(p.links)
+    for g in p.groups:
+        bd.gcol += range(offsets[(g.kind, g.index)][0], offsets[(g.kind, g.index)][0] + g.size)
+    for gi in p.signed:
+        bd.tcol.append(int(p.offs[gi]))
+        bd.scol.append(sigcol[(p.groups[gi].kind, p.groups[gi].index)])
+    for A in p.Ainv:
+        bd.add_floats("ainv", A)
+    for gi, g in enumerate(p.groups):
+        later = [L for L in g.links if block_of[L] > bi]
+        if later and p.F is not None:
+            bd.propagation(an, p, gi, g, later)
+            rec[9] += 1
+        if p.parent_side.get(gi):
+            bd.cbrec.append([int(p.offs[gi]), g.index])
+            rec[11] += 1
+    bd.brec.append(rec)
+
+
+def build_program(an, plans=None) -> Program:
+    """The :class:`Program` of ``an`` (``plans`` from :func:`.blocks.make_plans`)."""
+    plans = make_plans(an) if plans is None else plans
+    groups = unknown_groups(an)
+    offsets, c = {}, 0
+    for g in groups:
+        offsets[(g.kind, g.index)] = (c, g.size)
+        c += g.size
+    signed = [(p.groups[gi].kind, p.groups[gi].index) for p in plans for gi in p.signed]
+    sigcol = {k: i for i, k in enumerate(signed)}
+    block_of = {L: i for i, p in enumerate(plans) for L in p.links}
+    trec, tflt, terms = general_terms(an, plans, block_of)
+    bd = _Builder()
+    for bi, p in enumerate(plans):
+        _block(bd, an, bi, p, block_of, offsets, sigcol, terms)
+    jrec, jflt = _joints(an)
+    cat = (lambda xs: np.concatenate(xs) if xs else np.zeros(1))
+    ints = (jrec, np.array(bd.brec, I64).reshape(-1, 14), np.array(bd.blinks, I64),
+            np.array(bd.gcol, I64), np.array(bd.tcol + [0], I64), np.array(bd.scol + [0], I64),
+            np.array(bd.prec, I64).reshape(-1, 7), np.array(bd.later + [0], I64),
+            np.array(bd.cbrec, I64).reshape(-1, 2), np.array(an.tree.moving, I64), trec,
+            np.array([an.tree.base], I64))
+    flts = (jflt, _links(an), np.ascontiguousarray(an.S, float), np.asarray(an.mech.gravity, float),
+            cat(bd.ainv), cat(bd.cmat), tflt)
+    covered = all(p.F is not None or int(p.offs[-1]) == 6 * len(p.links) for p in plans)
+    return Program(ints, flts, c, offsets, signed, [p.names for p in plans], covered)

@@ -1,0 +1,122 @@
+"""Column terms of the kernel's world-frame blocks (blocks without a constant frame).
+
+A block whose unknowns share no link in which they are all fixed (a motor spread over
+several joints by a transmission, an ideal coupling) is solved per sample in world axes,
+like :func:`~.general.solve_general`.  The kernel assembles its matrix from *terms*: every
+column C_u,L of :class:`~.equations.Columns` is a sum of wrenches
+
+* ``coef * [d ; (P - o_L) x d]``: a force along d through P, or
+* ``coef * [0 ; d]``: a moment along d,
+
+with d = R_X d_X and P = o_X + R_X p_X for a link X (the joint child for a joint frame:
+R_joint = R_child R_jc^T, o_joint = o_child - R_joint p_jc; the carrier for a mesh), and a
+term of a geared mesh's separating force is multiplied by the sign of its t (Eq. 14).
+Written here from the model, independently of :class:`~.equations.Columns`, which the
+kernel's tests compare against.
+
+``trec`` (T, 6) int: [target link, row block-link position or -1 (a later link: the term
+propagates the solved wrench), block column, 0 force / 1 moment, frame link X, signed-mesh
+position in the block or -1]; ``tflt`` (T, 7): [coef, d_X (3), p_X (3)].
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..model.gears import helical_terms
+from .general import is_geared
+
+
+def _joint_frame(jt):
+    """(E, p): the joint frame's axes (columns) and origin in its child's frame."""
+    E = np.asarray(jt.R_jc, float).T
+    return E, -E @ np.asarray(jt.p_jc, float)
+
+
+def _axial(an, ji, L, coef):
+    """Terms of a unit generalised force of joint ji on link L (see Columns.axial)."""
+    jt = an.mech.joints[ji]
+    idx = an.tree.index
+    sign = float(idx[jt.child] == L) - float(idx[jt.parent] == L)
+    if not sign:
+        return []
+    E, p = _joint_frame(jt)
+    kind = 0 if jt.type == "prismatic" else 1
+    return [(kind, idx[jt.child], -1, coef * sign, E[:, 2], p)]
+
+
+def _joint(an, ji, L):
+    """Per column j of joint ji's reaction on L: its terms (see Columns.joint)."""
+    jt = an.mech.joints[ji]
+    c = an.tree.index[jt.child]
+    s = 1.0 if c == L else -1.0
+    E, p = _joint_frame(jt)
+    if jt.type == "prismatic":
+        spec = [(0, 0), (0, 1), (1, 0), (1, 1), (1, 2)]
+    else:
+        spec = [(0, 0), (0, 1), (0, 2), (1, 0), (1, 1)]
+    return [[(kind, c, -1, s, E[:, i], p)] for kind, i in spec]
+
+
+def _motor(an, mi, L):
+    if an.motor_joints and an.motor_joints[mi] is not None:
+        return [[t for ji, coef in an.motor_joints[mi] for t in _axial(an, ji, L, coef)]]
+    x = an.motor_links[mi]
+    ji = an.tree.parent_joint[x]
+    jt = an.mech.joints[ji]
+    E, p = _joint_frame(jt)
+    kind = 0 if jt.type == "prismatic" else 1
+    return [[(kind, x, -1, 1.0 if L == x else -1.0, E[:, 2], p)]]
+
+
+def _mesh(an, ci, L, t_pos):
+    c = an.circuits[ci]
+    if c.joints is not None:
+        b, a = c.joints
+        return [_axial(an, b, L, 1.0) + _axial(an, a, L, -c.ratio)]
+    zero = np.zeros(3)
+    if c.geometry is not None:
+        gm, gp = c.geometry, an.mech.gears[c.gear]
+        tan_t, ax = helical_terms(gm, gp.pressure_angle, gp.helix_angle, gp.hand)
+        s = 1.0 if L == c.j else -1.0
+        return [[(0, c.carrier, -1, s, gm.ut + ax, gm.P), (0, c.carrier, t_pos, s * tan_t, gm.us, gm.P)]]
+    out = []
+    if L == c.j:
+        out.append((1, c.carrier, -1, 1.0, c.zj, zero))
+    if L == c.k:
+        out.append((1, c.carrier, -1, -c.ratio, c.zk, zero))
+    if L == c.carrier:
+        out += [(1, c.carrier, -1, -1.0, c.zj, zero), (1, c.carrier, -1, c.ratio, c.zk, zero)]
+    return [out]
+
+
+def group_terms(an, g, L, t_pos):
+    """Per column of group g: the terms of its wrench on link L (t_pos: the block position
+    of g's sign, for a geared mesh)."""
+    if g.kind == "joint":
+        return _joint(an, g.index, L)
+    if g.kind == "motor":
+        return _motor(an, g.index, L)
+    return _mesh(an, g.index, L, t_pos)
+
+
+def general_terms(an, plans, block_of):
+    """(trec, tflt, {block: (offset, count)}) of the blocks without a constant frame."""
+    rec, flt, where = [], [], {}
+    for bi, p in enumerate(plans):
+        if p.F is not None:
+            continue
+        start = len(rec)
+        for gi, g in enumerate(p.groups):
+            t_pos = p.signed.index(gi) if is_geared(an, g) else -1
+            for L in g.links:
+                row = p.links.index(L) if L in p.links else -1
+                if row < 0 and block_of[L] < bi:
+                    continue
+                for j, terms in enumerate(group_terms(an, g, L, t_pos)):
+                    for kind, X, sgn, coef, d, pt in terms:
+                        rec.append([L, row, int(p.offs[gi]) + j, kind, X, sgn])
+                        flt.append(np.concatenate([[coef], d, pt]))
+        where[bi] = (start, len(rec) - start)
+    trec = np.array(rec, np.int64).reshape(-1, 6) if rec else np.zeros((1, 6), np.int64)
+    tflt = np.array(flt, float).reshape(-1, 7) if flt else np.zeros((1, 7))
+    return trec, tflt, where

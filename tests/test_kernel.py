@@ -1,0 +1,264 @@
+"""The compiled per-sample kernel (backend "kernel") against the numpy block solve.
+
+The numpy path (:func:`gearcli.dynamics.blocks.solve_blocks` over arrays) is the reference:
+the kernel shares none of its arithmetic (its own scalar kinematics, loads, column terms and
+sign search, :mod:`gearcli.dynamics.kernel`), only the constant block matrices.  Every result
+must agree to 1e-12 of the largest load of the sample, on every bundled mechanism and on the
+test factories' mechanisms, along random trajectories large enough that tooth forces change
+sign, with external loads; threads must not change a bit; a sample with no consistent sign
+pattern must be named as the numpy path names it; and a wrong program entry must be caught.
+"""
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+pytest.importorskip("numba")
+
+from big_mechanisms import binary_tree_urdf, geared_chain, serial_chain  # noqa: E402
+from factories import paper_2dof_variant, planetary_2dof, spatial_3dof  # noqa: E402
+from factories_own import PUMA_YAML, dh_geared, urdf_prismatic_chain  # noqa: E402
+from gearcli import analyse, load_mechanism, parse_mechanism  # noqa: E402
+from gearcli.dynamics.kernel_driver import job_ranges  # noqa: E402
+from gearcli.dynamics.signs import SignError  # noqa: E402
+from gearcli.dynamics.solve import solve, solver_for  # noqa: E402
+from gearcli.io.urdf_reader import load_urdf, parse_urdf  # noqa: E402
+from test_urdf import ERD, erd, talos_left_arm  # noqa: E402
+
+MECH = Path(__file__).resolve().parents[1] / "mechanisms"
+FIELDS = ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial", "motor_speed")
+TOL = 1e-12
+BUNDLED = sorted(p.name for p in MECH.glob("*.yaml")) + ["geared_arm.urdf"]
+
+
+def _with_loads(text: str) -> str:
+    """The mechanism with two external loads: one in link axes (per sample in the tests),
+    one constant in base axes."""
+    doc = yaml.safe_load(text)
+    names = [ln["name"] for ln in doc["links"] if ln["name"] != doc["base"]]
+    doc["loads"] = [
+        {"name": "tip", "link": doc.get("end_effector", names[-1]), "point": [0.11, -0.03, 0.02],
+         "frame": "link", "force": [1.0, 2.0, -3.0], "moment": [0.1, 0.0, 0.2]},
+        {"name": "side", "link": names[0], "point": [0.0, 0.05, 0.01], "frame": "base",
+         "force": [0.0, -4.0, 1.5], "moment": [0.3, -0.1, 0.0]}]
+    return yaml.safe_dump(doc)
+
+
+def mechanism(key: str):
+    if key in BUNDLED:
+        return load_mechanism(MECH / key)
+    kind, _, arg = key.partition(":")
+    makers = {
+        "variant": lambda: parse_mechanism(paper_2dof_variant(np.random.default_rng(int(arg)))[0]),
+        "spatial": lambda: parse_mechanism(spatial_3dof(j5_parent=arg or "1")[0]),
+        "planetary": lambda: parse_mechanism(planetary_2dof()[0]),
+        "dh_geared": lambda: parse_mechanism(dh_geared(int(arg))[0]),
+        "puma": lambda: parse_mechanism(PUMA_YAML),
+        "prismatic": lambda: parse_urdf(urdf_prismatic_chain(int(arg))[0]),
+        "geared_chain": lambda: parse_mechanism(geared_chain(int(arg))),
+        "serial_chain": lambda: parse_mechanism(serial_chain(int(arg))),
+        "tree": lambda: parse_urdf(binary_tree_urdf(int(arg))),
+        "loaded": lambda: parse_mechanism(_with_loads((MECH / arg).read_text())),
+    }
+    return makers[kind]()
+
+
+GENERATED = ["variant:1", "variant:2", "spatial:1", "spatial:0", "planetary", "dh_geared:3", "puma",
+             "prismatic:5", "geared_chain:7", "serial_chain:7", "tree:3",
+             "loaded:paper_2dof.yaml", "loaded:bendix_wrist.yaml"]
+
+
+def trajectory(an, n, seed=0):
+    rng = np.random.default_rng(seed)
+    return (rng.uniform(-np.pi, np.pi, (n, an.dof)), rng.normal(size=(n, an.dof)) * 3.0,
+            rng.normal(size=(n, an.dof)) * 20.0)
+
+
+def per_sample_loads(an, n, seed=1):
+    """Per-sample values of the first load (the others keep their constants)."""
+    if not an.mech.loads:
+        return None
+    rng = np.random.default_rng(seed)
+    return {an.mech.loads[0].name: rng.normal(size=(n, 6)) * 5.0}
+
+
+def worst(a, b) -> float:
+    """max over samples of max|a - b| / (1 + largest load of the sample)."""
+    n = b.motor.shape[0]
+    fa = np.concatenate([getattr(a, f).reshape(n, -1) for f in FIELDS], axis=1)
+    fb = np.concatenate([getattr(b, f).reshape(n, -1) for f in FIELDS], axis=1)
+    return float(np.max(np.abs(fa - fb).max(axis=1) / (1.0 + np.abs(fb).max(axis=1))))
+
+
+@pytest.mark.parametrize("key", BUNDLED + GENERATED)
+def test_kernel_equals_numpy(key):
+    an = analyse(mechanism(key))
+    assert solver_for(an).backend() == "kernel"           # "auto" takes the kernel
+    q, qd, qdd = trajectory(an, 600)
+    loads = per_sample_loads(an, 600)
+    ref = solve(an, q, qd, qdd, backend="numpy", loads=loads)
+    res = solve(an, q, qd, qdd, backend="kernel", loads=loads, jobs=1)
+    assert worst(res, ref) < TOL
+    geared = [i for i, c in enumerate(an.circuits) if c.geometry is not None]
+    for i in geared:                                      # both branches of |t| exercised
+        assert (ref.gear_t[:, i] > 0).any() and (ref.gear_t[:, i] < 0).any()
+
+
+@pytest.mark.skipif(ERD is None, reason="example-robot-data not installed")
+@pytest.mark.parametrize("case", ["ur_description/urdf/ur5_robot.urdf", "panda_description/urdf/panda.urdf",
+                                  "talos_left_arm", "talos_data/robots/talos_full_v2.urdf"])
+def test_kernel_equals_numpy_on_robots(case, tmp_path):
+    """Published robots; Talos' transmissions and mimic joints need world-frame blocks."""
+    path = talos_left_arm(tmp_path) if case == "talos_left_arm" else erd(case)
+    an = analyse(load_urdf(path))
+    assert solver_for(an).backend() == "kernel"
+    q, qd, qdd = trajectory(an, 200)
+    assert worst(solve(an, q, qd, qdd, backend="kernel"), solve(an, q, qd, qdd, backend="numpy")) < TOL
+
+
+def test_general_blocks_are_exercised():
+    """geared_arm.urdf has a block without a constant frame (a transmission): the kernel's
+    world-frame solve is compared above."""
+    an = analyse(mechanism("geared_arm.urdf"))
+    assert any(p.F is None for p in solver_for(an).plans)
+
+
+@pytest.mark.parametrize("key", ["bendix_wrist.yaml", "loaded:bendix_wrist.yaml"])
+def test_threads_change_no_bit(key):
+    an = analyse(mechanism(key))
+    n = 5001
+    assert len(job_ranges(n, 2)) == 2
+    q, qd, qdd = trajectory(an, n, seed=3)
+    loads = per_sample_loads(an, n)
+    one = solve(an, q, qd, qdd, jobs=1, loads=loads)
+    two = solve(an, q, qd, qdd, jobs=2, loads=loads)
+    for f in FIELDS:
+        assert np.array_equal(getattr(one, f), getattr(two, f)), f
+
+
+def _sign_error(an, q, qd, qdd, backend, chunk):
+    with pytest.raises(SignError) as info, np.errstate(all="ignore"):
+        solve(an, q, qd, qdd, backend=backend, chunk=chunk, jobs=2)
+    return info.value.sample, info.value.meshes
+
+
+@pytest.mark.parametrize("key", ["paper_2dof.yaml", "bendix_wrist.yaml", "geared_arm.urdf"])
+def test_sign_error_names_the_same_sample(key):
+    """Samples with no consistent sign pattern (a NaN acceleration fails the first geared
+    block): the error names the sample, and the meshes, that the numpy path names."""
+    an = analyse(mechanism(key))
+    n = 4400
+    q, qd, qdd = trajectory(an, n, seed=5)
+    rng = np.random.default_rng(9)
+    for s in rng.choice(n, 12, replace=False):
+        qdd[s, rng.integers(an.dof)] = np.nan
+    first = int(np.flatnonzero(np.isnan(qdd).any(axis=1))[0])
+    for chunk in (7, 20_000):
+        ref = _sign_error(an, q, qd, qdd, "numpy", chunk)
+        assert ref[0] == first
+        assert _sign_error(an, q, qd, qdd, "kernel", chunk) == ref
+
+
+# two one-link arms on one base (a tree), each driven through a spur pair: arm a's blocks first
+def _arm(tag: str, y: float) -> str:
+    inertial = ('<inertial><origin xyz="0.2 0 0"/><mass value="4"/>'
+                '<inertia ixx="0.005" ixy="0" ixz="0" iyy="0.06" iyz="0" izz="0.06"/></inertial>')
+    small = ('<inertial><origin xyz="0 0 0"/><mass value="0.2"/>'
+             '<inertia ixx="5e-05" ixy="0" ixz="0" iyy="5e-05" iyz="0" izz="3e-05"/></inertial>')
+    return f"""
+  <link name="{tag}">{inertial}</link>
+  <link name="p{tag}">{small}</link>
+  <joint name="J{tag}" type="continuous"><parent link="base"/><child link="{tag}"/>
+    <origin xyz="0 {y} 0.1"/><axis xyz="0 0 1"/></joint>
+  <joint name="K{tag}" type="continuous"><parent link="base"/><child link="p{tag}"/>
+    <origin xyz="0.12 {y} 0.05"/><axis xyz="0 0 1"/><mimic joint="J{tag}" multiplier="-3" offset="0"/>
+    <gearcli:gear name="g{tag}" kind="external" teeth="20 60" mesh_point="0.09 {y} 0.05" pressure_angle_deg="20"/>
+  </joint>
+  <transmission name="t{tag}"><type>transmission_interface/SimpleTransmission</type>
+    <joint name="K{tag}"><hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface></joint>
+    <actuator name="m{tag}"><mechanicalReduction>1</mechanicalReduction></actuator></transmission>"""
+
+
+TWO_ARMS = ('<robot name="two_arms" xmlns:gearcli="https://gearcli.dev/urdf/1">\n'
+            '  <gearcli:mechanism gravity="0 0 -9.81"/>\n  <link name="base"/>'
+            + _arm("a", 0.0) + _arm("b", 1.0) + "\n</robot>\n")
+
+
+def test_sign_error_follows_the_numpy_path_through_chunks_and_blocks():
+    """Sample 100 fails only in arm b's (later) block, sample 200 in arm a's (earlier) one
+    (a rate so large that the kinematics of that arm overflow to NaN):
+    in one chunk the numpy path stops at arm a's block and names sample 200; with chunks
+    of 150 samples it names sample 100.  The kernel, which solves every sample through
+    every block, must name the same."""
+    an = analyse(parse_urdf(TWO_ARMS))
+    col = {name: i for i, name in enumerate(an.independent_names)}
+    q, qd, qdd = trajectory(an, 4400, seed=2)
+    qd[100, col["Jb"]] = 1e200          # w x w overflows: NaN in arm b only (0 * 1e200 = 0)
+    qd[200, col["Ja"]] = 1e200
+    expect = {20_000: (200, ["'ga'"]), 150: (100, ["'gb'"])}
+    for chunk, named in expect.items():
+        assert _sign_error(an, q, qd, qdd, "numpy", chunk) == named
+        assert _sign_error(an, q, qd, qdd, "kernel", chunk) == named
+
+
+def test_backend_choice_and_errors():
+    an = analyse(mechanism("paper_2dof.yaml"))
+    q = np.zeros((3, an.dof))
+    with pytest.raises(ValueError, match="unknown backend"):
+        solve(an, q, q, q, backend="fortran")
+    with pytest.raises(ValueError, match="method 'block' only"):
+        solve(an, q, q, q, method="full", backend="kernel")
+    with pytest.raises(ValueError, match="jobs"):
+        solve(an, q, q, q, backend="kernel", jobs=0)
+    res = solve(an, q, q, q, method="full")               # auto: numpy for the full solve
+    assert res.motor.shape == (3, len(an.motor_links))
+
+
+def test_verify_with_the_kernel():
+    an = analyse(mechanism("loaded:bendix_wrist.yaml"))
+    q, qd, qdd = trajectory(an, 300)
+    res = solve(an, q, qd, qdd, backend="kernel", verify=True, chunk=128, loads=per_sample_loads(an, 300))
+    assert res.residual is not None and res.residual < 1e-12
+
+
+# --- the comparison catches a wrong program ----------------------------------------------------
+def _flag_row(prog) -> int:
+    """A joint record whose parent is not the base and whose R_pj is not the identity."""
+    jrec, jflt = prog.ints[0], prog.flts[0]
+    return next(k for k in range(len(jrec)) if not jrec[k, 4] & 3
+                and not np.allclose(jflt[k, :9].reshape(3, 3), np.eye(3)))
+
+
+MUTATIONS = [("flts", 0, 10), ("flts", 1, None), ("flts", 4, 7), ("flts", 5, 3), ("flts", 6, 2), ("ints", 0, None)]
+
+
+@pytest.mark.parametrize("field,which,flat", MUTATIONS)
+def test_a_wrong_program_entry_is_caught(field, which, flat):
+    """Perturb one entry of the program (a joint placement, an inertia, an inverse block
+    matrix, a propagation column, a world-frame term, a kinematic shortcut flag): the
+    comparison of test_kernel_equals_numpy must then fail."""
+    key = "geared_arm.urdf" if which == 6 else "loaded:bendix_wrist.yaml"
+    an = analyse(mechanism(key))
+    sol = solver_for(an)
+    prog = sol.kernel_program()
+    arrays = list(getattr(prog, field))
+    bad = arrays[which].copy()
+    if field == "ints":
+        bad[_flag_row(prog), 4] |= 2                      # claim R_pj = I wrongly
+    else:
+        flat = 13 * an.tree.moving[-1] + 5 if flat is None else flat    # an inertia entry
+        bad.reshape(-1)[flat] += 1e-6 * (1.0 + abs(bad.reshape(-1)[flat]))
+    q, qd, qdd = trajectory(an, 400)
+    loads = per_sample_loads(an, 400)
+    ref = solve(an, q, qd, qdd, backend="numpy", loads=loads)
+    assert worst(solve(an, q, qd, qdd, backend="kernel", loads=loads), ref) < TOL
+    sol._program = dataclasses.replace(prog, **{field: tuple(bad if i == which else x for i, x in enumerate(arrays))})
+    try:
+        res = solve(an, q, qd, qdd, backend="kernel", loads=loads)
+    finally:
+        sol._program = prog
+    assert worst(res, ref) > 1e3 * TOL
