@@ -229,6 +229,11 @@ TRAJ_HELP = ("Trajectory CSV: header t,q:<joint>,... for every independent joint
              "optional qd:/qdd: columns (rad/s, rad/s^2); time t in s, strictly increasing.")
 
 
+METHOD_OPTION = typer.Option("block", "--method", help="'block': level-by-level schedule (fast); 'full': cross-check.")
+JOBS_OPTION = typer.Option(None, "--jobs", "-j", min=1, help="Kernel threads (default: all cores; same results).")
+BACKEND_OPTION = typer.Option("auto", "--backend", help="'kernel' (numba), 'numpy' (reference) or 'auto'.")
+
+
 @app.command()
 @reports_bad_input
 def solve(
@@ -241,15 +246,12 @@ def solve(
                                   "values, 1..17 (default 9; 17 round-trips float64)."),
     degrees: bool = typer.Option(False, "--degrees", help="Angle columns of the trajectory are in "
                                  "degrees (deg, deg/s, deg/s^2)."),
-    method: str = typer.Option("block", "--method", help="'block': the level-by-level schedule "
-                               "(fast); 'full': all equations simultaneously (cross-check)."),
+    method: str = METHOD_OPTION,
     verify: bool = typer.Option(False, "--verify", help="Compute every link's Newton-Euler "
                                 "residual from the solved forces and print the worst (relative)."),
     chunk: int = typer.Option(20_000, "--chunk", min=100, help="Samples processed at once (bounds memory)."),
-    jobs: int = typer.Option(None, "--jobs", "-j", min=1, help="Threads for the compiled kernel "
-                             "(default: every usable core); results do not depend on it."),
-    backend: str = typer.Option("auto", "--backend", help="'kernel': compiled per-sample kernel "
-                                "(numba); 'numpy': array reference; 'auto': the kernel when available."),
+    jobs: int = JOBS_OPTION,
+    backend: str = BACKEND_OPTION,
 ) -> None:
     """Motor torques (N*m), bearing reaction wrenches (N, N*m, parent on child, joint frame)
     and gear tooth forces (N) at every sample of a trajectory.  Writes a table (CSV, Parquet,
@@ -259,8 +261,7 @@ def solve(
 
     from .pipeline import check_solve_options, solve_file  # noqa: PLC0415
 
-    an = load_analysis(mech)
-    check_solve_options(an, method, backend)
+    an = check_solve_options(load_analysis(mech), method, backend)
     out = output if output is not None else str(traj.with_suffix(".loads.csv"))
     err = Console(stderr=True, markup=False, highlight=False)
     if not err.is_terminal:

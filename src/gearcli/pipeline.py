@@ -67,9 +67,9 @@ class SolveReport:
     output: Path | None
 
 
-def check_solve_options(an: Analysis, method: str, backend: str) -> None:
-    """Raise :class:`GearcliError` for a bad ``--method`` or ``--backend`` (the kernel must be
-    available for the mechanism when asked for)."""
+def check_solve_options(an: Analysis, method: str, backend: str) -> Analysis:
+    """``an``, or :class:`GearcliError` for a bad ``--method`` or ``--backend`` (the kernel
+    must be available for the mechanism when asked for)."""
     if method not in ("block", "full"):
         raise GearcliError(f"--method: expected 'block' or 'full', got '{method}'")
     if backend not in BACKENDS:
@@ -78,6 +78,7 @@ def check_solve_options(an: Analysis, method: str, backend: str) -> None:
         solver_for(an).backend(method, backend)
     except ValueError as exc:
         raise GearcliError(f"--backend: {exc}") from None
+    return an
 
 
 def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, method: str = "block",

@@ -165,14 +165,20 @@ def _propagate(F, p0, np_, prec, cmat, later, R, o, x, rhs):
 
 
 @njit(**OPTS)
-def _store(n, b, brec, gcol, scol, cbrec, q, x, sig, X, SG):
+def _store(n, b, brec, gcol, scol, cbrec, turns, q, x, sig, X, SG):
     """Write block b's solution (joint reactions in the child's basis) and signs."""
     nloc, g0, m, t0, cb0, ncb = brec[b, 3], brec[b, 4], brec[b, 5], brec[b, 6], brec[b, 10], brec[b, 11]
     for i in range(nloc):
         X[n, gcol[g0 + i]] = x[i]
     for e in range(cb0, cb0 + ncb):
-        c0 = cbrec[e, 0]
-        cq, sq = np.cos(q[cbrec[e, 1]]), np.sin(q[cbrec[e, 1]])
+        c0, j = cbrec[e, 0], cbrec[e, 1]
+        if j >= 0:
+            angle = q[j]
+        else:
+            angle = 0.0
+            for k in range(q.shape[0]):
+                angle += turns[cbrec[e, 2] + k] * q[k]
+        cq, sq = np.cos(angle), np.sin(angle)
         for h in (0, 3):
             x0, x1 = x[c0 + h], x[c0 + h + 1]
             X[n, gcol[g0 + c0 + h]] = cq * x0 + sq * x1
@@ -185,7 +191,7 @@ def _store(n, b, brec, gcol, scol, cbrec, q, x, sig, X, SG):
 def _blocks(n, ints, flts, q, R, o, rhs, r, x, sig, A, X, SG, fail):
     """Every block of the schedule in order, for sample n."""
     jrec, brec, blinks, gcol, tcol, scol, prec, later, cbrec, moving, trec, meta = ints
-    jflt, lflt, S, g, ainv, cmat, tflt = flts
+    jflt, lflt, S, g, ainv, cmat, tflt, turns = flts
     base = meta[0]
     ctx = (ainv, trec, tflt, R, o, A)
     for b in range(brec.shape[0]):
@@ -207,7 +213,7 @@ def _blocks(n, ints, flts, q, R, o, rhs, r, x, sig, A, X, SG, fail):
             world_propagate(k0, nt, trec, tflt, sig, R, o, x, rhs)
         else:
             _propagate(F, brec[b, 8], brec[b, 9], prec, cmat, later, R, o, x, rhs)
-        _store(n, b, brec, gcol, scol, cbrec, q, x, sig, X, SG)
+        _store(n, b, brec, gcol, scol, cbrec, turns, q, x, sig, X, SG)
 
 
 @njit(**OPTS)

@@ -20,8 +20,10 @@ reading what to do from the arrays built here once per analysis (from the
 * ``prec`` (P, 7) int per propagated group [first column, size, 1 if signed, cmat offset,
   primary link, later-links offset, count]; ``cmat`` its C_plus (6, size) then C_sep;
   ``later`` the later links;
-* ``cbrec`` (C, 2) int [first column, joint index]: joint reactions solved in the parent's
-  basis, turned by -q to the child's; ``meta`` [base link id].
+* ``cbrec`` (C, 3) int [first column, joint index or -1, offset in ``turns``]: joint
+  reactions solved in another link's basis, turned to the child's by -q of the joint, or
+  by -(q @ row) with the (J,) row at the offset in ``turns`` (a basis carried by a third
+  coaxial link, :mod:`.coaxial_frames`); ``meta`` [base link id].
 
 Blocks without a constant frame (F = -1 in ``brec``) are solved in world axes from the
 column terms of :mod:`.kernel_terms`.
@@ -100,7 +102,7 @@ class _Builder:
 
     def __init__(self):
         self.brec, self.blinks, self.gcol, self.tcol, self.scol = [], [], [], [], []
-        self.ainv, self.prec, self.cmat, self.later, self.cbrec = [], [], [], [], []
+        self.ainv, self.prec, self.cmat, self.later, self.cbrec, self.turns = [], [], [], [], [], []
         self.ainv_len = self.cmat_len = 0
 
     def add_floats(self, attr: str, arr) -> int:
@@ -139,7 +141,11 @@ def _block(bd: _Builder, an, bi, p, block_of, offsets, sigcol, terms):
             bd.propagation(an, p, gi, g, later)
             rec[9] += 1
         if p.parent_side.get(gi):
-            bd.cbrec.append([int(p.offs[gi]), g.index])
+            if gi in p.turn:               # basis carried by a third coaxial link: q @ row
+                bd.cbrec.append([int(p.offs[gi]), -1, len(bd.turns)])
+                bd.turns += [float(v) for v in p.turn[gi]]
+            else:
+                bd.cbrec.append([int(p.offs[gi]), g.index, 0])
             rec[11] += 1
     bd.brec.append(rec)
 
@@ -164,9 +170,9 @@ def build_program(an, plans=None) -> Program:
     ints = (jrec, np.array(bd.brec, I64).reshape(-1, 14), np.array(bd.blinks, I64),
             np.array(bd.gcol, I64), np.array(bd.tcol + [0], I64), np.array(bd.scol + [0], I64),
             np.array(bd.prec, I64).reshape(-1, 7), np.array(bd.later + [0], I64),
-            np.array(bd.cbrec, I64).reshape(-1, 2), np.array(an.tree.moving, I64), trec,
+            np.array(bd.cbrec, I64).reshape(-1, 3), np.array(an.tree.moving, I64), trec,
             np.array([an.tree.base], I64))
     flts = (jflt, _links(an), np.ascontiguousarray(an.S, float), np.asarray(an.mech.gravity, float),
-            cat(bd.ainv), cat(bd.cmat), tflt)
+            cat(bd.ainv), cat(bd.cmat), tflt, np.array(bd.turns + [0.0]))
     covered = all(p.F is not None or int(p.offs[-1]) == 6 * len(p.links) for p in plans)
     return Program(ints, flts, c, offsets, signed, [p.names for p in plans], covered)
