@@ -37,6 +37,7 @@ import numpy as np
 
 from ..errors import Issue, TrajectoryError
 from .load_columns import load_columns, load_samples
+from .text_lines import line_chunks
 
 PAD = 64
 MAX_ABS = 1e12        # largest |value| accepted, SI units (s, rad, m and their rates)
@@ -283,19 +284,8 @@ class TrajectoryReader:
         last_t = None
         with self._open() as f:
             self._readline(f, 1)
-            lineno = 1
-            while True:
-                lines, linenos = [], []
-                while len(lines) < self.chunk:
-                    lineno += 1
-                    text = self._readline(f, lineno)
-                    if not text:
-                        break
-                    if text.strip():
-                        lines.append(text)
-                        linenos.append(lineno)
-                if not lines:
-                    return
+            too_long = lambda n: _fail(self.file, n, "", f"line longer than {MAX_LINE} characters")  # noqa: E731
+            for lines, linenos in line_chunks(f, 1, self.chunk, MAX_LINE, too_long):
                 data = _parse_rows(lines, linenos, self.header, self.sep, self.file)
                 si = data * self.scale
                 _check_values(data, si, lines, linenos, self.header, self.sep, self.file)

@@ -20,6 +20,9 @@ random tables with ties, negative zeros, subnormals and huge values against ``"%
 """
 from __future__ import annotations
 
+import io
+import os
+
 import numpy as np
 
 FAST_DIGITS = 10
@@ -43,6 +46,26 @@ def format_rows(tab: np.ndarray, digits: int = 9, compiled: bool = True) -> str:
     return compiled_rows(tab, digits)
 
 
+def write_rows(f, tab: np.ndarray, digits: int = 9, compiled: bool = True) -> None:
+    """Write :func:`format_rows` to the text file ``f``; the compiled bytes go straight
+    to the binary buffer of a plain :class:`io.TextIOWrapper` (no decoding, re-encoding)."""
+    tab = np.asarray(tab, dtype=float)
+    if compiled and digits <= FAST_DIGITS and type(f) is io.TextIOWrapper and os.linesep == "\n" and _ascii_safe(f):
+        data = compiled_bytes(tab, digits)
+        f.flush()
+        f.buffer.write(data)
+    else:
+        f.write(format_rows(tab, digits, compiled))
+
+
+def _ascii_safe(f) -> bool:
+    """True when the text file encodes ASCII as itself (UTF-8, ASCII, Latin-1, ...)."""
+    try:
+        return "x,-.e+0123456789\n".encode(f.encoding) == b"x,-.e+0123456789\n"
+    except (LookupError, TypeError):
+        return False
+
+
 def python_rows(tab: np.ndarray, digits: int = 9) -> str:
     """CSV text by Python's ``%`` formatting (the reference behaviour)."""
     n, m = tab.shape
@@ -52,6 +75,11 @@ def python_rows(tab: np.ndarray, digits: int = 9) -> str:
 
 def compiled_rows(tab: np.ndarray, digits: int = 9) -> str:
     """CSV text by the compiled two-pass writer (see the module docstring)."""
+    return str(compiled_bytes(tab, digits), "ascii")
+
+
+def compiled_bytes(tab: np.ndarray, digits: int = 9) -> memoryview:
+    """ASCII bytes of :func:`compiled_rows` (no copy to a ``str``)."""
     from . import csv_kernels as k  # noqa: PLC0415 (numba: imported only for large tables)
 
     if not 1 <= digits <= FAST_DIGITS:
@@ -71,4 +99,4 @@ def compiled_rows(tab: np.ndarray, digits: int = 9) -> str:
     np.cumsum(lengths, out=offsets[1:])
     out = np.empty(v.size * (digits + 8) + extra.size, np.uint8)
     used = k.emit(v, mant, expo, kind, extra, offsets, ncol, digits, out)
-    return out[:used].tobytes().decode("ascii")
+    return memoryview(out[:used])

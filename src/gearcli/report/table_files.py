@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .csv_text import format_rows
+from .csv_text import write_rows
 
 FORMATS = {".csv": "csv", ".parquet": "parquet", ".feather": "feather", ".npz": "npz"}
 """Output file extension -> format (a name without extension is CSV)."""
@@ -59,7 +59,7 @@ class CsvTable:
         f.write(",".join(names) + "\n")
 
     def write(self, tab: np.ndarray) -> None:
-        self.f.write(format_rows(tab, self.precision, compiled=self.compiled))
+        write_rows(self.f, tab, self.precision, compiled=self.compiled)
 
     def close(self) -> None:
         pass
