@@ -234,3 +234,66 @@ def test_bearings_on_a_prismatic_joint_are_refused(run_cli, tmp_path, text):
     assert r.exit_code == 2
     first = r.stderr.splitlines()[0]
     assert re.match(rf"{re.escape(str(path))}:\d+: joints\[1\]\.bearings: rolling-bearing ratings", first), first
+
+
+PINION_ON_CARRIAGE = """
+name: pinion_on_carriage
+base: frame
+end_effector: carriage
+links:
+  - {name: frame}
+  - {name: carriage, mass: 5.0}
+  - {name: pinion, mass: 0.3, inertia: [1.0e-4, 1.0e-4, 1.5e-4]}
+joints:
+  - {name: Jx, parent: frame, child: carriage, type: prismatic, origin: {xyz: [0, 0, 0]}, axis: [1, 0, 0]}
+  - {name: Jp, parent: carriage, child: pinion, origin: {xyz: [0, 0.03, 0]}, axis: [0, 0, 1]}
+gears:
+  - {name: rack, links: [pinion, frame], kind: rack, mesh_point: [0, 0, 0], carrier: carriage}
+motors:
+  - {name: m1, link: pinion}
+loads:
+  - {name: push, link: carriage, point: [0, 0, 0], frame: base, force: [-100, 0, 0]}
+"""
+
+
+@pytest.mark.parametrize("method", ["block", "full"])
+def test_pinion_riding_on_the_carriage(method):
+    """The motor pinion rides on the carriage (the carrier) and meshes a rack fixed in the
+    frame below it: at the mesh point (0, -0.03) from the pinion axis, u_t = +x, so the
+    frame runs +r theta relative to the carriage and the carriage x = -r theta.  Power
+    balance by hand: tau theta_dot = d/dt(m x_dot^2/2 + I theta_dot^2/2) - F x_dot."""
+    an = analyse(parse_mechanism(PINION_ON_CARRIAGE))
+    np.testing.assert_allclose(an.A[0, 0], -1 / 0.03, rtol=1e-12)
+    x, xd, xdd = (np.array([[0.0], [0.1], [-0.2]]), np.array([[0.0], [0.3], [-0.5]]),
+                  np.array([[0.0], [2.0], [1.0]]))
+    res = solve(an, x, xd, xdd, method=method, verify=True)
+    assert res.residual < 1e-12
+    th_d, th_dd = -xd / 0.03, -xdd / 0.03
+    # the pinion's centre moves with the carriage: its kinetic energy has 0.3 x_dot^2 / 2 too
+    dT = (5.0 + 0.3) * xd * xdd + 1.5e-4 * th_d * th_dd
+    np.testing.assert_allclose(res.motor * th_d, dT - (-100.0) * xd, atol=1e-12)
+    np.testing.assert_allclose(res.motor[0, 0], -100.0 * 0.03, rtol=1e-12)
+
+
+def test_rack_tooth_rating_by_hand(text):
+    """A rated rack pair: the pinion's teeth follow from its pitch radius and the module
+    (2 x 0.024 / 0.002 = 24, Lewis Y = 0.337 from Shigley's table), the rack has Y = 0.485
+    (the pinion governs), and the Hertz stress has (u + 1) / u = 1 (a rack is u -> inf):
+    sigma_H = Z_H Z_E sqrt(|t| / (d1 b)), Z_H = sqrt(2 / (sin 20 cos 20))."""
+    from gearcli.design.checks import Requirements, build_checks
+    from gearcli.design.evaluate import Samples, signal
+    from gearcli.errors import Collector
+    from gearcli.report.columns import named_columns
+    rated = text.replace("    pressure_angle_deg: 20\n", "    pressure_angle_deg: 20\n    rating: {module: 0.002, "
+                         "face_width: 0.02, bending_stress_limit: 2.0e8, contact_stress_limit: 8.0e8}\n")
+    an = analyse(parse_mechanism(rated))
+    res = solve(an, *static([0.0]))
+    col = Collector("<test>", {})
+    checks = [c for c in build_checks(an, Requirements(), col) if c.component == "gear rack"]
+    assert not col.issues and len(checks) == 2
+    s = Samples(np.zeros(1), named_columns(an, res), np.zeros((1, 2)))
+    got = {c.quantity: signal(c, s, an.mech)[0] for c in checks}
+    a = np.radians(20.0)
+    assert got["bending safety"] == pytest.approx(80.0 / (0.02 * 0.002 * 0.337), rel=1e-12)
+    ZH = np.sqrt(2 / (np.sin(a) * np.cos(a)))
+    assert got["contact safety"] == pytest.approx(ZH * 189.8e3 * np.sqrt(80.0 / (0.048 * 0.02)), rel=1e-12)
