@@ -297,3 +297,9 @@ def test_rack_tooth_rating_by_hand(text):
     assert got["bending safety"] == pytest.approx(80.0 / (0.02 * 0.002 * 0.337), rel=1e-12)
     ZH = np.sqrt(2 / (np.sin(a) * np.cos(a)))
     assert got["contact safety"] == pytest.approx(ZH * 189.8e3 * np.sqrt(80.0 / (0.048 * 0.02)), rel=1e-12)
+
+
+def test_graph_marks_the_prismatic_joint(run_cli, mech_dir):
+    rack = mech_dir / "rack_axis.yaml"
+    assert "Jx: frame -> carriage (prismatic)" in run_cli("graph", rack).stdout
+    assert '"frame" -> "carriage" [label="a (prismatic)", penwidth=1];' in run_cli("graph", rack, "--dot").stdout

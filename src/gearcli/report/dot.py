@@ -59,12 +59,16 @@ def _thin_lines(an: Analysis, real: bool) -> list[str]:
         for jt in an.mech.joints:
             lab = an.label[an.tree.index[jt.child]]
             out.append(f"  {quote(jt.parent)} -> {quote(jt.child)} "
-                       f"{_attrs(label=f'{lab} ({jt.name})', penwidth=1)};")
+                       f"{_attrs(label=f'{lab} ({jt.name}){_SLIDES[jt.type]}', penwidth=1)};")
         return out
     for i in an.tree.moving:
+        kind = an.mech.joints[an.tree.parent_joint[i]].type
         out.append(f"  {quote(n[an.canonical_parent[i]])} -> {quote(n[i])} "
-                   f"{_attrs(label=an.label[i], penwidth=1)};")
+                   f"{_attrs(label=an.label[i] + _SLIDES[kind], penwidth=1)};")
     return out
+
+
+_SLIDES = {"revolute": "", "prismatic": " (prismatic)"}
 
 
 def _heavy_lines(an: Analysis) -> list[str]:
@@ -94,6 +98,6 @@ def to_dot(an: Analysis, real: bool = False) -> str:
     ]
     if not real:
         lines += ["  // levels (thin-edge distance from the root)", *_rank_lines(an)]
-    lines += ["  // thin edges: revolute joints, labelled by axis", *_thin_lines(an, real),
+    lines += ["  // thin edges: joints, labelled by axis (prismatic ones marked)", *_thin_lines(an, real),
               "  // heavy edges: gear pairs", *_heavy_lines(an), "}"]
     return "\n".join(lines) + "\n"

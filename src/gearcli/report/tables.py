@@ -66,8 +66,9 @@ def links_table(an: Analysis) -> Table:
             t.add_row(name, "0", "base", "-", "-", "-")
             continue
         jt = an.mech.joints[an.tree.parent_joint[i]]
+        slides = " (prismatic)" if jt.type == "prismatic" else ""
         t.add_row(name, str(an.level[i]), "primary" if i in prim else "secondary",
-                  n[an.canonical_parent[i]], str(an.label[i]), f"{jt.name}: {jt.parent} -> {jt.child}")
+                  n[an.canonical_parent[i]], str(an.label[i]), f"{jt.name}: {jt.parent} -> {jt.child}{slides}")
     return t
 
 
