@@ -303,3 +303,16 @@ def test_graph_marks_the_prismatic_joint(run_cli, mech_dir):
     rack = mech_dir / "rack_axis.yaml"
     assert "Jx: frame -> carriage (prismatic)" in run_cli("graph", rack).stdout
     assert '"frame" -> "carriage" [label="a (prismatic)", penwidth=1];' in run_cli("graph", rack, "--dot").stdout
+
+
+def test_urdf_bearings_on_a_prismatic_joint_are_refused(run_cli, tmp_path, axis):
+    path = tmp_path / "rack.urdf"
+    export_urdf(axis, path)
+    text = path.read_text().replace(
+        '<joint name="Jx" type="prismatic">',
+        '<joint name="Jx" type="prismatic">\n    <gearcli:bearing name="a" position="0.0" C="5400.0" C0="2360.0" '
+        'type="ball"/>')
+    path.write_text(text)
+    r = run_cli("check", path)
+    assert r.exit_code == 2 and "Traceback" not in r.stderr
+    assert "joint 'Jx'" in r.stderr and "rolling-bearing ratings" in r.stderr, r.stderr
