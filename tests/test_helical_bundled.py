@@ -246,3 +246,12 @@ def test_pinocchio_rnea_per_shaft_with_tooth_forces(mech_dir, an):
             x = res.joint[n, ji[JOINT_OF[name]]]
             want = np.r_[x[:5], motor]
             assert rel_err(data.f[jid].vector, want) < 1e-9
+
+
+@pytest.mark.parametrize("backend", ["numpy", "kernel"])
+def test_block_equals_full_on_bundled_trajectory(mech_dir, an, backend):
+    """Consistency check: the block schedule (both backends) against the full solve."""
+    _, q, qd, qdd = trajectory(mech_dir)
+    a, b = solve(an, q, qd, qdd, method="block", backend=backend), solve(an, q, qd, qdd, method="full")
+    for f in ("motor", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial"):
+        assert rel_err(getattr(a, f), getattr(b, f)) < 1e-12, f

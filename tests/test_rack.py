@@ -120,10 +120,12 @@ def test_power_balance_along_bundled_trajectory(mech_dir, text, gravity, method)
     assert np.ptp(p_motor) > 10.0      # the motion really exercises the balance
 
 
-def test_block_equals_full_on_bundled_trajectory(mech_dir, axis):
+@pytest.mark.parametrize("backend", ["numpy", "kernel"])
+def test_block_equals_full_on_bundled_trajectory(mech_dir, axis, backend):
+    """Consistency check: the block schedule (both backends) against the full solve."""
     data = np.loadtxt(mech_dir / "rack_axis_traj.csv", delimiter=",", skiprows=1)
     q, qd, qdd = data[:, 1:2], data[:, 2:3], data[:, 3:4]
-    a, b = solve(axis, q, qd, qdd, method="block"), solve(axis, q, qd, qdd, method="full")
+    a, b = solve(axis, q, qd, qdd, method="block", backend=backend), solve(axis, q, qd, qdd, method="full")
     for f in ("motor", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial"):
         assert rel_err(getattr(a, f), getattr(b, f)) < 1e-12, f
 
