@@ -27,15 +27,21 @@ def line_chunks(f, lineno: int, chunk: int, max_line: int,
         block = f.read(BLOCK)
         parts = (rest + block).split("\n")
         rest = parts.pop() if block else ""
-        bad = next((i for i, p in enumerate(parts) if len(p) >= max_line), None)
-        if bad is None and len(rest) >= max_line:
+        bad = None
+        if parts and max(map(len, parts)) >= max_line:
+            bad = next(i for i, p in enumerate(parts) if len(p) >= max_line)
+        elif len(rest) >= max_line:
             bad = len(parts)
         if bad is not None:      # the lines before it are still yielded by full chunks, as a
             parts = parts[:bad]  # line-by-line reader would have done before meeting it
-        kept = [(n, p) for n, p in enumerate(parts, lineno + 1) if p and not p.isspace()]
+        if "" not in parts and not any(map(str.isspace, parts)):   # no blank line (usual)
+            nos += range(lineno + 1, lineno + 1 + len(parts))
+            lines += parts
+        else:
+            kept = [(n, p) for n, p in enumerate(parts, lineno + 1) if p and not p.isspace()]
+            nos += [n for n, _ in kept]
+            lines += [p for _, p in kept]
         lineno += len(parts)
-        nos += [n for n, _ in kept]
-        lines += [p for _, p in kept]
         while len(lines) >= chunk:
             yield lines[:chunk], nos[:chunk]
             del lines[:chunk], nos[:chunk]
