@@ -136,3 +136,13 @@ def test_public_api():
     assert issubclass(gearcli.MechanismError, gearcli.GearcliError)
     with pytest.raises(AttributeError):
         gearcli.no_such_name  # noqa: B018
+
+
+def test_cli_import_stays_light():
+    """`gearcli --help` must not pay for numpy, scipy or the analysis (report modules the
+    CLI imports at the top use them only under TYPE_CHECKING or inside functions)."""
+    import subprocess
+    import sys
+    code = "import sys, gearcli.cli; print(sorted(m for m in ('numpy', 'scipy') if m in sys.modules))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"

@@ -3,22 +3,22 @@
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
-import numpy as np
-
-from ..analysis.graph import Analysis
+if TYPE_CHECKING:   # no numpy or analysis import for `gearcli --help`
+    from ..analysis.graph import Analysis
 
 OPPOSITE = {"right": "left", "left": "right"}
 
 
 def _vec(x) -> str:
-    return "[" + ", ".join(f"{float(v):.6g}" for v in np.asarray(x, float)) + "]"
+    return "[" + ", ".join(f"{float(v):.6g}" for v in x) + "]"
 
 
 def load_dicts(an: Analysis) -> list[dict]:
     """Each external load: name, link, frame, point (m, link frame), force (N), moment (N*m)."""
-    return [{"name": ld.name, "link": ld.link, "frame": ld.frame, "point": np.asarray(ld.point, float).tolist(),
-             "force": np.asarray(ld.force, float).tolist(), "moment": np.asarray(ld.moment, float).tolist()}
+    return [{"name": ld.name, "link": ld.link, "frame": ld.frame, "point": [float(v) for v in ld.point],
+             "force": [float(v) for v in ld.force], "moment": [float(v) for v in ld.moment]}
             for ld in an.mech.loads]
 
 

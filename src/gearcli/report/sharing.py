@@ -2,7 +2,10 @@
 pairs share their load, and by which model."""
 from __future__ import annotations
 
-from ..analysis.graph import Analysis
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:   # no numpy or analysis import for `gearcli --help`
+    from ..analysis.graph import Analysis
 
 MODEL = "load shared by mesh stiffness, min sum t^2/k"
 
