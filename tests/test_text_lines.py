@@ -58,3 +58,30 @@ def test_line_chunks_equal_a_line_by_line_reader(seed, monkeypatch):
     for chunk in (1, 3, 7, 100):
         for max_line in (8, 20, 1 << 20):
             assert blocked(text, chunk, max_line) == reference(text, chunk, max_line), (chunk, max_line)
+
+
+TOKENS = ["1", "-1", "+1", "1.", ".5", "-.5", "1e5", "1E+05", "1e-400", "1e400", "inf", "-inf", "nan", "NaN",
+          "Infinity", "-Infinity", "INF", " 1", "1 ", '"1.5"', "", "1_0", "0x10", "1d5", "1,5", "\u0661",
+          "1.5e", "e5", ".", "-", "+", "--1", "1e", "00012", "0.1e-2", "\t2", "1.7976931348623157e308",
+          "4.9e-324", "2.4703282292062327e-324", "nan(1)", "+nan", "-nan", "1.0\x00", '"', '""']
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_fast_number_parsing_agrees_with_loadtxt(seed):
+    """parse_floats either declines (None) or returns exactly loadtxt's values."""
+    from gearcli.io.csv_numbers import parse_floats
+
+    rng = np.random.default_rng(seed)
+    accepted = 0
+    for _ in range(400):
+        n, ncol = int(rng.integers(1, 4)), int(rng.integers(1, 4))
+        lines = [",".join(str(rng.choice(TOKENS)) if rng.random() < 0.3 else
+                          repr(float(rng.normal() * 10.0 ** rng.integers(-300, 300))) for _ in range(ncol))
+                 for _ in range(n)]
+        fast = parse_floats(lines, ncol, ",")
+        if fast is None:
+            continue
+        accepted += 1
+        ref = np.loadtxt(lines, delimiter=",", quotechar='"', comments=None, ndmin=2, dtype=float)
+        assert ref.shape == (n, ncol) and np.array_equal(fast.view(np.int64), ref.view(np.int64)), lines
+    assert accepted > 50

@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import Issue, TrajectoryError
+from .csv_numbers import parse_floats
 from .load_columns import load_columns, load_samples
 from .text_lines import line_chunks
 
@@ -173,6 +174,9 @@ def _bad_cell(lines: list[str], linenos: list[int], header: list[str], sep: str,
 def _parse_rows(lines: list[str], linenos: list[int], header: list[str], sep: str, file: str) -> np.ndarray:
     """Rows of floats (n, ncol); on failure, find and report the first bad cell."""
     _check_utf8(file, lines, linenos)
+    data = parse_floats(lines, len(header), sep)
+    if data is not None:
+        return data
     try:
         data = np.loadtxt(lines, delimiter=sep, quotechar='"', comments=None, ndmin=2, dtype=float)
         ok = data.shape == (len(lines), len(header))
