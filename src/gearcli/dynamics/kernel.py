@@ -19,11 +19,12 @@ import numpy as np
 from numba import njit
 
 from .kernel_links import INLINE, OPTS, cross, external, inertia, joint_space, kinematics, rot
+from .kernel_output import write_outputs
 from .kernel_world import world_gather, world_propagate, world_solve
 from .signs import MAX_EXHAUSTIVE, TOL_SIGN
 
 
-@njit(**OPTS)
+@njit(**INLINE)
 def _gather(F, base, lk0, B, blinks, R, o, rhs, r):
     """r (6B) = the block links' right-hand sides in F's axes about o_F."""
     if F == base:            # the base: at rest, world axes, about the origin
@@ -45,7 +46,7 @@ def _gather(F, base, lk0, B, blinks, R, o, rhs, r):
             r[6 * i + 3 + h] = R[F, 0, h] * m0 + R[F, 1, h] * m1 + R[F, 2, h] * m2
 
 
-@njit(**OPTS)
+@njit(**INLINE)
 def _apply(ainv, off, n, nr, r, x):
     """x (n) = Ainv r, Ainv (n, nr) row-major at ``off``."""
     if nr == 6:
@@ -64,7 +65,7 @@ def _apply(ainv, off, n, nr, r, x):
         x[i] = s
 
 
-@njit(**OPTS)
+@njit(**INLINE)
 def consistent(x, tcol, t0, m, sig, tol):
     """True when every t agrees with its sign (up to tol; signs.resolve_signs)."""
     for i in range(m):
@@ -73,21 +74,21 @@ def consistent(x, tcol, t0, m, sig, tol):
     return True
 
 
-@njit(**OPTS)
+@njit(**INLINE)
 def own_signs(x, tcol, t0, m, sig):
     """sig = the signs of the solution's own t (zero counts as positive)."""
     for i in range(m):
         sig[i] = -1.0 if x[tcol[t0 + i]] < 0 else 1.0
 
 
-@njit(**OPTS)
+@njit(**INLINE)
 def pattern_signs(p, m, sig):
     """sig = pattern p of :func:`.signs.sign_patterns` (bit m-1-i set: t_i negative)."""
     for i in range(m):
         sig[i] = -1.0 if (p >> (m - 1 - i)) & 1 else 1.0
 
 
-@njit(**OPTS)
+@njit(**INLINE)
 def _pattern(m, sig):
     """Position of the signs in :func:`.signs.sign_patterns` (signs.pattern_index)."""
     k = 0
@@ -97,7 +98,7 @@ def _pattern(m, sig):
     return k
 
 
-@njit(**OPTS)
+@njit(**INLINE)
 def _trial(ctx, world, a0, k0, nt, n, nr, r, x, m, sig):
     """x = the block's solution for the signs ``sig`` (constant frame: Ainv[pattern] r)."""
     ainv, trec, tflt, R, o, A = ctx
@@ -107,29 +108,28 @@ def _trial(ctx, world, a0, k0, nt, n, nr, r, x, m, sig):
         _apply(ainv, a0 + _pattern(m, sig) * n * nr, n, nr, r, x)
 
 
-@njit(**OPTS)
+@njit(**INLINE)
 def _resolve(ctx, world, a0, k0, nt, n, nr, r, x, tcol, t0, m, sig, tol):
-    """Solve a block with a consistent sign pattern (signs.resolve_signs); False if none."""
+    """Solve a block with a consistent sign pattern (signs.resolve_signs); False if none.
+
+    Step 0: every t positive; steps 1..m: the signs of the previous solution's own t;
+    then every pattern in :func:`.signs.sign_patterns` order (m <= MAX_EXHAUSTIVE).  One
+    call site of the solve keeps the compiled code small."""
     for i in range(m):
         sig[i] = 1.0
-    _trial(ctx, world, a0, k0, nt, n, nr, r, x, m, sig)
-    if consistent(x, tcol, t0, m, sig, tol):
-        return True
-    for _ in range(m):
-        own_signs(x, tcol, t0, m, sig)
+    steps = 1 + m + ((1 << m) if m <= MAX_EXHAUSTIVE else 0)
+    for step in range(steps):
+        if step > m:
+            pattern_signs(step - m - 1, m, sig)
+        elif step > 0:
+            own_signs(x, tcol, t0, m, sig)
         _trial(ctx, world, a0, k0, nt, n, nr, r, x, m, sig)
         if consistent(x, tcol, t0, m, sig, tol):
             return True
-    if m <= MAX_EXHAUSTIVE:
-        for p in range(1 << m):
-            pattern_signs(p, m, sig)
-            _trial(ctx, world, a0, k0, nt, n, nr, r, x, m, sig)
-            if consistent(x, tcol, t0, m, sig, tol):
-                return True
     return False
 
 
-@njit(**OPTS)
+@njit(**INLINE)
 def _propagate(F, p0, np_, prec, cmat, later, R, o, x, rhs):
     """rhs[L] -= the solved wrenches of the block's groups on their later links L."""
     for e in range(p0, p0 + np_):
@@ -164,12 +164,13 @@ def _propagate(F, p0, np_, prec, cmat, later, R, o, x, rhs):
                 rhs[L, 3 + h] -= s * (mo[h] + e2[h])
 
 
-@njit(**OPTS)
+@njit(**INLINE)
 def _store(n, b, brec, gcol, scol, cbrec, turns, q, x, sig, X, SG):
-    """Write block b's solution (joint reactions in the child's basis) and signs."""
+    """Write block b's solution (joint reactions in the child's basis) into the solution
+    row X and its signs into SG[n]."""
     nloc, g0, m, t0, cb0, ncb = brec[b, 3], brec[b, 4], brec[b, 5], brec[b, 6], brec[b, 10], brec[b, 11]
     for i in range(nloc):
-        X[n, gcol[g0 + i]] = x[i]
+        X[gcol[g0 + i]] = x[i]
     for e in range(cb0, cb0 + ncb):
         c0, j = cbrec[e, 0], cbrec[e, 1]
         if j >= 0:
@@ -181,17 +182,18 @@ def _store(n, b, brec, gcol, scol, cbrec, turns, q, x, sig, X, SG):
         cq, sq = np.cos(angle), np.sin(angle)
         for h in (0, 3):
             x0, x1 = x[c0 + h], x[c0 + h + 1]
-            X[n, gcol[g0 + c0 + h]] = cq * x0 + sq * x1
-            X[n, gcol[g0 + c0 + h + 1]] = -sq * x0 + cq * x1
+            X[gcol[g0 + c0 + h]] = cq * x0 + sq * x1
+            X[gcol[g0 + c0 + h + 1]] = -sq * x0 + cq * x1
     for i in range(m):
         SG[n, scol[t0 + i]] = sig[i]
 
 
-@njit(**OPTS)
+@njit(**INLINE)
 def _blocks(n, ints, flts, q, R, o, rhs, r, x, sig, A, X, SG, fail):
     """Every block of the schedule in order, for sample n."""
-    jrec, brec, blinks, gcol, tcol, scol, prec, later, cbrec, moving, trec, meta = ints
-    jflt, lflt, S, g, ainv, cmat, tflt, turns = flts
+    brec, blinks, gcol, tcol, scol, prec, later, cbrec, trec, meta = (ints[1], ints[2], ints[3], ints[4], ints[5],
+                                                                      ints[6], ints[7], ints[8], ints[10], ints[11])
+    ainv, cmat, tflt, turns = flts[4], flts[5], flts[6], flts[7]
     base = meta[0]
     ctx = (ainv, trec, tflt, R, o, A)
     for b in range(brec.shape[0]):
@@ -217,21 +219,23 @@ def _blocks(n, ints, flts, q, R, o, rhs, r, x, sig, A, X, SG, fail):
 
 
 @njit(**OPTS)
-def run(ints, flts, ldrec, ldflt, vals, qi, qdi, qddi, start, stop, X, SG, fail, scratch):
-    """Solve samples start..stop-1 of qi, qdi, qddi (N, dof) into X (N, ncols) (every unknown, in
-    :func:`~gearcli.analysis.schedule.unknown_groups` order, joint reactions in the child's
-    basis), SG (N, signed meshes) the sign of each t used and fail (N,) the first block with
-    no consistent sign pattern (-1: none); ``fail`` must come filled with -1.  ``scratch``
-    from :func:`~.kernel_driver.scratch` (one per thread).  Compiled without numba's
-    reference counting (``_nrt=False``, which costs ~10 ns an array passed): nothing here
-    allocates."""
+def run(ints, flts, ldrec, ldflt, vals, qi, qdi, qddi, start, stop, outs, scratch):
+    """Solve samples start..stop-1 of qi, qdi, qddi (N, dof) into the output arrays ``outs``
+    (motor (N, M), tau (N, dof), joint (N, J*6), gear_t, gear_sep (N, G), gear_radial,
+    gear_axial (N, G*2), motor speed (N, M), the sign of each t used (N, signed meshes) and
+    fail (N,): the first block with no consistent sign pattern, -1 if none, which must come
+    filled with -1).  ``scratch`` from :func:`~.kernel_driver.scratch` (one per thread).
+    Compiled without numba's reference counting (``_nrt=False``: ~10 ns an array passed
+    otherwise): nothing here allocates."""
     jrec, moving = ints[0], ints[9]
     jflt, lflt, S, g = flts[0], flts[1], flts[2], flts[3]
-    R, o, w, dw, a, rhs, Rj, oj, q, qd, qdd, r, x, sig, A = scratch
+    R, o, w, dw, a, rhs, Rj, oj, q, qd, qdd, r, x, sig, A, xrow = scratch
+    SG, fail = outs[8], outs[9]
     for n in range(start, stop):
         joint_space(S, qi, qdi, qddi, n, q, qd, qdd)
         kinematics(jrec, jflt, q, qd, qdd, R, o, w, dw, a, Rj, oj)
         for L in moving:
             inertia(L, lflt, g, R, w, dw, a, rhs)
         external(n, ldrec, ldflt, vals, R, rhs)
-        _blocks(n, ints, flts, q, R, o, rhs, r, x, sig, A, X, SG, fail)
+        _blocks(n, ints, flts, q, R, o, rhs, r, x, sig, A, xrow, SG, fail)
+        write_outputs(n, xrow, qdi, ints, flts, outs)

@@ -48,11 +48,15 @@ def scratch(prog: Program) -> tuple:
     R[:] = np.eye(3)                          # the base stays at rest
     return (R, np.zeros((nL, 3)), np.zeros((nL, 3)), np.zeros((nL, 3)), np.zeros((nL, 3)),
             np.zeros((nL, 6)), np.zeros((3, 3)), np.zeros(3), np.zeros(J), np.zeros(J), np.zeros(J),
-            np.zeros(nx), np.zeros(nx), np.ones(max([1] + [int(b) for b in brec[:, 5]])), np.zeros((nr, nx)))
+            np.zeros(nx), np.zeros(nx), np.ones(max([1] + [int(b) for b in brec[:, 5]])), np.zeros((nr, nx)),
+            np.zeros(prog.ncols))
+
+
+OUTPUTS = ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial", "motor_speed")
 
 
 def kernel_solve(prog: Program, an, q, qd, qdd, values: dict, jobs: int | None, chunk: int):
-    """Every unknown of every sample, by the kernel.
+    """The loads of every sample, by the kernel.
 
     Parameters
     ----------
@@ -62,25 +66,29 @@ def kernel_solve(prog: Program, an, q, qd, qdd, values: dict, jobs: int | None, 
 
     Returns
     -------
-    ({(kind, index): (N, size)} unknowns (views of one array), {(kind, index): (N,) sign of t}).
+    ({name: array} the fields of :class:`~.solve.Result` (``OUTPUTS``, shaped as there),
+    {(kind, index): (N,) sign of t}).
     """
-    n = q.shape[0]
-    X = np.empty((n, prog.ncols))
+    n, dof = q.shape
+    J, G, M = len(an.mech.joints), len(an.circuits), len(an.motor_links)
+    out = {"motor": np.empty((n, M)), "tau": np.empty((n, dof)), "joint": np.empty((n, J, 6)),
+           "gear_t": np.empty((n, G)), "gear_sep": np.empty((n, G)), "gear_radial": np.empty((n, G, 2)),
+           "gear_axial": np.empty((n, G, 2)), "motor_speed": np.empty((n, M))}
     SG = np.empty((n, len(prog.signed)))
     fail = np.full(n, -1, np.int64)
+    outs = tuple(a.reshape(n, -1) for a in out.values()) + (SG, fail)
     ldrec, ldflt, vals = load_arrays(an, values, n)
     args = (prog.ints, prog.flts, ldrec, ldflt, vals, *(np.ascontiguousarray(a, float) for a in (q, qd, qdd)))
     ranges = job_ranges(n, jobs)
     if len(ranges) == 1:
-        run(*args, 0, n, X, SG, fail, scratch(prog))
+        run(*args, 0, n, outs, scratch(prog))
     else:
         with ThreadPoolExecutor(len(ranges)) as pool:
-            for f in [pool.submit(run, *args, s, e, X, SG, fail, scratch(prog)) for s, e in ranges]:
+            for f in [pool.submit(run, *args, s, e, outs, scratch(prog)) for s, e in ranges]:
                 f.result()
     if np.any(fail >= 0):
         raise _sign_error(prog, fail, chunk)
-    x_all = {k: X[:, c:c + size] for k, (c, size) in prog.offsets.items()}
-    return x_all, {k: SG[:, i] for i, k in enumerate(prog.signed)}
+    return out, {k: SG[:, i] for i, k in enumerate(prog.signed)}
 
 
 def _sign_error(prog: Program, fail: np.ndarray, chunk: int) -> SignError:

@@ -11,8 +11,8 @@ import math
 
 from numba import njit
 
-OPTS = dict(cache=True, nogil=True, fastmath=False, error_model="numpy", _nrt=False)
-INLINE = OPTS
+from .kernel_math import INLINE, OPTS, add, cx, load3, load9, mm, mtv, mv, row3, row9, scale, store3, store9, sub
+
 
 
 @njit(**INLINE)
@@ -39,96 +39,57 @@ def joint_space(S, qi, qdi, qddi, n, q, qd, qdd):
 
 
 @njit(**INLINE)
-def _place(k, f, flags, p, c, prismatic, qk, R, o, Rj, oj):
-    """Joint frame (Rj, oj) of joint record k and its child's R[c], o[c] (kinematics.forward).
+def _joint_frame(k, f, flags, Rp, op, qk, prismatic):
+    """Joint frame (R, o) of joint record k at qk (kinematics.forward), base axes.
 
-    ``flags``: 1 parent is the base, 2 R_pj = I, 4 R_jc = I, 8 p_jc = 0 (skipped products)."""
+    ``flags``: 1 parent is the base, 2 R_pj = I (skipped products)."""
     if flags & 1:
-        for i in range(3):
-            oj[i] = f[k, 9 + i]
-            for j in range(3):
-                Rj[i, j] = f[k, 3 * i + j]
-    elif flags & 2:
-        for i in range(3):
-            oj[i] = o[p, i] + R[p, i, 0] * f[k, 9] + R[p, i, 1] * f[k, 10] + R[p, i, 2] * f[k, 11]
-            for j in range(3):
-                Rj[i, j] = R[p, i, j]
+        R0, oj = row9(f, k, 0), row3(f, k, 9)
     else:
-        for i in range(3):
-            oj[i] = o[p, i] + R[p, i, 0] * f[k, 9] + R[p, i, 1] * f[k, 10] + R[p, i, 2] * f[k, 11]
-            for j in range(3):
-                Rj[i, j] = R[p, i, 0] * f[k, j] + R[p, i, 1] * f[k, 3 + j] + R[p, i, 2] * f[k, 6 + j]
+        R0 = Rp if flags & 2 else mm(Rp, row9(f, k, 0))
+        oj = add(op, mv(Rp, row3(f, k, 9)))
     if prismatic:
-        for i in range(3):
-            oj[i] += Rj[i, 2] * qk
-    else:
-        cq, sq = math.cos(qk), math.sin(qk)
-        for i in range(3):
-            x0, x1 = Rj[i, 0], Rj[i, 1]
-            Rj[i, 0] = cq * x0 + sq * x1
-            Rj[i, 1] = cq * x1 - sq * x0
-    for i in range(3):
-        if flags & 8:
-            o[c, i] = oj[i]
-        else:
-            o[c, i] = oj[i] + Rj[i, 0] * f[k, 21] + Rj[i, 1] * f[k, 22] + Rj[i, 2] * f[k, 23]
-        for j in range(3):
-            if flags & 4:
-                R[c, i, j] = Rj[i, j]
-            else:
-                R[c, i, j] = Rj[i, 0] * f[k, 12 + j] + Rj[i, 1] * f[k, 15 + j] + Rj[i, 2] * f[k, 18 + j]
+        return R0, add(oj, scale((R0[2], R0[5], R0[8]), qk))
+    cq, sq = math.cos(qk), math.sin(qk)
+    return (cq * R0[0] + sq * R0[1], cq * R0[1] - sq * R0[0], R0[2],
+            cq * R0[3] + sq * R0[4], cq * R0[4] - sq * R0[3], R0[5],
+            cq * R0[6] + sq * R0[7], cq * R0[7] - sq * R0[6], R0[8]), oj
 
 
 @njit(**INLINE)
-def _rates(k, f, p, c, prismatic, qdk, qddk, Rj, oj, o, w, dw, a):
-    """w[c], dw[c], a[c] of the child of a joint (kinematics.forward)."""
-    zx, zy, zz = Rj[0, 2], Rj[1, 2], Rj[2, 2]
-    wx, wy, wz = w[p, 0], w[p, 1], w[p, 2]
-    ax_, ay_, az_ = dw[p, 0], dw[p, 1], dw[p, 2]
-    rx, ry, rz = oj[0] - o[p, 0], oj[1] - o[p, 1], oj[2] - o[p, 2]
-    t = cross(ax_, ay_, az_, rx, ry, rz)
-    u = cross(wx, wy, wz, rx, ry, rz)
-    v = cross(wx, wy, wz, u[0], u[1], u[2])
-    a0, a1, a2 = a[p, 0] + t[0] + v[0], a[p, 1] + t[1] + v[1], a[p, 2] + t[2] + v[2]
-    if prismatic:
-        w[c, 0], w[c, 1], w[c, 2] = wx, wy, wz
-        dw[c, 0], dw[c, 1], dw[c, 2] = ax_, ay_, az_
-        e = cross(wx, wy, wz, zx * qdk, zy * qdk, zz * qdk)
-        a0 += zx * qddk + 2.0 * e[0]
-        a1 += zy * qddk + 2.0 * e[1]
-        a2 += zz * qddk + 2.0 * e[2]
+def _joint(k, jrec, f, q, qd, qdd, R, o, w, dw, a):
+    """The child of joint record k: R, o, w, dw, a (kinematics.forward; flags 4 R_jc = I,
+    8 p_jc = 0 skip products)."""
+    ji, p, c, pr, flags = jrec[k, 0], jrec[k, 1], jrec[k, 2], jrec[k, 3] == 1, jrec[k, 4]
+    qdk, qddk = qd[ji], qdd[ji]
+    op, wp, ap, dwp = load3(o, p), load3(w, p), load3(a, p), load3(dw, p)
+    Rj, oj = _joint_frame(k, f, flags, load9(R, p), op, q[ji], pr)
+    z = (Rj[2], Rj[5], Rj[8])
+    r = sub(oj, op)
+    aj = add(ap, add(cx(dwp, r), cx(wp, cx(wp, r))))
+    if pr:
+        wc, dwc = wp, dwp
+        aj = add(aj, add(scale(z, qddk), scale(cx(wp, scale(z, qdk)), 2.0)))
     else:
-        e = cross(wx, wy, wz, zx, zy, zz)
-        w[c, 0], w[c, 1], w[c, 2] = wx + zx * qdk, wy + zy * qdk, wz + zz * qdk
-        dw[c, 0] = ax_ + zx * qddk + e[0] * qdk
-        dw[c, 1] = ay_ + zy * qddk + e[1] * qdk
-        dw[c, 2] = az_ + zz * qddk + e[2] * qdk
-    rx = Rj[0, 0] * f[k, 21] + Rj[0, 1] * f[k, 22] + Rj[0, 2] * f[k, 23]
-    ry = Rj[1, 0] * f[k, 21] + Rj[1, 1] * f[k, 22] + Rj[1, 2] * f[k, 23]
-    rz = Rj[2, 0] * f[k, 21] + Rj[2, 1] * f[k, 22] + Rj[2, 2] * f[k, 23]
-    t = cross(dw[c, 0], dw[c, 1], dw[c, 2], rx, ry, rz)
-    u = cross(w[c, 0], w[c, 1], w[c, 2], rx, ry, rz)
-    v = cross(w[c, 0], w[c, 1], w[c, 2], u[0], u[1], u[2])
-    a[c, 0] = a0 + t[0] + v[0]
-    a[c, 1] = a1 + t[1] + v[1]
-    a[c, 2] = a2 + t[2] + v[2]
+        wc = add(wp, scale(z, qdk))
+        dwc = add(add(dwp, scale(z, qddk)), scale(cx(wp, z), qdk))
+    store9(R, c, Rj if flags & 4 else mm(Rj, row9(f, k, 12)))
+    if flags & 8:
+        store3(o, c, oj)
+        store3(a, c, aj)
+    else:
+        rc = mv(Rj, row3(f, k, 21))
+        store3(o, c, add(oj, rc))
+        store3(a, c, add(aj, add(cx(dwc, rc), cx(wc, cx(wc, rc)))))
+    store3(w, c, wc)
+    store3(dw, c, dwc)
 
 
 @njit(**INLINE)
 def kinematics(jrec, jflt, q, qd, qdd, R, o, w, dw, a, Rj, oj):
     """Every link's R, o, w, dw, a of one sample (base frame; the base row stays at rest)."""
     for k in range(jrec.shape[0]):
-        ji, p, c, pr = jrec[k, 0], jrec[k, 1], jrec[k, 2], jrec[k, 3] == 1
-        _place(k, jflt, jrec[k, 4], p, c, pr, q[ji], R, o, Rj, oj)
-        _rates(k, jflt, p, c, pr, qd[ji], qdd[ji], Rj, oj, o, w, dw, a)
-
-
-@njit(**INLINE)
-def _rot_t(R, L, x, y, z):
-    """R[L]^T v."""
-    return (R[L, 0, 0] * x + R[L, 1, 0] * y + R[L, 2, 0] * z,
-            R[L, 0, 1] * x + R[L, 1, 1] * y + R[L, 2, 1] * z,
-            R[L, 0, 2] * x + R[L, 1, 2] * y + R[L, 2, 2] * z)
+        _joint(k, jrec, jflt, q, qd, qdd, R, o, w, dw, a)
 
 
 @njit(**INLINE)
@@ -140,33 +101,19 @@ def rot(R, L, x, y, z):
 
 
 @njit(**INLINE)
-def _inertia_times(lflt, L, v):
-    """I_c v (link axes) of link L."""
-    return (lflt[L, 1] * v[0] + lflt[L, 2] * v[1] + lflt[L, 3] * v[2],
-            lflt[L, 4] * v[0] + lflt[L, 5] * v[1] + lflt[L, 6] * v[2],
-            lflt[L, 7] * v[0] + lflt[L, 8] * v[1] + lflt[L, 9] * v[2])
-
-
-@njit(**INLINE)
 def inertia(L, lflt, g, R, w, dw, a, rhs):
     """rhs[L] = d'Alembert wrench of link L about o_L, base frame (inertia.inertia_wrench)."""
     m = lflt[L, 0]
-    wb = _rot_t(R, L, w[L, 0], w[L, 1], w[L, 2])
-    ab = _rot_t(R, L, dw[L, 0], dw[L, 1], dw[L, 2])
-    Iw = _inertia_times(lflt, L, wb)
-    Ia = _inertia_times(lflt, L, ab)
-    e = cross(wb[0], wb[1], wb[2], Iw[0], Iw[1], Iw[2])
-    Nw = rot(R, L, Ia[0] + e[0], Ia[1] + e[1], Ia[2] + e[2])
-    rc = rot(R, L, lflt[L, 10], lflt[L, 11], lflt[L, 12])
-    t = cross(dw[L, 0], dw[L, 1], dw[L, 2], rc[0], rc[1], rc[2])
-    u = cross(w[L, 0], w[L, 1], w[L, 2], rc[0], rc[1], rc[2])
-    v = cross(w[L, 0], w[L, 1], w[L, 2], u[0], u[1], u[2])
-    F0 = m * (a[L, 0] + t[0] + v[0] - g[0])
-    F1 = m * (a[L, 1] + t[1] + v[1] - g[1])
-    F2 = m * (a[L, 2] + t[2] + v[2] - g[2])
-    M = cross(rc[0], rc[1], rc[2], F0, F1, F2)
-    rhs[L, 0], rhs[L, 1], rhs[L, 2] = F0, F1, F2
-    rhs[L, 3], rhs[L, 4], rhs[L, 5] = Nw[0] + M[0], Nw[1] + M[1], Nw[2] + M[2]
+    I = row9(lflt, L, 1)
+    RL, wL, dwL = load9(R, L), load3(w, L), load3(dw, L)
+    wb = mtv(RL, wL)
+    Nb = add(mv(I, mtv(RL, dwL)), cx(wb, mv(I, wb)))   # Eq. (18), link axes
+    rc = mv(RL, row3(lflt, L, 10))
+    ac = add(load3(a, L), add(cx(dwL, rc), cx(wL, cx(wL, rc))))
+    F = scale(sub(ac, (g[0], g[1], g[2])), m)             # Eq. (17) with gravity
+    M = add(mv(RL, Nb), cx(rc, F))
+    rhs[L, 0], rhs[L, 1], rhs[L, 2] = F[0], F[1], F[2]
+    rhs[L, 3], rhs[L, 4], rhs[L, 5] = M[0], M[1], M[2]
 
 
 @njit(**INLINE)

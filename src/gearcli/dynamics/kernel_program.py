@@ -23,7 +23,8 @@ reading what to do from the arrays built here once per analysis (from the
 * ``cbrec`` (C, 3) int [first column, joint index or -1, offset in ``turns``]: joint
   reactions solved in another link's basis, turned to the child's by -q of the joint, or
   by -(q @ row) with the (J,) row at the offset in ``turns`` (a basis carried by a third
-  coaxial link, :mod:`.coaxial_frames`); ``meta`` [base link id].
+  coaxial link, :mod:`.coaxial_frames`); ``meta`` [base link id];
+* the output maps of :func:`.kernel_output.output_constants` and the structure matrix A.
 
 Blocks without a constant frame (F = -1 in ``brec``) are solved in world axes from the
 column terms of :mod:`.kernel_terms`.
@@ -36,6 +37,7 @@ import numpy as np
 
 from ..analysis.schedule import unknown_groups
 from .blocks import _primary_side, make_plans
+from .kernel_output import output_constants
 from .kernel_terms import general_terms
 
 I64 = np.int64
@@ -167,12 +169,14 @@ def build_program(an, plans=None) -> Program:
         _block(bd, an, bi, p, block_of, offsets, sigcol, terms)
     jrec, jflt = _joints(an)
     cat = (lambda xs: np.concatenate(xs) if xs else np.zeros(1))
+    jout, mcol, gcol, mflt = output_constants(an, offsets)
     ints = (jrec, np.array(bd.brec, I64).reshape(-1, 14), np.array(bd.blinks, I64),
             np.array(bd.gcol, I64), np.array(bd.tcol + [0], I64), np.array(bd.scol + [0], I64),
             np.array(bd.prec, I64).reshape(-1, 7), np.array(bd.later + [0], I64),
             np.array(bd.cbrec, I64).reshape(-1, 3), np.array(an.tree.moving, I64), trec,
-            np.array([an.tree.base], I64))
+            np.array([an.tree.base], I64), jout, mcol, gcol)
     flts = (jflt, _links(an), np.ascontiguousarray(an.S, float), np.asarray(an.mech.gravity, float),
-            cat(bd.ainv), cat(bd.cmat), tflt, np.array(bd.turns + [0.0]))
+            cat(bd.ainv), cat(bd.cmat), tflt, np.array(bd.turns + [0.0]), mflt,
+            np.ascontiguousarray(an.A, float))
     covered = all(p.F is not None or int(p.offs[-1]) == 6 * len(p.links) for p in plans)
     return Program(ints, flts, c, offsets, signed, [p.names for p in plans], covered)

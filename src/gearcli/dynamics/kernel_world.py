@@ -3,17 +3,18 @@
 The block's balances (Eqs. 15-16, 19-20) in base axes about each link's origin, assembled
 from the column terms of :mod:`.kernel_terms` for a sign pattern of its t and solved by
 Gaussian elimination with partial pivoting (like :func:`~.general.solve_general`, which
-calls LAPACK): a singular matrix gives NaN, which no sign pattern accepts.
+calls LAPACK): a singular matrix gives NaN, which no sign pattern accepts.  The solve is
+not inlined into the kernel (it is rare and costs far more than a call).
 """
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
 
-from .kernel_links import OPTS, cross, rot
+from .kernel_links import INLINE, OPTS, cross, rot
 
 
-@njit(**OPTS)
+@njit(**INLINE)
 def term_wrench(k, L, trec, tflt, sig, R, o):
     """Wrench (6-tuple, base axes, about o_L) of term k per unit of its unknown."""
     X = trec[k, 4]
@@ -75,7 +76,7 @@ def _eliminate(A, nr, r, x):
         x[c] = s / A[c, c]
 
 
-@njit(**OPTS)
+@njit(**INLINE)
 def world_gather(lk0, B, blinks, rhs, r):
     """r (6B) = the block links' right-hand sides (base axes, about each link's origin)."""
     for i in range(B):
@@ -91,7 +92,7 @@ def world_solve(k0, nt, trec, tflt, sig, R, o, nr, r, x, A):
     _eliminate(A, nr, r, x)
 
 
-@njit(**OPTS)
+@njit(**INLINE)
 def world_propagate(k0, nt, trec, tflt, sig, R, o, x, rhs):
     """rhs[L] -= the solved wrenches on the later links (terms with no block row)."""
     for k in range(k0, k0 + nt):

@@ -20,9 +20,10 @@ from __future__ import annotations
 
 import weakref
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
-from threadpoolctl import threadpool_limits
+from threadpoolctl import ThreadpoolController
 
 from ..analysis.schedule import unknown_groups
 from ..model.gears import helical_terms
@@ -70,6 +71,18 @@ class Result:
     gear_axial: np.ndarray
     residual: float | None = None
     motor_speed: np.ndarray | None = None   # (N, M) motor speeds A^T qd, rad/s (m/s linear)
+
+
+@lru_cache(maxsize=1)
+def _blas_controller() -> ThreadpoolController:
+    return ThreadpoolController()
+
+
+def one_blas_thread():
+    """Context limiting BLAS to one thread.  The controller (the scan of the loaded
+    libraries) is built once: ``threadpool_limits`` rescans on every call, ~3 ms, as long
+    as a 5,000-sample kernel solve."""
+    return _blas_controller().limit(limits=1, user_api="blas")
 
 
 def joint_space(an, q_ind, qd_ind=None, qdd_ind=None):
@@ -147,19 +160,19 @@ class Solver:
         values = load_values(self.an.mech, q.shape[0], loads)
         # the operands are 3x3 to 48x48 matrices: BLAS threads only contend (2-3x slower
         # with a busy second core), so one BLAS thread, whatever the environment says
-        with threadpool_limits(limits=1, user_api="blas"):
+        with one_blas_thread():
             if path == "kernel":
-                res = self._by_kernel(q, qd, qdd, values, jobs, chunk, verify)
-            else:
-                res = self._by_numpy(q, qd, qdd, method, chunk, verify, values)
+                return self._by_kernel(q, qd, qdd, values, jobs, chunk, verify)
+            res = self._by_numpy(q, qd, qdd, method, chunk, verify, values)
         res.motor_speed = qd @ self.an.A
         return res
 
     def _by_kernel(self, q, qd, qdd, values, jobs, chunk, verify) -> Result:
         from .kernel_driver import kernel_solve  # noqa: PLC0415  (imports numba)
-        x_all, sig = kernel_solve(self.kernel_program(), self.an, q, qd, qdd, values, jobs, chunk)
-        res = _result(self.an, self.groups, x_all)
+        out, sig = kernel_solve(self.kernel_program(), self.an, q, qd, qdd, values, jobs, chunk)
+        res = Result(**out)
         if verify:
+            x_all = _unknowns(self.an, res)
             worst = 0.0
             for s in range(0, q.shape[0], chunk):
                 sl = slice(s, s + chunk)
@@ -282,6 +295,16 @@ def residual(an, groups, cols, b, x_all, sig) -> float:
         scale = 1.0 + np.max(np.abs(np.concatenate([b[L] for L in an.tree.moving], axis=1)), axis=1)
         worst = max(worst, sign_violation(t, signs, scale))
     return worst
+
+
+def _unknowns(an, res: Result) -> dict:
+    """{(kind, index): (N, size)} every unknown back from a result (the inverse of
+    :func:`_result`: joint reactions in the child's basis without the axis component)."""
+    x = {("motor", i): res.motor[:, i:i + 1] for i in range(res.motor.shape[1])}
+    x.update({("mesh", ci): res.gear_t[:, ci:ci + 1] for ci in range(res.gear_t.shape[1])})
+    for ji, jt in enumerate(an.mech.joints):
+        x[("joint", ji)] = res.joint[:, ji, [0, 1, 3, 4, 5] if jt.type == "prismatic" else [0, 1, 2, 3, 4]]
+    return x
 
 
 def _result(an, groups, x_all) -> Result:
