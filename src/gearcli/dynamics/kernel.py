@@ -18,7 +18,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .kernel_links import INLINE, OPTS, cross, external, inertia, joint_space, kinematics, rot
+from .kernel_links import INLINE, OPTS, external, inertia, joint_space, kinematics
+from .kernel_math import add, cx, load3, load9, mtv, mv, sub
 from .kernel_output import write_outputs
 from .kernel_world import world_gather, world_propagate, world_solve
 from .signs import MAX_EXHAUSTIVE, TOL_SIGN
@@ -27,23 +28,16 @@ from .signs import MAX_EXHAUSTIVE, TOL_SIGN
 @njit(**INLINE)
 def _gather(F, base, lk0, B, blinks, R, o, rhs, r):
     """r (6B) = the block links' right-hand sides in F's axes about o_F."""
-    if F == base:            # the base: at rest, world axes, about the origin
-        for i in range(B):
-            L = blinks[lk0 + i]
-            e = cross(o[L, 0], o[L, 1], o[L, 2], rhs[L, 0], rhs[L, 1], rhs[L, 2])
-            for h in range(3):
-                r[6 * i + h] = rhs[L, h]
-                r[6 * i + 3 + h] = rhs[L, 3 + h] + e[h]
-        return
+    at_rest = F == base      # the base: world axes about the origin already
+    RF, oF = load9(R, F), load3(o, F)
     for i in range(B):
         L = blinks[lk0 + i]
-        dx, dy, dz = o[L, 0] - o[F, 0], o[L, 1] - o[F, 1], o[L, 2] - o[F, 2]
-        e = cross(dx, dy, dz, rhs[L, 0], rhs[L, 1], rhs[L, 2])
-        for h in range(3):
-            r[6 * i + h] = R[F, 0, h] * rhs[L, 0] + R[F, 1, h] * rhs[L, 1] + R[F, 2, h] * rhs[L, 2]
-        m0, m1, m2 = rhs[L, 3] + e[0], rhs[L, 4] + e[1], rhs[L, 5] + e[2]
-        for h in range(3):
-            r[6 * i + 3 + h] = R[F, 0, h] * m0 + R[F, 1, h] * m1 + R[F, 2, h] * m2
+        f = (rhs[L, 0], rhs[L, 1], rhs[L, 2])
+        m = add((rhs[L, 3], rhs[L, 4], rhs[L, 5]), cx(sub(load3(o, L), oF), f))
+        if not at_rest:
+            f, m = mtv(RF, f), mtv(RF, m)
+        r[6 * i], r[6 * i + 1], r[6 * i + 2] = f[0], f[1], f[2]
+        r[6 * i + 3], r[6 * i + 4], r[6 * i + 5] = m[0], m[1], m[2]
 
 
 @njit(**INLINE)
@@ -130,42 +124,52 @@ def _resolve(ctx, world, a0, k0, nt, n, nr, r, x, tcol, t0, m, sig, tol):
 
 
 @njit(**INLINE)
-def _propagate(F, p0, np_, prec, cmat, later, R, o, x, rhs):
-    """rhs[L] -= the solved wrenches of the block's groups on their later links L."""
-    for e in range(p0, p0 + np_):
-        c0, size, signed, co, P, l0, nl = (prec[e, 0], prec[e, 1], prec[e, 2], prec[e, 3],
-                                           prec[e, 4], prec[e, 5], prec[e, 6])
-        wF0, wF1, wF2, wF3, wF4, wF5 = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-        for j in range(size):
-            xj = x[c0 + j]
-            wF0 += cmat[co + j] * xj
-            wF1 += cmat[co + size + j] * xj
-            wF2 += cmat[co + 2 * size + j] * xj
-            wF3 += cmat[co + 3 * size + j] * xj
-            wF4 += cmat[co + 4 * size + j] * xj
-            wF5 += cmat[co + 5 * size + j] * xj
-            if signed == 1:
-                ax = abs(xj)
-                cs = co + 6 * size
-                wF0 += cmat[cs + j] * ax
-                wF1 += cmat[cs + size + j] * ax
-                wF2 += cmat[cs + 2 * size + j] * ax
-                wF3 += cmat[cs + 3 * size + j] * ax
-                wF4 += cmat[cs + 4 * size + j] * ax
-                wF5 += cmat[cs + 5 * size + j] * ax
-        f = rot(R, F, wF0, wF1, wF2)
-        mo = rot(R, F, wF3, wF4, wF5)
-        for i in range(nl):
-            L = later[l0 + i]
-            s = 1.0 if L == P else -1.0
-            e2 = cross(o[F, 0] - o[L, 0], o[F, 1] - o[L, 1], o[F, 2] - o[L, 2], f[0], f[1], f[2])
-            for h in range(3):
-                rhs[L, h] -= s * f[h]
-                rhs[L, 3 + h] -= s * (mo[h] + e2[h])
+def _wrench_in_F(c0, size, signed, co, cmat, x):
+    """C_plus x + C_sep |x| (6-tuple): a group's wrench on its primary link, F axes."""
+    w0, w1, w2, w3, w4, w5 = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    for j in range(size):
+        xj = x[c0 + j]
+        w0 += cmat[co + j] * xj
+        w1 += cmat[co + size + j] * xj
+        w2 += cmat[co + 2 * size + j] * xj
+        w3 += cmat[co + 3 * size + j] * xj
+        w4 += cmat[co + 4 * size + j] * xj
+        w5 += cmat[co + 5 * size + j] * xj
+        if signed == 1:
+            ax = abs(xj)
+            cs = co + 6 * size
+            w0 += cmat[cs + j] * ax
+            w1 += cmat[cs + size + j] * ax
+            w2 += cmat[cs + 2 * size + j] * ax
+            w3 += cmat[cs + 3 * size + j] * ax
+            w4 += cmat[cs + 4 * size + j] * ax
+            w5 += cmat[cs + 5 * size + j] * ax
+    return (w0, w1, w2), (w3, w4, w5)
 
 
 @njit(**INLINE)
-def _store(n, b, brec, gcol, scol, cbrec, turns, q, x, sig, X, SG):
+def _propagate(F, base, p0, np_, prec, cmat, later, R, o, x, rhs):
+    """rhs[L] -= the solved wrenches of the block's groups on their later links L."""
+    RF, oF = load9(R, F), load3(o, F)
+    for e in range(p0, p0 + np_):
+        f, mo = _wrench_in_F(prec[e, 0], prec[e, 1], prec[e, 2], prec[e, 3], cmat, x)
+        if F != base:
+            f, mo = mv(RF, f), mv(RF, mo)                 # world axes, about o_F
+        P, l0, nl = prec[e, 4], prec[e, 5], prec[e, 6]
+        for i in range(nl):
+            L = later[l0 + i]
+            s = 1.0 if L == P else -1.0
+            m = add(mo, cx(sub(oF, load3(o, L)), f))
+            rhs[L, 0] -= s * f[0]
+            rhs[L, 1] -= s * f[1]
+            rhs[L, 2] -= s * f[2]
+            rhs[L, 3] -= s * m[0]
+            rhs[L, 4] -= s * m[1]
+            rhs[L, 5] -= s * m[2]
+
+
+@njit(**INLINE)
+def _store(n, b, brec, gcol, scol, cbrec, turns, q, cs, x, sig, X, SG):
     """Write block b's solution (joint reactions in the child's basis) into the solution
     row X and its signs into SG[n]."""
     nloc, g0, m, t0, cb0, ncb = brec[b, 3], brec[b, 4], brec[b, 5], brec[b, 6], brec[b, 10], brec[b, 11]
@@ -173,13 +177,13 @@ def _store(n, b, brec, gcol, scol, cbrec, turns, q, x, sig, X, SG):
         X[gcol[g0 + i]] = x[i]
     for e in range(cb0, cb0 + ncb):
         c0, j = cbrec[e, 0], cbrec[e, 1]
-        if j >= 0:
-            angle = q[j]
+        if j >= 0:                                 # the joint's own angle
+            cq, sq = cs[j, 0], cs[j, 1]
         else:
             angle = 0.0
             for k in range(q.shape[0]):
                 angle += turns[cbrec[e, 2] + k] * q[k]
-        cq, sq = np.cos(angle), np.sin(angle)
+            cq, sq = np.cos(angle), np.sin(angle)
         for h in (0, 3):
             x0, x1 = x[c0 + h], x[c0 + h + 1]
             X[gcol[g0 + c0 + h]] = cq * x0 + sq * x1
@@ -189,7 +193,7 @@ def _store(n, b, brec, gcol, scol, cbrec, turns, q, x, sig, X, SG):
 
 
 @njit(**INLINE)
-def _blocks(n, ints, flts, q, R, o, rhs, r, x, sig, A, X, SG, fail):
+def _blocks(n, ints, flts, q, cs, R, o, rhs, r, x, sig, A, X, SG, fail):
     """Every block of the schedule in order, for sample n."""
     brec, blinks, gcol, tcol, scol, prec, later, cbrec, trec, meta = (ints[1], ints[2], ints[3], ints[4], ints[5],
                                                                       ints[6], ints[7], ints[8], ints[10], ints[11])
@@ -214,8 +218,8 @@ def _blocks(n, ints, flts, q, R, o, rhs, r, x, sig, A, X, SG, fail):
         if world:
             world_propagate(k0, nt, trec, tflt, sig, R, o, x, rhs)
         else:
-            _propagate(F, brec[b, 8], brec[b, 9], prec, cmat, later, R, o, x, rhs)
-        _store(n, b, brec, gcol, scol, cbrec, turns, q, x, sig, X, SG)
+            _propagate(F, base, brec[b, 8], brec[b, 9], prec, cmat, later, R, o, x, rhs)
+        _store(n, b, brec, gcol, scol, cbrec, turns, q, cs, x, sig, X, SG)
 
 
 @njit(**OPTS)
@@ -229,13 +233,13 @@ def run(ints, flts, ldrec, ldflt, vals, qi, qdi, qddi, start, stop, outs, scratc
     otherwise): nothing here allocates."""
     jrec, moving = ints[0], ints[9]
     jflt, lflt, S, g = flts[0], flts[1], flts[2], flts[3]
-    R, o, w, dw, a, rhs, Rj, oj, q, qd, qdd, r, x, sig, A, xrow = scratch
+    R, o, w, dw, a, rhs, cs, q, qd, qdd, r, x, sig, A, xrow = scratch
     SG, fail = outs[8], outs[9]
     for n in range(start, stop):
         joint_space(S, qi, qdi, qddi, n, q, qd, qdd)
-        kinematics(jrec, jflt, q, qd, qdd, R, o, w, dw, a, Rj, oj)
+        kinematics(jrec, jflt, q, qd, qdd, R, o, w, dw, a, cs)
         for L in moving:
             inertia(L, lflt, g, R, w, dw, a, rhs)
         external(n, ldrec, ldflt, vals, R, rhs)
-        _blocks(n, ints, flts, q, R, o, rhs, r, x, sig, A, xrow, SG, fail)
+        _blocks(n, ints, flts, q, cs, R, o, rhs, r, x, sig, A, xrow, SG, fail)
         write_outputs(n, xrow, qdi, ints, flts, outs)

@@ -38,8 +38,9 @@ def job_ranges(n: int, jobs: int | None) -> list[tuple[int, int]]:
 
 
 def scratch(prog: Program) -> tuple:
-    """Per-thread work arrays of :func:`.kernel.run` (R, o, w, dw, a, rhs per link; joint
-    frame; q, qd, qdd per joint; block right-hand side, solution, signs and matrix)."""
+    """Per-thread work arrays of :func:`.kernel.run` (R, o, w, dw, a, rhs per link; cos,
+    sin, q, qd, qdd per joint; block right-hand side, solution, signs and matrix; the
+    solution row)."""
     nL, J = prog.flts[1].shape[0], prog.flts[2].shape[0]
     brec = prog.ints[1]
     nr = max([6] + [6 * int(b) for b in brec[:, 2]])
@@ -47,7 +48,7 @@ def scratch(prog: Program) -> tuple:
     R = np.zeros((nL, 3, 3))
     R[:] = np.eye(3)                          # the base stays at rest
     return (R, np.zeros((nL, 3)), np.zeros((nL, 3)), np.zeros((nL, 3)), np.zeros((nL, 3)),
-            np.zeros((nL, 6)), np.zeros((3, 3)), np.zeros(3), np.zeros(J), np.zeros(J), np.zeros(J),
+            np.zeros((nL, 6)), np.zeros((J, 2)), np.zeros(J), np.zeros(J), np.zeros(J),
             np.zeros(nx), np.zeros(nx), np.ones(max([1] + [int(b) for b in brec[:, 5]])), np.zeros((nr, nx)),
             np.zeros(prog.ncols))
 

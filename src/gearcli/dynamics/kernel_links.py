@@ -49,21 +49,21 @@ def _joint_frame(k, f, flags, Rp, op, qk, prismatic):
         R0 = Rp if flags & 2 else mm(Rp, row9(f, k, 0))
         oj = add(op, mv(Rp, row3(f, k, 9)))
     if prismatic:
-        return R0, add(oj, scale((R0[2], R0[5], R0[8]), qk))
+        return R0, add(oj, scale((R0[2], R0[5], R0[8]), qk)), 1.0, 0.0
     cq, sq = math.cos(qk), math.sin(qk)
     return (cq * R0[0] + sq * R0[1], cq * R0[1] - sq * R0[0], R0[2],
             cq * R0[3] + sq * R0[4], cq * R0[4] - sq * R0[3], R0[5],
-            cq * R0[6] + sq * R0[7], cq * R0[7] - sq * R0[6], R0[8]), oj
+            cq * R0[6] + sq * R0[7], cq * R0[7] - sq * R0[6], R0[8]), oj, cq, sq
 
 
 @njit(**INLINE)
-def _joint(k, jrec, f, q, qd, qdd, R, o, w, dw, a):
+def _joint(k, jrec, f, q, qd, qdd, R, o, w, dw, a, cs):
     """The child of joint record k: R, o, w, dw, a (kinematics.forward; flags 4 R_jc = I,
-    8 p_jc = 0 skip products)."""
+    8 p_jc = 0 skip products); cs[joint] = cos, sin of its angle (reused by the blocks)."""
     ji, p, c, pr, flags = jrec[k, 0], jrec[k, 1], jrec[k, 2], jrec[k, 3] == 1, jrec[k, 4]
     qdk, qddk = qd[ji], qdd[ji]
     op, wp, ap, dwp = load3(o, p), load3(w, p), load3(a, p), load3(dw, p)
-    Rj, oj = _joint_frame(k, f, flags, load9(R, p), op, q[ji], pr)
+    Rj, oj, cs[ji, 0], cs[ji, 1] = _joint_frame(k, f, flags, load9(R, p), op, q[ji], pr)
     z = (Rj[2], Rj[5], Rj[8])
     r = sub(oj, op)
     aj = add(ap, add(cx(dwp, r), cx(wp, cx(wp, r))))
@@ -86,10 +86,11 @@ def _joint(k, jrec, f, q, qd, qdd, R, o, w, dw, a):
 
 
 @njit(**INLINE)
-def kinematics(jrec, jflt, q, qd, qdd, R, o, w, dw, a, Rj, oj):
-    """Every link's R, o, w, dw, a of one sample (base frame; the base row stays at rest)."""
+def kinematics(jrec, jflt, q, qd, qdd, R, o, w, dw, a, cs):
+    """Every link's R, o, w, dw, a of one sample (base frame; the base row stays at rest)
+    and every joint's cos, sin (J, 2)."""
     for k in range(jrec.shape[0]):
-        _joint(k, jrec, jflt, q, qd, qdd, R, o, w, dw, a)
+        _joint(k, jrec, jflt, q, qd, qdd, R, o, w, dw, a, cs)
 
 
 @njit(**INLINE)
