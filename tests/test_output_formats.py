@@ -250,3 +250,18 @@ def test_plot_refuses_a_corrupt_binary_file(run_cli, tmp_path, ext):
     bad.write_bytes(b"PAR1 not really" * 10)
     refused(run_cli("plot", bad, "motor:*", "-o", tmp_path / "fig.png"), f"bad{ext}: cannot read the")
     assert not (tmp_path / "fig.png").exists()
+
+
+@pytest.mark.parametrize("jobs", [1, 3])
+def test_write_rows_in_threads_writes_the_same_text(tmp_path, jobs):
+    from gearcli.report.csv_text import write_rows
+
+    tab = hostile_values(np.random.default_rng(7), 800).reshape(-1, 9)
+    expect = printf_rows(tab, 9)
+    with open(tmp_path / "a.csv", "w", encoding="utf-8", newline="") as f:   # bytes to f.buffer
+        f.write("h\n")
+        write_rows(f, tab, 9, compiled=True, jobs=jobs)
+    assert (tmp_path / "a.csv").read_text() == "h\n" + expect
+    s = io.StringIO()                                                       # str path
+    write_rows(s, tab, 9, compiled=True, jobs=jobs)
+    assert s.getvalue() == expect

@@ -147,7 +147,8 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
     def opened(f):
         meta = {"gearcli_version": __version__, "mechanism": str(mech_path), "trajectory": str(traj_path),
                 "conventions": CONVENTIONS}
-        return open_table(fmt, f, names, column_units(an), meta, precision=precision or 9, rows=rows)
+        return open_table(fmt, f, names, column_units(an), meta, precision=precision or 9, rows=rows,
+                          jobs=jobs)
 
     out = None if out_path is None or to_stdout else Path(out_path)
     if out_path is None:

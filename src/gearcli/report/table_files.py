@@ -16,6 +16,7 @@ appends a chunk ``(n, ncol)`` of rows and ``close()`` finishes the file.
 """
 from __future__ import annotations
 
+import os
 import zipfile
 from pathlib import Path
 
@@ -53,13 +54,15 @@ def ascii_unit(unit: str) -> str:
 class CsvTable:
     """CSV: header, then rows of ``precision`` significant digits."""
 
-    def __init__(self, f, names, units, metadata, *, precision: int = 9, rows: int | None = None):
+    def __init__(self, f, names, units, metadata, *, precision: int = 9, rows: int | None = None,
+                 jobs: int | None = None):
         self.f, self.precision = f, precision
+        self.jobs = jobs or os.cpu_count() or 1
         self.compiled = rows is not None and rows * len(names) >= COMPILED_MIN_VALUES
         f.write(",".join(names) + "\n")
 
     def write(self, tab: np.ndarray) -> None:
-        write_rows(self.f, tab, self.precision, compiled=self.compiled)
+        write_rows(self.f, tab, self.precision, compiled=self.compiled, jobs=self.jobs)
 
     def close(self) -> None:
         pass
@@ -149,10 +152,12 @@ def _quietly(close) -> None:
         pass
 
 
-def open_table(fmt: str, f, names, units, metadata, *, precision: int = 9, rows: int | None = None):
-    """The writer of format ``fmt`` (see :data:`FORMATS`) on the open file ``f``."""
+def open_table(fmt: str, f, names, units, metadata, *, precision: int = 9, rows: int | None = None,
+               jobs: int | None = None):
+    """The writer of format ``fmt`` (see :data:`FORMATS`) on the open file ``f``; ``jobs``
+    threads format CSV (default: all cores)."""
     if fmt == "csv":
-        return CsvTable(f, names, units, metadata, precision=precision, rows=rows)
+        return CsvTable(f, names, units, metadata, precision=precision, rows=rows, jobs=jobs)
     if fmt in ("parquet", "feather"):
         return ArrowTable(f, names, units, metadata, kind=fmt)
     return NpzTable(f, names, units, metadata, rows=rows)
