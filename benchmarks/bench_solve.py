@@ -2,14 +2,19 @@
 
     python benchmarks/bench_solve.py [--repeat 5] [--samples 100000] [--big 10000000]
 
-Reports, as medians over --repeat runs:
-  * samples/s of the library solver core (block schedule and full simultaneous solve, and
-    their ratio) on the bundled paper_2dof and bendix_wrist mechanisms;
+Reports, as medians over --repeat runs, with the load average:
+  * samples/s of the library solver core on the bundled paper_2dof and bendix_wrist
+    mechanisms: the compiled kernel (backend="kernel") with 1 and 2 jobs, the numpy block
+    path, the full simultaneous solve, and the ratios kernel/numpy and 2 jobs/1 job;
+  * with --first-call: the kernel's first call in a fresh process, compiling (an empty
+    NUMBA_CACHE_DIR) and then loading the compiled code from that disk cache;
   * wall time of the whole `gearcli solve` command (CSV in and out) on --samples samples of
     paper_2dof;
   * with --big N: peak resident memory of `gearcli solve` on N samples (output discarded).
 Aims on a 2-core machine: >= 300,000 samples/s (paper_2dof) and >= 100,000 samples/s
-(Bendix) in the library; `gearcli solve` on 100,000 samples in < 5 s; 10 million samples in
+(Bendix) in the library (numpy path); issue 11: the kernel on Bendix at Pinocchio's
+rneaInParallel figure on one core (1.24M samples/s on a quiet machine; side by side in
+benchmarks/bench_speed.py) and >= 1.8x that with two jobs; `gearcli solve` on 100,000 samples in < 5 s; 10 million samples in
 < 1 GB.
 """
 from __future__ import annotations
@@ -42,18 +47,43 @@ def median_rate(fn, n, repeat):
     return n / float(np.median(ts)), float(np.median(ts))
 
 
+def load_line() -> str:
+    one, five, fifteen = os.getloadavg()
+    return f"load average {one:.2f} {five:.2f} {fifteen:.2f}"
+
+
 def core(repeat: int, n: int) -> None:
-    print(f"library solver core, {n} random samples, median of {repeat}")
-    print(f"{'mechanism':<16}{'block /s':>14}{'full /s':>14}{'block/full':>12}")
+    """samples/s of the compiled kernel and the numpy path, one and two jobs, same run."""
+    print(f"library solver core, {n} random samples, median of {repeat}; {load_line()}")
+    cols = ("kernel j1", "kernel j2", "numpy", "full", "kernel/numpy", "j2/j1")
+    print(f"{'mechanism':<16}" + "".join(f"{c:>14}" for c in cols))
     for name in ("paper_2dof", "bendix_wrist"):
         an = analyse(load_mechanism(ROOT / "mechanisms" / f"{name}.yaml"))
         rng = np.random.default_rng(0)
         q, qd, qdd = (rng.normal(size=(n, an.dof)) for _ in range(3))
-        solve(an, q[:100], qd[:100], qdd[:100])
-        rb, _ = median_rate(lambda: solve(an, q, qd, qdd), n, repeat)
+        solve(an, q[:100], qd[:100], qdd[:100], backend="kernel")    # compiled (or cached) once
+        k1, _ = median_rate(lambda: solve(an, q, qd, qdd, backend="kernel", jobs=1), n, repeat)
+        k2, _ = median_rate(lambda: solve(an, q, qd, qdd, backend="kernel", jobs=2), n, repeat)
+        rb, _ = median_rate(lambda: solve(an, q, qd, qdd, backend="numpy"), n, repeat)
         m = max(n // 10, 1000)
         rf, _ = median_rate(lambda: solve(an, q[:m], qd[:m], qdd[:m], method="full"), m, repeat)
-        print(f"{name:<16}{rb:>14,.0f}{rf:>14,.0f}{rb / rf:>12.1f}")
+        figs = (f"{k1:,.0f}", f"{k2:,.0f}", f"{rb:,.0f}", f"{rf:,.0f}", f"{k1 / rb:.1f}x", f"{k2 / k1:.2f}x")
+        print(f"{name:<16}" + "".join(f"{c:>14}" for c in figs))
+    print(f"({load_line()} at the end)")
+
+
+def first_calls() -> None:
+    """Cost of the kernel's first call in a fresh process: compiled, then from the disk cache."""
+    code = ("import time, numpy as np; from pathlib import Path; from gearcli import analyse, load_mechanism, solve; "
+            f"an = analyse(load_mechanism(Path({str(ROOT / 'mechanisms' / 'bendix_wrist.yaml')!r}))); "
+            "q = np.zeros((10, an.dof)); t = time.process_time(); w = time.perf_counter(); "
+            "solve(an, q, q, q, backend='kernel', jobs=1); "
+            "print(f'{time.perf_counter() - w:.2f} s wall, {time.process_time() - t:.2f} s CPU')")
+    with tempfile.TemporaryDirectory() as d:
+        env = dict(os.environ, NUMBA_CACHE_DIR=d)    # an empty cache: the first run compiles
+        for what in ("first call, compiling", "first call of a new process, from the disk cache"):
+            out = subprocess.run([sys.executable, "-c", code], env=env, check=True, capture_output=True, text=True)
+            print(f"kernel {what}: {out.stdout.strip()}")
 
 
 def trajectory_file(path: Path, n: int) -> None:
@@ -103,9 +133,13 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--samples", type=int, default=100_000)
     ap.add_argument("--big", type=int, default=0, help="also measure memory on this many samples")
+    ap.add_argument("--first-call", action="store_true", help="also time the kernel's first call "
+                    "(compiling, then from the disk cache; about a minute)")
     a = ap.parse_args()
     print(f"python {sys.version.split()[0]}, numpy {np.__version__}, {os.cpu_count()} cpus")
     core(a.repeat, a.samples)
+    if a.first_call:
+        first_calls()
     command(a.repeat, a.samples)
     if a.big:
         big(a.big)

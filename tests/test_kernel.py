@@ -216,6 +216,14 @@ def test_backend_choice_and_errors():
         solve(an, q, q, q, backend="kernel", jobs=0)
     res = solve(an, q, q, q, method="full")               # auto: numpy for the full solve
     assert res.motor.shape == (3, len(an.motor_links))
+    sol = solver_for(an)
+    sol.kernel_problem = "a stand-in reason"             # as when numba finds no cache directory
+    try:
+        assert sol.backend() == "numpy"
+        with pytest.raises(ValueError, match="unavailable: a stand-in reason"):
+            solve(an, q, q, q, backend="kernel")
+    finally:
+        sol.kernel_problem = None
 
 
 def test_verify_with_the_kernel():

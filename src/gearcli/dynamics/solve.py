@@ -119,17 +119,25 @@ class Solver:
         self.groups = unknown_groups(an)
         self.plans = make_plans(an)
         self._program = None
+        self.kernel_problem: str | None = None
 
     def kernel_program(self):
         """The compiled kernel's program of this mechanism (:mod:`.kernel_program`), or None
-        when numba does not import; built on first use."""
-        if self._program is None:
+        when the kernel cannot be used here (``self.kernel_problem`` says why); built on
+        first use."""
+        if self._program is None and self.kernel_problem is None:
             try:
                 from .kernel_program import build_program  # noqa: PLC0415  (imports numba)
             except ImportError:
+                self.kernel_problem = "numba does not import"
+                return None
+            except RuntimeError as exc:     # numba found no writable cache directory
+                self.kernel_problem = f"numba: {exc}"
                 return None
             self._program = build_program(self.an, self.plans)
-        return self._program
+            if not self._program.covered:
+                self.kernel_problem = "a block of this mechanism is not square (a redundant set solved in world axes)"
+        return self._program if self.kernel_problem is None else None
 
     def backend(self, method: str = "block", backend: str = "auto") -> str:
         """The path a solve takes: "kernel" or "numpy" (see :func:`solve`)."""
@@ -139,12 +147,10 @@ class Solver:
             return "numpy"
         if method == "full":
             raise ValueError("backend 'kernel' solves method 'block' only")
-        prog = self.kernel_program()
-        if prog is not None and prog.covered:
+        if self.kernel_program() is not None:
             return "kernel"
         if backend == "kernel":
-            why = "numba does not import" if prog is None else "a block of this mechanism is not square"
-            raise ValueError(f"backend 'kernel' unavailable: {why}")
+            raise ValueError(f"backend 'kernel' unavailable: {self.kernel_problem}")
         return "numpy"
 
     def solve(self, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK,
