@@ -55,6 +55,7 @@ def test_compiled_csv_text_equals_printf(digits):
         tab = v[: v.size // ncol * ncol].reshape(-1, ncol)
         got = compiled_rows(tab, digits)
         assert got == printf_rows(tab, digits)
+        assert compiled_rows(np.asfortranarray(tab), digits) == got      # column-major input
     assert "-0," not in got and "\n-0\n" not in got
 
 

@@ -54,24 +54,33 @@ def column_names(an) -> list[str]:
 
 
 def table(an, t: np.ndarray, res: Result) -> np.ndarray:
-    """The output columns of :func:`column_names` as one (N, ncol) array."""
-    parts = [t[:, None], res.motor, res.tau]
-    for ci, c in enumerate(an.circuits):
-        if c.geometry is None:
-            parts.append(res.gear_t[:, ci:ci + 1])
-            continue
-        parts += [res.gear_t[:, ci:ci + 1], res.gear_sep[:, ci:ci + 1],
-                  np.stack([res.gear_radial[:, ci, 0], res.gear_axial[:, ci, 0],
-                            res.gear_radial[:, ci, 1], res.gear_axial[:, ci, 1]], axis=1)]
-    W = res.joint
-    for ji in range(W.shape[1]):
-        w = W[:, ji]
-        parts += [w, np.stack([np.hypot(w[:, 0], w[:, 1]), np.abs(w[:, 2]), np.hypot(w[:, 3], w[:, 4])], axis=1)]
+    """The output columns of :func:`column_names` as one (N, ncol) array, in Fortran order
+    (each column contiguous: a Parquet/Arrow column without copy)."""
     if res.motor_speed is None:
         raise ValueError("Result.motor_speed is missing (results come from gearcli.solve)")
-    speed = res.motor_speed
-    parts.append(np.stack([speed, res.motor * speed], axis=2).reshape(speed.shape[0], -1))
-    return np.hstack(parts)
+    n = len(t)
+    out = np.empty((n, len(column_names(an))), order="F")
+    c = 0
+
+    def put(*cols):
+        nonlocal c
+        for x in cols:
+            x = np.asarray(x).reshape(n, -1)
+            out[:, c:c + x.shape[1]] = x
+            c += x.shape[1]
+
+    put(t, res.motor, res.tau)
+    for ci, circ in enumerate(an.circuits):
+        put(res.gear_t[:, ci])
+        if circ.geometry is not None:
+            put(res.gear_sep[:, ci], res.gear_radial[:, ci, 0], res.gear_axial[:, ci, 0],
+                res.gear_radial[:, ci, 1], res.gear_axial[:, ci, 1])
+    for ji in range(res.joint.shape[1]):
+        w = res.joint[:, ji]
+        put(w, np.hypot(w[:, 0], w[:, 1]), np.abs(w[:, 2]), np.hypot(w[:, 3], w[:, 4]))
+    for mi in range(res.motor_speed.shape[1]):
+        put(res.motor_speed[:, mi], res.motor[:, mi] * res.motor_speed[:, mi])
+    return out
 
 
 def named_columns(an, res: Result, t: np.ndarray | None = None) -> dict[str, np.ndarray]:

@@ -20,65 +20,64 @@ _ZEROS = np.frombuffer(b"0.000", np.uint8).copy()
 
 
 @njit(cache=True, nogil=True)
-def decompose(v, bits, digits, band, mant, expo, kind):
-    """``bits``: ``v.view(np.int64)``.  Fill ``mant`` (rounded mantissa, ``10**(digits-1) <= m < 10**digits``), ``expo``
-    (decimal exponent of the rounded value) and ``kind`` for every value of ``v`` (n,)."""
+def decompose(tab, digits, band, mant, expo, kind):
+    """Fill ``mant`` (rounded mantissa, ``10**(digits-1) <= m < 10**digits``), ``expo``
+    (decimal exponent of the rounded value) and ``kind`` (all (n, ncol), C order) for every
+    value of ``tab`` (n, ncol), any memory layout."""
     lo = 10.0 ** (digits - 1) - 0.5
     hi = 10.0 ** digits - 0.5
     p10 = _P10
-    for i in range(v.size):
-        a = abs(v[i])
-        if a == 0.0:
-            kind[i] = ZERO
-            continue
-        if not (_LOW <= a <= _HIGH):      # also NaN
-            kind[i] = SPECIAL
-            continue
-        e2 = ((bits[i] >> 52) & 0x7FF) - 1023          # a in [2**e2, 2**(e2 + 1))
-        e = int(math.floor(e2 * _LOG10_2))             # the exponent of a, or one less
-        s = a * p10[digits - 1 - e + 300]
-        while s >= hi:
-            e += 1
+    for i in range(tab.shape[0]):
+        for j in range(tab.shape[1]):
+            a = abs(tab[i, j])
+            if a == 0.0:
+                kind[i, j] = ZERO
+                continue
+            if not (_LOW <= a <= _HIGH):      # also NaN
+                kind[i, j] = SPECIAL
+                continue
+            e2 = math.frexp(a)[1] - 1                   # a in [2**e2, 2**(e2 + 1))
+            e = int(math.floor(e2 * _LOG10_2))          # the exponent of a, or one less
             s = a * p10[digits - 1 - e + 300]
-        f = s - math.floor(s)
-        if abs(f - 0.5) < band or not (lo <= s < hi):
-            kind[i] = SPECIAL
-            continue
-        kind[i] = NORMAL
-        mant[i] = np.uint64(s + 0.5)
-        expo[i] = e
+            while s >= hi:
+                e += 1
+                s = a * p10[digits - 1 - e + 300]
+            f = s - math.floor(s)
+            if abs(f - 0.5) < band or not (lo <= s < hi):
+                kind[i, j] = SPECIAL
+                continue
+            kind[i, j] = NORMAL
+            mant[i, j] = np.uint64(s + 0.5)
+            expo[i, j] = e
 
 
 @njit(cache=True, nogil=True)
-def emit(v, mant, expo, kind, extra, offsets, ncol, digits, out):
-    """Write the CSV characters of ``v`` (rows of ``ncol`` values) into ``out``; return
-    the number of bytes written.  A normal value's digits are all written, then the
-    position advances past the kept ones only (trailing zeros dropped)."""
+def emit(tab, mant, expo, kind, extra, offsets, digits, out):
+    """Write the CSV characters of ``tab`` (n, ncol) row by row into ``out``; return the
+    number of bytes written.  A normal value's digits are all written, then the position
+    advances past the kept ones only (trailing zeros dropped).  Special values take their
+    text from ``extra`` (``offsets``), in row-major order."""
     pos = 0
     js = 0
-    col = 0
-    for i in range(v.size):
-        k = kind[i]
-        if k == ZERO:
-            out[pos] = 48
+    ncol = tab.shape[1]
+    for i in range(tab.shape[0]):
+        for j in range(ncol):
+            k = kind[i, j]
+            if k == ZERO:
+                out[pos] = 48
+                pos += 1
+            elif k == SPECIAL:
+                for b in range(offsets[js], offsets[js + 1]):
+                    out[pos] = extra[b]
+                    pos += 1
+                js += 1
+            else:
+                if tab[i, j] < 0.0:
+                    out[pos] = 45
+                    pos += 1
+                pos = _normal(mant[i, j], expo[i, j], digits, out, pos)
+            out[pos] = 44 if j + 1 < ncol else 10
             pos += 1
-        elif k == SPECIAL:
-            for b in range(offsets[js], offsets[js + 1]):
-                out[pos] = extra[b]
-                pos += 1
-            js += 1
-        else:
-            if v[i] < 0.0:
-                out[pos] = 45
-                pos += 1
-            pos = _normal(mant[i], expo[i], digits, out, pos)
-        col += 1
-        if col == ncol:
-            out[pos] = 10
-            col = 0
-        else:
-            out[pos] = 44
-        pos += 1
     return pos
 
 

@@ -103,19 +103,18 @@ def compiled_bytes(tab: np.ndarray, digits: int = 9) -> memoryview:
 
     if not 1 <= digits <= FAST_DIGITS:
         raise ValueError(f"compiled_rows: digits must be 1..{FAST_DIGITS}, got {digits}")
-    n, ncol = tab.shape
-    v = np.ascontiguousarray(tab, dtype=np.float64).ravel()
-    mant = np.empty(v.size, np.uint64)
-    expo = np.empty(v.size, np.int64)
-    kind = np.empty(v.size, np.uint8)
-    k.decompose(v, v.view(np.int64), digits, _TIE_BAND, mant, expo, kind)
-    special = np.flatnonzero(kind == k.SPECIAL)
+    tab = np.asarray(tab, dtype=np.float64)
+    mant = np.empty(tab.shape, np.uint64)
+    expo = np.empty(tab.shape, np.int64)
+    kind = np.empty(tab.shape, np.uint8)
+    k.decompose(tab, digits, _TIE_BAND, mant, expo, kind)
+    special = np.nonzero(kind == k.SPECIAL)       # row-major order, as they are written
     fmt = f"%.{digits}g"
-    texts = [fmt % (x + 0.0) for x in v[special].tolist()]
+    texts = [fmt % (x + 0.0) for x in tab[special].tolist()]
     extra = np.frombuffer("".join(texts).encode("ascii"), np.uint8)
     lengths = np.fromiter(map(len, texts), np.int64, len(texts))
-    offsets = np.zeros(special.size + 1, np.int64)
+    offsets = np.zeros(len(texts) + 1, np.int64)
     np.cumsum(lengths, out=offsets[1:])
-    out = np.empty(v.size * (digits + 8) + extra.size, np.uint8)
-    used = k.emit(v, mant, expo, kind, extra, offsets, ncol, digits, out)
+    out = np.empty(tab.size * (digits + 8) + extra.size, np.uint8)
+    used = k.emit(tab, mant, expo, kind, extra, offsets, digits, out)
     return memoryview(out[:used])
