@@ -266,3 +266,36 @@ def test_write_rows_in_threads_writes_the_same_text(tmp_path, jobs):
     s = io.StringIO()                                                       # str path
     write_rows(s, tab, 9, compiled=True, jobs=jobs)
     assert s.getvalue() == expect
+
+
+@pytest.mark.parametrize("ext", [".parquet", ".feather", ".npz"])
+def test_interrupt_and_sigterm_mid_binary_write_leave_nothing(run_cli, tmp_path, monkeypatch, ext):
+    import signal
+
+    import gearcli.pipeline as pipeline
+
+    (tmp_path / f"out{ext}").write_bytes(b"previous")
+    before = snapshot(tmp_path)
+    real = pipeline.solve
+    calls = []
+
+    def late(exc):
+        def solve(*a, **k):
+            calls.append(1)
+            if len(calls) == 2:            # after the first chunk was written
+                if exc is None:
+                    os.kill(os.getpid(), signal.SIGTERM)
+                else:
+                    raise exc
+            return real(*a, **k)
+        return solve
+
+    monkeypatch.setattr(pipeline, "solve", late(KeyboardInterrupt()))
+    r = run_cli("solve", MECH, TRAJ, "-o", tmp_path / f"out{ext}", "--chunk", "500")
+    assert r.exit_code == 130 and r.stderr.strip() == "gearcli: interrupted", r.stderr
+    assert snapshot(tmp_path) == before and len(calls) == 2
+    calls.clear()
+    monkeypatch.setattr(pipeline, "solve", late(None))
+    r = run_cli("solve", MECH, TRAJ, "-o", tmp_path / f"out{ext}", "--chunk", "500")
+    assert r.exit_code == 143 and r.stderr.strip() == "gearcli: terminated (SIGTERM)", r.stderr
+    assert snapshot(tmp_path) == before

@@ -85,3 +85,23 @@ def test_fast_number_parsing_agrees_with_loadtxt(seed):
         ref = np.loadtxt(lines, delimiter=",", quotechar='"', comments=None, ndmin=2, dtype=float)
         assert ref.shape == (n, ncol) and np.array_equal(fast.view(np.int64), ref.view(np.int64)), lines
     assert accepted > 50
+
+
+@pytest.mark.parametrize("bad", ["x", "", "nan(1)", "1e999", "1,5", '"2'])
+def test_reader_reports_the_same_error_with_and_without_the_fast_parser(tmp_path, monkeypatch, bad):
+    import gearcli.io.trajectory as trajectory
+    from gearcli.errors import TrajectoryError
+
+    t = np.arange(3000) * 1e-3
+    rows = [f"{float(a)!r},{float(np.sin(a))!r},{float(np.cos(a))!r}" for a in t]
+    rows[2500] = f"{float(t[2500])!r},{bad},0.5"
+    path = tmp_path / "traj.csv"
+    path.write_text("t,q:J1,q:J2\n" + "\n".join(rows) + "\n")
+    messages = []
+    for fast_rows in (2000, 10**9):
+        monkeypatch.setattr(trajectory, "FAST_PARSE_ROWS", fast_rows)
+        reader = trajectory.TrajectoryReader(path, ["J1", "J2"], chunk=5000)
+        with pytest.raises(TrajectoryError) as err:
+            reader.check()
+        messages.append(str(err.value))
+    assert messages[0] == messages[1] and ":2502:" in messages[0], messages

@@ -45,6 +45,7 @@ MAX_ABS = 1e12        # largest |value| accepted, SI units (s, rad, m and their 
 MIN_STEP = 1e-9       # s, smallest time step
 MAX_LINE = 1 << 20    # characters per line
 SEPARATORS = ",;\t"
+FAST_PARSE_ROWS = 2000   # from this many rows a chunk is parsed by pyarrow (its import: ~0.2 s)
 _NUMBER = re.compile(r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)?|nan)", re.I)
 
 
@@ -174,7 +175,7 @@ def _bad_cell(lines: list[str], linenos: list[int], header: list[str], sep: str,
 def _parse_rows(lines: list[str], linenos: list[int], header: list[str], sep: str, file: str) -> np.ndarray:
     """Rows of floats (n, ncol); on failure, find and report the first bad cell."""
     _check_utf8(file, lines, linenos)
-    data = parse_floats(lines, len(header), sep)
+    data = parse_floats(lines, len(header), sep) if len(lines) >= FAST_PARSE_ROWS else None
     if data is not None:
         return data
     try:
