@@ -49,6 +49,8 @@ TESTS = [
     "tests/test_rack.py::test_static_rack_by_hand",
     "tests/test_rack.py::test_rack_sign_from_geometry",
     "tests/test_rack.py::test_power_balance_along_bundled_trajectory",
+    "tests/test_rack.py::test_pinion_riding_on_the_carriage",
+    "tests/test_rack.py::test_pinocchio_rnea_with_the_tooth_force_as_fext",
     "tests/test_helical.py::test_static_helical_by_hand",
     "tests/test_helical_bundled.py::test_static_reduction_by_hand",
     "tests/test_helical_bundled.py::test_bearing_radial_and_axial_loads_by_hand",

@@ -318,3 +318,47 @@ def test_urdf_bearings_on_a_prismatic_joint_are_refused(run_cli, tmp_path, axis)
     r = run_cli("check", path)
     assert r.exit_code == 2 and "Traceback" not in r.stderr
     assert "joint 'Jx'" in r.stderr and "rolling-bearing ratings" in r.stderr, r.stderr
+
+
+def test_pinocchio_rnea_with_the_tooth_force_as_fext(mech_dir, axis):
+    """Oracle: pinion (revolute about z) and carriage (prismatic along x) in Pinocchio with
+    the test's own inertias; the tooth force rebuilt from gearcli's t with the test's own
+    directions (tangential +x on the pinion, separating +y pushing it off the rack) and the
+    payload as fext.  RNEA gives the motor torque on the pinion and no force along the
+    guide (the rack's teeth drive the carriage), and its transmitted joint wrenches are
+    gearcli's bearing and guide reactions."""
+    pin = pytest.importorskip("pinocchio")
+    data_csv = np.loadtxt(mech_dir / "rack_axis_traj.csv", delimiter=",", skiprows=1)[::40]
+    x, xd, xdd = data_csv[:, 1:2], data_csv[:, 2:3], data_csv[:, 3:4]
+    res = solve(axis, x, xd, xdd)
+    model = pin.Model()
+    o_p = np.array([0.0, 0.0, 0.05])
+    jp = model.addJoint(0, pin.JointModelRZ(), pin.SE3(np.eye(3), o_p), "Jp")
+    model.appendBodyToJoint(jp, pin.Inertia(M_P, np.zeros(3), np.diag([6.0e-5, 6.0e-5, IZZ_P])), pin.SE3.Identity())
+    jx = model.addJoint(0, pin.JointModelPX(), pin.SE3(np.eye(3), O_C), "Jx")
+    model.appendBodyToJoint(jx, pin.Inertia(M_C, COM_C, np.diag([0.02, 0.03, 0.04])), pin.SE3.Identity())
+    data = model.createData()
+    names = [j.name for j in axis.mech.joints]
+    P = np.array([0.0, -R, 0.05])
+    for n in range(x.shape[0]):
+        t = res.gear_t[n, 0]
+        g = np.array([t, abs(t) * TAN20, 0.0])          # on the pinion
+        th = x[n, 0] / R
+        Rz = pin.utils.rotate("z", th)
+        oc = O_C + [x[n, 0], 0, 0]
+        f_c, m_c = -g + LOAD_F, np.cross(P - oc, -g) + np.cross(LOAD_P, LOAD_F)
+        fext = pin.StdVec_Force()
+        fext.append(pin.Force.Zero())
+        fext.append(pin.Force(Rz.T @ g, Rz.T @ np.cross(P - o_p, g)))
+        fext.append(pin.Force(f_c, m_c))
+        tau = pin.rnea(model, data, np.array([th, x[n, 0]]), np.array([xd[n, 0] / R, xd[n, 0]]),
+                       np.array([xdd[n, 0] / R, xdd[n, 0]]), fext)
+        assert abs(tau[0] - res.motor[n, 0]) < 1e-9 * (1 + abs(res.motor[n, 0]))
+        assert abs(tau[1]) < 1e-9 * (1 + abs(t))
+        jr = res.joint[n, names.index("Jp")]
+        assert rel_err(data.f[jp].vector, np.r_[jr[:5], res.motor[n, 0]]) < 1e-9
+        jr = res.joint[n, names.index("Jx")]        # guide frame: z along x; compare invariants
+        fp, mp = data.f[jx].linear, data.f[jx].angular
+        assert abs(np.hypot(jr[0], jr[1]) - np.linalg.norm(fp[1:])) < 1e-9 * np.linalg.norm(fp)
+        assert abs(jr[5] - mp[0]) < 1e-9 * (1 + np.linalg.norm(mp))
+        assert abs(np.linalg.norm(jr[3:6]) - np.linalg.norm(mp)) < 1e-9 * (1 + np.linalg.norm(mp))
