@@ -103,8 +103,10 @@ def test_planets_equally_spaced(mech_dir):
     close(sun_mesh["sun-planet3"], [0.012 * np.cos(4 * np.pi / 3), 0.012 * np.sin(4 * np.pi / 3), -0.01], 1e-15)
 
 
-@pytest.mark.parametrize("n", [2, 3, 4])
+@pytest.mark.parametrize("n", [2, 3, 4, 8])
 def test_each_planet_carries_one_nth_of_the_lumped_planet(mech_dir, bundled, n):
+    """(8 planets: 16 signed meshes in one block, 65536 sign patterns: the maps are made
+    only for the patterns the motion meets.)"""
     an = variant(bundled, with_planets(n))
     one = variant(bundled, lumped(n))
     assert an.dof == one.dof == 1
@@ -262,6 +264,8 @@ def _line(text: str, needle: str) -> int:
 @pytest.mark.parametrize("old, new, needle, place, reason", [
     ("    planets: 3", "    planets: 1", "planets: 1", "joints[2].planets", "1 is less than the minimum of 2"),
     ("    planets: 3", "    planets: 2.5", "planets: 2.5", "joints[2].planets", "2.5 is not of type 'integer'"),
+    ("    planets: 3", "    planets: 100000", "planets: 100000", "joints[2].planets",
+     "100000 is greater than the maximum of 64"),
     ("  - {name: motor, link: sun}", "  - {name: motor, link: planet}", "    planets: 3", "joints[2].planets",
      r"^planet link 'planet' cannot be used by motors\[0\]: only its joint on the carrier and its gear pairs "
      r"are copied$"),

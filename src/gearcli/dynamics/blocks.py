@@ -21,8 +21,9 @@ from .coaxial_frames import coaxial_links, turn_row
 from .equations import Columns
 from .general import is_geared, mesh_names, solve_general
 from .kinematics import Kinematics, forward
-from .sharing import least_load_map, mesh_weights
-from .signs import pattern_index, resolve_signs, sign_patterns
+from .pattern_maps import PatternMaps
+from .sharing import mesh_weights
+from .signs import MAX_EXHAUSTIVE, pattern_index, resolve_signs, sign_patterns
 
 
 @dataclass(frozen=True, eq=False)
@@ -34,9 +35,10 @@ class BlockPlan:
     F: int | None           # frame link, None -> general solve
     signed: list[int]       # positions in groups of signed mesh unknowns
     offs: np.ndarray        # column offsets of the groups
-    patterns: list          # sign patterns
-    Ainv: list              # inverse matrix per pattern, (n, 6*len(links)); rectangular
-                            # (n > 6*len(links)) for a redundant gear set: least-t^2/k map
+    patterns: list          # sign patterns (up to signs.MAX_EXHAUSTIVE signed meshes, else [])
+    Ainv: PatternMaps       # solution map per pattern (n, 6*len(links)), a sequence made on
+                            # first use; rectangular (n > 6*len(links)) for a redundant gear
+                            # set: the least-t^2/k map
     names: list             # gear pair names of the signed unknowns (messages)
     C: dict                 # group position -> (C_plus (6,size), C_sep (6,size)) in F about o_F, primary side
     parent_side: dict       # group position -> True when a joint basis is not its child's (rotate by -q)
@@ -94,22 +96,24 @@ def _owned_groups(an, groups) -> dict[int, list]:
     return owned
 
 
-def _constant_matrices(an, blk, gs, offs, signed, to_F, cols) -> list[np.ndarray]:
-    """Inverse of the block matrix in F about o_F, for each sign pattern; for a redundant
-    block (more unknowns than equations) the rectangular (n, 6B) map to the solution that
-    minimises sum t^2 / k (:func:`.sharing.least_load_map`)."""
+def _constant_matrices(an, blk, gs, offs, signed, to_F, cols) -> PatternMaps:
+    """Solution map of the block in F about o_F for each sign pattern, made on first use
+    (:class:`.pattern_maps.PatternMaps`): the inverse of the square block matrix, or for a
+    redundant block (more unknowns than equations) the rectangular (n, 6B) map to the
+    solution that minimises sum t^2 / k (:func:`.sharing.least_load_map`)."""
     w = mesh_weights(an, gs) if offs[-1] > 6 * len(blk) else None
-    Ainv = []
-    for pat in sign_patterns(len(signed)):
-        sig = dict(zip(signed, pat))
-        A = np.zeros((6 * len(blk), offs[-1]))
-        for gi, g in enumerate(gs):
-            for L in g.links:
-                if L in blk:
-                    r0 = 6 * blk.index(L)
-                    A[r0:r0 + 6, offs[gi]:offs[gi + 1]] = to_F(cols.group(g, L, sig.get(gi, 1.0)), L)
-        Ainv.append(np.linalg.inv(A) if w is None else least_load_map(A, w))
-    return Ainv
+    A = np.zeros((6 * len(blk), offs[-1]))
+    halves = np.zeros((len(signed), 6 * len(blk)))
+    for gi, g in enumerate(gs):
+        for L in g.links:
+            if L in blk:
+                r0 = 6 * blk.index(L)
+                A[r0:r0 + 6, offs[gi]:offs[gi + 1]] = to_F(cols.group(g, L, 1.0), L)
+                if gi in signed:
+                    minus = to_F(cols.group(g, L, -1.0), L)[:, 0]
+                    halves[signed.index(gi), r0:r0 + 6] = 0.5 * (A[r0:r0 + 6, offs[gi]] - minus)
+                    A[r0:r0 + 6, offs[gi]] = 0.5 * (A[r0:r0 + 6, offs[gi]] + minus)
+    return PatternMaps(A, halves, [int(offs[gi]) for gi in signed], w)
 
 
 def _propagation_columns(an, F, gs, signed, to_F, cols) -> tuple[dict, dict]:
@@ -175,7 +179,8 @@ def make_plans(an) -> tuple[BlockPlan, ...]:
 
         Ainv = _constant_matrices(an, blk, gs, offs, signed, to_F, cols)
         C, parent_side = _propagation_columns(an, F, gs, signed, to_F, cols)
-        plans.append(BlockPlan(tuple(blk), gs, F, signed, offs, sign_patterns(len(signed)), Ainv, names,
+        pats = sign_patterns(len(signed)) if len(signed) <= MAX_EXHAUSTIVE else []
+        plans.append(BlockPlan(tuple(blk), gs, F, signed, offs, pats, Ainv, names,
                                C, parent_side, turn))
     return tuple(plans)
 

@@ -73,12 +73,14 @@ def least_load_map(A: np.ndarray, w: np.ndarray) -> np.ndarray:
     """(n, m) matrix X with x = X r the minimiser of sum w t^2 subject to A x = r, for one
     constant block matrix A (m, n), m < n.  Raises :class:`SharingError` if not unique."""
     m, n = A.shape
-    K = _kkt(A, w)
-    sv = np.linalg.svd(K, compute_uv=False)
-    if sv[-1] <= _RTOL * sv[0]:
-        raise SharingError("the load-sharing (KKT) system of a redundant gear set is singular")
     rhs = np.vstack([np.zeros((n, m)), np.eye(m)])
-    return np.linalg.solve(K, rhs)[:n]
+    try:
+        X = np.linalg.solve(_kkt(A, w), rhs)[:n]
+    except np.linalg.LinAlgError:
+        X = None
+    if X is None or not np.all(np.isfinite(X)) or np.max(np.abs(A @ X - np.eye(m))) > 1e-8:
+        raise SharingError("the load-sharing (KKT) system of a redundant gear set is singular")
+    return X
 
 
 def least_load_solve(A: np.ndarray, r: np.ndarray, w: np.ndarray) -> np.ndarray:
