@@ -152,9 +152,20 @@ def _block(bd: _Builder, an, bi, p, block_of, offsets, sigcol, terms):
     bd.brec.append(rec)
 
 
+MAX_PATTERNS = 256
+"""Sign patterns of one constant block up to which the program holds every pattern's map:
+a block's maps are made on first use (:class:`.pattern_maps.PatternMaps`), and 2^m of them
+for m signed meshes (2^16 for 8 planets) would take minutes to make; such a mechanism is
+left to the numpy path, which makes only the patterns a motion meets."""
+
+
 def build_program(an, plans=None) -> Program:
-    """The :class:`Program` of ``an`` (``plans`` from :func:`.blocks.make_plans`)."""
+    """The :class:`Program` of ``an`` (``plans`` from :func:`.blocks.make_plans`); not
+    ``covered`` (and empty) when a constant block has more than :data:`MAX_PATTERNS` sign
+    patterns."""
     plans = make_plans(an) if plans is None else plans
+    if any(p.F is not None and len(p.Ainv) > MAX_PATTERNS for p in plans):
+        return Program((), (), 0, {}, [], [], False)
     groups = unknown_groups(an)
     offsets, c = {}, 0
     for g in groups:

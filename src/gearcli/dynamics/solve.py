@@ -136,7 +136,8 @@ class Solver:
                 return None
             self._program = build_program(self.an, self.plans)
             if not self._program.covered:
-                self.kernel_problem = "a block of this mechanism is not square (a redundant set solved in world axes)"
+                self.kernel_problem = ("a redundant gear set of this mechanism has no constant frame, or a block "
+                                       "has more sign patterns than the program holds (kernel_program.MAX_PATTERNS)")
         return self._program if self.kernel_problem is None else None
 
     def backend(self, method: str = "block", backend: str = "auto") -> str:
