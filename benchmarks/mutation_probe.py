@@ -14,7 +14,10 @@ Usage (from the repository root, test extra installed)::
 
 Exit status 0 when every mutation is caught, 1 when one is missed, 2 when a snippet is not
 found exactly once in the current source (the list must be kept in sync with ``src/``) or
-when the unmutated copy fails the tests.  Consistency checks that share gearcli's own
+when the unmutated copy fails the tests.  A mutation of the array implementation only
+(:data:`NUMPY_ONLY`) runs with the numpy path as the default backend; the others run with
+the default (the compiled kernel wherever it applies, recompiled in each copy: ~20 s CPU).
+Consistency checks that share gearcli's own
 kinematics or equation assembly (block vs full solve, the Newton-Euler residual of the
 solution, balances on gearcli's kinematics) are deliberately not in :data:`TESTS`.
 """
@@ -67,6 +70,19 @@ class Mutation:
     name: str
     description: str
     edits: tuple   # ((path under src/gearcli, old snippet, new snippet), ...)
+
+    @property
+    def numpy_path(self) -> bool:
+        """True for a bug in the array implementation only (its kinematics, loads or
+        columns): the compiled kernel, the default backend, does not run that code, so the
+        mutated copy is made to solve by the numpy path (:data:`NUMPY_DEFAULT`)."""
+        return any(e[0] in NUMPY_ONLY for e in self.edits)
+
+
+NUMPY_ONLY = {"dynamics/kinematics.py", "dynamics/inertia.py", "dynamics/equations.py"}
+# the edit that makes "auto" take the numpy path in a copy
+NUMPY_DEFAULT = ("dynamics/solve.py", 'if backend == "numpy" or (backend == "auto" and method == "full"):',
+                 'if backend in ("numpy", "auto") or method == "full":')
 
 
 MUTATIONS = [
@@ -131,6 +147,21 @@ MUTATIONS = [
              (("dynamics/sharing.py", "w.append(scale.get(g.index, 1.0))", "w.append(1.0)"),)),
     Mutation("sharing-weights-inverted", "min sum k t^2 instead of min sum t^2 / k",
              (("dynamics/sharing.py", "else kmin / x for i, x", "else x / kmin for i, x"),)),
+    # the compiled kernel (backend "auto" takes it for every bundled mechanism)
+    Mutation("kernel-gravity-sign", "kernel: gravity with the wrong sign in the d'Alembert force",
+             (("dynamics/kernel_links.py", "F = scale(sub(ac, (g[0], g[1], g[2])), m)",
+               "F = scale(add(ac, (g[0], g[1], g[2])), m)"),)),
+    Mutation("kernel-drop-w-x-z-qd", "kernel: angular acceleration without the w_parent x z qd term",
+             (("dynamics/kernel_links.py", "dwc = add(add(dwp, scale(z, qddk)), scale(cx(wp, z), qdk))",
+               "dwc = add(dwp, scale(z, qddk))"),)),
+    Mutation("kernel-propagation-sign", "kernel: a solved wrench passed on to a later link with the primary's sign",
+             (("dynamics/kernel.py", "s = 1.0 if L == P else -1.0", "s = 1.0"),)),
+    Mutation("kernel-child-basis-turn", "kernel: joint reaction turned to the child's basis by +q instead of -q",
+             (("dynamics/kernel.py", "X[gcol[g0 + c0 + h]] = cq * x0 + sq * x1",
+               "X[gcol[g0 + c0 + h]] = cq * x0 - sq * x1"),)),
+    Mutation("kernel-world-arm", "kernel: world-frame block, moment arm from the frame link's origin",
+             (("dynamics/kernel_world.py", "o[X, 0] + P[0] - o[L, 0], o[X, 1] + P[1] - o[L, 1], o[X, 2] + P[2] - o[L, 2]",
+               "P[0], P[1], P[2]"),)),
 ]
 
 
@@ -148,7 +179,7 @@ def copy_source(dest: Path) -> Path:
 
 def apply(src: Path, m: Mutation) -> None:
     """Apply m's edits to the copy ``src`` (…/gearcli); each old snippet must occur once."""
-    for rel, old, new in m.edits:
+    for rel, old, new in m.edits + ((NUMPY_DEFAULT,) if m.numpy_path else ()):
         path = src / rel
         if not path.is_file():
             raise SnippetError(f"{m.name}: file src/gearcli/{rel} does not exist")

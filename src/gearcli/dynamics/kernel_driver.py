@@ -77,7 +77,7 @@ def kernel_solve(prog: Program, an, q, qd, qdd, values: dict, jobs: int | None, 
            "gear_axial": np.empty((n, G, 2)), "motor_speed": np.empty((n, M))}
     SG = np.empty((n, len(prog.signed)))
     fail = np.full(n, -1, np.int64)
-    outs = tuple(a.reshape(n, -1) for a in out.values()) + (SG, fail)
+    outs = tuple(a.reshape(n, int(np.prod(a.shape[1:]))) for a in out.values()) + (SG, fail)
     ldrec, ldflt, vals = load_arrays(an, values, n)
     args = (prog.ints, prog.flts, ldrec, ldflt, vals, *(np.ascontiguousarray(a, float) for a in (q, qd, qdd)))
     ranges = job_ranges(n, jobs)
