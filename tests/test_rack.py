@@ -362,3 +362,18 @@ def test_pinocchio_rnea_with_the_tooth_force_as_fext(mech_dir, axis):
         assert abs(np.hypot(jr[0], jr[1]) - np.linalg.norm(fp[1:])) < 1e-9 * np.linalg.norm(fp)
         assert abs(jr[5] - mp[0]) < 1e-9 * (1 + np.linalg.norm(mp))
         assert abs(np.linalg.norm(jr[3:6]) - np.linalg.norm(mp)) < 1e-9 * (1 + np.linalg.norm(mp))
+
+
+def test_pinocchio_reads_the_exported_axis(tmp_path, text):
+    """The exported URDF in Pinocchio (the rack's mimic ignored, both joints free), with the
+    payload removed: RNEA projected by S (q = S x) is gearcli's equivalent force on Jx."""
+    pytest.importorskip("pinocchio")
+    from test_urdf import pinocchio_loads
+    an = analyse(parse_mechanism(text.split("loads:")[0]))
+    path = tmp_path / "axis.urdf"
+    export_urdf(an, path)
+    x = np.linspace(-0.15, 0.15, 7)[:, None]
+    xd, xdd = np.cos(10 * x), np.sin(20 * x)
+    res = solve(an, x, xd, xdd)
+    tau_pin, _ = pinocchio_loads(path, an.mech, x @ an.S.T, xd @ an.S.T, xdd @ an.S.T)
+    assert rel_err(res.tau, tau_pin @ an.S) < 1e-9

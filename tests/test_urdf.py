@@ -465,7 +465,7 @@ def test_export_of_a_urdf_import_round_trips(tmp_path):
     _same_results(an, an2)
 
 
-@pytest.mark.parametrize("name", ["paper_2dof", "bendix_wrist"])
+@pytest.mark.parametrize("name", ["paper_2dof", "bendix_wrist", "rack_axis", "helical_reduction"])
 def test_yourdfpy_loads_export_without_warnings(name, caplog):
     import yourdfpy
 
