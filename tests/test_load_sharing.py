@@ -340,3 +340,31 @@ def test_stiffness_for_all_pairs_of_a_set_or_none(run_cli, tmp_path, bundled):
     assert lines[0].startswith(f"{path}:{_line(text, 'name: planet-ring')}: gears[1]: gear pair 'planet-ring1' has "
                                "no stiffness but other pairs of its redundant gear set have: give stiffness for "
                                "every pair of the set ('sun-planet1' (gears[0]), "), lines[0]
+
+
+def test_schedule_puts_the_excess_in_the_redundant_block(mech_dir):
+    """Dulmage-Mendelsohn with more unknowns than equations: the blocks that do not hold a
+    redundant set stay square, the redundant set's block has exactly G - rank(circuit rows)
+    unknowns more than equations, and every unknown is solved once (checked from the
+    equation incidence: unknowns of a block = those of its links not solved earlier)."""
+    text = (mech_dir / "paper_2dof.yaml").read_text()
+    text = text.replace("\nmotors:", '\n  - {name: "5-1b", links: ["5", "1"], ratio: -3.0, '
+                        "mesh_point: [0.09, 0, -0.05]}\nmotors:")
+    for an in (analyse(parse_mechanism(text, "dup.yaml")), analyse(load_mechanism(mech_dir / "planetary_3p.yaml"))):
+        base = an.tree.base
+        unknowns = [(f"joint {ji}", 5, {jt.parent, jt.child} - {an.mech.base}) for ji, jt in enumerate(an.mech.joints)]
+        unknowns += [(f"mesh {ci}", 1, {an.names[c.j], an.names[c.k]} - {an.mech.base}) for ci, c in enumerate(an.circuits)]
+        unknowns += [(f"motor {mi}", 1, {an.names[x], an.names[s]} - {an.names[base]})
+                     for mi, (x, s) in enumerate(zip(an.motor_links, an.motor_stators))]
+        rows = np.array([c.row for c in an.circuits])
+        excess = len(an.circuits) - np.linalg.matrix_rank(rows, tol=1e-9)
+        redundant_links = {an.names[x] for s in an.redundant for i in s for x in (an.circuits[i].j, an.circuits[i].k)}
+        known, extra = set(), 0
+        for block in (set(an.name_of(b)) for b in an.schedule):
+            new = [(u, n) for u, n, links in unknowns if u not in known and links & block]
+            more = sum(n for _, n in new) - 6 * len(block)
+            assert more == 0 or (more > 0 and block & redundant_links), (block, more)
+            extra += more
+            known |= {u for u, _ in new}
+        assert extra == excess == 1 + (an.mech.name == "planetary_3p")
+        assert known == {u for u, _, _ in unknowns}
