@@ -210,7 +210,7 @@ def _blocks(n, ints, flts, q, cs, R, o, rhs, r, x, sig, A, X, SG, fail):
         else:
             _gather(F, base, lk0, B, blinks, R, o, rhs, r)
         big = 0.0
-        for i in range(nr):
+        for i in range(nr if m > 0 else 0):       # the zero tolerance of t (Eq. 14)
             big = max(big, abs(r[i]))
         ok = _resolve(ctx, world, a0, k0, nt, nloc, nr, r, x, tcol, t0, m, sig, TOL_SIGN * (1.0 + big))
         if not ok and fail[n] < 0:

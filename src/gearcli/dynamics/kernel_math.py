@@ -8,7 +8,9 @@ from __future__ import annotations
 
 from numba import njit
 
-OPTS = dict(cache=True, nogil=True, fastmath=False, error_model="numpy", _nrt=False)
+# fused multiply-adds allowed ("contract": one rounding instead of two, ~5% faster); no other
+# fast-math flag: NaN must reach the sign search (a sample without a consistent pattern)
+OPTS = dict(cache=True, nogil=True, fastmath={"contract"}, error_model="numpy", _nrt=False)
 # helpers are inlined into their caller at numba's IR level: a call passes every array
 # as a struct of ~9 words on the stack, more than the work of most helpers
 INLINE = dict(OPTS, inline="always")
