@@ -63,6 +63,24 @@ def _misuse(data: dict, planet: str, carrier: str, path: str, col: Collector) ->
     return bool(where)
 
 
+def _assembly_fits(data: dict, planet: str, n: int, path: str, col: Collector) -> bool:
+    """Equal spacing of a simple planet (one external pair with a sun, one internal pair
+    with a ring, the same planet tooth count in both, teeth given): every planet meshes
+    both central gears only if (z_sun + z_ring) / N is a whole number."""
+    pairs = [g for g in data.get("gears", []) if planet in g["links"]]
+    kinds = sorted(g.get("kind", "external") for g in pairs)
+    if kinds != ["external", "internal"] or not all("teeth" in g for g in pairs):
+        return True
+    own = {g["teeth"][g["links"].index(planet)] for g in pairs}
+    central = [g["teeth"][1 - g["links"].index(planet)] for g in pairs]
+    if len(own) != 1 or sum(central) % n == 0:
+        return True
+    col.add(f"{path}.planets", f"{n} equally spaced planets do not fit: (z_sun + z_ring) / N = "
+            f"{sum(central)}/{n} is not a whole number (the planets' teeth cannot mesh the sun and the "
+            "ring at every position)")
+    return False
+
+
 def _copies(spec: dict, n: int, a0, u, names: dict, place) -> list[dict]:
     """N copies of ``spec``: names from ``names`` {key: base name}, geometry by ``place``."""
     out = []
@@ -100,7 +118,7 @@ def expand_planets(data: dict, geometry, col: Collector) -> dict:
             col.add(f"{path}.planets", "planets need a revolute joint given by origin/axis (not dh)")
             continue
         axis = _carrier_axis(data, carrier, geometry, col, path)
-        if axis is None or _misuse(data, planet, carrier, path, col):
+        if axis is None or _misuse(data, planet, carrier, path, col) or not _assembly_fits(data, planet, n, path, col):
             continue
         a0, u = axis
         lists["links"] = _expand(lists["links"], lambda s: s["name"] == planet,
