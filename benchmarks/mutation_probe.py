@@ -62,6 +62,7 @@ TESTS = [
     "tests/test_load_sharing.py::test_each_planet_carries_one_nth_of_the_lumped_planet",
     "tests/test_load_sharing.py::test_unequal_stiffness_shares_in_proportion",
     "tests/test_load_sharing.py::test_least_load_map_two_parallel_springs",
+    "tests/test_load_sharing.py::test_split_path_drive_by_hand",
 ]
 
 

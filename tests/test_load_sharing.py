@@ -370,3 +370,50 @@ def test_schedule_puts_the_excess_in_the_redundant_block(mech_dir):
             known |= {u for u, _ in new}
         assert extra == excess == 1 + (an.mech.name == "planetary_3p")
         assert known == {u for u, _, _ in unknowns}
+
+
+# --- a split-path drive: one pinion, two idlers, one output gear (all on the housing) -----------------
+
+def split_path(k1: float, k2: float) -> str:
+    """Pinion A (20 teeth, module 2 mm) drives gear C (30 teeth) through two idlers B1, B2
+    (15 teeth) at +-60 degrees: two parallel paths A-Bi-C, stiffness k_i on both meshes of
+    path i.  Gear C carries a resisting moment of 3 N*m (a load); no gravity."""
+    rA, rB, rC = 0.02, 0.015, 0.03
+    b = [np.array([np.cos(a), np.sin(a), 0.0]) * (rA + rB) for a in (np.pi / 3, -np.pi / 3)]
+    xc = b[0][0] + np.sqrt((rB + rC) ** 2 - b[0][1] ** 2)
+    c = np.array([xc, 0.0, 0.0])
+    links = ["  - {name: H}"] + [f"  - {{name: {n}, mass: 0.1, inertia: [1.0e-5, 1.0e-5, 2.0e-5]}}" for n in "A B1 B2 C".split()]
+    joints = [f"  - {{name: J{n}, parent: H, child: {n}, origin: {{xyz: {list(map(float, o))}}}}}"
+              for n, o in (("A", np.zeros(3)), ("B1", b[0]), ("B2", b[1]), ("C", c))]
+    gears = []
+    for i, (bi, k) in enumerate(zip(b, (k1, k2))):
+        pa = bi * rA / (rA + rB)
+        pc = bi + (c - bi) * rB / (rB + rC)
+        gears.append(f"  - {{name: A-B{i + 1}, links: [A, B{i + 1}], teeth: [20, 15], mesh_point: {list(map(float, pa))}, stiffness: {k}}}")
+        gears.append(f"  - {{name: B{i + 1}-C, links: [B{i + 1}, C], teeth: [15, 30], mesh_point: {list(map(float, pc))}, stiffness: {k}}}")
+    return ("name: split\ngravity: [0, 0, 0]\nbase: H\nend_effector: C\nlinks:\n" + "\n".join(links)
+            + "\njoints:\n" + "\n".join(joints) + "\ngears:\n" + "\n".join(gears)
+            + "\nmotors:\n  - {name: M, link: A}\nloads:\n  - {name: out, link: C, frame: base, moment: [0, 0, -3.0]}\n")
+
+
+@pytest.mark.parametrize("k", [(1.0e8, 1.0e8), (1.0e8, 4.0e8)])
+def test_split_path_drive_by_hand(k):
+    """At rest: motor torque = 3 N*m x r_A / r_C = 2 N*m; each idler carries equal forces
+    on its two meshes (its own torque balance), and the pinion's balance fixes their sum:
+    t_1 + t_2 = 2 / r_A = 100 N, split t_i = 100 k_i / (k_1 + k_2) (min sum 2 t_i^2 / k_i)."""
+    an = analyse(parse_mechanism(split_path(*k), "split.yaml"))
+    assert an.dof == 1 and len(an.redundant) == 1
+    z = np.zeros((1, 1))
+    for method in ("block", "full"):
+        res = solve(an, z, z, z, method=method, verify=True)
+        assert res.residual < 1e-13
+        assert res.motor[0, 0] == pytest.approx(2.0, rel=1e-12)
+        for i in (0, 1):
+            for pair in (f"A-B{i + 1}", f"B{i + 1}-C"):
+                assert abs(res.gear_t[0, gear_index(an, pair)]) == pytest.approx(100 * k[i] / sum(k), rel=1e-12)
+    q = np.linspace(-3, 3, 40)[:, None]
+    blk = solve(an, q, 4 * np.cos(q), 30 * np.sin(3 * q), verify=True)
+    full = solve(an, q, 4 * np.cos(q), 30 * np.sin(3 * q), method="full", verify=True)
+    close(blk.gear_t, full.gear_t, 1e-11)
+    close(blk.joint, full.joint, 1e-11)
+    assert blk.residual < 1e-13
