@@ -270,3 +270,15 @@ def test_a_wrong_program_entry_is_caught(field, which, flat):
     finally:
         sol._program = prog
     assert worst(res, ref) > 1e3 * TOL
+
+
+def test_cached_kernel_follows_its_helpers():
+    """The digest in kernel.py is that of the helper modules compiled into ``run`` (edit
+    it with them: numba checks a cached function against its own file only)."""
+    import hashlib
+
+    from gearcli.dynamics import kernel
+    d = Path(kernel.__file__).parent
+    text = b"".join((d / f).read_bytes() for f in kernel.HELPER_FILES)
+    assert hashlib.sha256(text).hexdigest()[:16] == kernel.HELPERS_DIGEST, \
+        "a kernel helper module changed: update HELPERS_DIGEST in dynamics/kernel.py"

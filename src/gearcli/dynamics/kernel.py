@@ -24,6 +24,14 @@ from .kernel_output import write_outputs
 from .kernel_world import world_gather, world_propagate, world_solve
 from .signs import MAX_EXHAUSTIVE, TOL_SIGN
 
+# numba re-validates a cached function against its own file only, and the helpers of the
+# modules imported above (and the constants of signs.py) are compiled into :func:`run`: this
+# digest of their sources
+# (tests/test_kernel.py checks it) changes this file whenever they change, so that the
+# disk cache of ``run`` is never stale
+HELPERS_DIGEST = "db17416af8d5b9d8"
+HELPER_FILES = ("kernel_links.py", "kernel_math.py", "kernel_output.py", "kernel_world.py", "signs.py")
+
 
 @njit(**INLINE)
 def _gather(F, base, lk0, B, blinks, R, o, rhs, r):
