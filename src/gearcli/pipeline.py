@@ -118,12 +118,12 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
     def run(table_file):
         try:
             solve_chunks(table_file)
+            if table_file is not None:
+                table_file.close()
         except BaseException:
             if table_file is not None:
                 table_file.abort()
             raise
-        if table_file is not None:
-            table_file.close()
 
     def solve_chunks(table_file):
         nonlocal worst, n
