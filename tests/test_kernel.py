@@ -23,7 +23,7 @@ from big_mechanisms import binary_tree_urdf, geared_chain, serial_chain  # noqa:
 from factories import paper_2dof_variant, planetary_2dof, spatial_3dof  # noqa: E402
 from factories_own import PUMA_YAML, dh_geared, urdf_prismatic_chain  # noqa: E402
 from gearcli import analyse, load_mechanism, parse_mechanism  # noqa: E402
-from gearcli.dynamics.kernel_driver import job_ranges  # noqa: E402
+from gearcli.dynamics.kernel_driver import job_ranges, threads_for  # noqa: E402
 from gearcli.dynamics.signs import SignError  # noqa: E402
 from gearcli.dynamics.solve import solve, solver_for  # noqa: E402
 from gearcli.io.urdf_reader import load_urdf, parse_urdf  # noqa: E402
@@ -130,8 +130,8 @@ def test_general_blocks_are_exercised():
 @pytest.mark.parametrize("key", ["bendix_wrist.yaml", "loaded:bendix_wrist.yaml"])
 def test_threads_change_no_bit(key):
     an = analyse(mechanism(key))
-    n = 5001
-    assert len(job_ranges(n, 2)) == 2
+    n = 20_001
+    assert threads_for(n, 2) == 2 and len(job_ranges(n, 2)) == 10     # taken in turn
     q, qd, qdd = trajectory(an, n, seed=3)
     loads = per_sample_loads(an, n)
     one = solve(an, q, qd, qdd, jobs=1, loads=loads)

@@ -1,9 +1,9 @@
 """Running the compiled kernel (:mod:`.kernel`) over a trajectory, on one or more threads.
 
 Imported only when the kernel backend is used (it imports numba).  The samples are split
-into contiguous ranges, one per thread; the kernel releases the GIL (``nogil``) and each
-sample's arithmetic does not depend on the split, so the results are bitwise identical
-for any number of jobs.
+into contiguous ranges that the threads take in turn; the kernel releases the GIL
+(``nogil``) and each sample's arithmetic does not depend on the split, so the results are
+bitwise identical for any number of jobs.
 """
 from __future__ import annotations
 
@@ -27,14 +27,25 @@ def usable_cores() -> int:
         return max(1, os.cpu_count() or 1)
 
 
-def job_ranges(n: int, jobs: int | None) -> list[tuple[int, int]]:
-    """Contiguous (start, stop) sample ranges, one per thread (``jobs`` None: every core)."""
+def threads_for(n: int, jobs: int | None) -> int:
+    """Threads for n samples (``jobs`` None: every usable core; at least
+    MIN_SAMPLES_PER_JOB samples a thread)."""
     jobs = usable_cores() if jobs is None else int(jobs)
     if jobs < 1:
         raise ValueError(f"jobs must be at least 1, got {jobs}")
-    jobs = max(1, min(jobs, n // MIN_SAMPLES_PER_JOB))
-    cuts = [round(i * n / jobs) for i in range(jobs + 1)]
-    return [(cuts[i], cuts[i + 1]) for i in range(jobs)]
+    return max(1, min(jobs, n // MIN_SAMPLES_PER_JOB))
+
+
+def job_ranges(n: int, jobs: int | None) -> list[tuple[int, int]]:
+    """Contiguous (start, stop) sample ranges the threads take in turn: 8 a thread (at
+    least MIN_SAMPLES_PER_JOB samples each), so that a thread slowed by a busy core takes
+    fewer of them instead of making the others wait (``jobs`` None: every core)."""
+    threads = threads_for(n, jobs)
+    if threads == 1:
+        return [(0, n)]
+    parts = max(threads, min(8 * threads, n // MIN_SAMPLES_PER_JOB))
+    cuts = [round(i * n / parts) for i in range(parts + 1)]
+    return [(cuts[i], cuts[i + 1]) for i in range(parts)]
 
 
 def scratch(prog: Program) -> tuple:
@@ -84,7 +95,7 @@ def kernel_solve(prog: Program, an, q, qd, qdd, values: dict, jobs: int | None, 
     if len(ranges) == 1:
         run(*args, 0, n, outs, scratch(prog))
     else:
-        with ThreadPoolExecutor(len(ranges)) as pool:
+        with ThreadPoolExecutor(threads_for(n, jobs)) as pool:
             for f in [pool.submit(run, *args, s, e, outs, scratch(prog)) for s, e in ranges]:
                 f.result()
     if np.any(fail >= 0):
