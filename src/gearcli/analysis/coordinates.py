@@ -14,6 +14,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+from scipy.linalg import qr
 
 from ..errors import Collector
 from .context import Home
@@ -91,20 +92,21 @@ def independent_coordinates(h: Home, cparent: list, canon: np.ndarray, primary: 
 def circuit_rank(h: Home, circuits: list[Circuit]) -> CircuitRank:
     """Rank of the circuit rows, judged on rows scaled to unit length with the ratio
     tolerance RTOL_RANK (rounded mesh points must not turn two redundant planets into
-    "0 degrees of freedom"), and a basis of independent rows taken in file order."""
+    "0 degrees of freedom"), and a basis of independent rows (every row when they are
+    independent, else the pivots of a column-pivoted QR of the scaled rows' transpose).
+    The left singular vectors are computed only when some rows depend on the others."""
     G = len(circuits)
     Gam = np.array([c.row for c in circuits]).reshape(G, h.J)
     if G == 0:
         return CircuitRank(Gam, 0, [], np.zeros(0), np.zeros((0, 0)))
     Gn = Gam / np.maximum(np.linalg.norm(Gam, axis=1, keepdims=True), 1e-300)
-    U, sv, _ = np.linalg.svd(Gn)
+    sv = np.linalg.svd(Gn, compute_uv=False)
     rank = int(np.sum(sv > RTOL_RANK * sv[0]))
-    basis: list[int] = []
-    for i in range(G):                      # greedy: a row joins if it adds to the rank
-        trial = Gn[basis + [i]]
-        if len(basis) < rank and np.linalg.svd(trial, compute_uv=False)[-1] > RTOL_RANK * sv[0]:
-            basis.append(i)
-    return CircuitRank(Gam, rank, basis, sv, U)
+    if rank == G:
+        return CircuitRank(Gam, rank, list(range(G)), sv, np.zeros((G, 0)))
+    U, sv, _ = np.linalg.svd(Gn)
+    _, _, piv = qr(Gn.T, mode="economic", pivoting=True)
+    return CircuitRank(Gam, rank, sorted(int(i) for i in piv[:rank]), sv, U)
 
 
 def redundant_sets(cr: CircuitRank) -> tuple[tuple[int, ...], ...]:
@@ -164,7 +166,8 @@ def _pairs(h: Home, circuits: list[Circuit], which) -> str:
 def _contradiction(h: Home, circuits: list[Circuit], cr: CircuitRank, excess: int, col: Collector) -> None:
     """Refuse gear pairs whose closure equations contradict: the ``excess`` smallest nonzero
     singular directions of the rows name the pairs involved."""
-    U = cr.U[:, cr.rank - excess:cr.rank]
+    Uall = cr.U if cr.U.shape[1] else np.linalg.svd(cr.Gam / np.linalg.norm(cr.Gam, axis=1, keepdims=True))[0]
+    U = Uall[:, cr.rank - excess:cr.rank]
     involved = sorted({i for v in U.T for i in np.flatnonzero(np.abs(v) > 1e-8)})
     misfit = cr.sv[cr.rank - 1] / cr.sv[0]
     col.add("gears", "gear pairs " + _pairs(h, circuits, involved) + " form a redundant set whose closure "
