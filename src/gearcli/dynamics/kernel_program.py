@@ -164,7 +164,7 @@ def build_program(an, plans=None) -> Program:
     ``covered`` (and empty) when a constant block has more than :data:`MAX_PATTERNS` sign
     patterns."""
     plans = make_plans(an) if plans is None else plans
-    if any(p.F is not None and len(p.Ainv) > MAX_PATTERNS for p in plans):
+    if any(p.F is not None and (1 << len(p.signed)) > MAX_PATTERNS for p in plans):
         return Program((), (), 0, {}, [], [], False)
     groups = unknown_groups(an)
     offsets, c = {}, 0

@@ -29,9 +29,10 @@ class PatternMaps(Sequence):
     def __init__(self, A_mid: np.ndarray, halves: np.ndarray, cols: list[int], w: np.ndarray | None):
         self.A_mid, self.halves, self.cols, self.w = A_mid, halves, list(cols), w
         self._maps: dict[int, np.ndarray] = {}
+        self.count = 1 << len(self.cols)     # number of patterns (may exceed sys.maxsize)
 
     def __len__(self) -> int:
-        return 1 << len(self.cols)
+        return self.count
 
     def matrix(self, index: int) -> np.ndarray:
         """The block matrix A_sigma (6B, n) of pattern ``index``."""
@@ -45,8 +46,8 @@ class PatternMaps(Sequence):
         if isinstance(index, slice):
             return [self[i] for i in range(*index.indices(len(self)))]
         if index < 0:
-            index += len(self)
-        if not 0 <= index < len(self):
+            index += self.count
+        if not 0 <= index < self.count:
             raise IndexError(index)
         X = self._maps.get(index)
         if X is None:
