@@ -417,3 +417,13 @@ def test_split_path_drive_by_hand(k):
     close(blk.gear_t, full.gear_t, 1e-11)
     close(blk.joint, full.joint, 1e-11)
     assert blk.residual < 1e-13
+
+
+def test_urdf_mimic_gear_stiffness(mech_dir, tmp_path):
+    """stiffness is read from a gearcli:gear inside a <joint> with <mimic> too."""
+    text = (mech_dir / "geared_arm.urdf").read_text()
+    assert text.count('<gearcli:gear name="pinion-shoulder"') == 1
+    path = tmp_path / "arm.urdf"
+    path.write_text(text.replace('<gearcli:gear name="pinion-shoulder"', '<gearcli:gear name="pinion-shoulder" stiffness="2.5e8"'))
+    mech = load_mechanism(path)
+    assert [g.stiffness for g in mech.gears if g.name == "pinion-shoulder"] == [2.5e8]

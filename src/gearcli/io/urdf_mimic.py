@@ -9,7 +9,7 @@ from ..spatial import rot_z
 from .urdf_xml import q
 
 MIMIC_GEAR_ATTRS = ("name", "kind", "teeth", "carrier", "mesh_point", "pressure_angle",
-                    "pressure_angle_deg", "cone_angles", "cone_angles_deg")
+                    "pressure_angle_deg", "cone_angles", "cone_angles_deg", "stiffness")
 
 
 class Mimics:
