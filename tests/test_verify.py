@@ -297,3 +297,45 @@ def test_bad_trajectory_rows_are_listed_with_the_other_problems(run_cli, tmp_pat
     err = r.stderr.strip().splitlines()
     assert any(x.startswith(f"{tmp_path / 'rotor.csv'}:6:") for x in err), err
     assert any("unknown output column 'nope'" in x for x in err), err
+
+
+def test_pool_workers_share_the_cores(monkeypatch):
+    """-j N worker processes each get cores // N solver threads (no oversubscription), and
+    the partials do not depend on the solver's thread count."""
+    from gearcli.batch import runner
+
+    submitted = []
+
+    class FakePool:
+        def __init__(self, max_workers):
+            self.workers = max_workers
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return False
+
+        def submit(self, fn, job, threads):
+            from concurrent.futures import Future
+
+            submitted.append((self.workers, threads))
+            fut = Future()
+            fut.set_result(fn(job, threads))
+            return fut
+
+    monkeypatch.setattr(runner, "ProcessPoolExecutor", FakePool)
+    monkeypatch.setattr(runner.os, "cpu_count", lambda: 8)
+    from gearcli.batch.manifest import load_manifest
+
+    manifest = load_manifest(DESIGNS / "ci_example.yaml")
+    import dataclasses
+
+    job = runner.jobs_of(manifest)[0]
+    todo = [dataclasses.replace(job, trajectory=i) for i in range(3)]
+    pooled = runner._run_local(todo, 4, None)
+    assert submitted == [(3, 2)] * 3          # 3 jobs -> 3 workers, 8 // 3 = 2 threads each
+    serial = runner._run_local(todo, 1, None)
+    assert pooled.keys() == serial.keys()
+    for k in serial:
+        assert repr(pooled[k]) == repr(serial[k])

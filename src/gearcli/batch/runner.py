@@ -49,19 +49,21 @@ def case_analysis(mech_path: str | Path):
     return _analysis(str(mech_path), os.path.getmtime(mech_path))
 
 
-def solve_samples(an, traj_path, degrees: bool) -> Samples:
-    """Solve a trajectory file: times, every output column, and every real joint's rate."""
+def solve_samples(an, traj_path, degrees: bool, threads: int | None = None) -> Samples:
+    """Solve a trajectory file: times, every output column, and every real joint's rate;
+    ``threads``: the solver's threads (None: every core)."""
     tr = read_trajectory(traj_path, an.independent_names, degrees=degrees, linear=prismatic_independent(an),
                          loads=an.mech.loads)
-    res = solve(an, tr.q, tr.qd, tr.qdd, loads=tr.loads)
+    res = solve(an, tr.q, tr.qd, tr.qdd, loads=tr.loads, jobs=threads)
     return Samples(tr.t, named_columns(an, res, tr.t), tr.qd @ an.S.T)
 
 
-def run_job(job: Job) -> list[tuple]:
-    """The partials of every check of the job's case on the job's trajectory."""
+def run_job(job: Job, threads: int | None = None) -> list[tuple]:
+    """The partials of every check of the job's case on the job's trajectory (``threads``:
+    the solver's threads; the pools give each worker its share of the cores)."""
     an = case_analysis(job.mechanism)
     checks = build_checks(an, job.req, Collector(job.mechanism))
-    return partials(checks, solve_samples(an, job.path, job.degrees), an.mech)
+    return partials(checks, solve_samples(an, job.path, job.degrees, threads), an.mech)
 
 
 def jobs_of(manifest: Manifest) -> list[Job]:
@@ -104,8 +106,10 @@ def _run_local(todo: list[Job], workers: int, progress) -> dict:
             if progress:
                 progress()
         return results
-    with ProcessPoolExecutor(max_workers=min(workers, len(todo))) as pool:
-        futures = {pool.submit(run_job, job): job for job in todo}
+    workers = min(workers, len(todo))
+    share = max(1, (os.cpu_count() or 1) // workers)    # no more solver threads than cores
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        futures = {pool.submit(run_job, job, share): job for job in todo}
         for fut in as_completed(futures):
             job = futures[fut]
             results[(job.case, job.trajectory)] = fut.result()
@@ -135,7 +139,8 @@ def _run_dask(todo: list[Job], address: str, progress) -> dict:
 
     results = {}
     with _dask_client(address) as client:
-        futures = {client.submit(run_job, job, pure=False): job for job in todo}
+        # one solver thread per task: a Dask worker already runs tasks in its own threads
+        futures = {client.submit(run_job, job, 1, pure=False): job for job in todo}
         for fut in dask_completed(list(futures), loop=client.loop):
             job = futures[fut]
             results[(job.case, job.trajectory)] = fut.result()
