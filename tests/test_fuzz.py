@@ -12,6 +12,16 @@ number of bytes; a failing rename) must give:
 * no stray file in the directory (temporary or partial outputs);
 * inputs unchanged.
 
+This session's features have their own targets: the bundled ``planetary_3p`` (``planets:``
+expansion, load sharing), ``rack_axis`` and ``helical_reduction`` mutated (also field by
+field: ``planets: 65``, ``kind: rack``, ``hand: x`` ...) under check/graph/export/solve, the
+kernel and numpy backends agreeing on every mutated mechanism; their trajectories solved to
+``-o`` .csv/.parquet/.feather/.npz/unknown extensions with ``--precision``, ``--jobs``,
+``--backend`` and ``--method`` (bad values: exit 2, nothing written; binary tables read
+back and checked finite); files of >= 2000 rows (parsed by pyarrow) with mutated cells,
+which must give the same status, message (line, column) and bytes as the line-by-line
+reader.
+
 Profiles (``GEARCLI_FUZZ``): ``ci`` (default; deterministic, well under 2 minutes) and
 ``long`` (``GEARCLI_FUZZ=long python -m pytest tests/test_fuzz.py``; 2,500 inputs per
 target).  With ``GEARCLI_FUZZ_RECORD=stats.jsonl`` problems are recorded (one JSON line
@@ -166,9 +176,40 @@ def problems(result, hung: bool, work: Path, inputs: dict, allowed_outputs=()) -
         elif p.name in allowed_outputs and p.is_file() and not p.is_symlink():
             if result.exit_code == 2:
                 out.append(f"output {p.name} written although the exit status is 2")
-            elif NON_FINITE.search(p.read_bytes()):
-                out.append(f"non-finite number written to {p.name}")
+            else:
+                out += non_finite_in(p)
     return out
+
+
+def table_of(path: Path) -> dict:
+    """{column: float64 array} of a loads table in any output format (by extension)."""
+    import numpy as np
+    ext = path.suffix.lower()
+    if ext == ".npz":
+        with np.load(path, allow_pickle=False) as z:
+            return {k: np.asarray(z[k]) for k in z.files}
+    if ext in (".parquet", ".feather"):
+        import pyarrow.feather as pf
+        import pyarrow.parquet as pq
+        t = pq.read_table(path) if ext == ".parquet" else pf.read_table(path)
+        return {n: c.to_numpy() for n, c in zip(t.column_names, t.columns)}
+    lines = path.read_bytes().decode().splitlines()
+    head = lines[0].split(",")
+    data = np.array([[float(x) for x in ln.split(",")] for ln in lines[1:]]).reshape(-1, len(head))
+    return {h: data[:, i] for i, h in enumerate(head)}
+
+
+def non_finite_in(path: Path) -> list[str]:
+    """A problem when an output file holds a NaN or an infinity (or cannot be read back)."""
+    import numpy as np
+    if path.suffix.lower() not in (".parquet", ".feather", ".npz"):
+        return [f"non-finite number written to {path.name}"] if NON_FINITE.search(path.read_bytes()) else []
+    try:
+        cols = table_of(path)
+    except Exception as exc:   # noqa: BLE001 (any failure to read it back is the finding)
+        return [f"output {path.name} unreadable: {type(exc).__name__}: {exc}"[:300]]
+    bad = [k for k, v in cols.items() if v.dtype.kind == "f" and not np.isfinite(v).all()]
+    return [f"non-finite number written to {path.name} (column {bad[0]})"] if bad else []
 
 
 def verdict(target: str, problems_found: list[str], files: dict, exit_code=None) -> None:
@@ -322,3 +363,199 @@ def test_fuzz_output_faults(fault, command, budget, tmpfile):
         if fault in ("symlink", "dangling") and not (work / ("link" if fault == "symlink" else "dangle")).is_symlink():
             found.append("symlink replaced by a file")
         verdict("output", found, files, None if hung else result.exit_code)
+
+
+# --- this session's features: planets, racks, helical pairs, output formats, kernel, fast reader ---
+def few(n: int):
+    """``n`` examples in the ci profile (these targets run whole solves), the profile's count otherwise."""
+    return settings(max_examples=n) if PROFILE == "ci" else settings()
+
+
+NEW_YAMLS = ["planetary_3p.yaml", "rack_axis.yaml", "helical_reduction.yaml"]
+NEW_TRAJ = {y: y.replace(".yaml", "_traj.csv") for y in NEW_YAMLS}
+FIELDS = ["planets", "stiffness", "helix_angle_deg", "hand", "kind", "type", "teeth", "mesh_point", "axis",
+          "module", "pressure_angle_deg", "force", "point", "frame", "link", "links", "xyz", "mass", "name"]
+FIELD_VALUES = [b"0", b"1", b"2", b"-1", b"64", b"65", b"3.0", b"3.5", b"1e9", b"true", b"null", b"x", b"[]",
+                b"[1, 2]", b"[0, 0, 0]", b"[.nan, 0, 1]", b"rack", b"internal", b"bevel", b"prismatic",
+                b"revolute", b"left", b"right", b"90", b"45", b"-15", b"1e-300", b".inf", b"''", b"planet1",
+                b"housing", b"carrier", b"{}", b"base", b"link", b"[24, 0]"]
+
+
+@st.composite
+def field_mutation(draw):
+    """A value of a named YAML field replaced (``planets: 3`` -> ``planets: 65``)."""
+    return draw(st.sampled_from(FIELDS)), draw(st.integers(0, 1 << 30)), draw(st.one_of(
+        st.sampled_from(FIELD_VALUES), st.sampled_from(NASTY_NUMBERS)))
+
+
+def apply_field(data: bytes, mut) -> bytes:
+    key, a, blob = mut
+    hits = list(re.finditer(rb"(?<![A-Za-z_])" + key.encode() + rb":\s*(\[[^\]\n]*\]|[^,}\n#]+)", data))
+    if not hits:
+        return data
+    m = hits[a % len(hits)]
+    return data[:m.start(1)] + blob + data[m.end(1):]
+
+
+new_mutations = st.lists(st.one_of(mutation(), field_mutation(), field_mutation()), min_size=1, max_size=3)
+
+
+def mutate(data: bytes, muts) -> bytes:
+    for m in muts:
+        data = apply_field(data, m) if isinstance(m[0], str) and m[0] in FIELDS else apply(data, m)
+    return data
+
+
+def solved(work: Path, backend: str, out: str):
+    args = ["solve", work / "mech.yaml", work / "traj.csv", "-o", work / out, "--backend", backend,
+            "--precision", "17"]
+    result, hung = run_cli(args)
+    return result, hung
+
+
+@few(25)
+@given(name=st.sampled_from(NEW_YAMLS), muts=new_mutations,
+       command=st.sampled_from(["check", "graph", "json", "dot", "solve", "solve", "export"]))
+def test_fuzz_new_mechanisms(name, muts, command):
+    """Mutated planetary_3p / rack_axis / helical_reduction.  ``solve`` runs the kernel and the
+    numpy backends: same exit status, same message, same numbers (1e-9 of each column's peak)."""
+    import numpy as np
+    files = {"mech.yaml": mutate((MECH_DIR / name).read_bytes(), muts), "traj.csv": short_csv(NEW_TRAJ[name], 30)}
+    with tempfile.TemporaryDirectory(prefix="gearcli-fuzz-") as d:
+        work = Path(d)
+        for k, v in files.items():
+            (work / k).write_bytes(v)
+        if command != "solve":
+            args = {"check": ["check"], "graph": ["graph"], "json": ["graph", "--json"], "dot": ["graph", "--dot"],
+                    "export": ["export"]}[command] + [work / "mech.yaml"]
+            result, hung = run_cli(args + (["-o", work / "out.urdf"] if command == "export" else []))
+            found = problems(result, hung, work, files, ("out.urdf",))
+            verdict("new-yaml", found, files, None if hung else result.exit_code)
+            return
+        found, codes, firsts, tables = [], [], [], []
+        for backend, out in (("kernel", "k.csv"), ("numpy", "n.csv")):
+            result, hung = solved(work, backend, out)
+            found += problems(result, hung, work, files, ("k.csv", "n.csv"))
+            if hung:
+                break
+            codes.append(result.exit_code)
+            firsts.append(result.stderr.strip().splitlines()[:1] if result.exit_code else [])
+            if result.exit_code == 0 and (work / out).is_file():
+                tables.append(table_of(work / out))
+        if len(codes) == 2 and (codes[0] != codes[1] or firsts[0] != firsts[1]):
+            found.append(f"backends disagree: kernel exit {codes[0]} {firsts[0]}, numpy exit {codes[1]} {firsts[1]}")
+        if len(tables) == 2:
+            for col, a in tables[0].items():
+                b = tables[1].get(col)
+                tol = 1e-9 * max(1.0, float(np.max(np.abs(a)))) if a.size else 0
+                if b is None or b.shape != a.shape or np.max(np.abs(a - b), initial=0) > tol:
+                    found.append(f"backends differ in column {col}")
+                    break
+        verdict("new-yaml", found, files, codes[-1] if codes else None)
+
+
+EXTS = [".csv", ".parquet", ".feather", ".npz", ".CSV", ".Parquet", ".txt", ".xlsx", "", ".csv.gz", ".npy"]
+KNOWN = {".csv", ".parquet", ".feather", ".npz"}
+
+
+@few(30)
+@given(name=st.sampled_from(NEW_YAMLS), muts=st.lists(mutation(), max_size=3), n=st.sampled_from([2, 3, 5, 30]),
+       ext=st.sampled_from(EXTS), precision=st.sampled_from([None, None, 1, 6, 9, 17, 0, 18, -1, "x", "9.5"]),
+       jobs=st.sampled_from([None, None, 1, 2, 3, 0, -1, "two"]),
+       backend=st.sampled_from([None, "auto", "kernel", "numpy", "numba", ""]), degrees=st.booleans(),
+       method=st.sampled_from([None, None, "full"]))
+def test_fuzz_new_trajectories(name, muts, n, ext, precision, jobs, backend, degrees, method):
+    """Mutated trajectories of the new mechanisms written in every format with every option;
+    a bad option or an unknown extension is exit 2 with nothing written."""
+    data = short_csv(NEW_TRAJ[name], n)
+    for m in muts:
+        data = apply(data, m)
+    files = {"mech.yaml": (MECH_DIR / name).read_bytes(), "traj.csv": data}
+    out = "out" + ext
+    opts = [("--precision", precision), ("--jobs", jobs), ("--backend", backend), ("--method", method)]
+    extra = [str(x) for k, v in opts if v is not None for x in (k, v)] + (["--degrees"] if degrees else [])
+    with tempfile.TemporaryDirectory(prefix="gearcli-fuzz-") as d:
+        work = Path(d)
+        for k, v in files.items():
+            (work / k).write_bytes(v)
+        result, hung = run_cli(["solve", work / "mech.yaml", work / "traj.csv", "-o", work / out, *extra])
+        found = problems(result, hung, work, files, (out,))
+        bad_option = (ext.lower() not in KNOWN or precision not in (None, 1, 6, 9, 17)
+                      or jobs not in (None, 1, 2, 3) or backend not in (None, "auto", "kernel", "numpy"))
+        if not hung and bad_option and result.exit_code != 2:
+            found.append(f"bad option or extension {ext!r} not refused (exit {result.exit_code})")
+        if not hung and result.exit_code == 0 and not (work / out).is_file():
+            found.append("exit 0 without the output file")
+        if not hung and result.exit_code == 0 and not muts and precision is not None and ext.lower() == ".csv":
+            cells = (work / out).read_text().splitlines()[1].split(",")
+            digits = max(len(re.sub(r"[^0-9]", "", c.split("e")[0]).lstrip("0")) for c in cells)
+            if digits > precision:
+                found.append(f"--precision {precision} wrote {digits} significant digits")
+        verdict("new-traj", found, files, None if hung else result.exit_code)
+
+
+def long_trajectory(name: str, rows: int) -> bytes:
+    """The bundled trajectory repeated (time shifted) to ``rows`` samples: read by pyarrow."""
+    lines = (MECH_DIR / name).read_bytes().splitlines()
+    head, body = lines[0], lines[1:]
+    t_end, out, k = float(body[-1].split(b",")[0]), [head], 0
+    while len(out) <= rows:
+        for ln in body:
+            if len(out) > rows:
+                break
+            cells = ln.split(b",")
+            cells[0] = repr(float(cells[0]) + k * (t_end + 0.001)).encode()
+            out.append(b",".join(cells))
+        k += 1
+    return b"\n".join(out) + b"\n"
+
+
+CELLS = st.one_of(st.sampled_from(NASTY_NUMBERS), st.sampled_from(
+    [b" 1.5", b"1.5 ", b"+1.5", b".5", b"5.", b"1E5", b"1e+05", b"0001", b"-0.0", b"Infinity", b"1.5e",
+     b'"1.5"', b'"1.5', b"1.5\"", b"1.5,2", b"", b"\t", b"1\x00", b"\xff", b"\xc3\xa9", b"1e-400", b"1.0e-5000",
+     b"0e0", b"- 1", b"1 2", b"+-1", b"nan(1)", b"-nan", b"+inf", b"1d5", b"\xef\xbb\xbf1"]),
+    st.floats(allow_nan=True, allow_infinity=True).map(lambda x: repr(x).encode()),
+    st.binary(min_size=1, max_size=6))
+
+
+@few(10)
+@given(name=st.sampled_from(["paper_2dof_traj.csv", "planetary_3p_traj.csv", "rack_axis_traj.csv",
+                             "bendix_wrist_traj.csv"]),
+       rows=st.sampled_from([2001, 4500]), cells=st.lists(st.tuples(st.integers(0, 1 << 30), st.integers(0, 99),
+                                                                     CELLS), min_size=1, max_size=2),
+       chunk=st.sampled_from([None, 2000, 3000]))
+def test_fuzz_large_trajectory(name, rows, cells, chunk):
+    """Files of >= 2000 rows (pyarrow parses them) with mutated cells: the same exit status,
+    message (line and column) and output bytes as the line-by-line reader (pyarrow off)."""
+    import gearcli.io.trajectory as trajectory
+    mech = name.replace("_traj.csv", ".yaml")
+    lines = long_trajectory(name, rows).split(b"\n")
+    for r, c, blob in cells:
+        i = 1 + r % rows
+        row = lines[i].split(b",")
+        row[c % len(row)] = blob
+        lines[i] = b",".join(row)
+    files = {"mech.yaml": (MECH_DIR / mech).read_bytes(), "traj.csv": b"\n".join(lines)}
+    runs, found = [], []
+    for fast in (True, False):
+        with tempfile.TemporaryDirectory(prefix="gearcli-fuzz-") as d:
+            work = Path(d)
+            for k, v in files.items():
+                (work / k).write_bytes(v)
+            saved = trajectory.FAST_PARSE_ROWS
+            trajectory.FAST_PARSE_ROWS = saved if fast else 1 << 40
+            try:
+                result, hung = run_cli(["solve", work / "mech.yaml", work / "traj.csv", "-o", work / "out.csv"]
+                                       + (["--chunk", str(chunk)] if chunk else []))
+            finally:
+                trajectory.FAST_PARSE_ROWS = saved
+            found += problems(result, hung, work, files, ("out.csv",))
+            if hung:
+                break
+            runs.append((result.exit_code, result.stderr.replace(str(work), "<dir>"),
+                         (work / "out.csv").read_bytes() if (work / "out.csv").is_file() else None))
+    if len(runs) == 2 and runs[0] != runs[1]:
+        found.append(f"fast reader differs: exit {runs[0][0]} {runs[0][1].strip()[:200]!r} vs "
+                     f"exit {runs[1][0]} {runs[1][1].strip()[:200]!r}"
+                     + (" (outputs differ)" if runs[0][2] != runs[1][2] else ""))
+    verdict("large-traj", found, files, runs[0][0] if runs else None)
