@@ -137,6 +137,8 @@ def run_cli(args) -> tuple[object, bool]:
             result = CliRunner().invoke(app, [str(a) for a in args])
         result.leaked = [f"{w.category.__name__}: {w.message}" for w in caught
                          if issubclass(w.category, RuntimeWarning)]
+        if result.exc_info and isinstance(result.exc_info[1], Hang):   # caught by the runner
+            return None, True
         return result, False
     except Hang:
         return None, True
@@ -366,6 +368,22 @@ def test_fuzz_output_faults(fault, command, budget, tmpfile):
 
 
 # --- this session's features: planets, racks, helical pairs, output formats, kernel, fast reader ---
+_WARM = []
+
+
+def warm_kernel() -> None:
+    """Compile (or load from numba's disk cache) the kernel and CSV writer once, outside the
+    hang alarm: the first compile takes 20 s CPU, more than the alarm on a busy machine."""
+    if not _WARM:
+        from typer.testing import CliRunner
+
+        from gearcli.cli import app
+        with tempfile.TemporaryDirectory(prefix="gearcli-fuzz-") as d:
+            CliRunner().invoke(app, ["solve", str(MECH_DIR / "rack_axis.yaml"), str(MECH_DIR / "rack_axis_traj.csv"),
+                                     "-o", f"{d}/w.csv", "--backend", "kernel"])
+        _WARM.append(True)
+
+
 def few(n: int):
     """``n`` examples in the ci profile (these targets run whole solves), the profile's count otherwise."""
     return settings(max_examples=n) if PROFILE == "ci" else settings()
@@ -419,6 +437,7 @@ def solved(work: Path, backend: str, out: str):
 def test_fuzz_new_mechanisms(name, muts, command):
     """Mutated planetary_3p / rack_axis / helical_reduction.  ``solve`` runs the kernel and the
     numpy backends: same exit status, same message, same numbers (1e-9 of each column's peak)."""
+    warm_kernel()
     import numpy as np
     files = {"mech.yaml": mutate((MECH_DIR / name).read_bytes(), muts), "traj.csv": short_csv(NEW_TRAJ[name], 30)}
     with tempfile.TemporaryDirectory(prefix="gearcli-fuzz-") as d:
@@ -467,6 +486,7 @@ KNOWN = {".csv", ".parquet", ".feather", ".npz"}
 def test_fuzz_new_trajectories(name, muts, n, ext, precision, jobs, backend, degrees, method):
     """Mutated trajectories of the new mechanisms written in every format with every option;
     a bad option or an unknown extension is exit 2 with nothing written."""
+    warm_kernel()
     data = short_csv(NEW_TRAJ[name], n)
     for m in muts:
         data = apply(data, m)
@@ -527,6 +547,7 @@ CELLS = st.one_of(st.sampled_from(NASTY_NUMBERS), st.sampled_from(
 def test_fuzz_large_trajectory(name, rows, cells, chunk):
     """Files of >= 2000 rows (pyarrow parses them) with mutated cells: the same exit status,
     message (line and column) and output bytes as the line-by-line reader (pyarrow off)."""
+    warm_kernel()
     import gearcli.io.trajectory as trajectory
     mech = name.replace("_traj.csv", ".yaml")
     lines = long_trajectory(name, rows).split(b"\n")
