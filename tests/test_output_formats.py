@@ -169,6 +169,23 @@ def test_bad_output_format_or_precision_writes_nothing(run_cli, tmp_path, out, e
     assert snapshot(tmp_path) == before
 
 
+@pytest.mark.parametrize("name, fmt", [(".parquet", "parquet"), (".npz", "npz"), (".feather", "feather"),
+                                       (".csv", "csv"), ("out", "csv"), (".hidden", None), ("dir.v2/out", "csv")])
+def test_format_of_a_name_that_is_only_an_extension(name, fmt):
+    """``-o .parquet`` writes Parquet (it wrote CSV into a file named .parquet: pathlib sees a
+    hidden file without extension); a hidden name with another extension is refused."""
+    assert table_files.format_of(name) == fmt
+
+
+def test_dot_parquet_output_is_parquet(run_cli, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    r = run_cli("solve", MECH, TRAJ, "-o", ".parquet")
+    assert r.exit_code == 0, r.stderr
+    assert pq.read_table(tmp_path / ".parquet").num_rows > 0
+    refused(run_cli("solve", MECH, TRAJ, "-o", ".loads"), "unknown output format '.loads'")
+    assert not (tmp_path / ".loads").exists()
+
+
 class Failing(io.FileIO):
     """A binary file whose writes fail with ENOSPC after ``budget`` bytes."""
 

@@ -26,7 +26,7 @@ from .io.output import OutputError, atomic_output, output_target
 from .io.trajectory import TrajectoryReader
 from .model.mechanism import Mechanism
 from .report.columns import Summary, column_names, column_units, first_non_finite, table
-from .report.table_files import CONVENTIONS, FORMATS, format_of, open_table
+from .report.table_files import CONVENTIONS, FORMATS, extension, format_of, open_table
 
 VERIFY_TOLERANCE = 1e-8
 """``--verify`` fails when the worst relative Newton-Euler residual exceeds this (or is
@@ -171,7 +171,7 @@ def _output_format(out_path, inputs, precision: int | None) -> str:
     output_target(out_path, inputs)
     fmt = format_of(str(out_path))
     if fmt is None:
-        raise OutputError(str(out_path), f"unknown output format '{Path(out_path).suffix}' (the extension "
+        raise OutputError(str(out_path), f"unknown output format '{extension(str(out_path))}' (the extension "
                           f"chooses it: {', '.join(FORMATS)})")
     if precision is not None and fmt != "csv":
         raise OutputError(str(out_path), f"--precision applies to CSV output only, not {fmt}")

@@ -41,9 +41,15 @@ cached compilation cost ~1 s, Python's formatting ~0.4 us a value)."""
 def format_of(name: str) -> str | None:
     """Format of the output file ``name`` by its extension (case-insensitive): ``csv``
     (also for a name without extension and ``-``, stdout), ``parquet``, ``feather``,
-    ``npz``; None for another extension."""
-    suffix = Path(name).suffix.lower() if name != "-" else ""
+    ``npz``; None for another extension.  A name that is only an extension (``.parquet``,
+    a hidden file to :class:`~pathlib.Path`) has that extension."""
+    suffix = extension(name).lower() if name != "-" else ""
     return "csv" if suffix == "" else FORMATS.get(suffix)
+
+
+def extension(name: str) -> str:
+    """The extension of file ``name`` as written ('' for none; ``.parquet`` for ``.parquet``)."""
+    return Path("x" + Path(name).name).suffix
 
 
 def ascii_unit(unit: str) -> str:
