@@ -123,6 +123,18 @@ def test_arrow_formats_hold_full_float64_units_and_metadata(run_cli, tmp_path, r
     assert b"parent on the child" in meta[b"conventions"] and b"\n" not in meta[b"conventions"]
 
 
+def test_parquet_is_uncompressed_with_time_statistics_only(run_cli, tmp_path, reference):
+    """Float64 loads do not compress: pages are stored plain; only ``t`` has min/max (row-group
+    pruning by time) and they are the chunk's first and last times."""
+    loads, _ = reference
+    meta = pq.ParquetFile(solve_cli(run_cli, tmp_path / "out.parquet")).metadata
+    rg = meta.row_group(0)
+    assert {rg.column(i).compression for i in range(meta.num_columns)} == {"UNCOMPRESSED"}
+    st = rg.column(0).statistics
+    assert rg.column(0).is_stats_set and (st.min, st.max) == (loads[0, 0], loads[rg.num_rows - 1, 0])
+    assert not any(rg.column(i).is_stats_set for i in range(1, meta.num_columns))
+
+
 def test_npz_holds_one_2d_array_with_names_and_units(run_cli, tmp_path, bendix):
     z = np.load(solve_cli(run_cli, tmp_path / "out.npz"), allow_pickle=False)
     names = column_names(bendix)
