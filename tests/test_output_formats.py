@@ -282,6 +282,26 @@ def test_plot_refuses_a_corrupt_binary_file(run_cli, tmp_path, ext):
     assert not (tmp_path / "fig.png").exists()
 
 
+@pytest.mark.parametrize("ext", [".parquet", ".feather", ".npz", ".csv"])
+@pytest.mark.parametrize("content", [b"", b"garbage", b"\x93NUMPY"])
+def test_plot_refuses_an_empty_or_foreign_file(run_cli, tmp_path, ext, content):
+    """An empty .npz gave exit 1 'Aborted!' (np.load's EOFError is click's abort) and a text
+    file in .npz talked of pickled data: now exit 2 with one line."""
+    bad = tmp_path / f"bad{ext}"
+    bad.write_bytes(content)
+    r = run_cli("plot", bad, "motor:*", "-o", tmp_path / "fig.png")
+    refused(r, f"bad{ext}")
+    assert "pickle" not in r.stderr
+    assert not (tmp_path / "fig.png").exists()
+
+
+def test_plot_refuses_npz_loads_that_are_not_numbers(run_cli, tmp_path):
+    bad = tmp_path / "bad.npz"
+    np.savez(bad, columns=np.array(["t", "motor:m"]), units=np.array(["s", "N*m"]),
+             loads=np.array([["0", "x"], ["1", "y"]]))
+    refused(run_cli("plot", bad, "motor:*", "-o", tmp_path / "fig.png"), "bad.npz: cannot read the npz file")
+
+
 @pytest.mark.parametrize("jobs", [1, 3])
 def test_write_rows_in_threads_writes_the_same_text(tmp_path, jobs):
     from gearcli.report.csv_text import write_rows

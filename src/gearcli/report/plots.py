@@ -145,11 +145,14 @@ def read_loads(path) -> tuple[list[str], np.ndarray, dict]:
         return header, data, {n: column_unit(n) for n in header}
     try:
         if fmt == "npz":
+            if not zipfile.is_zipfile(path):     # np.load: EOFError on an empty file, pickle talk on others
+                raise ValueError("not an npz file (no zip archive)")
             with np.load(path, allow_pickle=False) as z:
-                header, data, units = [str(c) for c in z["columns"]], z["loads"], [str(u) for u in z["units"]]
+                header, units = [str(c) for c in z["columns"]], [str(u) for u in z["units"]]
+                data = np.asarray(z["loads"], dtype=float)
         else:
             header, data, units = _read_arrow(path, fmt)
-    except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
         raise GearcliError(f"{path}: cannot read the {fmt} file: {getattr(exc, 'strerror', None) or exc}") from None
     if not header or header[0] != "t" or data.ndim != 2 or data.shape[1] != len(header):
         raise GearcliError(f"{path}: not a loads table written by gearcli solve (first column 't')")
