@@ -427,3 +427,15 @@ def test_urdf_mimic_gear_stiffness(mech_dir, tmp_path):
     path.write_text(text.replace('<gearcli:gear name="pinion-shoulder"', '<gearcli:gear name="pinion-shoulder" stiffness="2.5e8"'))
     mech = load_mechanism(path)
     assert [g.stiffness for g in mech.gears if g.name == "pinion-shoulder"] == [2.5e8]
+
+
+@pytest.mark.parametrize("value", ["0", "-5"])
+def test_bad_stiffness_of_a_planet_pair_is_reported_once(run_cli, tmp_path, bundled, value):
+    """The three copies of 'sun-planet' printed the same line three times."""
+    text = bundled.replace("stiffness: 3.0e8", f"stiffness: {value}")
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    res = run_cli("check", path)
+    assert res.exit_code == 2
+    assert res.stderr.splitlines() == [f"{path}:{_line(text, 'stiffness: ' + value)}: gears[0].stiffness: mesh "
+                                       f"stiffness must be positive, got {value} N/m"]

@@ -85,8 +85,11 @@ class Collector:
         return self.lines.get("", None)
 
     def add(self, path: str, message: str) -> None:
-        """Record a problem at YAML/element ``path`` (its line looked up)."""
-        self.issues.append(Issue(self.file, path, self.line_of(path), message))
+        """Record a problem at YAML/element ``path`` (its line looked up), once (the copies
+        of a ``planets: N`` item report at their original's path)."""
+        issue = Issue(self.file, path, self.line_of(path), message)
+        if issue not in self.issues:
+            self.issues.append(issue)
 
     def raise_if_any(self) -> None:
         """Raise a :class:`MechanismError` with every problem recorded so far, if any."""
