@@ -49,22 +49,31 @@ def _gather(F, base, lk0, B, blinks, R, o, rhs, r):
 
 
 @njit(**INLINE)
+def _row(ainv, b, nr, r):
+    """Row of Ainv at ``b`` (nr long) times r."""
+    if nr == 6:
+        return (ainv[b] * r[0] + ainv[b + 1] * r[1] + ainv[b + 2] * r[2]
+                + ainv[b + 3] * r[3] + ainv[b + 4] * r[4] + ainv[b + 5] * r[5])
+    s = 0.0
+    for j in range(0, nr, 6):   # unrolled by six: independent products, short chains
+        s += (ainv[b + j] * r[j] + ainv[b + j + 1] * r[j + 1] + ainv[b + j + 2] * r[j + 2]
+              + ainv[b + j + 3] * r[j + 3] + ainv[b + j + 4] * r[j + 4] + ainv[b + j + 5] * r[j + 5])
+    return s
+
+
+@njit(**INLINE)
 def _apply(ainv, off, n, nr, r, x):
     """x (n) = Ainv r, Ainv (n, nr) row-major at ``off``."""
-    if nr == 6:
-        r0, r1, r2, r3, r4, r5 = r[0], r[1], r[2], r[3], r[4], r[5]
-        for i in range(n):
-            b = off + 6 * i
-            x[i] = (ainv[b] * r0 + ainv[b + 1] * r1 + ainv[b + 2] * r2
-                    + ainv[b + 3] * r3 + ainv[b + 4] * r4 + ainv[b + 5] * r5)
-        return
     for i in range(n):
-        s = 0.0
-        b = off + i * nr
-        for j in range(0, nr, 6):   # unrolled by six: independent products, short chains
-            s += (ainv[b + j] * r[j] + ainv[b + j + 1] * r[j + 1] + ainv[b + j + 2] * r[j + 2]
-                  + ainv[b + j + 3] * r[j + 3] + ainv[b + j + 4] * r[j + 4] + ainv[b + j + 5] * r[j + 5])
-        x[i] = s
+        x[i] = _row(ainv, off + i * nr, nr, r)
+
+
+@njit(**INLINE)
+def _apply_t(ainv, off, nr, r, x, tcol, t0, m):
+    """Only the signed t of x = Ainv r (all a sign trial needs; the same row products)."""
+    for i in range(m):
+        c = tcol[t0 + i]
+        x[c] = _row(ainv, off + c * nr, nr, r)
 
 
 @njit(**INLINE)
@@ -101,13 +110,14 @@ def _pattern(m, sig):
 
 
 @njit(**INLINE)
-def _trial(ctx, world, a0, k0, nt, n, nr, r, x, m, sig):
-    """x = the block's solution for the signs ``sig`` (constant frame: Ainv[pattern] r)."""
+def _trial(ctx, world, a0, k0, nt, n, nr, r, x, tcol, t0, m, sig):
+    """x = the block's solution for the signs ``sig`` (world axes), or only its signed t
+    (constant frame: those rows of Ainv[pattern] r; :func:`_resolve` completes x)."""
     ainv, trec, tflt, R, o, A = ctx
     if world:
         world_solve(k0, nt, trec, tflt, sig, R, o, nr, r, x, A)
     else:
-        _apply(ainv, a0 + _pattern(m, sig) * n * nr, n, nr, r, x)
+        _apply_t(ainv, a0 + _pattern(m, sig) * n * nr, nr, r, x, tcol, t0, m)
 
 
 @njit(**INLINE)
@@ -116,7 +126,13 @@ def _resolve(ctx, world, a0, k0, nt, n, nr, r, x, tcol, t0, m, sig, tol):
 
     Step 0: every t positive; steps 1..m: the signs of the previous solution's own t;
     then every pattern in :func:`.signs.sign_patterns` order (m <= MAX_EXHAUSTIVE).  One
-    call site of the solve keeps the compiled code small."""
+    call site of the solve keeps the compiled code small.  A constant-frame block's trials
+    compute its t only (m rows of Ainv r): the whole x is computed once, for the pattern
+    accepted (bitwise what a full trial gives: the same row products)."""
+    if not world:
+        if m == 0:
+            _apply(ctx[0], a0, n, nr, r, x)
+            return True
     for i in range(m):
         sig[i] = 1.0
     steps = 1 + m + ((1 << m) if m <= MAX_EXHAUSTIVE else 0)
@@ -125,8 +141,10 @@ def _resolve(ctx, world, a0, k0, nt, n, nr, r, x, tcol, t0, m, sig, tol):
             pattern_signs(step - m - 1, m, sig)
         elif step > 0:
             own_signs(x, tcol, t0, m, sig)
-        _trial(ctx, world, a0, k0, nt, n, nr, r, x, m, sig)
+        _trial(ctx, world, a0, k0, nt, n, nr, r, x, tcol, t0, m, sig)
         if consistent(x, tcol, t0, m, sig, tol):
+            if not world:
+                _apply(ctx[0], a0 + _pattern(m, sig) * n * nr, n, nr, r, x)
             return True
     return False
 
@@ -223,7 +241,7 @@ def _blocks(n, ints, flts, q, cs, R, o, rhs, r, x, sig, A, X, SG, fail):
         ok = _resolve(ctx, world, a0, k0, nt, nloc, nr, r, x, tcol, t0, m, sig, TOL_SIGN * (1.0 + big))
         if not ok and fail[n] < 0:
             fail[n] = b
-        if world:
+        if nt > 0:                                # world axes, or its link's (kernel_terms.local_inverse)
             world_propagate(k0, nt, trec, tflt, sig, R, o, x, rhs)
         else:
             _propagate(F, base, brec[b, 8], brec[b, 9], prec, cmat, later, R, o, x, rhs)

@@ -27,7 +27,9 @@ reading what to do from the arrays built here once per analysis (from the
 * the output maps of :func:`.kernel_output.output_constants` and the structure matrix A.
 
 Blocks without a constant frame (F = -1 in ``brec``) are solved in world axes from the
-column terms of :mod:`.kernel_terms`.
+column terms of :mod:`.kernel_terms`; one whose matrix is nevertheless constant in its one
+link's axes gets F = that link and its inverse (:func:`_local_frame`), and keeps its terms
+(term count > 0) for the propagation.
 """
 from __future__ import annotations
 
@@ -38,7 +40,7 @@ import numpy as np
 from ..analysis.schedule import unknown_groups
 from .blocks import _primary_side, make_plans
 from .kernel_output import output_constants
-from .kernel_terms import general_terms
+from .kernel_terms import general_terms, local_inverse
 
 I64 = np.int64
 
@@ -152,6 +154,16 @@ def _block(bd: _Builder, an, bi, p, block_of, offsets, sigcol, terms):
     bd.brec.append(rec)
 
 
+def _local_frame(bd: _Builder, trec, tflt, p) -> None:
+    """A world-frame block whose matrix is constant in its link's axes
+    (:func:`.kernel_terms.local_inverse`) becomes a constant-frame block in that link
+    (F = the link, its inverse in ``ainv``) that keeps its terms for the propagation."""
+    rec = bd.brec[-1]
+    Ainv = local_inverse(trec, tflt, rec[12], rec[13], p.links[0], rec[3])
+    if Ainv is not None:
+        rec[0], rec[7] = p.links[0], bd.add_floats("ainv", Ainv)
+
+
 MAX_PATTERNS = 256
 """Sign patterns of one constant block up to which the program holds every pattern's map:
 a block's maps are made on first use (:class:`.pattern_maps.PatternMaps`), and 2^m of them
@@ -178,6 +190,8 @@ def build_program(an, plans=None) -> Program:
     bd = _Builder()
     for bi, p in enumerate(plans):
         _block(bd, an, bi, p, block_of, offsets, sigcol, terms)
+        if p.F is None and len(p.links) == 1 and not p.signed:
+            _local_frame(bd, trec, tflt, p)
     jrec, jflt = _joints(an)
     cat = (lambda xs: np.concatenate(xs) if xs else np.zeros(1))
     jout, mcol, gcol, mflt = output_constants(an, offsets)

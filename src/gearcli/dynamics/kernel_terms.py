@@ -120,3 +120,31 @@ def general_terms(an, plans, block_of):
     trec = np.array(rec, np.int64).reshape(-1, 6) if rec else np.zeros((1, 6), np.int64)
     tflt = np.array(flt, float).reshape(-1, 7) if flt else np.zeros((1, 7))
     return trec, tflt, where
+
+
+MAX_LOCAL_CONDITION = 1e8
+"""Largest condition number of a world-frame block's matrix that :func:`local_inverse`
+inverts once instead of eliminating per sample."""
+
+
+def local_inverse(trec, tflt, k0: int, nt: int, link: int, n: int):
+    """The inverse (n, n) of a world-frame block's matrix in ``link``'s axes about its
+    origin, when that matrix is constant: the block is the one link ``link``, it has no
+    signed mesh (the caller checks both) and every term on it has ``link`` as its frame
+    link X (a term then reads, in link axes, coef [d_X ; p_X x d_X] or coef [0 ; d_X]:
+    no pose enters).  None otherwise, or when the matrix is singular or worse conditioned
+    than :data:`MAX_LOCAL_CONDITION`.  The kernel then solves the block like a
+    constant-frame block (rotating its right-hand side into link axes) and still
+    propagates its wrenches from the terms."""
+    A = np.zeros((n, n))
+    for k in range(k0, k0 + nt):
+        row, col, kind, X = trec[k, 1], trec[k, 2], trec[k, 3], trec[k, 4]
+        if row < 0:
+            continue
+        if row != 0 or X != link or trec[k, 5] >= 0:
+            return None
+        coef, d, p = tflt[k, 0], tflt[k, 1:4], tflt[k, 4:7]
+        A[:, col] += coef * (np.concatenate([np.zeros(3), d]) if kind == 1 else np.concatenate([d, np.cross(p, d)]))
+    if n != 6 or not np.isfinite(cond := np.linalg.cond(A)) or cond > MAX_LOCAL_CONDITION:
+        return None
+    return np.linalg.inv(A)
