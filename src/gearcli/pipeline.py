@@ -7,8 +7,11 @@ Data flow: :func:`~gearcli.loader.load_mechanism` -> :func:`~gearcli.graph.analy
 from __future__ import annotations
 
 import math
+import queue
 import sys
+import threading
 import warnings
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -115,50 +118,138 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
     worst = 0.0
     n = 0
 
-    def run(table_file):
-        try:
-            solve_chunks(table_file)
-            if table_file is not None:
-                table_file.close()
-        except BaseException:
-            if table_file is not None:
-                table_file.abort()
-            raise
-
     def solve_chunks(table_file):
+        # one warnings scope around the reading thread's lifetime: catch_warnings is process-wide,
+        # so the reader's own (in derivatives) must nest inside it, never interleave with another
+        with warnings.catch_warnings(), Prefetch(reader) as parts:
+            warnings.simplefilter("ignore")
+            for part in parts:
+                with np.errstate(all="ignore"):
+                    res = solve(an, part.q, part.qd, part.qdd, method=method, chunk=chunk, verify=verify,
+                                loads=part.loads, backend=backend, jobs=jobs)
+                    tab = table(an, part.t, res)
+                record(table_file, part, tab, res)
+
+    def record(table_file, part, tab, res):
         nonlocal worst, n
-        for part in reader:
-            with np.errstate(all="ignore"), warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                res = solve(an, part.q, part.qd, part.qdd, method=method, chunk=chunk, verify=verify,
-                            loads=part.loads, backend=backend, jobs=jobs)
-                tab = table(an, part.t, res)
-            _check_loads(reader, part, tab, names)
-            if verify:
-                _check_residual(reader, part, res.residual)
-                worst = max(worst, res.residual)
-            summary.add(tab)
-            if table_file is not None:
-                table_file.write(tab)
-            n += len(part.t)
-            if progress is not None:
-                progress(advance=len(part.t))
+        _check_loads(reader, part, tab, names)
+        if verify:
+            _check_residual(reader, part, res.residual)
+            worst = max(worst, res.residual)
+        summary.add(tab)
+        if table_file is not None:
+            table_file.write(tab)
+        n += len(part.t)
+        if progress is not None:
+            progress(advance=len(part.t))
 
     def opened(f):
         meta = {"gearcli_version": __version__, "mechanism": str(mech_path), "trajectory": str(traj_path),
                 "conventions": CONVENTIONS}
-        return open_table(fmt, f, names, column_units(an), meta, precision=precision or 9, rows=rows,
-                          jobs=jobs)
+        return BackgroundWriter(open_table(fmt, f, names, column_units(an), meta, precision=precision or 9,
+                                           rows=rows, jobs=jobs))
 
     out = None if out_path is None or to_stdout else Path(out_path)
     if out_path is None:
-        run(None)
+        _run(solve_chunks, None)
     elif out is None:
-        run(opened(sys.stdout))
+        _run(solve_chunks, opened(sys.stdout))
     else:
         with atomic_output(out, (mech_path, traj_path), binary=fmt != "csv") as f:
-            run(opened(f))
+            _run(solve_chunks, opened(f))
     return SolveReport(an, n, summary, worst if verify else None, out)
+
+
+def _run(solve_chunks, table_file) -> None:
+    """``solve_chunks(table_file)``, then close the table file (abort it on failure)."""
+    try:
+        solve_chunks(table_file)
+        if table_file is not None:
+            table_file.close()
+    except BaseException:
+        if table_file is not None:
+            table_file.abort()
+        raise
+
+
+class Prefetch:
+    """Context manager iterating ``items`` one item ahead in a background thread (reading and
+    spline differentiation of chunk k + 1 overlap the solve of chunk k; parsing, LAPACK and
+    the kernel release the GIL).  Items, and an exception raised by ``items``, arrive in
+    order; leaving the context stops the thread (after the item it is producing)."""
+
+    def __init__(self, items, depth: int = 1):
+        self.items, self.queue, self.stop = items, queue.Queue(maxsize=depth), threading.Event()
+        self.thread = threading.Thread(target=self._run, name="gearcli-read", daemon=True)
+
+    def __enter__(self):
+        self.thread.start()
+        return self._iter()
+
+    def __exit__(self, *exc) -> None:
+        self.stop.set()
+        self.thread.join()
+
+    def _run(self) -> None:
+        try:
+            for x in self.items:
+                if not self._put((True, x)):
+                    return
+        except BaseException as exc:   # noqa: BLE001 (re-raised in the consuming thread)
+            self._put((False, exc))
+            return
+        self._put((False, None))
+
+    def _put(self, item) -> bool:
+        while not self.stop.is_set():
+            try:
+                self.queue.put(item, timeout=0.05)
+                return True
+            except queue.Full:
+                continue
+        return False
+
+    def _iter(self):
+        while True:
+            ok, x = self.queue.get()
+            if ok:
+                yield x
+            elif x is None:
+                return
+            else:
+                raise x
+
+
+class BackgroundWriter:
+    """A table writer (:func:`~gearcli.report.table_files.open_table`) whose ``write`` runs in
+    a background thread, overlapping the solve of the next chunk (pyarrow and the compiled
+    CSV formatter release the GIL).  One write at a time, in order; a failed write raises at
+    the next ``write`` or at ``close``; ``abort`` waits for the running write first."""
+
+    def __init__(self, table_file):
+        self.file, self.pending = table_file, None
+        self.pool = ThreadPoolExecutor(1, thread_name_prefix="gearcli-write")
+
+    def _wait(self) -> None:
+        pending, self.pending = self.pending, None
+        if pending is not None:
+            pending.result()
+
+    def write(self, tab: np.ndarray) -> None:
+        self._wait()
+        self.pending = self.pool.submit(self.file.write, tab)
+
+    def close(self) -> None:
+        try:
+            self._wait()
+            self.file.close()
+        finally:
+            self.pool.shutdown()
+
+    def abort(self) -> None:
+        """Release the writer after a failure, once the write under way is over."""
+        self.pool.shutdown(wait=True, cancel_futures=True)
+        self.file.abort()
 
 
 def _output_format(out_path, inputs, precision: int | None) -> str:
