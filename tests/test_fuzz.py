@@ -303,11 +303,24 @@ class FullDisk(io.TextIOWrapper):
         return super().write(s)
 
 
+class FullDiskRaw(io.FileIO):
+    """The raw file under the text wrapper (the CSV writer writes bytes to ``f.buffer``) and
+    the binary formats' file: ENOSPC once the budget is spent."""
+
+    def write(self, b):
+        FullDisk.budget -= len(b)
+        if FullDisk.budget < 0:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return super().write(b)
+
+
 @given(fault=st.sampled_from(["input", "mech", "dot", "dir", "devnull", "missing", "empty", "symlink",
                               "dangling", "hardlink", "enospc", "rename", "ok"]),
-       command=st.sampled_from(["solve", "export"]), budget=st.integers(0, 20000), tmpfile=st.booleans())
-def test_fuzz_output_faults(fault, command, budget, tmpfile):
+       command=st.sampled_from(["solve", "export"]), budget=st.integers(0, 20000), tmpfile=st.booleans(),
+       ext=st.sampled_from([".csv", ".csv", ".parquet", ".feather", ".npz"]))
+def test_fuzz_output_faults(fault, command, budget, tmpfile, ext):
     import gearcli.io.output as output
+    warm_kernel()   # numba's modules imported before os.O_TMPFILE is taken away below
 
     files = {"mech.yaml": (MECH_DIR / "paper_2dof.yaml").read_bytes(),
              "traj.csv": short_csv("paper_2dof_traj.csv")}
@@ -315,8 +328,10 @@ def test_fuzz_output_faults(fault, command, budget, tmpfile):
     saved_tmpfile = getattr(os, "O_TMPFILE", None)
 
     def fdopen(fd, mode="r", **kw):
-        f = real_fdopen(fd, "wb")
         FullDisk.budget = budget
+        if "b" in mode:
+            return FullDiskRaw(fd, "wb")
+        f = io.BufferedWriter(FullDiskRaw(fd, "wb"))
         return FullDisk(f, encoding=kw.get("encoding"), newline=kw.get("newline"), write_through=True)
 
     def replace(*a, **k):
@@ -327,10 +342,11 @@ def test_fuzz_output_faults(fault, command, budget, tmpfile):
         for k, v in files.items():
             (work / k).write_bytes(v)
         own = "traj.csv" if command == "solve" else "mech.yaml"    # an input of the command
+        out = "out" + (ext if command == "solve" else ".csv")
         target = {"input": work / own, "mech": work / "mech.yaml", "dot": f"{work}/./{own}",
-                  "dir": work, "devnull": "/dev/null", "missing": work / "no" / "out.csv", "empty": "",
+                  "dir": work, "devnull": "/dev/null", "missing": work / "no" / out, "empty": "",
                   "symlink": work / "link", "dangling": work / "dangle", "hardlink": work / "hard",
-                  }.get(fault, work / "out.csv")
+                  }.get(fault, work / out)
         extra = {}
         if fault == "symlink":
             os.symlink("mech.yaml", work / "link")
@@ -357,7 +373,7 @@ def test_fuzz_output_faults(fault, command, budget, tmpfile):
         inputs = dict(files)
         if fault == "hardlink":
             inputs["hard"] = files["mech.yaml"]
-        allowed = {"out.csv", "real.out", "link", "dangle"}
+        allowed = {out, "real.out", "link", "dangle"}
         found = problems(result, hung, work, inputs, allowed)
         if fault in ("input", "mech", "dot", "dir", "devnull", "missing", "empty", "symlink", "hardlink") \
                 and not hung and result.exit_code != 2:
