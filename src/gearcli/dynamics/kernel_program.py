@@ -116,14 +116,33 @@ class _Builder:
         setattr(self, attr + "_len", off + arr.size)
         return off
 
-    def propagation(self, an, p, gi, g, later) -> None:
+    def propagation(self, an, p, gi, g, later, first: int) -> bool:
+        """Append group gi's propagation record (False: merged into the previous one)."""
         Cp, Cs = p.C[gi]
+        if Cs is None and self._merge(int(p.offs[gi]), g.size, _primary_side(an, g), later, Cp, first):
+            return False
         off = self.add_floats("cmat", Cp)
         if Cs is not None:
             self.add_floats("cmat", Cs)
         self.prec.append([int(p.offs[gi]), g.size, int(Cs is not None), off, _primary_side(an, g),
                           len(self.later), len(later)])
         self.later += later
+        return True
+
+    def _merge(self, c0, size, P, later, Cp, first) -> bool:
+        """Unsigned groups in adjacent columns acting on the same later links (same primary
+        link) share one record: their wrenches are summed in F before the one rotation
+        (a serial chain's joint reaction and motor torque)."""
+        if len(self.prec) <= first:
+            return False
+        last = self.prec[-1]
+        if last[2] or last[0] + last[1] != c0 or last[4] != P or self.later[last[5]:last[5] + last[6]] != later:
+            return False
+        prev = self.cmat.pop().reshape(6, last[1])
+        self.cmat_len -= prev.size
+        last[3] = self.add_floats("cmat", np.hstack([prev, np.asarray(Cp, float).reshape(6, size)]))
+        last[1] += size
+        return True
 
 
 def _block(bd: _Builder, an, bi, p, block_of, offsets, sigcol, terms):
@@ -141,8 +160,7 @@ def _block(bd: _Builder, an, bi, p, block_of, offsets, sigcol, terms):
         bd.add_floats("ainv", A)
     for gi, g in enumerate(p.groups):
         later = [L for L in g.links if block_of[L] > bi]
-        if later and p.F is not None:
-            bd.propagation(an, p, gi, g, later)
+        if later and p.F is not None and bd.propagation(an, p, gi, g, later, rec[8]):
             rec[9] += 1
         if p.parent_side.get(gi):
             if gi in p.turn:               # basis carried by a third coaxial link: q @ row
