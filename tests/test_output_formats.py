@@ -124,7 +124,7 @@ def test_arrow_formats_hold_full_float64_units_and_metadata(run_cli, tmp_path, r
 
 
 def test_parquet_is_uncompressed_with_time_statistics_only(run_cli, tmp_path, reference):
-    """Float64 loads do not compress: pages are stored plain; only ``t`` has min/max (row-group
+    """Float64 loads hardly compress: pages are stored plain; only ``t`` has min/max (row-group
     pruning by time) and they are the chunk's first and last times."""
     loads, _ = reference
     meta = pq.ParquetFile(solve_cli(run_cli, tmp_path / "out.parquet")).metadata
