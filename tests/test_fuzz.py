@@ -601,3 +601,31 @@ def test_fuzz_large_trajectory(name, rows, cells, chunk, sep, eol, load_column):
                      f"exit {runs[1][0]} {runs[1][1].strip()[:200]!r}"
                      + (" (outputs differ)" if runs[0][2] != runs[1][2] else ""))
     verdict("large-traj", found, files, runs[0][0] if runs else None)
+
+
+_EXPORTED: dict = {}
+
+
+def exported(name: str) -> bytes:
+    """The URDF ``gearcli export`` writes for bundled ``name`` (made once; racks, helical
+    pairs, planet copies and stiffness as gearcli extension elements)."""
+    if name not in _EXPORTED:
+        with tempfile.TemporaryDirectory(prefix="gearcli-fuzz-") as d:
+            result, hung = run_cli(["export", MECH_DIR / name, "-o", f"{d}/m.urdf"])
+            assert not hung and result.exit_code == 0, result.stderr
+            _EXPORTED[name] = Path(f"{d}/m.urdf").read_bytes()
+    return _EXPORTED[name]
+
+
+@few(6)
+@given(name=st.sampled_from(NEW_YAMLS), muts=mutations, command=st.sampled_from(["check", "graph", "solve", "solve"]))
+def test_fuzz_new_urdf(name, muts, command):
+    """Mutated URDF exports of planetary_3p, rack_axis and helical_reduction."""
+    warm_kernel()
+    data = exported(name)
+    for m in muts:
+        data = apply(data, m)
+    files = {"mech.urdf": data, "traj.csv": short_csv(NEW_TRAJ[name], 30)}
+    args = (lambda w: ["solve", w / "mech.urdf", w / "traj.csv", "-o", w / "out.csv", "--verify"]) \
+        if command == "solve" else (lambda w: [command, w / "mech.urdf"])
+    run_case("new-urdf", files, args)
