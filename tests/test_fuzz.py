@@ -20,7 +20,7 @@ kernel and numpy backends agreeing on every mutated mechanism; their trajectorie
 ``--backend`` and ``--method`` (bad values: exit 2, nothing written; binary tables read
 back and checked finite); files of >= 2000 rows (parsed by pyarrow) with mutated cells,
 which must give the same status, message (line, column) and bytes as the line-by-line
-reader.
+reader; the URDF exports of the three new mechanisms, mutated.
 
 Profiles (``GEARCLI_FUZZ``): ``ci`` (default; deterministic, well under 2 minutes) and
 ``long`` (``GEARCLI_FUZZ=long python -m pytest tests/test_fuzz.py``; 2,500 inputs per
