@@ -1,7 +1,7 @@
 """Side-by-side speed of gearcli and Pinocchio (issue 11); prints figures, not a test.
 
     python benchmarks/bench_speed.py [--quick] [--repeat 5] [--samples 20000] [--cli-samples 1000000]
-                                     [--big] [--skip cli,links,n]
+                                     [--cli-repeat 1] [--big] [--skip cli,links,n]
 
 Prints, in one run (medians over --repeat, ratios from the same run, load average at the
 start and the end, thread counts stated):
@@ -260,25 +260,30 @@ def library_solve_time(mech: Path, traj: Path) -> float:
     return time.perf_counter() - t0
 
 
-def cli_section(n: int, old_format: bool) -> None:
+def cli_section(n: int, old_format: bool, repeat: int = 1) -> None:
+    """Library solve and CLI runs, each the median of ``repeat`` runs (CLI runs interleaved)."""
     mech = MECHS / "bendix_wrist.yaml"
     print(f"\n## `gearcli solve` end to end, Bendix wrist, {n:,} samples (positions only; rates by spline)\n")
     with tempfile.TemporaryDirectory() as d:
         traj = Path(d) / "traj.csv"
         bendix_trajectory(traj, n)
-        lib = library_solve_time(mech, traj)
+        lib = np.median([library_solve_time(mech, traj) for _ in range(repeat)])
         rows = [("library `gearcli.solve` alone (same samples, chunks of 20,000)", lib, None, None)]
         runs = [("out.csv", CLI), ("out.parquet", CLI)]
         if old_format:
             runs.append(("old.csv", CLI_PY_FORMAT))
+        measured, size = {out: [] for out, _ in runs}, {}
+        for _ in range(repeat):
+            for out, code in runs:
+                measured[out].append(run_measured(code, ["solve", str(mech), str(traj), "-o", str(Path(d) / out)]))
+                size[out] = (Path(d) / out).stat().st_size / 1e6
+                (Path(d) / out).unlink()
         for out, code in runs:
-            wall, rss = run_measured(code, ["solve", str(mech), str(traj), "-o", str(Path(d) / out)])
-            size = (Path(d) / out).stat().st_size / 1e6
-            label = f"`gearcli solve -o {out}` ({size:,.0f} MB)"
+            wall, rss = np.median([m[0] for m in measured[out]]), max(m[1] for m in measured[out])
+            label = f"`gearcli solve -o {out}` ({size[out]:,.0f} MB)"
             if code is CLI_PY_FORMAT:
                 label += ", CSV text by Python's `%` (the writer before issue 11)"
             rows.append((label, wall, rss, wall / lib))
-            (Path(d) / out).unlink()
     print("| run | wall time | peak memory | / library solve |\n|---|---|---|---|")
     for label, wall, rss, ratio in rows:
         print(f"| {label} | {wall:.1f} s | {'' if rss is None else f'{rss:,.0f} MB'} | "
@@ -398,6 +403,7 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="small sizes (about a minute)")
     ap.add_argument("--repeat", type=int, default=None, help="runs per figure (default 5, --quick 3)")
     ap.add_argument("--samples", type=int, default=None, help="samples per library figure (default 20,000)")
+    ap.add_argument("--cli-repeat", type=int, default=1, help="runs per CLI figure (median; default 1)")
     ap.add_argument("--cli-samples", type=int, default=None, help="samples of the CLI runs (default 1,000,000)")
     ap.add_argument("--big", action="store_true", help="also 1e7 samples (library and CLI peak memory; minutes)")
     ap.add_argument("--skip", default="", help="comma list of sections to skip: lib,cli,links,n")
@@ -414,7 +420,7 @@ def main() -> None:
     if "lib" not in skip:
         library_section(n, repeat)
     if "cli" not in skip:
-        cli_section(cli_n, old_format=not a.quick)
+        cli_section(cli_n, old_format=not a.quick, repeat=a.cli_repeat)
         format_section(20_000 if a.quick else 100_000, repeat)
     if "links" not in skip:
         links_section(max(n // 4, 1000), repeat, (2, 4, 8, 16, 32, 64) if not a.quick else (2, 8, 32))
