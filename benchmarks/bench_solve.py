@@ -29,6 +29,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from timing import load_line, median_time  # noqa: E402 (benchmarks/timing.py)
 
 from gearcli import solve
 from gearcli import analyse
@@ -39,17 +40,11 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def median_rate(fn, n, repeat):
-    ts = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        ts.append(time.perf_counter() - t0)
-    return n / float(np.median(ts)), float(np.median(ts))
+    """(samples/s, median s) of ``repeat`` calls of ``fn()`` on ``n`` samples."""
+    t = median_time(fn, repeat)
+    return n / t, t
 
 
-def load_line() -> str:
-    one, five, fifteen = os.getloadavg()
-    return f"load average {one:.2f} {five:.2f} {fifteen:.2f}"
 
 
 def core(repeat: int, n: int) -> None:

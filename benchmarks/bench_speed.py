@@ -34,6 +34,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from timing import load_line, median_time  # noqa: E402 (benchmarks/timing.py)
 from threadpoolctl import threadpool_info, threadpool_limits
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -55,18 +56,8 @@ def erd_robots() -> Path | None:
     return None
 
 
-def load_line() -> str:
-    one, five, fifteen = os.getloadavg()
-    return f"load average {one:.2f} {five:.2f} {fifteen:.2f} ({os.cpu_count()} cpus)"
 
 
-def median_time(fn, repeat: int) -> float:
-    ts = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        ts.append(time.perf_counter() - t0)
-    return float(np.median(ts))
 
 
 def rate(fn, n: int, repeat: int) -> float:
