@@ -339,3 +339,17 @@ def test_pool_workers_share_the_cores(monkeypatch):
     assert pooled.keys() == serial.keys()
     for k in serial:
         assert repr(pooled[k]) == repr(serial[k])
+
+
+@pytest.mark.parametrize("key, needs", [("min_bending_safety", "gears[].rating"),
+                                        ("min_contact_safety", "gears[].rating")])
+def test_a_requirement_that_checks_nothing_is_refused(run_cli, tmp_path, key, needs):
+    """The rotor has bearings but no gears: a gear requirement would silently check nothing."""
+    case = write_rotor_case(tmp_path, "[{name: x, position: 0, C: 3000, C0: 3000, type: ball}]")
+    good, _ = run_json(run_cli, tmp_path, "cases:\n" + case)
+    assert good.exit_code == 0, good.stderr
+    (tmp_path / "out.json").unlink()
+    r, doc = run_json(run_cli, tmp_path, "cases:\n" + case.replace("min_static_safety: 1.5", f"{key}: 2"))
+    assert r.exit_code == 2 and doc is None
+    assert f"design.yaml:2: cases[0].{key}: checks nothing: 'rotor.yaml' has no {needs}" in r.stderr
+    assert "Traceback" not in r.stderr

@@ -138,6 +138,7 @@ def _prepare_case(spec: dict, where: str, base: Path, col: Collector, issues: li
     issues += [str(i) for i in mcol.issues]
     if not checks:
         col.add(f"{where}.mechanism", f"nothing to check: '{spec['mechanism']}' has no ratings and the case no limits")
+    _unused_requirements(spec, where, checks, col)
     for tp in trajs:
         try:
             TrajectoryReader(tp, an.independent_names, degrees=spec.get("degrees", False),
@@ -146,6 +147,22 @@ def _prepare_case(spec: dict, where: str, base: Path, col: Collector, issues: li
             issues += exc.lines()
     name = spec.get("name", Path(spec["mechanism"]).stem)
     return Case(name, mech_path, tuple(trajs), bool(spec.get("degrees", False)), req, tuple(checks))
+
+
+REQUIREMENT_CHECKS = {"bearing_life_h": ("L10 life", "joints[].bearings with C"),
+                      "min_static_safety": ("static safety s0", "joints[].bearings"),
+                      "min_bending_safety": ("bending safety", "gears[].rating"),
+                      "min_contact_safety": ("contact safety", "gears[].rating")}
+"""Requirement key -> (quantity of the checks it sets, the ratings those checks need)."""
+
+
+def _unused_requirements(spec: dict, where: str, checks, col: Collector) -> None:
+    """A requirement the case gives but no check uses is an error, not a silent no-op."""
+    quantities = {c.quantity for c in checks}
+    for key, (quantity, needs) in REQUIREMENT_CHECKS.items():
+        if key in spec and quantity not in quantities:
+            col.add(f"{where}.{key}", f"checks nothing: '{spec['mechanism']}' has no {needs} "
+                    f"(remove {key} or rate the parts)")
 
 
 def _split_build(an, req: Requirements, ccol: Collector, mcol: Collector) -> list[Check]:
