@@ -151,9 +151,9 @@ def _rref(M: np.ndarray) -> np.ndarray:
             continue
         M[[r, p]] = M[[p, r]]
         M[r] /= M[r, c]
-        for i in range(M.shape[0]):
-            if i != r:
-                M[i] -= M[i, c] * M[r]
+        f = M[:, c].copy()
+        f[r] = 0.0
+        M -= np.outer(f, M[r])            # eliminate column c from every other row
         r += 1
     return M
 
