@@ -46,6 +46,11 @@ sys.path.insert(0, str(ROOT / "tests"))      # big_mechanisms: generated geared 
 from gearcli import analyse, load_mechanism, solve  # noqa: E402
 from gearcli.report.urdf_writer import export_urdf  # noqa: E402
 
+try:
+    from gearcli.dynamics.solve import BACKENDS  # noqa: E402
+except ImportError:          # an older gearcli
+    BACKENDS = ()
+
 MECHS = ROOT / "mechanisms"
 SOLVE_PARAMS = inspect.signature(solve).parameters
 
@@ -148,7 +153,7 @@ def gearcli_rates(an, q, qd, qdd, repeat: int) -> dict:
     """samples/s of gearcli.solve: kernel / numpy backends (1 and 2 workers), full method."""
     n = q.shape[0]
     out = {}
-    backends = ("kernel", "numpy") if "backend" in SOLVE_PARAMS else (None,)
+    backends = ((("llvm",) if "llvm" in BACKENDS else ()) + ("kernel", "numpy")) if "backend" in SOLVE_PARAMS else (None,)
     for backend in backends:
         for jobs in ((1, 2) if "jobs" in SOLVE_PARAMS and backend != "numpy" else (None,)):   # numpy: 1 thread
             kw = {} if backend is None else {"backend": backend}
@@ -172,10 +177,12 @@ def fmt_rate(r) -> str:
 def library_section(n: int, repeat: int) -> None:
     print(f"\n## Library, all loads (gearcli) vs torques only (Pinocchio): samples/s, {n:,} random samples, "
           f"median of {repeat}")
-    print("gearcli: one BLAS thread; 'x2' = jobs=2 (two kernel threads; the numpy path has one); "
+    print("gearcli: one BLAS thread; 'x2' = jobs=2 (two kernel threads; the numpy path has one); llvm = the "
+          "kernel generated per mechanism (compiled in the warm-up run); "
           "Pinocchio rneaInParallel with 1 and 2 threads\n")
-    head = ["mechanism", "gearcli kernel", "kernel x2", "gearcli numpy", "gearcli full",
-            "pin rnea loop", "rneaInParallel 1", "rneaInParallel 2", "kernel / rIP 1", "kernel x2 / rIP 2"]
+    head = ["mechanism", "gearcli llvm", "llvm x2", "gearcli kernel", "kernel x2", "gearcli numpy", "gearcli full",
+            "pin rnea loop", "rneaInParallel 1", "rneaInParallel 2", "llvm / rIP 1", "llvm x2 / rIP 2",
+            "kernel / rIP 1", "kernel x2 / rIP 2"]
     print("| " + " | ".join(head) + " |\n|" + "---|" * len(head))
     with tempfile.TemporaryDirectory() as d:
         for name, path, urdf in subjects(Path(d)):
@@ -190,11 +197,13 @@ def library_section(n: int, repeat: int) -> None:
                 print(f"WARNING {name}: gearcli tau differs from Pinocchio's by {diff:.1e} (relative)")
             k1 = g.get(("kernel", 1), g.get(("default", 1)))
             k2 = g.get(("kernel", 2))
-            row = [f"{name} ({an.dof} dof, {len(mech.joints)} joints)", fmt_rate(k1), fmt_rate(k2),
-                   fmt_rate(g.get(("numpy", 1))), fmt_rate(g["full"]),
+            l1, l2 = g.get(("llvm", 1)), g.get(("llvm", 2))
+            ratio = (lambda a, b: "n/a" if a is None else f"{a / b:.2f}x")
+            row = [f"{name} ({an.dof} dof, {len(mech.joints)} joints)", fmt_rate(l1), fmt_rate(l2),
+                   fmt_rate(k1), fmt_rate(k2), fmt_rate(g.get(("numpy", 1))), fmt_rate(g["full"]),
                    fmt_rate(p["rnea loop"]), fmt_rate(p["rneaInParallel 1"]), fmt_rate(p["rneaInParallel 2"]),
-                   f"{k1 / p['rneaInParallel 1']:.2f}x",
-                   "n/a" if k2 is None else f"{k2 / p['rneaInParallel 2']:.2f}x"]
+                   ratio(l1, p["rneaInParallel 1"]), ratio(l2, p["rneaInParallel 2"]),
+                   ratio(k1, p["rneaInParallel 1"]), ratio(k2, p["rneaInParallel 2"])]
             print("| " + " | ".join(row) + " |", flush=True)
     print("\nEvery row: gearcli's equivalent joint torques equal Pinocchio's (S^T tau) to 1e-8 relative or a "
           "WARNING line says otherwise.")

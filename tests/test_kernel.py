@@ -1,8 +1,9 @@
-"""The compiled per-sample kernel (backend "kernel") against the numpy block solve.
+"""The compiled per-sample kernels (backends "kernel" and "llvm") against the numpy block solve.
 
 The numpy path (:func:`gearcli.dynamics.blocks.solve_blocks` over arrays) is the reference:
-the kernel shares none of its arithmetic (its own scalar kinematics, loads, column terms and
-sign search, :mod:`gearcli.dynamics.kernel`), only the constant block matrices.  Every result
+the kernels share none of its arithmetic (their own scalar kinematics, loads, column terms
+and sign search, :mod:`gearcli.dynamics.kernel` and the code :mod:`gearcli.dynamics.llvm_kernel`
+generates), only the constant block matrices.  Every result
 must agree to 1e-12 of the largest load of the sample, on every bundled mechanism and on the
 test factories' mechanisms, along random trajectories large enough that tooth forces change
 sign, with external loads; threads must not change a bit; a sample with no consistent sign
@@ -33,6 +34,8 @@ MECH = Path(__file__).resolve().parents[1] / "mechanisms"
 FIELDS = ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial", "motor_speed")
 TOL = 1e-12
 BUNDLED = sorted(p.name for p in MECH.glob("*.yaml")) + ["geared_arm.urdf"]
+NO_LLVM = {"rack_axis.yaml", "talos_left_arm", "talos_data/robots/talos_full_v2.urdf"}   # world-frame blocks
+BACKENDS = ["kernel", "llvm"]
 
 
 def _with_loads(text: str) -> str:
@@ -94,14 +97,30 @@ def worst(a, b) -> float:
     return float(np.max(np.abs(fa - fb).max(axis=1) / (1.0 + np.abs(fb).max(axis=1))))
 
 
+def compiled_backend(an, key, backend) -> bool:
+    """True when ``backend`` solves ``key``'s mechanism ("auto" then takes llvm, else the
+    kernel); the llvm backend must refuse exactly the mechanisms of NO_LLVM."""
+    sol = solver_for(an)
+    if backend == "llvm" and key in NO_LLVM:
+        assert not sol.llvm_available() and "no constant frame" in sol.llvm_problem
+        assert sol.backend() == "kernel"
+        with pytest.raises(ValueError, match="backend 'llvm' unavailable"):
+            solve(an, np.zeros((2, an.dof)), np.zeros((2, an.dof)), np.zeros((2, an.dof)), backend="llvm")
+        return False
+    assert sol.backend() == ("kernel" if key in NO_LLVM else "llvm")
+    return True
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("key", BUNDLED + GENERATED)
-def test_kernel_equals_numpy(key):
+def test_kernel_equals_numpy(key, backend):
     an = analyse(mechanism(key))
-    assert solver_for(an).backend() == "kernel"           # "auto" takes the kernel
+    if not compiled_backend(an, key, backend):
+        return
     q, qd, qdd = trajectory(an, 600)
     loads = per_sample_loads(an, 600)
     ref = solve(an, q, qd, qdd, backend="numpy", loads=loads)
-    res = solve(an, q, qd, qdd, backend="kernel", loads=loads, jobs=1)
+    res = solve(an, q, qd, qdd, backend=backend, loads=loads, jobs=1)
     assert worst(res, ref) < TOL
     geared = [i for i, c in enumerate(an.circuits) if c.geometry is not None]
     for i in geared:                                      # both branches of |t| exercised
@@ -109,15 +128,17 @@ def test_kernel_equals_numpy(key):
 
 
 @pytest.mark.skipif(ERD is None, reason="example-robot-data not installed")
+@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("case", ["ur_description/urdf/ur5_robot.urdf", "panda_description/urdf/panda.urdf",
                                   "talos_left_arm", "talos_data/robots/talos_full_v2.urdf"])
-def test_kernel_equals_numpy_on_robots(case, tmp_path):
+def test_kernel_equals_numpy_on_robots(case, backend, tmp_path):
     """Published robots; Talos' transmissions and mimic joints need world-frame blocks."""
     path = talos_left_arm(tmp_path) if case == "talos_left_arm" else erd(case)
     an = analyse(load_urdf(path))
-    assert solver_for(an).backend() == "kernel"
+    if not compiled_backend(an, case, backend):
+        return
     q, qd, qdd = trajectory(an, 200)
-    assert worst(solve(an, q, qd, qdd, backend="kernel"), solve(an, q, qd, qdd, backend="numpy")) < TOL
+    assert worst(solve(an, q, qd, qdd, backend=backend), solve(an, q, qd, qdd, backend="numpy")) < TOL
 
 
 def test_general_blocks_are_exercised():
@@ -127,15 +148,16 @@ def test_general_blocks_are_exercised():
     assert any(p.F is None for p in solver_for(an).plans)
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("key", ["bendix_wrist.yaml", "loaded:bendix_wrist.yaml"])
-def test_threads_change_no_bit(key):
+def test_threads_change_no_bit(key, backend):
     an = analyse(mechanism(key))
     n = 20_001
     assert threads_for(n, 2) == 2 and len(job_ranges(n, 2)) == 10     # taken in turn
     q, qd, qdd = trajectory(an, n, seed=3)
     loads = per_sample_loads(an, n)
-    one = solve(an, q, qd, qdd, jobs=1, loads=loads)
-    two = solve(an, q, qd, qdd, jobs=2, loads=loads)
+    one = solve(an, q, qd, qdd, jobs=1, loads=loads, backend=backend)
+    two = solve(an, q, qd, qdd, jobs=2, loads=loads, backend=backend)
     for f in FIELDS:
         assert np.array_equal(getattr(one, f), getattr(two, f)), f
 
@@ -146,8 +168,9 @@ def _sign_error(an, q, qd, qdd, backend, chunk):
     return info.value.sample, info.value.meshes
 
 
-@pytest.mark.parametrize("key", ["paper_2dof.yaml", "bendix_wrist.yaml", "geared_arm.urdf"])
-def test_sign_error_names_the_same_sample(key):
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("key", ["paper_2dof.yaml", "bendix_wrist.yaml", "geared_arm.urdf", "planetary_3p.yaml"])
+def test_sign_error_names_the_same_sample(key, backend):
     """Samples with no consistent sign pattern (a NaN acceleration fails the first geared
     block): the error names the sample, and the meshes, that the numpy path names."""
     an = analyse(mechanism(key))
@@ -160,7 +183,7 @@ def test_sign_error_names_the_same_sample(key):
     for chunk in (7, 20_000):
         ref = _sign_error(an, q, qd, qdd, "numpy", chunk)
         assert ref[0] == first
-        assert _sign_error(an, q, qd, qdd, "kernel", chunk) == ref
+        assert _sign_error(an, q, qd, qdd, backend, chunk) == ref
 
 
 # two one-link arms on one base (a tree), each driven through a spur pair: arm a's blocks first
@@ -188,7 +211,8 @@ TWO_ARMS = ('<robot name="two_arms" xmlns:gearcli="https://gearcli.dev/urdf/1">\
             + _arm("a", 0.0) + _arm("b", 1.0) + "\n</robot>\n")
 
 
-def test_sign_error_follows_the_numpy_path_through_chunks_and_blocks():
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_sign_error_follows_the_numpy_path_through_chunks_and_blocks(backend):
     """Sample 100 fails only in arm b's (later) block, sample 200 in arm a's (earlier) one
     (a rate so large that the kinematics of that arm overflow to NaN):
     in one chunk the numpy path stops at arm a's block and names sample 200; with chunks
@@ -202,7 +226,7 @@ def test_sign_error_follows_the_numpy_path_through_chunks_and_blocks():
     expect = {20_000: (200, ["'ga'"]), 150: (100, ["'gb'"])}
     for chunk, named in expect.items():
         assert _sign_error(an, q, qd, qdd, "numpy", chunk) == named
-        assert _sign_error(an, q, qd, qdd, "kernel", chunk) == named
+        assert _sign_error(an, q, qd, qdd, backend, chunk) == named
 
 
 def test_backend_choice_and_errors():
@@ -226,10 +250,11 @@ def test_backend_choice_and_errors():
         sol.kernel_problem = None
 
 
-def test_verify_with_the_kernel():
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_verify_with_the_kernel(backend):
     an = analyse(mechanism("loaded:bendix_wrist.yaml"))
     q, qd, qdd = trajectory(an, 300)
-    res = solve(an, q, qd, qdd, backend="kernel", verify=True, chunk=128, loads=per_sample_loads(an, 300))
+    res = solve(an, q, qd, qdd, backend=backend, verify=True, chunk=128, loads=per_sample_loads(an, 300))
     assert res.residual is not None and res.residual < 1e-12
 
 
@@ -241,34 +266,52 @@ def _flag_row(prog) -> int:
                 and not np.allclose(jflt[k, :9].reshape(3, 3), np.eye(3)))
 
 
-MUTATIONS = [("flts", 0, 10), ("flts", 1, None), ("flts", 4, 7), ("flts", 5, 3), ("flts", 6, 2), ("ints", 0, None)]
+BENDIX = "loaded:bendix_wrist.yaml"
+MUTATIONS = [(BENDIX, "flts", 0, 10), (BENDIX, "flts", 1, None), (BENDIX, "flts", 4, 7), (BENDIX, "flts", 5, 3),
+             ("geared_arm.urdf", "flts", 6, 2), ("planetary_3p.yaml", "flts", 4, "t row"), (BENDIX, "ints", 0, None)]
 
 
-@pytest.mark.parametrize("field,which,flat", MUTATIONS)
-def test_a_wrong_program_entry_is_caught(field, which, flat):
-    """Perturb one entry of the program (a joint placement, an inertia, an inverse block
-    matrix, a propagation column, a world-frame term, a kinematic shortcut flag): the
-    comparison of test_kernel_equals_numpy must then fail."""
-    key = "geared_arm.urdf" if which == 6 else "loaded:bendix_wrist.yaml"
-    an = analyse(mechanism(key))
-    sol = solver_for(an)
-    prog = sol.kernel_program()
+def _t_row(prog) -> np.ndarray:
+    """Flat positions in ``ainv`` of the first block's first t row, in every pattern's map."""
+    rec = prog.ints[1][0]
+    n, nr, a0, t = int(rec[3]), 6 * int(rec[2]), int(rec[7]), int(prog.ints[4][rec[6]])
+    return np.concatenate([a0 + k * n * nr + t * nr + np.arange(nr) for k in range(1 << int(rec[5]))])
+
+
+def _mutated(prog, an, field, which, flat):
     arrays = list(getattr(prog, field))
     bad = arrays[which].copy()
     if field == "ints":
         bad[_flag_row(prog), 4] |= 2                      # claim R_pj = I wrongly
     else:
-        flat = 13 * an.tree.moving[-1] + 5 if flat is None else flat    # an inertia entry
+        flat = _t_row(prog) if flat == "t row" else 13 * an.tree.moving[-1] + 5 if flat is None else flat
         bad.reshape(-1)[flat] += 1e-6 * (1.0 + abs(bad.reshape(-1)[flat]))
+    return dataclasses.replace(prog, **{field: tuple(bad if i == which else x for i, x in enumerate(arrays))})
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("key,field,which,flat", MUTATIONS)
+def test_a_wrong_program_entry_is_caught(key, field, which, flat, backend):
+    """Perturb one entry of the program (a joint placement, an inertia, an inverse block
+    matrix, a propagation column, a world-frame term, a kinematic shortcut flag; for
+    planetary_3p, whose llvm code reads its 64 pattern maps from a table, one row of
+    them): the comparison of test_kernel_equals_numpy must then fail.  The generated
+    kernel does not read the shortcut flags (its constants fold the same products away)."""
+    if backend == "llvm" and field == "ints":
+        pytest.skip("the llvm kernel folds constants instead of reading shortcut flags")
+    an = analyse(mechanism(key))
+    sol = solver_for(an)
+    prog = sol.kernel_program()
     q, qd, qdd = trajectory(an, 400)
     loads = per_sample_loads(an, 400)
     ref = solve(an, q, qd, qdd, backend="numpy", loads=loads)
-    assert worst(solve(an, q, qd, qdd, backend="kernel", loads=loads), ref) < TOL
-    sol._program = dataclasses.replace(prog, **{field: tuple(bad if i == which else x for i, x in enumerate(arrays))})
+    assert worst(solve(an, q, qd, qdd, backend=backend, loads=loads), ref) < TOL
+    kept = sol._llvm
+    sol._program, sol._llvm = _mutated(prog, an, field, which, flat), None
     try:
-        res = solve(an, q, qd, qdd, backend="kernel", loads=loads)
+        res = solve(an, q, qd, qdd, backend=backend, loads=loads)
     finally:
-        sol._program = prog
+        sol._program, sol._llvm = prog, kept
     assert worst(res, ref) > 1e3 * TOL
 
 

@@ -1,51 +1,18 @@
 """Running the compiled kernel (:mod:`.kernel`) over a trajectory, on one or more threads.
 
 Imported only when the kernel backend is used (it imports numba).  The samples are split
-into contiguous ranges that the threads take in turn; the kernel releases the GIL
-(``nogil``) and each sample's arithmetic does not depend on the split, so the results are
+over threads by :mod:`.jobs` (the kernel releases the GIL: ``nogil``); the results are
 bitwise identical for any number of jobs.
 """
 from __future__ import annotations
 
-import os
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from .jobs import job_ranges, sign_error, threads_for, usable_cores  # noqa: F401  (re-exported)
 from .kernel import run
 from .kernel_program import Program, load_arrays
-from .signs import SignError
-
-MIN_SAMPLES_PER_JOB = 2_000   # fewer samples per thread: the thread costs more than it saves
-
-
-def usable_cores() -> int:
-    """Cores this process may run on (its CPU affinity), at least 1."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:               # not on Linux
-        return max(1, os.cpu_count() or 1)
-
-
-def threads_for(n: int, jobs: int | None) -> int:
-    """Threads for n samples (``jobs`` None: every usable core; at least
-    MIN_SAMPLES_PER_JOB samples a thread)."""
-    jobs = usable_cores() if jobs is None else int(jobs)
-    if jobs < 1:
-        raise ValueError(f"jobs must be at least 1, got {jobs}")
-    return max(1, min(jobs, n // MIN_SAMPLES_PER_JOB))
-
-
-def job_ranges(n: int, jobs: int | None) -> list[tuple[int, int]]:
-    """Contiguous (start, stop) sample ranges the threads take in turn: 8 a thread (at
-    least MIN_SAMPLES_PER_JOB samples each), so that a thread slowed by a busy core takes
-    fewer of them instead of making the others wait (``jobs`` None: every core)."""
-    threads = threads_for(n, jobs)
-    if threads == 1:
-        return [(0, n)]
-    parts = max(threads, min(8 * threads, n // MIN_SAMPLES_PER_JOB))
-    cuts = [round(i * n / parts) for i in range(parts + 1)]
-    return [(cuts[i], cuts[i + 1]) for i in range(parts)]
 
 
 def scratch(prog: Program) -> tuple:
@@ -99,15 +66,5 @@ def kernel_solve(prog: Program, an, q, qd, qdd, values: dict, jobs: int | None, 
             for f in [pool.submit(run, *args, s, e, outs, scratch(prog)) for s, e in ranges]:
                 f.result()
     if np.any(fail >= 0):
-        raise _sign_error(prog, fail, chunk)
+        raise sign_error(prog.names, fail, chunk)
     return out, {k: SG[:, i] for i, k in enumerate(prog.signed)}
-
-
-def _sign_error(prog: Program, fail: np.ndarray, chunk: int) -> SignError:
-    """The error the numpy path raises: in the first chunk with a failure, the first sample
-    failing at the earliest block that fails (that path stops at that block)."""
-    first = int(np.flatnonzero(fail >= 0)[0])
-    c0 = first - first % chunk
-    part = fail[c0:c0 + chunk]
-    block = int(part[part >= 0].min())
-    return SignError(c0 + int(np.flatnonzero(part == block)[0]), prog.names[block])

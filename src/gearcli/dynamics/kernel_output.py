@@ -4,37 +4,14 @@ From the sample's solution row (every unknown, in
 :func:`~gearcli.analysis.schedule.unknown_groups` order, joint reactions in the child's
 basis): the joint reaction wrenches (N, J, 6) with the zero component of the joint's own
 direction, the motor torques, the tooth forces t with their separating, radial and axial
-components (the constants of :func:`output_constants`), the equivalent joint torques
+components (the constants of :func:`.output_maps.output_constants`), the equivalent joint torques
 tau = A motor and the motor speeds A^T qd.
 """
 from __future__ import annotations
 
-import numpy as np
 from numba import njit
 
-from ..model.gears import helical_terms
 from .kernel_links import INLINE, OPTS
-
-
-def output_constants(an, offsets: dict):
-    """(jout (J, 2) int [first column, 1 if prismatic], mcol (M,) and gcol (G,) columns,
-    mflt (G, 10) [1 if gear geometry, tan(phi_t), t and |t| tan(phi_t) coefficients of the
-    radial and axial components on j and on k])."""
-    mech = an.mech
-    jout = np.array([[offsets[("joint", ji)][0], int(jt.type == "prismatic")] for ji, jt in enumerate(mech.joints)],
-                    np.int64).reshape(-1, 2)
-    mcol = np.array([offsets[("motor", i)][0] for i in range(len(an.motor_links))] + [0], np.int64)
-    gcol = np.array([offsets[("mesh", ci)][0] for ci in range(len(an.circuits))] + [0], np.int64)
-    mflt = np.zeros((len(an.circuits) + 1, 10))
-    for ci, c in enumerate(an.circuits):
-        if c.geometry is None:
-            continue
-        gm, gp = c.geometry, mech.gears[c.gear]
-        tan_t, a = helical_terms(gm, gp.pressure_angle, gp.helix_angle, gp.hand)
-        ua = gm.ut + a
-        mflt[ci] = [1.0, tan_t, ua @ gm.rad_j, gm.us @ gm.rad_j, ua @ gm.zj, gm.us @ gm.zj,
-                    ua @ gm.rad_k, gm.us @ gm.rad_k, ua @ gm.zk, gm.us @ gm.zk]
-    return jout, mcol, gcol, mflt
 
 
 @njit(**INLINE)

@@ -39,7 +39,7 @@ import numpy as np
 
 from ..analysis.schedule import unknown_groups
 from .blocks import _primary_side, make_plans
-from .kernel_output import output_constants
+from .output_maps import output_constants
 from .kernel_terms import general_terms, local_inverse
 
 I64 = np.int64

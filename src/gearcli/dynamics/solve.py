@@ -18,6 +18,7 @@ precomputed block plans live in a :class:`Solver`, built once per analysis.
 """
 from __future__ import annotations
 
+import sys
 import weakref
 from dataclasses import dataclass
 from functools import lru_cache
@@ -36,7 +37,10 @@ from .kinematics import forward
 from .signs import SignError, sign_violation
 
 DEFAULT_CHUNK = 20_000
-BACKENDS = ("auto", "kernel", "numpy")
+BACKENDS = ("auto", "llvm", "kernel", "numpy")
+LLVM_MIN_SAMPLES = 20_000
+"""Samples from which "auto" compiles the llvm kernel even when the numba kernel is already
+loaded in the process (compiling costs 0.1-0.3 s, ~1 us a sample saved: README "Speed")."""
 
 
 @dataclass
@@ -120,6 +124,8 @@ class Solver:
         self.plans = make_plans(an)
         self._program = None
         self.kernel_problem: str | None = None
+        self._llvm = None
+        self.llvm_problem: str | None = None
 
     def kernel_program(self):
         """The compiled kernel's program of this mechanism (:mod:`.kernel_program`), or None
@@ -140,14 +146,42 @@ class Solver:
                                        "has more sign patterns than the program holds (kernel_program.MAX_PATTERNS)")
         return self._program if self.kernel_problem is None else None
 
-    def backend(self, method: str = "block", backend: str = "auto") -> str:
-        """The path a solve takes: "kernel" or "numpy" (see :func:`solve`)."""
+    def llvm_kernel(self):
+        """The generated kernel of this mechanism (:class:`.llvm_driver.LlvmKernel`), or None
+        when the llvm backend cannot be used here (``self.llvm_problem`` says why);
+        compiled on first use and kept."""
+        if self._llvm is None and self.llvm_available():
+            from .llvm_driver import LlvmKernel  # noqa: PLC0415  (imports llvmlite)
+            self._llvm = LlvmKernel(self.kernel_program(), self.an)
+        return self._llvm
+
+    def llvm_available(self) -> bool:
+        """True when the llvm backend can solve this mechanism (without compiling it)."""
+        if self.llvm_problem is None and self._llvm is None:
+            prog = self.kernel_program()
+            if prog is None:
+                self.llvm_problem = f"no kernel program: {self.kernel_problem}"
+            else:
+                from .llvm_driver import llvm_problem  # noqa: PLC0415
+                self.llvm_problem = llvm_problem(prog)
+        return self.llvm_problem is None
+
+    def backend(self, method: str = "block", backend: str = "auto", n: int | None = None) -> str:
+        """The path a solve of n samples takes: "llvm", "kernel" or "numpy" (see :func:`solve`)."""
         if backend not in BACKENDS:
             raise ValueError(f"unknown backend '{backend}' (expected one of {', '.join(BACKENDS)})")
         if backend == "numpy" or (backend == "auto" and method == "full"):
             return "numpy"
         if method == "full":
-            raise ValueError("backend 'kernel' solves method 'block' only")
+            raise ValueError(f"backend '{backend}' solves method 'block' only")
+        if backend == "llvm":
+            if not self.llvm_available():
+                raise ValueError(f"backend 'llvm' unavailable: {self.llvm_problem}")
+            return "llvm"
+        if backend == "auto" and self.llvm_available() and (
+                self._llvm is not None or n is None or n >= LLVM_MIN_SAMPLES
+                or "gearcli.dynamics.kernel" not in sys.modules):
+            return "llvm"
         if self.kernel_program() is not None:
             return "kernel"
         if backend == "kernel":
@@ -163,20 +197,23 @@ class Solver:
             raise ValueError(f"unknown method '{method}' (expected 'block' or 'full')")
         if chunk < 1:
             raise ValueError(f"chunk must be at least 1, got {chunk}")
-        path = self.backend(method, backend)
+        path = self.backend(method, backend, q.shape[0])
         values = load_values(self.an.mech, q.shape[0], loads)
         # the operands are 3x3 to 48x48 matrices: BLAS threads only contend (2-3x slower
         # with a busy second core), so one BLAS thread, whatever the environment says
         with one_blas_thread():
-            if path == "kernel":
-                return self._by_kernel(q, qd, qdd, values, jobs, chunk, verify)
+            if path != "numpy":
+                return self._by_kernel(path, q, qd, qdd, values, jobs, chunk, verify)
             res = self._by_numpy(q, qd, qdd, method, chunk, verify, values)
         res.motor_speed = qd @ self.an.A
         return res
 
-    def _by_kernel(self, q, qd, qdd, values, jobs, chunk, verify) -> Result:
-        from .kernel_driver import kernel_solve  # noqa: PLC0415  (imports numba)
-        out, sig = kernel_solve(self.kernel_program(), self.an, q, qd, qdd, values, jobs, chunk)
+    def _by_kernel(self, path, q, qd, qdd, values, jobs, chunk, verify) -> Result:
+        if path == "llvm":
+            out, sig = self.llvm_kernel().solve(self.an, q, qd, qdd, values, jobs, chunk)
+        else:
+            from .kernel_driver import kernel_solve  # noqa: PLC0415  (imports numba)
+            out, sig = kernel_solve(self.kernel_program(), self.an, q, qd, qdd, values, jobs, chunk)
         res = Result(**out)
         if verify:
             x_all = _unknowns(self.an, res)
@@ -262,14 +299,20 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
         ``{load name: array (N, 6) or (6,)}``: [fx, fy, fz, mx, my, mz] of an external load
         of ``an.mech.loads`` (N, N*m about the load point, in the load's frame: base or
         link), overriding the constant of the mechanism file; loads not given keep it.
-    backend : {"auto", "kernel", "numpy"}
-        "kernel": the compiled per-sample kernel (:mod:`.kernel`, numba; method "block"
-        only); "numpy": the array implementation (the readable reference); "auto"
-        (default): the kernel when numba imports and it covers the mechanism (every block
-        square), else numpy.  Both give the same results to rounding (~1e-15 relative).
+    backend : {"auto", "llvm", "kernel", "numpy"}
+        "llvm": a kernel generated for this mechanism as LLVM IR (:mod:`.llvm_kernel`,
+        llvmlite; compiled on first use, 0.1-0.3 s, and kept with the analysis; method
+        "block" only; not for a block without a constant frame); "kernel": the compiled
+        data-driven kernel (:mod:`.kernel`, numba, cached on disk; method "block" only);
+        "numpy": the array implementation (the readable reference); "auto" (default):
+        llvm where it is available, unless the numba kernel is already loaded in the process,
+        the llvm kernel not yet compiled and the call has fewer than
+        :data:`LLVM_MIN_SAMPLES` samples; else the kernel where numba imports and it covers
+        the mechanism (every block square); else numpy.  All give the same results to
+        rounding (~1e-15 relative).
     jobs : int, optional
-        Threads the kernel splits the samples over (contiguous ranges; results bitwise
-        identical for any number); None: every usable core.  The numpy path uses one.
+        Threads a compiled kernel splits the samples over (contiguous ranges; results
+        bitwise identical for any number); None: every usable core.  The numpy path uses one.
 
     Raises
     ------
@@ -277,7 +320,7 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
         when no sign pattern of the tooth forces is consistent at some sample (named).
     ValueError
         for bad shapes, an unknown load name or a load value that is not finite, an unknown
-        backend, or backend "kernel" where it is unavailable.
+        backend, or backend "llvm" or "kernel" where it is unavailable.
     """
     return solver_for(an).solve(q, qd, qdd, method=method, chunk=chunk, verify=verify, loads=loads,
                                 backend=backend, jobs=jobs)

@@ -1,0 +1,57 @@
+"""Splitting a trajectory over threads, and the sign error of a compiled solve (no numba).
+
+Shared by the compiled backends (:mod:`.kernel_driver`, :mod:`.llvm_driver`): the samples
+are split into contiguous ranges that the threads take in turn; a compiled kernel releases
+the GIL and each sample's arithmetic does not depend on the split, so the results are
+bitwise identical for any number of jobs.
+"""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from .signs import SignError
+
+MIN_SAMPLES_PER_JOB = 2_000   # fewer samples per thread: the thread costs more than it saves
+
+
+def usable_cores() -> int:
+    """Cores this process may run on (its CPU affinity), at least 1."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:               # not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def threads_for(n: int, jobs: int | None) -> int:
+    """Threads for n samples (``jobs`` None: every usable core; at least
+    MIN_SAMPLES_PER_JOB samples a thread)."""
+    jobs = usable_cores() if jobs is None else int(jobs)
+    if jobs < 1:
+        raise ValueError(f"jobs must be at least 1, got {jobs}")
+    return max(1, min(jobs, n // MIN_SAMPLES_PER_JOB))
+
+
+def job_ranges(n: int, jobs: int | None) -> list[tuple[int, int]]:
+    """Contiguous (start, stop) sample ranges the threads take in turn: 8 a thread (at
+    least MIN_SAMPLES_PER_JOB samples each), so that a thread slowed by a busy core takes
+    fewer of them instead of making the others wait (``jobs`` None: every core)."""
+    threads = threads_for(n, jobs)
+    if threads == 1:
+        return [(0, n)]
+    parts = max(threads, min(8 * threads, n // MIN_SAMPLES_PER_JOB))
+    cuts = [round(i * n / parts) for i in range(parts + 1)]
+    return [(cuts[i], cuts[i + 1]) for i in range(parts)]
+
+
+def sign_error(names: list, fail: np.ndarray, chunk: int) -> SignError:
+    """The error the numpy path raises, from ``fail`` (N,) (the first failing block of each
+    sample, -1 if none; ``names`` the signed meshes of each block): in the first chunk
+    with a failure, the first sample failing at the earliest block that fails (that path
+    stops at that block)."""
+    first = int(np.flatnonzero(fail >= 0)[0])
+    c0 = first - first % chunk
+    part = fail[c0:c0 + chunk]
+    block = int(part[part >= 0].min())
+    return SignError(c0 + int(np.flatnonzero(part == block)[0]), names[block])

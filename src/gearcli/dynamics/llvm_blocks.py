@@ -1,0 +1,146 @@
+"""Generated block solves (the second half of :mod:`.llvm_kernel`), one sample.
+
+Per block of the schedule, as :func:`.kernel._blocks` does: gather the block links'
+right-hand sides in its frame F about o_F, solve x = Ainv[pattern] r (straight-line for a
+block without signed meshes, else with the sign search of :mod:`.llvm_signs`), pass the
+solved wrenches on to the later links (the propagation records and their C_plus, C_sep
+columns, or the column terms of :mod:`.kernel_terms` for a block solved in its link's
+axes) and write the solution into the sample's row (joint reactions turned to their
+child's basis).  A block without a constant frame (world axes, Gaussian elimination per
+sample) is not generated: :func:`problem` names it.
+"""
+from __future__ import annotations
+
+import llvmlite.ir as ir
+
+from .llvm_build import I64, Emitter
+from .llvm_links import Sample, _floats
+from .llvm_signs import SignedBlock, resolve, signs_of, tolerance
+
+
+def problem(prog) -> str | None:
+    """Why the generated kernel cannot solve ``prog``'s mechanism, or None."""
+    if not prog.covered:
+        return ("a redundant gear set of this mechanism has no constant frame, or a block has more sign "
+                "patterns than the program holds (kernel_program.MAX_PATTERNS)")
+    if any(int(F) < 0 for F in prog.ints[1][:, 0]):
+        return ("a block has no constant frame (solved in world axes by elimination per sample), which the "
+                "llvm backend does not generate; backend 'kernel' solves it")
+    return None
+
+
+def gather(e: Emitter, s: Sample, F: int, links) -> list:
+    """r (6B) = the block links' right-hand sides in F's axes about o_F (kernel._gather)."""
+    RF, oF = s.R[F], s.o[F]
+    r = []
+    for L in links:
+        f, m = s.rhs[L][:3], s.rhs[L][3:]
+        m = e.vadd(m, e.cx(e.vsub(s.o[L], oF), f))
+        r += list(e.mtv(RF, f)) + list(e.mtv(RF, m))
+    return r
+
+
+def _wrench_in_F(e: Emitter, rec, cmat, x: list):
+    """C_plus x + C_sep |x| of one propagation record: (f, m) on its primary link, F axes."""
+    c0, size, signed, co = (int(v) for v in rec[:4])
+    xs = x[c0:c0 + size]
+    w = [e.dot(_floats(cmat[co + h * size:co + (h + 1) * size]), xs) for h in range(6)]
+    if signed:
+        ax = [e.call("fabs", v) for v in xs]
+        cs = co + 6 * size
+        w = [e.add(w[h], e.dot(_floats(cmat[cs + h * size:cs + (h + 1) * size]), ax)) for h in range(6)]
+    return tuple(w[:3]), tuple(w[3:])
+
+
+def _subtract(e: Emitter, s: Sample, L: int, w, scale) -> None:
+    """rhs[L] -= scale * w (w a 6-tuple)."""
+    s.rhs[L] = tuple(e.sub(s.rhs[L][h], e.mul(scale, w[h])) for h in range(6))
+
+
+def propagate(e: Emitter, s: Sample, F: int, recs, prog, x: list) -> None:
+    """rhs[L] -= the solved wrenches of the block's groups on their later links (kernel._propagate)."""
+    cmat, later = prog.flts[5], prog.ints[7]
+    RF, oF = s.R[F], s.o[F]
+    for rec in recs:
+        f, mo = _wrench_in_F(e, rec, cmat, x)
+        f, mo = e.mv(RF, f), e.mv(RF, mo)                    # world axes, about o_F
+        P, l0, nl = (int(v) for v in rec[4:7])
+        for L in (int(v) for v in later[l0:l0 + nl]):
+            m = e.vadd(mo, e.cx(e.vsub(oF, s.o[L]), f))
+            _subtract(e, s, L, f + m, 1.0 if L == P else -1.0)
+
+
+def term_wrench(e: Emitter, s: Sample, trec_k, tflt_k, L: int, sig: list):
+    """Wrench (6-tuple, base axes, about o_L) of one column term per unit of its unknown
+    (kernel_world.term_wrench)."""
+    X = int(trec_k[4])
+    coef = float(tflt_k[0])
+    if trec_k[5] >= 0:
+        coef = e.mul(coef, sig[int(trec_k[5])])
+    f = _floats(tflt_k)
+    d = e.mv(s.R[X], f[1:4])
+    if trec_k[3] == 1:
+        return (0.0, 0.0, 0.0) + e.scale(d, coef)
+    P = e.mv(s.R[X], f[4:7])
+    arm = e.vsub(e.vadd(s.o[X], P), s.o[L])
+    return e.scale(d, coef) + e.scale(e.cx(arm, d), coef)
+
+
+def propagate_terms(e: Emitter, s: Sample, k0: int, nt: int, prog, x: list, sig: list) -> None:
+    """rhs[L] -= the solved wrenches on the later links from the terms with no block row
+    (kernel_world.world_propagate)."""
+    trec, tflt = prog.ints[10], prog.flts[6]
+    for k in range(k0, k0 + nt):
+        if trec[k, 1] >= 0:
+            continue
+        L = int(trec[k, 0])
+        _subtract(e, s, L, term_wrench(e, s, trec[k], tflt[k], L, sig), x[int(trec[k, 2])])
+
+
+def store(e: Emitter, s: Sample, rec, prog, x: list) -> None:
+    """The block's solution into the sample's row ``s.sol`` (kernel._store): joint
+    reactions solved in another basis turned to their child's by -q (or -(q @ row))."""
+    gcol, cbrec, turns = prog.ints[3], prog.ints[8], prog.flts[7]
+    nloc, g0, cb0, ncb = int(rec[3]), int(rec[4]), int(rec[10]), int(rec[11])
+    for i in range(nloc):
+        s.sol[int(gcol[g0 + i])] = x[i]
+    for c0, j, off in ((int(v) for v in cbrec[k]) for k in range(cb0, cb0 + ncb)):
+        if j >= 0:
+            cq, sq = s.cs[j]
+        else:
+            angle = e.dot(s.q, _floats(turns[off:off + len(s.q)]))
+            cq, sq = e.call("cos", angle), e.call("sin", angle)
+        for h in (0, 3):
+            x0, x1 = x[c0 + h], x[c0 + h + 1]
+            s.sol[int(gcol[g0 + c0 + h])] = e.add(e.mul(cq, x0), e.mul(sq, x1))
+            s.sol[int(gcol[g0 + c0 + h + 1])] = e.sub(e.mul(cq, x1), e.mul(sq, x0))
+
+
+def blocks(e: Emitter, fn, s: Sample, prog, n, fail, sg_row) -> None:
+    """Every block of the schedule in order for sample n: ``fail`` (i64*) gets the first
+    block with no consistent sign pattern (it comes filled with -1), ``sg_row`` (double*)
+    the sign of each t used."""
+    brec, blinks, tcol, scol, prec = prog.ints[1], prog.ints[2], prog.ints[4], prog.ints[5], prog.ints[6]
+    ainv = prog.flts[4]
+    for b, rec in enumerate(brec):
+        F, lk0, B, nloc, m, t0, a0, p0, np_, k0, nt = (int(rec[i]) for i in (0, 1, 2, 3, 5, 6, 7, 8, 9, 12, 13))
+        nr = 6 * B
+        r = gather(e, s, F, [int(v) for v in blinks[lk0:lk0 + B]])
+        maps = [ainv[a0 + k * nloc * nr:a0 + (k + 1) * nloc * nr].reshape(nloc, nr) for k in range(1 << m)]
+        if m == 0:
+            x, sig = [e.dot(_floats(maps[0][i]), r) for i in range(nloc)], []
+        else:
+            def on_fail(b=b):
+                old = e.load(fail, n)
+                e.b.store(e.b.select(e.b.icmp_signed("<", old, ir.Constant(I64, 0)), ir.Constant(I64, b), old),
+                          e.b.gep(fail, [n]))
+            blk = SignedBlock(e, maps, [int(c) for c in tcol[t0:t0 + m]], f"b{b}")
+            x, p = resolve(e, fn, blk, r, tolerance(e, r), on_fail, f"b{b}")
+            sig = signs_of(e, p, m)
+            for i in range(m):
+                e.store(sig[i], sg_row, int(scol[t0 + i]))
+        if nt > 0:
+            propagate_terms(e, s, k0, nt, prog, x, sig)
+        else:
+            propagate(e, s, F, prec[p0:p0 + np_], prog, x)
+        store(e, s, rec, prog, x)

@@ -1,0 +1,138 @@
+"""Arithmetic for the generated kernel (:mod:`.llvm_kernel`): doubles that fold constants.
+
+A value is either a Python ``float`` (a constant of the mechanism, known when the code is
+generated) or an LLVM ``double`` (known per sample).  :class:`Emitter` emits an
+instruction only when an operand is a per-sample value and skips what the constants make
+trivial: a product with an exact 0.0 is 0.0, a product with 1.0 (-1.0) is the other
+operand (negated), a sum with 0.0 is the other term.  Skipping ``0.0 * x`` drops a NaN or
+an infinity that x might carry; the inputs are checked finite upstream
+(:func:`.external.load_values`, the trajectory readers) and a sample whose own arithmetic
+overflows still reaches the sign search through the products that remain.  Only the
+``contract`` fast-math flag is set (fused multiply-adds): NaN must reach the sign search.
+
+A 3-vector is a 3-tuple of values, a 3x3 matrix a row-major 9-tuple (as in
+:mod:`.kernel_math`).
+"""
+from __future__ import annotations
+
+import math
+
+import llvmlite.ir as ir
+
+D = ir.DoubleType()
+I1 = ir.IntType(1)
+I64 = ir.IntType(64)
+DP = D.as_pointer()
+I64P = I64.as_pointer()
+FLAGS = ("contract",)
+
+
+class Emitter:
+    """Folding double arithmetic on an :class:`llvmlite.ir.IRBuilder` (see module docstring)."""
+
+    def __init__(self, builder: ir.IRBuilder, module: ir.Module):
+        self.b = builder
+        self.module = module
+        self._fns = {}
+
+    @staticmethod
+    def const(a) -> ir.Value:
+        """``a`` as an LLVM value (a float becomes a double constant)."""
+        return ir.Constant(D, a) if isinstance(a, float) else a
+
+    def intrinsic(self, name: str, nargs: int = 1) -> ir.Function:
+        """The declaration of ``llvm.<name>.f64`` (sin, cos, fabs, ...)."""
+        if name not in self._fns:
+            self._fns[name] = ir.Function(self.module, ir.FunctionType(D, [D] * nargs), f"llvm.{name}.f64")
+        return self._fns[name]
+
+    def add(self, a, b):
+        if isinstance(a, float) and isinstance(b, float):
+            return a + b
+        if isinstance(a, float) and a == 0.0:
+            return b
+        if isinstance(b, float) and b == 0.0:
+            return a
+        return self.b.fadd(self.const(a), self.const(b), flags=FLAGS)
+
+    def neg(self, a):
+        return -a if isinstance(a, float) else self.b.fneg(a, flags=FLAGS)
+
+    def sub(self, a, b):
+        if isinstance(a, float) and isinstance(b, float):
+            return a - b
+        if isinstance(b, float) and b == 0.0:
+            return a
+        if isinstance(a, float) and a == 0.0:
+            return self.neg(b)
+        return self.b.fsub(self.const(a), self.const(b), flags=FLAGS)
+
+    def mul(self, a, b):
+        if isinstance(a, float) and isinstance(b, float):
+            return a * b
+        if isinstance(b, float):
+            a, b = b, a
+        if isinstance(a, float):
+            if a == 0.0:
+                return 0.0
+            if a == 1.0:
+                return b
+            if a == -1.0:
+                return self.neg(b)
+        return self.b.fmul(self.const(a), self.const(b), flags=FLAGS)
+
+    def dot(self, xs, ys):
+        """sum_i xs[i] ys[i], left to right."""
+        s = 0.0
+        for x, y in zip(xs, ys):
+            s = self.add(s, self.mul(x, y))
+        return s
+
+    def call(self, name: str, a):
+        """llvm.<name>.f64(a) (folded for a constant)."""
+        if isinstance(a, float):
+            return abs(a) if name == "fabs" else getattr(math, name)(a)
+        return self.b.call(self.intrinsic(name), [a])
+
+    # --- 3-vectors and 3x3 matrices (tuples of values) -----------------------------------
+    def vadd(self, a, b):
+        return tuple(self.add(x, y) for x, y in zip(a, b))
+
+    def vsub(self, a, b):
+        return tuple(self.sub(x, y) for x, y in zip(a, b))
+
+    def scale(self, a, s):
+        return tuple(self.mul(x, s) for x in a)
+
+    def cx(self, a, b):
+        """a x b."""
+        return (self.sub(self.mul(a[1], b[2]), self.mul(a[2], b[1])),
+                self.sub(self.mul(a[2], b[0]), self.mul(a[0], b[2])),
+                self.sub(self.mul(a[0], b[1]), self.mul(a[1], b[0])))
+
+    def mv(self, R, v):
+        """R v."""
+        return tuple(self.dot(R[3 * i:3 * i + 3], v) for i in range(3))
+
+    def mtv(self, R, v):
+        """R^T v."""
+        return tuple(self.dot(R[i::3], v) for i in range(3))
+
+    def mm(self, A, B):
+        """A B."""
+        return tuple(self.dot(A[3 * i:3 * i + 3], B[j::3]) for i in range(3) for j in range(3))
+
+    # --- memory -------------------------------------------------------------------------
+    def load(self, ptr, index):
+        """ptr[index] (index an LLVM i64 or a Python int)."""
+        idx = ir.Constant(I64, index) if isinstance(index, int) else index
+        return self.b.load(self.b.gep(ptr, [idx]))
+
+    def store(self, value, ptr, index):
+        """ptr[index] = value."""
+        idx = ir.Constant(I64, index) if isinstance(index, int) else index
+        self.b.store(self.const(value), self.b.gep(ptr, [idx]))
+
+    def row(self, ptr, n, width: int):
+        """A pointer to row n of a (N, width) C-ordered array at ``ptr``."""
+        return self.b.gep(ptr, [self.b.mul(n, ir.Constant(I64, width))])

@@ -1,0 +1,112 @@
+"""Compiling the generated kernel (:mod:`.llvm_kernel`) and running it, on one or more threads.
+
+LLVM through llvmlite: the IR is optimised at O3 for the host CPU (new pass manager) and
+compiled by MCJIT in memory, once per :class:`~.solve.Solver` (:class:`LlvmKernel` keeps
+the engine alive: freeing it frees the code).  Called through ctypes, which releases the
+GIL: the threads of :mod:`.jobs` run the samples in parallel, each sample's arithmetic
+independent of the split (bitwise identical results for any number of jobs).
+"""
+from __future__ import annotations
+
+import ctypes
+import time
+from concurrent.futures import ThreadPoolExecutor
+from functools import lru_cache
+
+import numpy as np
+
+from .jobs import job_ranges, sign_error, threads_for
+from .kernel_program import Program, load_arrays
+from .llvm_blocks import problem
+from .llvm_kernel import ARGS, build_module
+from .llvm_outputs import OUTPUTS, widths
+
+
+@lru_cache(maxsize=1)
+def _llvm():
+    import llvmlite.binding as llvm  # noqa: PLC0415  (initialises LLVM: only when used)
+
+    llvm.initialize_native_target()
+    llvm.initialize_native_asmprinter()
+    return llvm
+
+
+def _target_machine():
+    """(llvmlite.binding, a new target machine for the host CPU): one per kernel (its
+    execution engine owns the target machine and frees it with itself)."""
+    llvm = _llvm()
+    target = llvm.Target.from_default_triple()
+    return llvm, target.create_target_machine(opt=3, cpu=llvm.get_host_cpu_name(),
+                                              features=llvm.get_host_cpu_features().flatten())
+
+
+def mech_loads(an) -> list:
+    """(link id, values in link axes, load point) of each external load of ``an``."""
+    return [(an.tree.index[ld.link], ld.frame == "link", np.asarray(ld.point, float)) for ld in an.mech.loads]
+
+
+class LlvmKernel:
+    """The compiled kernel of one mechanism.
+
+    ``build_seconds`` (IR generation) and ``compile_seconds`` (LLVM optimisation and code
+    generation) say what it cost; ``assembly()`` returns its machine code as text."""
+
+    def __init__(self, prog: Program, an):
+        llvm, tm = _target_machine()
+        t0 = time.perf_counter()
+        module = build_module(prog, mech_loads(an))
+        module.triple, module.data_layout = tm.triple, str(tm.target_data)
+        self.ir = str(module)
+        t1 = time.perf_counter()
+        mod = llvm.parse_assembly(self.ir)
+        mod.verify()
+        pto = llvm.create_pipeline_tuning_options(3)
+        pb = llvm.create_pass_builder(tm, pto)
+        pb.getModulePassManager().run(mod, pb)
+        self._module, self._tm = mod, tm
+        self._engine = llvm.create_mcjit_compiler(mod, tm)
+        self._engine.finalize_object()
+        proto = ctypes.CFUNCTYPE(None, *([ctypes.c_void_p] * (len(ARGS) - 2) + [ctypes.c_int64] * 2))
+        self._run = proto(self._engine.get_function_address("run"))
+        self.build_seconds, self.compile_seconds = t1 - t0, time.perf_counter() - t1
+        self.prog = prog
+
+    def assembly(self) -> str:
+        """The optimised module's machine code (to check what LLVM made of it)."""
+        return self._tm.emit_assembly(self._module)
+
+    def solve(self, an, q, qd, qdd, values: dict, jobs: int | None, chunk: int):
+        """The loads of every sample, as :func:`.kernel_driver.kernel_solve` returns them."""
+        prog = self.prog
+        n, dof = q.shape
+        J, G, M = len(an.mech.joints), len(an.circuits), len(an.motor_links)
+        out = {"motor": np.empty((n, M)), "tau": np.empty((n, dof)), "joint": np.empty((n, J, 6)),
+               "gear_t": np.empty((n, G)), "gear_sep": np.empty((n, G)), "gear_radial": np.empty((n, G, 2)),
+               "gear_axial": np.empty((n, G, 2)), "motor_speed": np.empty((n, M))}
+        w = widths(prog)
+        SG = np.empty((n, max(w["signs"], 1)))
+        fail = np.full(n, -1, np.int64)
+        ldrec, _, vals = load_arrays(an, values, n)
+        ldrow = np.ascontiguousarray(ldrec[:, 2:4] if len(ldrec) else np.zeros((1, 2), np.int64))
+        keep = [np.ascontiguousarray(a, float) for a in (q, qd, qdd)] + [np.ascontiguousarray(vals, float), ldrow]
+        keep += [out[k] if out[k].size else np.empty((n, 1)) for k in OUTPUTS] + [SG, fail]
+        ptrs = [a.ctypes.data for a in keep]
+        ranges = job_ranges(n, jobs)
+        if len(ranges) == 1:
+            self._run(*ptrs, 0, n)
+        else:
+            with ThreadPoolExecutor(threads_for(n, jobs)) as pool:
+                for f in [pool.submit(self._run, *ptrs, s, e) for s, e in ranges]:
+                    f.result()
+        if np.any(fail >= 0):
+            raise sign_error(prog.names, fail, chunk)
+        return out, {k: SG[:, i] for i, k in enumerate(prog.signed)}
+
+
+def llvm_problem(prog: Program) -> str | None:
+    """Why the llvm backend cannot solve ``prog``'s mechanism (None: it can)."""
+    try:
+        import llvmlite.binding  # noqa: F401, PLC0415
+    except ImportError:
+        return "llvmlite does not import"
+    return problem(prog)

@@ -1,0 +1,75 @@
+"""The per-mechanism kernel generated as LLVM IR (backend "llvm").
+
+:func:`build_module` writes, from a :class:`~.kernel_program.Program`, one function
+
+    run(qi, qdi, qddi, vals, ldrow, motor, tau, joint, gear_t, gear_sep, gear_radial,
+        gear_axial, motor_speed, signs, fail, start, stop)
+
+whose loop over the samples start..stop-1 does what :func:`.kernel.run` does per sample,
+with every structural integer and every constant of the program (fixed transforms,
+masses, inertias, inverse block matrices, propagation columns, output coefficients) in
+the code: joint space, kinematics, inertia and external loads (:mod:`.llvm_links`), the
+blocks in schedule order (:mod:`.llvm_blocks`, :mod:`.llvm_signs`) and the outputs
+(:mod:`.llvm_outputs`), straight-line except for the sign search.  Only the inputs (the
+independent q, qd, qdd (N, dof), C-ordered), the external load values with their row
+layout ``ldrow`` (per load [first row, 1 if one row a sample]) and the output arrays
+(C-ordered rows of :func:`.llvm_outputs.widths`; ``fail`` (N,) int64 filled with -1) are
+pointers.  Compiled by :mod:`.llvm_driver`.
+"""
+from __future__ import annotations
+
+import llvmlite.ir as ir
+
+from .llvm_blocks import blocks
+from .llvm_build import DP, I64, I64P, Emitter
+from .llvm_links import external, inertia, joint_space, kinematics
+from .llvm_outputs import OUTPUTS, widths, write_outputs
+
+ARGS = ("qi", "qdi", "qddi", "vals", "ldrow") + OUTPUTS + ("signs", "fail", "start", "stop")
+
+
+def _signature(mod: ir.Module) -> ir.Function:
+    types = [DP] * 4 + [I64P] + [DP] * (len(OUTPUTS) + 1) + [I64P, I64, I64]
+    fn = ir.Function(mod, ir.FunctionType(ir.VoidType(), types), "run")
+    for arg, name in zip(fn.args, ARGS):
+        arg.name = name
+        if isinstance(arg.type, ir.PointerType):
+            arg.add_attribute("noalias")
+    return fn
+
+
+def _sample(e: Emitter, fn, prog, loads, n) -> None:
+    """The code of sample n (the loop body)."""
+    a = dict(zip(ARGS, fn.args))
+    S = prog.flts[2]
+    dof = S.shape[1]
+    ind = [[e.load(e.row(a[k], n, dof), d) for d in range(dof)] for k in ("qi", "qdi", "qddi")]
+    s = joint_space(e, S, *ind)
+    kinematics(e, s, prog.ints[0], prog.flts[0], int(prog.ints[11][0]))
+    for L in prog.ints[9]:
+        inertia(e, s, int(L), prog.flts[1], prog.flts[3])
+    external(e, s, loads, n, a["vals"], a["ldrow"])
+    w = widths(prog)
+    blocks(e, fn, s, prog, n, a["fail"], e.row(a["signs"], n, max(w["signs"], 1)))
+    write_outputs(e, s, prog, ind[1], {k: e.row(a[k], n, max(w[k], 1)) for k in OUTPUTS})
+
+
+def build_module(prog, loads) -> ir.Module:
+    """The IR module of ``prog``'s kernel (``loads``: per external load of the mechanism,
+    (link id, True if its values are in link axes, load point (3,) in the link frame))."""
+    mod = ir.Module(name="gearcli_kernel")
+    fn = _signature(mod)
+    entry, body, done = fn.append_basic_block("entry"), fn.append_basic_block("sample"), fn.append_basic_block("done")
+    b = ir.IRBuilder(entry)
+    start, stop = fn.args[-2], fn.args[-1]
+    b.cbranch(b.icmp_signed("<", start, stop), body, done)
+    b.position_at_end(body)
+    n = b.phi(I64, "n")
+    n.add_incoming(start, entry)
+    _sample(Emitter(b, mod), fn, prog, loads, n)
+    n1 = b.add(n, ir.Constant(I64, 1))
+    n.add_incoming(n1, b.block)
+    b.cbranch(b.icmp_signed("<", n1, stop), body, done)
+    b.position_at_end(done)
+    b.ret_void()
+    return mod

@@ -1,0 +1,130 @@
+"""Generated per-sample kinematics and link loads (the first half of :mod:`.llvm_kernel`).
+
+The same formulas as :mod:`.kernel_links` (paper Eqs. 2-5 and 17-18, the external loads
+of :func:`.external.external_wrenches`), emitted straight-line per joint and link with
+every fixed transform, mass, inertia and load point of the :class:`~.kernel_program.Program`
+as a constant (:class:`~.llvm_build.Emitter` folds the zeros and ones: a joint on the base,
+an identity R_pj, a centre of mass on an axis cost nothing).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import llvmlite.ir as ir
+
+from .llvm_build import I64, Emitter
+
+EYE = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
+ZERO3 = (0.0, 0.0, 0.0)
+
+
+@dataclass
+class Sample:
+    """One sample's values while its code is generated (every entry a float or an LLVM double).
+
+    ``q, qd, qdd`` (J,) per real joint; ``R, o, w, dw, a`` per link (base frame; the base
+    at rest: identity and zeros, constants); ``cs`` per joint (cos, sin of its angle);
+    ``rhs`` per link the 6 right-hand-side entries (base frame, about o_L); ``sol`` per
+    column of the solution row its value (joint reactions in the child's basis).
+    """
+
+    q: list
+    qd: list
+    qdd: list
+    R: dict = field(default_factory=dict)
+    o: dict = field(default_factory=dict)
+    w: dict = field(default_factory=dict)
+    dw: dict = field(default_factory=dict)
+    a: dict = field(default_factory=dict)
+    cs: dict = field(default_factory=dict)
+    rhs: dict = field(default_factory=dict)
+    sol: dict = field(default_factory=dict)
+
+
+def _floats(row) -> tuple:
+    return tuple(float(v) for v in row)
+
+
+def joint_space(e: Emitter, S, qi: list, qdi: list, qddi: list) -> Sample:
+    """The sample's q, qd, qdd of every real joint = S times the independent ones
+    (``qi, qdi, qddi``: the loaded independent values)."""
+    rows = [_floats(S[j]) for j in range(S.shape[0])]
+    return Sample([e.dot(qi, s) for s in rows], [e.dot(qdi, s) for s in rows], [e.dot(qddi, s) for s in rows])
+
+
+def _joint_frame(e: Emitter, f, Rp, op, qk, prismatic: bool):
+    """(R, o, cos, sin) of the joint frame at qk, base axes (kernel_links._joint_frame)."""
+    R0 = e.mm(Rp, f[0:9])
+    oj = e.vadd(op, e.mv(Rp, f[9:12]))
+    if prismatic:
+        return R0, e.vadd(oj, e.scale((R0[2], R0[5], R0[8]), qk)), 1.0, 0.0
+    cq, sq = e.call("cos", qk), e.call("sin", qk)
+    Rj = []
+    for i in range(3):
+        r0, r1 = R0[3 * i], R0[3 * i + 1]
+        Rj += [e.add(e.mul(cq, r0), e.mul(sq, r1)), e.sub(e.mul(cq, r1), e.mul(sq, r0)), R0[3 * i + 2]]
+    return tuple(Rj), oj, cq, sq
+
+
+def _arm_accel(e: Emitter, a, dw, w, r):
+    """a + dw x r + w x (w x r)."""
+    return e.vadd(a, e.vadd(e.cx(dw, r), e.cx(w, e.cx(w, r))))
+
+
+def kinematics(e: Emitter, s: Sample, jrec, jflt, base: int) -> None:
+    """Every link's R, o, w, dw, a (kernel_links.kinematics) and every joint's cos, sin."""
+    s.R[base], s.o[base], s.w[base], s.dw[base], s.a[base] = EYE, ZERO3, ZERO3, ZERO3, ZERO3
+    for k in range(jrec.shape[0]):
+        ji, p, c, pr = (int(v) for v in jrec[k, :4])
+        f = _floats(jflt[k])
+        qdk, qddk = s.qd[ji], s.qdd[ji]
+        op, wp, dwp = s.o[p], s.w[p], s.dw[p]
+        Rj, oj, cq, sq = _joint_frame(e, f, s.R[p], op, s.q[ji], pr == 1)
+        s.cs[ji] = (cq, sq)
+        z = (Rj[2], Rj[5], Rj[8])
+        aj = _arm_accel(e, s.a[p], dwp, wp, e.vsub(oj, op))
+        if pr == 1:
+            wc, dwc = wp, dwp
+            aj = e.vadd(aj, e.vadd(e.scale(z, qddk), e.scale(e.cx(wp, e.scale(z, qdk)), 2.0)))
+        else:
+            wc = e.vadd(wp, e.scale(z, qdk))
+            dwc = e.vadd(e.vadd(dwp, e.scale(z, qddk)), e.scale(e.cx(wp, z), qdk))
+        s.R[c] = e.mm(Rj, f[12:21])
+        rc = e.mv(Rj, f[21:24])
+        s.o[c] = e.vadd(oj, rc)
+        s.a[c] = _arm_accel(e, aj, dwc, wc, rc)
+        s.w[c], s.dw[c] = wc, dwc
+
+
+def inertia(e: Emitter, s: Sample, L: int, lflt, g) -> None:
+    """rhs[L] = the d'Alembert wrench of link L about o_L, base frame (Eqs. 17-18)."""
+    f = _floats(lflt[L])
+    m, I, com = f[0], f[1:10], f[10:13]
+    RL, wL, dwL = s.R[L], s.w[L], s.dw[L]
+    wb = e.mtv(RL, wL)
+    Nb = e.vadd(e.mv(I, e.mtv(RL, dwL)), e.cx(wb, e.mv(I, wb)))
+    rc = e.mv(RL, com)
+    ac = _arm_accel(e, s.a[L], dwL, wL, rc)
+    F = e.scale(e.vsub(ac, _floats(g)), m)
+    M = e.vadd(e.mv(RL, Nb), e.cx(rc, F))
+    s.rhs[L] = F + M
+
+
+def external(e: Emitter, s: Sample, loads, n, vals, ldrow) -> None:
+    """rhs[L] -= every external load on L at sample n (kernel_links.external).
+
+    ``loads``: per load (link, 1 if in link axes, load point (3,)); ``vals`` the stacked
+    values (rows of 6) and ``ldrow`` per load [first row, 1 if one row a sample]: given at
+    run time (a load's values may be constant or per sample from call to call)."""
+    for k, (L, in_link, point) in enumerate(loads):
+        per = e.load(ldrow, 2 * k + 1)
+        row = e.b.add(e.load(ldrow, 2 * k), e.b.mul(n, per))
+        base = e.b.mul(row, ir.Constant(I64, 6))
+        v = [e.load(vals, e.b.add(base, ir.Constant(I64, i))) for i in range(6)]
+        f, m = tuple(v[:3]), tuple(v[3:])
+        if in_link:
+            f, m = e.mv(s.R[L], f), e.mv(s.R[L], m)
+        arm = e.mv(s.R[L], _floats(point))
+        mo = e.vadd(m, e.cx(arm, f))
+        old = s.rhs[L]
+        s.rhs[L] = tuple(e.sub(old[i], f[i]) for i in range(3)) + tuple(e.sub(old[3 + i], mo[i]) for i in range(3))
