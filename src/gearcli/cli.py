@@ -232,8 +232,7 @@ TRAJ_HELP = ("Trajectory CSV: header t,q:<joint>,... for every independent joint
 METHOD_OPTION = typer.Option("block", "--method", help="'block': level-by-level schedule (fast); 'full': cross-check.")
 JOBS_OPTION = typer.Option(None, "--jobs", "-j", min=1,
                            help="Threads: solve and CSV (default: all cores; same results).")
-BACKEND_OPTION = typer.Option("auto", "--backend",
-                              help="'llvm' (generated per mechanism), 'kernel' (numba), 'numpy' (reference) or 'auto'.")
+BACKEND_OPTION = typer.Option("auto", "--backend", help="'llvm', 'kernel' (numba), 'numpy' (reference) or 'auto'.")
 
 
 @app.command()
