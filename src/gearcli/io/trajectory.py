@@ -8,7 +8,8 @@ columns of prismatic joints (``linear``) are in m, m/s, m/s^2 either way.  Optio
 ``load:<name>:fx`` ... ``mz`` columns override external loads per sample (:mod:`.load_columns`).
 
 Missing rates/accelerations are derived from the positions with a quintic interpolating
-spline (:func:`scipy.interpolate.make_interp_spline`, k = 5, not-a-knot ends): for a smooth
+spline (:func:`scipy.interpolate.make_interp_spline`, k = 5, not-a-knot ends; computed by
+:mod:`.spline`, the same arithmetic without importing scipy.interpolate): for a smooth
 motion sampled at step h the error of the first derivative is O(h^5) and of the second
 O(h^4) (1.5e-8 rad/s^2 for a 1 Hz sine of 1 rad sampled at 1 kHz, 5e-12 rad/s on rates).  Long files are processed in
 chunks; each chunk's spline is fitted over the chunk plus ``PAD`` samples of each
@@ -38,6 +39,7 @@ import numpy as np
 from ..errors import Issue, TrajectoryError
 from .csv_numbers import parse_floats
 from .load_columns import load_columns, load_samples
+from .spline import spline_derivatives
 from .text_lines import line_chunks
 
 PAD = 64
@@ -80,7 +82,9 @@ def derivatives(t: np.ndarray, y: np.ndarray, order: int = 2) -> list[np.ndarray
     k = min(5, n - 1)
     if k < order:
         raise ValueError(f"{n} samples allow a spline of degree {k} < {order}")
-    from scipy.interpolate import make_interp_spline  # noqa: PLC0415  (only when rates are missing; keeps `check` fast)
+    if k == 5:
+        return spline_derivatives(t, y, order)     # the same values as scipy's, without importing scipy.interpolate
+    from scipy.interpolate import make_interp_spline  # noqa: PLC0415  (2 to 5 samples only)
 
     spl = make_interp_spline(t, y, k=k, check_finite=False)   # the reader checked every value finite
     out = []
