@@ -52,8 +52,8 @@ def test_auto_policy(monkeypatch):
 def test_both_pattern_codings_are_generated():
     """Bendix's signed blocks are a switch into straight-line code, planetary_3p's 2^6
     pattern maps a global table (their results: test_kernel.py)."""
-    small = solver_for(analyse(load_mechanism(MECH / "bendix_wrist.yaml"))).llvm_kernel().ir
-    big = solver_for(analyse(load_mechanism(MECH / "planetary_3p.yaml"))).llvm_kernel().ir
+    small = solver_for(analyse(load_mechanism(MECH / "bendix_wrist.yaml"))).llvm_kernel().jit.ir
+    big = solver_for(analyse(load_mechanism(MECH / "planetary_3p.yaml"))).llvm_kernel().jit.ir
     assert "switch i64" in small and '@"ainv_' not in small
     assert '@"ainv_b0" = internal constant [' in big
     assert SWITCH_LIMIT < 64 * (32 + 6) * 30
@@ -61,7 +61,7 @@ def test_both_pattern_codings_are_generated():
 
 def test_only_contraction_is_allowed():
     """No fast-math flag but ``contract`` (NaN must reach the sign search)."""
-    text = solver_for(analyse(load_mechanism(MECH / "bendix_wrist.yaml"))).llvm_kernel().ir
+    text = solver_for(analyse(load_mechanism(MECH / "bendix_wrist.yaml"))).llvm_kernel().jit.ir
     assert " contract " in text
     for flag in ("fast", "nnan", "ninf", "nsz", "arcp", "afn", "reassoc"):
         assert f" {flag} " not in text
@@ -75,3 +75,53 @@ def test_llvm_path_does_not_import_numba():
     env = {"PYTHONPATH": str(ROOT / "src"), "PATH": "/usr/bin:/bin"}
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True)
     assert out.stdout.strip() == "False"
+
+
+def _compiled_sincos():
+    """A function f(x, c, s, n) writing the generated cos, sin of x[i] (llvm_trig.sincos)."""
+    import ctypes
+
+    import llvmlite.ir as ir
+
+    from gearcli.dynamics.llvm_build import DP, I64, Emitter
+    from gearcli.dynamics.llvm_driver import Jit
+    from gearcli.dynamics.llvm_trig import sincos
+
+    mod = ir.Module("sincos_test")
+    fn = ir.Function(mod, ir.FunctionType(ir.VoidType(), [DP, DP, DP, I64]), "f")
+    entry, body, done = (fn.append_basic_block(s) for s in ("entry", "body", "done"))
+    b = ir.IRBuilder(entry)
+    b.branch(body)
+    b.position_at_end(body)
+    i = b.phi(I64)
+    i.add_incoming(ir.Constant(I64, 0), entry)
+    e = Emitter(b, mod)
+    c, s = sincos(e, e.load(fn.args[0], i))
+    e.store(c, fn.args[1], i)
+    e.store(s, fn.args[2], i)
+    i1 = b.add(i, ir.Constant(I64, 1))
+    i.add_incoming(i1, b.block)
+    b.cbranch(b.icmp_signed("<", i1, fn.args[3]), body, done)
+    b.position_at_end(done)
+    b.ret_void()
+    jit = Jit(mod)
+    f = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_int64)(jit.address("f"))
+    return jit, f
+
+
+def test_inline_sincos_matches_libm():
+    """Within 2 ulp-sized steps (4e-16 absolute) of numpy's cos and sin: random angles, the
+    quadrant boundaries k pi/4 and their neighbours, angles near the libm fallback limit and
+    far beyond it; NaN and infinities give NaN."""
+    rng = np.random.default_rng(4)
+    k = np.arange(-400, 401) * (np.pi / 4)
+    x = np.concatenate([rng.uniform(-20, 20, 20_000), rng.uniform(-1e5, 1e5, 2000), k, np.nextafter(k, 10),
+                        np.nextafter(k, -10), [0.0, -0.0, 1e-300, 99_999.9, 100_000.1, -3e7, 1e15]])
+    jit, f = _compiled_sincos()
+    c, s = np.empty_like(x), np.empty_like(x)
+    f(x.ctypes.data, c.ctypes.data, s.ctypes.data, x.size)
+    assert np.abs(c - np.cos(x)).max() < 4e-16 and np.abs(s - np.sin(x)).max() < 4e-16
+    bad = np.array([np.nan, np.inf, -np.inf])
+    c, s = np.empty(3), np.empty(3)
+    f(bad.ctypes.data, c.ctypes.data, s.ctypes.data, 3)
+    assert np.isnan(c).all() and np.isnan(s).all()

@@ -16,6 +16,7 @@ import llvmlite.ir as ir
 from .llvm_build import I64, Emitter
 from .llvm_links import Sample, _floats
 from .llvm_signs import SignedBlock, resolve, signs_of, tolerance
+from .llvm_trig import sincos
 
 
 def problem(prog) -> str | None:
@@ -109,7 +110,7 @@ def store(e: Emitter, s: Sample, rec, prog, x: list) -> None:
             cq, sq = s.cs[j]
         else:
             angle = e.dot(s.q, _floats(turns[off:off + len(s.q)]))
-            cq, sq = e.call("cos", angle), e.call("sin", angle)
+            cq, sq = sincos(e, angle)
         for h in (0, 3):
             x0, x1 = x[c0 + h], x[c0 + h + 1]
             s.sol[int(gcol[g0 + c0 + h])] = e.add(e.mul(cq, x0), e.mul(sq, x1))

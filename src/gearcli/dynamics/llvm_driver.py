@@ -45,19 +45,15 @@ def mech_loads(an) -> list:
     return [(an.tree.index[ld.link], ld.frame == "link", np.asarray(ld.point, float)) for ld in an.mech.loads]
 
 
-class LlvmKernel:
-    """The compiled kernel of one mechanism.
+class Jit:
+    """An IR module compiled in memory (O3, host CPU); ``address(name)`` of its functions.
 
-    ``build_seconds`` (IR generation) and ``compile_seconds`` (LLVM optimisation and code
-    generation) say what it cost; ``assembly()`` returns its machine code as text."""
+    Keeps the execution engine alive (freeing it frees the code)."""
 
-    def __init__(self, prog: Program, an):
+    def __init__(self, module):
         llvm, tm = _target_machine()
-        t0 = time.perf_counter()
-        module = build_module(prog, mech_loads(an))
         module.triple, module.data_layout = tm.triple, str(tm.target_data)
         self.ir = str(module)
-        t1 = time.perf_counter()
         mod = llvm.parse_assembly(self.ir)
         mod.verify()
         pto = llvm.create_pipeline_tuning_options(3)
@@ -66,14 +62,30 @@ class LlvmKernel:
         self._module, self._tm = mod, tm
         self._engine = llvm.create_mcjit_compiler(mod, tm)
         self._engine.finalize_object()
-        proto = ctypes.CFUNCTYPE(None, *([ctypes.c_void_p] * (len(ARGS) - 2) + [ctypes.c_int64] * 2))
-        self._run = proto(self._engine.get_function_address("run"))
-        self.build_seconds, self.compile_seconds = t1 - t0, time.perf_counter() - t1
-        self.prog = prog
+
+    def address(self, name: str) -> int:
+        return self._engine.get_function_address(name)
 
     def assembly(self) -> str:
         """The optimised module's machine code (to check what LLVM made of it)."""
         return self._tm.emit_assembly(self._module)
+
+
+class LlvmKernel:
+    """The compiled kernel of one mechanism.
+
+    ``build_seconds`` (IR generation) and ``compile_seconds`` (LLVM optimisation and code
+    generation) say what it cost; ``jit.ir`` is its IR, ``jit.assembly()`` its machine code."""
+
+    def __init__(self, prog: Program, an):
+        t0 = time.perf_counter()
+        module = build_module(prog, mech_loads(an))
+        t1 = time.perf_counter()
+        self.jit = Jit(module)
+        proto = ctypes.CFUNCTYPE(None, *([ctypes.c_void_p] * (len(ARGS) - 2) + [ctypes.c_int64] * 2))
+        self._run = proto(self.jit.address("run"))
+        self.build_seconds, self.compile_seconds = t1 - t0, time.perf_counter() - t1
+        self.prog = prog
 
     def solve(self, an, q, qd, qdd, values: dict, jobs: int | None, chunk: int):
         """The loads of every sample, as :func:`.kernel_driver.kernel_solve` returns them."""

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import llvmlite.ir as ir
 
 from .llvm_build import I64, Emitter
+from .llvm_trig import sincos
 
 EYE = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
 ZERO3 = (0.0, 0.0, 0.0)
@@ -58,7 +59,7 @@ def _joint_frame(e: Emitter, f, Rp, op, qk, prismatic: bool):
     oj = e.vadd(op, e.mv(Rp, f[9:12]))
     if prismatic:
         return R0, e.vadd(oj, e.scale((R0[2], R0[5], R0[8]), qk)), 1.0, 0.0
-    cq, sq = e.call("cos", qk), e.call("sin", qk)
+    cq, sq = sincos(e, qk)
     Rj = []
     for i in range(3):
         r0, r1 = R0[3 * i], R0[3 * i + 1]
