@@ -105,3 +105,59 @@ def test_reader_reports_the_same_error_with_and_without_the_fast_parser(tmp_path
             reader.check()
         messages.append(str(err.value))
     assert messages[0] == messages[1] and ":2502:" in messages[0], messages
+
+
+ODD_LINES = ["", "  ", "\r", "1e999,0,0", "x,1,2", '"{t}",0.5,0.25', "{t},1\r,2", "{t},0.5,\u00e9",
+             "{t},1,2,3", "{t};1;2", "{t},nan,0", "{t}," + "1" * 90 + ",0", "{t},1,2\r"]
+
+
+def odd_trajectory(rng) -> bytes:
+    """Rows t, q:J1, q:J2 (increasing t), a few of them odd (blank, CRLF, quoted, bad,
+    non-ASCII, too long, ...), at random places; sometimes no final newline."""
+    n = int(rng.integers(300, 700))
+    rows = [f"{i * 1e-3!r},{float(np.sin(i))!r},{float(np.cos(i))!r}" for i in range(n)]
+    for _ in range(int(rng.integers(0, 3))):
+        i = int(rng.integers(0, n))
+        rows[i] = str(rng.choice(ODD_LINES)).replace("{t}", repr(i * 1e-3))
+    if rng.random() < 0.3:
+        rows = [r + "\r" for r in rows]
+    text = "t,q:J1,q:J2\n" + "\n".join(rows) + ("\n" if rng.random() < 0.7 else "")
+    return text.encode("utf-8")
+
+
+def read_all(path, chunk):
+    from gearcli.errors import TrajectoryError
+    from gearcli.io.trajectory import TrajectoryReader
+
+    try:
+        return [(d.tobytes(), n.tolist()) for d, n in TrajectoryReader(path, ["J1", "J2"], chunk=chunk)._raw()]
+    except TrajectoryError as exc:
+        return str(exc)
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_reader_straight_from_bytes_equals_line_by_line(tmp_path, monkeypatch, seed):
+    """Chunks read from the bytes (plain_chunks + pyarrow) give the same rows, line
+    numbers and errors as the line-by-line reader (FAST_PARSE_ROWS huge: never from the bytes)."""
+    import gearcli.io.trajectory as trajectory
+
+    rng = np.random.default_rng(seed)
+    path = tmp_path / "traj.csv"
+    path.write_bytes(odd_trajectory(rng))
+    monkeypatch.setattr(trajectory, "MAX_LINE", 80)
+    monkeypatch.setattr(text_lines, "BLOCK", int(rng.integers(50, 5000)))
+    for chunk in (129, 200, 1 << 40):
+        got = []
+        for fast_rows in (2, 1 << 40):
+            monkeypatch.setattr(trajectory, "FAST_PARSE_ROWS", fast_rows)
+            got.append(read_all(path, chunk))
+        assert got[0] == got[1], (chunk, got[0] if isinstance(got[0], str) else len(got[0]))
+
+
+def test_plain_chunks_stop_before_the_first_part_with_a_non_ascii_or_too_long_line():
+    data = b"h\n1,2\n3,4\n5,6\n\n7,8\n9,\xc3\xa9\n"      # blank lines are the parser's to refuse
+    assert list(text_lines.plain_chunks(io.BytesIO(data), 2, 1, 2, 100)) == [
+        (b"1,2\n3,4\n", 2, 2, 2), (b"5,6\n\n", 10, 4, 2)]
+    long = b"h\n1,2\n" + b"9" * 200 + b"\n3,4"
+    assert list(text_lines.plain_chunks(io.BytesIO(long), 2, 1, 1, 100)) == [(b"1,2\n", 2, 2, 1)]
+    assert list(text_lines.plain_chunks(io.BytesIO(long), 2, 1, 5, 300)) == [(long[2:], 2, 2, 3)]

@@ -10,23 +10,26 @@ gives None (pyarrow reads ``nan(1)``, which ``loadtxt`` refuses as not a number)
 """
 from __future__ import annotations
 
-import io
-
 import numpy as np
 
 
 def parse_floats(lines: list[str], ncol: int, sep: str) -> np.ndarray | None:
     """(len(lines), ncol) floats of the CSV ``lines`` (no newlines, UTF-8 text), or None
     when a cell is not a plain number or a row has another number of cells."""
+    if not lines:
+        return np.zeros((0, ncol))
+    return parse_bytes("\n".join(lines).encode("utf-8"), len(lines), ncol, sep)
+
+
+def parse_bytes(data: bytes, rows: int, ncol: int, sep: str) -> np.ndarray | None:
+    """(rows, ncol) floats of the CSV text ``data`` (``rows`` lines, UTF-8, the last one
+    with or without its newline), or None as :func:`parse_floats`."""
     import pyarrow as pa  # noqa: PLC0415 (a dependency; imported when rows are read)
     import pyarrow.csv as pc  # noqa: PLC0415
 
-    if not lines:
-        return np.zeros((0, ncol))
-    data = "\n".join(lines).encode("utf-8")
     names = [str(i) for i in range(ncol)]
     try:
-        t = pc.read_csv(io.BytesIO(data),
+        t = pc.read_csv(pa.BufferReader(data),
                         read_options=pc.ReadOptions(column_names=names, use_threads=False,
                                                     block_size=len(data) + 16),
                         parse_options=pc.ParseOptions(delimiter=sep, quote_char='"', ignore_empty_lines=False),
@@ -35,7 +38,9 @@ def parse_floats(lines: list[str], ncol: int, sep: str) -> np.ndarray | None:
                                                           quoted_strings_can_be_null=False))
     except (pa.ArrowInvalid, pa.ArrowNotImplementedError, ValueError, UnicodeError):
         return None
-    if t.num_rows != len(lines) or t.num_columns != ncol or any(c.null_count for c in t.columns):
+    if t.num_rows != rows or t.num_columns != ncol or any(c.null_count for c in t.columns):
         return None
-    out = np.column_stack([c.to_numpy() for c in t.columns]) if ncol else np.zeros((len(lines), 0))
+    out = np.empty((rows, ncol))
+    for i, c in enumerate(t.columns):
+        out[:, i] = c.to_numpy()
     return None if np.isnan(out).any() else out   # NaN cells (an error anyway): loadtxt's reading

@@ -135,3 +135,25 @@ def spline_derivatives(x: np.ndarray, y: np.ndarray, order: int = 2) -> list[np.
         t, k = t[1:-1], k - 1
         out.append(_evaluate(t, c, k, x, d))
     return out
+
+
+def derivatives(t: np.ndarray, y: np.ndarray, order: int = 2) -> list[np.ndarray]:
+    """First ``order`` derivatives of samples ``y`` (N, m) at times ``t`` (N,) by the
+    interpolating spline of degree k = min(5, N - 1) (not-a-knot ends).
+
+    Raises ValueError when N - 1 < ``order`` (too few samples for the derivatives).
+    """
+    n = len(t)
+    k = min(5, n - 1)
+    if k < order:
+        raise ValueError(f"{n} samples allow a spline of degree {k} < {order}")
+    if k == 5:
+        return spline_derivatives(t, y, order)     # the same values as scipy's, without importing it
+    from scipy.interpolate import make_interp_spline  # noqa: PLC0415  (2 to 5 samples only)
+
+    spl = make_interp_spline(t, y, k=k, check_finite=False)   # the reader checked every value finite
+    out = []
+    for _ in range(order):
+        spl = spl.derivative(1)      # the same coefficients as derivative(i) of the fit, one step each
+        out.append(spl(t))
+    return out

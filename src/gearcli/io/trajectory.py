@@ -37,10 +37,10 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import Issue, TrajectoryError
-from .csv_numbers import parse_floats
+from .csv_numbers import parse_bytes, parse_floats
 from .load_columns import load_columns, load_samples
-from .spline import spline_derivatives
-from .text_lines import line_chunks
+from .spline import derivatives
+from .text_lines import line_chunks, plain_chunks
 
 PAD = 64
 MAX_ABS = 1e12        # largest |value| accepted, SI units (s, rad, m and their rates)
@@ -70,28 +70,6 @@ def show(text: str, limit: int = 40) -> str:
     text = text.encode("unicode_escape", "backslashreplace").decode("ascii") \
         if not text.isprintable() else text
     return text if len(text) <= limit else text[:limit - 1] + "…"
-
-
-def derivatives(t: np.ndarray, y: np.ndarray, order: int = 2) -> list[np.ndarray]:
-    """First ``order`` derivatives of samples ``y`` (N, m) at times ``t`` (N,) by the
-    interpolating spline of degree k = min(5, N - 1) (not-a-knot ends).
-
-    Raises ValueError when N - 1 < ``order`` (too few samples for the derivatives).
-    """
-    n = len(t)
-    k = min(5, n - 1)
-    if k < order:
-        raise ValueError(f"{n} samples allow a spline of degree {k} < {order}")
-    if k == 5:
-        return spline_derivatives(t, y, order)     # the same values as scipy's, without importing scipy.interpolate
-    from scipy.interpolate import make_interp_spline  # noqa: PLC0415  (2 to 5 samples only)
-
-    spl = make_interp_spline(t, y, k=k, check_finite=False)   # the reader checked every value finite
-    out = []
-    for _ in range(order):
-        spl = spl.derivative(1)      # the same coefficients as derivative(i) of the fit, one step each
-        out.append(spl(t))
-    return out
 
 
 def _fail(file: str, line: int | None, place: str, message: str) -> TrajectoryError:
@@ -292,13 +270,41 @@ class TrajectoryReader:
         return max(n - 1, 0)
 
     def _raw(self):
-        """Yield (array of rows in SI units (n, ncol), line numbers (n,)), checked."""
-        c_t = self.cols["t"]
+        """Yield (array of rows in SI units (n, ncol), line numbers (n,)), checked: the
+        chunks of plain lines straight from the bytes (:meth:`_plain_rows`), from the first
+        other one on (blank or non-ASCII lines, a bad value: to report it) line by line."""
         last_t = None
+        with open(self.path, "rb") as f:
+            f.readline()        # the header (checked in __init__)
+            offset, lineno = f.tell(), 1
+            for part, offset, first, rows in plain_chunks(f, offset, lineno, self.chunk, MAX_LINE):
+                lineno = first - 1
+                si = self._plain_rows(part, rows, last_t)
+                if si is None:
+                    break
+                last_t = si[-1, self.cols["t"]]
+                yield si, np.arange(first, first + len(si))
+                offset, lineno = offset + len(part), lineno + len(si)
+        yield from self._lines_raw(offset, lineno, last_t)
+
+    def _plain_rows(self, part: bytes, rows: int, last_t: float | None) -> np.ndarray | None:
+        """Rows (n, ncol) in SI units of the ``rows`` CSV lines ``part``, or None when they are
+        fewer than ``FAST_PARSE_ROWS`` or any check of :meth:`_lines_raw` would fail on them."""
+        data = parse_bytes(part, rows, len(self.header), self.sep) if rows >= FAST_PARSE_ROWS else None
+        if data is None:
+            return None
+        si = data * self.scale
+        t = si[:, self.cols["t"]] if last_t is None else np.concatenate([[last_t], si[:, self.cols["t"]]])
+        ok = np.isfinite(data).all() and not (np.abs(si) > MAX_ABS).any()
+        return si if ok and not (np.diff(t) < MIN_STEP * (1 - 1e-6)).any() else None
+
+    def _lines_raw(self, offset: int, lineno: int, last_t: float | None):
+        """:meth:`_raw` line by line from byte ``offset``, after line ``lineno``."""
+        c_t = self.cols["t"]
         with self._open() as f:
-            self._readline(f, 1)
+            f.seek(offset)
             too_long = lambda n: _fail(self.file, n, "", f"line longer than {MAX_LINE} characters")  # noqa: E731
-            for lines, linenos in line_chunks(f, 1, self.chunk, MAX_LINE, too_long):
+            for lines, linenos in line_chunks(f, lineno, self.chunk, MAX_LINE, too_long):
                 data = _parse_rows(lines, linenos, self.header, self.sep, self.file)
                 si = data * self.scale
                 _check_values(data, si, lines, linenos, self.header, self.sep, self.file)
