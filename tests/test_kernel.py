@@ -34,7 +34,6 @@ MECH = Path(__file__).resolve().parents[1] / "mechanisms"
 FIELDS = ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial", "motor_speed")
 TOL = 1e-12
 BUNDLED = sorted(p.name for p in MECH.glob("*.yaml")) + ["geared_arm.urdf"]
-NO_LLVM = {"rack_axis.yaml", "talos_left_arm", "talos_data/robots/talos_full_v2.urdf"}   # world-frame blocks
 BACKENDS = ["kernel", "llvm"]
 
 
@@ -97,26 +96,17 @@ def worst(a, b) -> float:
     return float(np.max(np.abs(fa - fb).max(axis=1) / (1.0 + np.abs(fb).max(axis=1))))
 
 
-def compiled_backend(an, key, backend) -> bool:
-    """True when ``backend`` solves ``key``'s mechanism ("auto" then takes llvm, else the
-    kernel); the llvm backend must refuse exactly the mechanisms of NO_LLVM."""
+def compiled_backend(an) -> None:
+    """Both compiled backends cover every mechanism here: "auto" takes llvm."""
     sol = solver_for(an)
-    if backend == "llvm" and key in NO_LLVM:
-        assert not sol.llvm_available() and "no constant frame" in sol.llvm_problem
-        assert sol.backend() == "kernel"
-        with pytest.raises(ValueError, match="backend 'llvm' unavailable"):
-            solve(an, np.zeros((2, an.dof)), np.zeros((2, an.dof)), np.zeros((2, an.dof)), backend="llvm")
-        return False
-    assert sol.backend() == ("kernel" if key in NO_LLVM else "llvm")
-    return True
+    assert sol.llvm_available() and sol.backend() == "llvm"
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("key", BUNDLED + GENERATED)
 def test_kernel_equals_numpy(key, backend):
     an = analyse(mechanism(key))
-    if not compiled_backend(an, key, backend):
-        return
+    compiled_backend(an)
     q, qd, qdd = trajectory(an, 600)
     loads = per_sample_loads(an, 600)
     ref = solve(an, q, qd, qdd, backend="numpy", loads=loads)
@@ -135,8 +125,7 @@ def test_kernel_equals_numpy_on_robots(case, backend, tmp_path):
     """Published robots; Talos' transmissions and mimic joints need world-frame blocks."""
     path = talos_left_arm(tmp_path) if case == "talos_left_arm" else erd(case)
     an = analyse(load_urdf(path))
-    if not compiled_backend(an, case, backend):
-        return
+    compiled_backend(an)
     q, qd, qdd = trajectory(an, 200)
     assert worst(solve(an, q, qd, qdd, backend=backend), solve(an, q, qd, qdd, backend="numpy")) < TOL
 

@@ -11,8 +11,9 @@ import pytest
 
 pytest.importorskip("llvmlite")
 
-from gearcli import analyse, load_mechanism  # noqa: E402
-from gearcli.dynamics import solve as solve_mod  # noqa: E402
+from big_mechanisms import serial_chain  # noqa: E402
+from gearcli import analyse, load_mechanism, parse_mechanism  # noqa: E402
+from gearcli.dynamics import backends  # noqa: E402
 from gearcli.dynamics.llvm_signs import SWITCH_LIMIT  # noqa: E402
 from gearcli.dynamics.solve import solve, solver_for  # noqa: E402
 
@@ -31,15 +32,21 @@ def test_compiled_once_per_solver_and_kept():
 
 
 def test_auto_policy(monkeypatch):
-    """"auto": llvm once compiled, or from LLVM_MIN_SAMPLES samples, or when the numba
-    kernel is not loaded; the numba kernel for a small call otherwise."""
+    """"auto" takes llvm once compiled, or when its estimated compile time is at most what
+    the numba kernel costs extra for the call (its start when not loaded, then ~1 us a
+    sample more than llvm); a large mechanism (40 links) keeps the kernel for a small call."""
     import gearcli.dynamics.kernel  # noqa: F401, PLC0415  (the numba kernel loaded)
     an = analyse(load_mechanism(MECH / "helical_reduction.yaml"))
     sol = solver_for(an)
+    est = backends.llvm_compile_estimate(an)
+    assert 0 < est < backends.NUMBA_START_SECONDS
     assert sol.backend(n=10) == "kernel"
-    assert sol.backend(n=solve_mod.LLVM_MIN_SAMPLES) == "llvm"
+    assert sol.backend(n=int(est / backends.SAVED_SECONDS_PER_SAMPLE) + 1) == "llvm"
     monkeypatch.delitem(sys.modules, "gearcli.dynamics.kernel")
-    assert sol.backend(n=10) == "llvm"
+    assert sol.backend(n=10) == "llvm"                   # cheaper than starting numba
+    big = solver_for(analyse(parse_mechanism(serial_chain(40))))
+    assert backends.llvm_compile_estimate(big.an) > backends.NUMBA_START_SECONDS
+    assert big.backend(n=10) == "kernel" and big.backend(n=10**7) == "llvm"
     monkeypatch.undo()
     q = np.zeros((3, an.dof))
     solve(an, q, q, q, backend="llvm")
@@ -47,6 +54,18 @@ def test_auto_policy(monkeypatch):
     assert sol.backend("full", "auto", 10) == "numpy"
     with pytest.raises(ValueError, match="backend 'llvm' solves method 'block' only"):
         sol.backend("full", "llvm")
+
+
+def test_unavailable_without_a_kernel_program():
+    """A mechanism the kernel program does not cover: llvm refused with the reason, "auto"
+    takes numpy."""
+    an = analyse(load_mechanism(MECH / "coaxial_fig5.yaml"))
+    sol = solver_for(an)
+    sol.kernel_problem = "a stand-in reason"
+    q = np.zeros((3, an.dof))
+    with pytest.raises(ValueError, match="backend 'llvm' unavailable: no kernel program: a stand-in reason"):
+        solve(an, q, q, q, backend="llvm")
+    assert sol.backend() == "numpy"
 
 
 def test_both_pattern_codings_are_generated():

@@ -6,8 +6,8 @@ block without signed meshes, else with the sign search of :mod:`.llvm_signs`), p
 solved wrenches on to the later links (the propagation records and their C_plus, C_sep
 columns, or the column terms of :mod:`.kernel_terms` for a block solved in its link's
 axes) and write the solution into the sample's row (joint reactions turned to their
-child's basis).  A block without a constant frame (world axes, Gaussian elimination per
-sample) is not generated: :func:`problem` names it.
+child's basis).  A block without a constant frame is solved in world axes by Gaussian
+elimination per sample and per sign trial (:mod:`.llvm_world`).
 """
 from __future__ import annotations
 
@@ -17,6 +17,7 @@ from .llvm_build import I64, Emitter
 from .llvm_links import Sample, _floats
 from .llvm_signs import SignedBlock, resolve, signs_of, tolerance
 from .llvm_trig import sincos
+from .llvm_world import WorldBlock
 
 
 def problem(prog) -> str | None:
@@ -24,9 +25,6 @@ def problem(prog) -> str | None:
     if not prog.covered:
         return ("a redundant gear set of this mechanism has no constant frame, or a block has more sign "
                 "patterns than the program holds (kernel_program.MAX_PATTERNS)")
-    if any(int(F) < 0 for F in prog.ints[1][:, 0]):
-        return ("a block has no constant frame (solved in world axes by elimination per sample), which the "
-                "llvm backend does not generate; backend 'kernel' solves it")
     return None
 
 
@@ -126,16 +124,22 @@ def blocks(e: Emitter, fn, s: Sample, prog, n, fail, sg_row) -> None:
     for b, rec in enumerate(brec):
         F, lk0, B, nloc, m, t0, a0, p0, np_, k0, nt = (int(rec[i]) for i in (0, 1, 2, 3, 5, 6, 7, 8, 9, 12, 13))
         nr = 6 * B
-        r = gather(e, s, F, [int(v) for v in blinks[lk0:lk0 + B]])
-        maps = [ainv[a0 + k * nloc * nr:a0 + (k + 1) * nloc * nr].reshape(nloc, nr) for k in range(1 << m)]
+        links = [int(v) for v in blinks[lk0:lk0 + B]]
+        tcols = [int(c) for c in tcol[t0:t0 + m]]
+        if F < 0:                       # world axes about each link's origin (kernel_world.world_gather)
+            r = [v for L in links for v in s.rhs[L]]
+            blk = WorldBlock(s, prog, k0, nt, nloc, tcols, term_wrench)
+        else:
+            r = gather(e, s, F, links)
+            maps = [ainv[a0 + k * nloc * nr:a0 + (k + 1) * nloc * nr].reshape(nloc, nr) for k in range(1 << m)]
+            blk = SignedBlock(e, maps, tcols, f"b{b}") if m else None
         if m == 0:
-            x, sig = [e.dot(_floats(maps[0][i]), r) for i in range(nloc)], []
+            x, sig = (blk.solve(e, [], r) if F < 0 else [e.dot(_floats(maps[0][i]), r) for i in range(nloc)]), []
         else:
             def on_fail(b=b):
                 old = e.load(fail, n)
                 e.b.store(e.b.select(e.b.icmp_signed("<", old, ir.Constant(I64, 0)), ir.Constant(I64, b), old),
                           e.b.gep(fail, [n]))
-            blk = SignedBlock(e, maps, [int(c) for c in tcol[t0:t0 + m]], f"b{b}")
             x, p = resolve(e, fn, blk, r, tolerance(e, r), on_fail, f"b{b}")
             sig = signs_of(e, p, m)
             for i in range(m):

@@ -81,6 +81,13 @@ class Emitter:
                 return self.neg(b)
         return self.b.fmul(self.const(a), self.const(b), flags=FLAGS)
 
+    def div(self, a, b):
+        if isinstance(a, float) and isinstance(b, float):
+            return a / b
+        if isinstance(b, float) and b == 1.0:
+            return a
+        return self.b.fdiv(self.const(a), self.const(b), flags=FLAGS)
+
     def dot(self, xs, ys):
         """sum_i xs[i] ys[i], left to right."""
         s = 0.0

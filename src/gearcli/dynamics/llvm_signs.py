@@ -131,7 +131,9 @@ class SignedBlock:
 def resolve(e: Emitter, fn, blk: SignedBlock, r: list, tol, on_fail, tag: str):
     """(x (n values), p): the block's solution with the first consistent sign pattern p
     (i64) of the search order (module docstring); ``on_fail()`` emits what a sample with
-    no consistent pattern does (its x is then that of the last pattern tried)."""
+    no consistent pattern does (its x is then that of the last pattern tried).  ``blk``:
+    a :class:`SignedBlock`, or a :class:`~.llvm_world.WorldBlock` whose trials solve the
+    whole block (kept for the pattern accepted)."""
     m = len(blk.tcols)
     steps = 1 + m + ((1 << m) if m <= MAX_EXHAUSTIVE else 0)
     pre = e.b.block
@@ -145,7 +147,9 @@ def resolve(e: Emitter, fn, blk: SignedBlock, r: list, tol, on_fail, tag: str):
     late = e.b.sub(step, ir.Constant(I64, m + 1))
     p = e.b.select(e.b.icmp_signed("==", step, ir.Constant(I64, 0)), ir.Constant(I64, 0),
                    e.b.select(e.b.icmp_signed("<=", step, ir.Constant(I64, m)), own, late))
-    t = blk.rows(e, fn, p, blk.tcols, r, f"{tag}_t")
+    full = getattr(blk, "full_trial", False)     # a trial solves the whole block
+    xs = blk.rows(e, fn, p, list(range(blk.n)), r, f"{tag}_x") if full else None
+    t = [xs[c] for c in blk.tcols] if full else blk.rows(e, fn, p, blk.tcols, r, f"{tag}_t")
     ok = _consistent(e, t, [_sign_bit(e, p, i, m) for i in range(m)], tol)
     e.b.cbranch(ok, accept, nxt)
     e.b.position_at_end(nxt)
@@ -160,7 +164,7 @@ def resolve(e: Emitter, fn, blk: SignedBlock, r: list, tol, on_fail, tag: str):
     on_fail()
     e.b.branch(accept)
     e.b.position_at_end(accept)
-    return blk.rows(e, fn, p, list(range(blk.n)), r, f"{tag}_x"), p
+    return (xs if full else blk.rows(e, fn, p, list(range(blk.n)), r, f"{tag}_x")), p
 
 
 def signs_of(e: Emitter, p, m: int) -> list:

@@ -18,7 +18,6 @@ precomputed block plans live in a :class:`Solver`, built once per analysis.
 """
 from __future__ import annotations
 
-import sys
 import weakref
 from dataclasses import dataclass
 from functools import lru_cache
@@ -28,19 +27,18 @@ from threadpoolctl import ThreadpoolController
 
 from ..analysis.schedule import unknown_groups
 from ..model.gears import helical_terms
+from .backends import BACKENDS, choose
 from .blocks import make_plans, solve_blocks
 from .equations import Columns
 from .general import is_geared, solve_full
 from .external import external_wrenches, load_values, subtract_external
 from .inertia import inertia_load
+from .kernel_program import build_program
 from .kinematics import forward
 from .signs import SignError, sign_violation
 
 DEFAULT_CHUNK = 20_000
-BACKENDS = ("auto", "llvm", "kernel", "numpy")
-LLVM_MIN_SAMPLES = 20_000
-"""Samples from which "auto" compiles the llvm kernel even when the numba kernel is already
-loaded in the process (compiling costs 0.1-0.3 s, ~1 us a sample saved: README "Speed")."""
+
 
 
 @dataclass
@@ -132,14 +130,6 @@ class Solver:
         when the kernel cannot be used here (``self.kernel_problem`` says why); built on
         first use."""
         if self._program is None and self.kernel_problem is None:
-            try:
-                from .kernel_program import build_program  # noqa: PLC0415  (imports numba)
-            except ImportError:
-                self.kernel_problem = "numba does not import"
-                return None
-            except RuntimeError as exc:     # numba found no writable cache directory
-                self.kernel_problem = f"numba: {exc}"
-                return None
             self._program = build_program(self.an, self.plans)
             if not self._program.covered:
                 self.kernel_problem = ("a redundant gear set of this mechanism has no constant frame, or a block "
@@ -166,27 +156,14 @@ class Solver:
                 self.llvm_problem = llvm_problem(prog)
         return self.llvm_problem is None
 
+    def compiled_llvm(self) -> bool:
+        """True once the llvm kernel of this mechanism is compiled."""
+        return self._llvm is not None
+
     def backend(self, method: str = "block", backend: str = "auto", n: int | None = None) -> str:
-        """The path a solve of n samples takes: "llvm", "kernel" or "numpy" (see :func:`solve`)."""
-        if backend not in BACKENDS:
-            raise ValueError(f"unknown backend '{backend}' (expected one of {', '.join(BACKENDS)})")
-        if backend == "numpy" or (backend == "auto" and method == "full"):
-            return "numpy"
-        if method == "full":
-            raise ValueError(f"backend '{backend}' solves method 'block' only")
-        if backend == "llvm":
-            if not self.llvm_available():
-                raise ValueError(f"backend 'llvm' unavailable: {self.llvm_problem}")
-            return "llvm"
-        if backend == "auto" and self.llvm_available() and (
-                self._llvm is not None or n is None or n >= LLVM_MIN_SAMPLES
-                or "gearcli.dynamics.kernel" not in sys.modules):
-            return "llvm"
-        if self.kernel_program() is not None:
-            return "kernel"
-        if backend == "kernel":
-            raise ValueError(f"backend 'kernel' unavailable: {self.kernel_problem}")
-        return "numpy"
+        """The path a solve of n samples takes: "llvm", "kernel" or "numpy" (see :func:`solve`
+        and :mod:`.backends`)."""
+        return choose(self, method, backend, n)
 
     def solve(self, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK,
               verify: bool = False, loads: dict | None = None, backend: str = "auto",
@@ -305,11 +282,10 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
         "block" only; not for a block without a constant frame); "kernel": the compiled
         data-driven kernel (:mod:`.kernel`, numba, cached on disk; method "block" only);
         "numpy": the array implementation (the readable reference); "auto" (default):
-        llvm where it is available, unless the numba kernel is already loaded in the process,
-        the llvm kernel not yet compiled and the call has fewer than
-        :data:`LLVM_MIN_SAMPLES` samples; else the kernel where numba imports and it covers
-        the mechanism (every block square); else numpy.  All give the same results to
-        rounding (~1e-15 relative).
+        llvm where it is available and its compile time pays off (once compiled, always;
+        the cost model of :mod:`.backends`), else the kernel where numba imports and it
+        covers the mechanism (every block square), else numpy.  All give the same results
+        to rounding (~1e-15 relative).
     jobs : int, optional
         Threads a compiled kernel splits the samples over (contiguous ranges; results
         bitwise identical for any number); None: every usable core.  The numpy path uses one.

@@ -1,0 +1,68 @@
+"""Which implementation a solve takes: "llvm", "kernel" (numba) or "numpy" (the reference).
+
+"auto" follows a cost model: the generated llvm kernel is compiled once per analysis
+(:class:`~.llvm_driver.LlvmKernel`; ~0.15-0.3 s for 5-10 links, ~4 s for Talos' 44) and
+then saves about :data:`SAVED_SECONDS_PER_SAMPLE` a sample against the numba kernel,
+whose first use in a process costs :data:`NUMBA_START_SECONDS` (import and its disk
+cache).  So "auto" takes llvm once it is compiled, or when its estimated compile time
+(:func:`llvm_compile_estimate`) is at most what the numba kernel would cost extra for
+this call; else the numba kernel where it is available; else numpy.
+"""
+from __future__ import annotations
+
+import sys
+
+BACKENDS = ("auto", "llvm", "kernel", "numpy")
+NUMBA_START_SECONDS = 0.4          # import numba and load the cached kernel (measured: 0.42 s)
+SAVED_SECONDS_PER_SAMPLE = 1e-6    # numba kernel minus llvm kernel, a sample (measured: 0.8-1.3 us)
+
+
+def llvm_compile_estimate(an) -> float:
+    """Rough seconds to generate and compile the llvm kernel of ``an`` (measured: 0.14 s
+    for 5 moving links, 0.25 s for 8, 4.4 s for 44; superlinear in the code size)."""
+    return 0.015 * len(an.tree.moving) ** 1.5
+
+
+def numba_kernel_problem() -> str | None:
+    """Why the numba kernel cannot run in this process, or None (imports it)."""
+    try:
+        from . import kernel_driver  # noqa: F401, PLC0415  (imports numba)
+    except ImportError:
+        return "numba does not import"
+    except RuntimeError as exc:        # numba found no writable cache directory
+        return f"numba: {exc}"
+    return None
+
+
+def _auto_llvm(sol, n: int | None) -> bool:
+    """True when "auto" takes llvm for a call of n samples (None: a large call)."""
+    if not sol.llvm_available():
+        return False
+    if sol.compiled_llvm() or n is None:
+        return True
+    numba_extra = 0.0 if "gearcli.dynamics.kernel" in sys.modules else NUMBA_START_SECONDS
+    return llvm_compile_estimate(sol.an) <= numba_extra + n * SAVED_SECONDS_PER_SAMPLE
+
+
+def choose(sol, method: str, backend: str, n: int | None) -> str:
+    """The path a solve of n samples by the :class:`~.solve.Solver` ``sol`` takes."""
+    if backend not in BACKENDS:
+        raise ValueError(f"unknown backend '{backend}' (expected one of {', '.join(BACKENDS)})")
+    if backend == "numpy" or (backend == "auto" and method == "full"):
+        return "numpy"
+    if method == "full":
+        raise ValueError(f"backend '{backend}' solves method 'block' only")
+    if backend == "llvm":
+        if not sol.llvm_available():
+            raise ValueError(f"backend 'llvm' unavailable: {sol.llvm_problem}")
+        return "llvm"
+    if backend == "auto" and _auto_llvm(sol, n):
+        return "llvm"
+    if sol.kernel_program() is not None:
+        if sol.kernel_problem is None:
+            sol.kernel_problem = numba_kernel_problem()
+        if sol.kernel_problem is None:
+            return "kernel"
+    if backend == "kernel":
+        raise ValueError(f"backend 'kernel' unavailable: {sol.kernel_problem}")
+    return "numpy"

@@ -1,0 +1,101 @@
+"""Generated world-frame block solve (a block without a constant frame), one sample.
+
+As :mod:`.kernel_world`: the block's balances in base axes about each link's origin,
+assembled from the column terms of :mod:`.kernel_terms` (the pose-dependent wrenches
+:func:`.llvm_blocks.term_wrench` emits) for a sign pattern of its t, then solved by
+Gaussian elimination with partial pivoting (the first largest pivot), straight-line: the
+row swaps are selects on the pivot's row.  A zero pivot (a singular matrix) makes the
+whole solution NaN, which no sign pattern accepts.
+"""
+from __future__ import annotations
+
+import llvmlite.ir as ir
+
+from .llvm_build import D, I1, I64, Emitter
+from .llvm_signs import signs_of
+
+
+def _pivot_row(e: Emitter, A, c: int):
+    """The row (i64) of the first largest |A[i][c]|, i >= c (a NaN is never larger)."""
+    best, idx = e.const(e.call("fabs", A[c][c])), ir.Constant(I64, c)
+    for i in range(c + 1, len(A)):
+        if isinstance(A[i][c], float) and A[i][c] == 0.0:
+            continue
+        a = e.const(e.call("fabs", A[i][c]))
+        gt = e.b.fcmp_ordered(">", a, best)
+        best, idx = e.b.select(gt, a, best), e.b.select(gt, ir.Constant(I64, i), idx)
+    return idx
+
+
+def _swap(e: Emitter, A, x, c: int, idx) -> None:
+    """Exchange rows c and idx (i64 >= c) of A (columns >= c) and x, in place."""
+    rows = [i for i in range(c + 1, len(A))]
+    is_row = {i: e.b.icmp_signed("==", idx, ir.Constant(I64, i)) for i in rows}
+    cols = range(c, len(A))
+
+    def pick(values):          # the value of row idx
+        v = e.const(values[c])
+        for i in rows:
+            v = e.b.select(is_row[i], e.const(values[i]), v)
+        return v
+    new_c = [pick([A[i][j] for i in range(len(A))]) for j in cols]
+    new_x = pick(x)
+    for i in rows:
+        for j in cols:
+            A[i][j] = e.b.select(is_row[i], e.const(A[c][j]), e.const(A[i][j]))
+        x[i] = e.b.select(is_row[i], e.const(x[c]), e.const(x[i]))
+    A[c][c:] = new_c
+    x[c] = new_x
+
+
+def eliminate(e: Emitter, A: list, r: list) -> list:
+    """x = A^-1 r (A square, a list of rows of values; partial pivoting), NaN if singular."""
+    n = len(r)
+    A = [list(row) for row in A]
+    x = list(r)
+    singular = ir.Constant(I1, 0)
+    for c in range(n):
+        if any(not (isinstance(A[i][c], float) and A[i][c] == 0.0) for i in range(c + 1, n)):
+            _swap(e, A, x, c, _pivot_row(e, A, c))
+        singular = e.b.or_(singular, e.b.fcmp_ordered("==", e.const(A[c][c]), ir.Constant(D, 0.0)))
+        for i in range(c + 1, n):
+            f = e.div(A[i][c], A[c][c])
+            for j in range(c + 1, n):
+                A[i][j] = e.sub(A[i][j], e.mul(f, A[c][j]))
+            x[i] = e.sub(x[i], e.mul(f, x[c]))
+    for c in range(n - 1, -1, -1):
+        s = x[c]
+        for j in range(c + 1, n):
+            s = e.sub(s, e.mul(A[c][j], x[j]))
+        x[c] = e.div(s, A[c][c])
+    nan = ir.Constant(D, float("nan"))
+    return [e.b.select(singular, nan, e.const(v)) for v in x]
+
+
+class WorldBlock:
+    """A block solved in world axes: its matrix from the terms, for a sign pattern p.
+
+    ``full_trial``: a trial solves the whole block (:func:`.llvm_signs.resolve` keeps
+    that solution for the pattern it accepts)."""
+
+    full_trial = True
+
+    def __init__(self, s, prog, k0: int, nt: int, n: int, tcols: list, wrench):
+        self.s, self.trec, self.tflt = s, prog.ints[10], prog.flts[6]
+        self.terms = [k for k in range(k0, k0 + nt) if self.trec[k, 1] >= 0]
+        self.n, self.tcols, self.wrench = n, tcols, wrench
+
+    def solve(self, e: Emitter, sig: list, r: list) -> list:
+        """x of the block for the signs ``sig`` (values) of its t."""
+        A = [[0.0] * self.n for _ in range(self.n)]
+        for k in self.terms:
+            row, col = int(self.trec[k, 1]), int(self.trec[k, 2])
+            w = self.wrench(e, self.s, self.trec[k], self.tflt[k], int(self.trec[k, 0]), sig)
+            for h in range(6):
+                A[6 * row + h][col] = e.add(A[6 * row + h][col], w[h])
+        return eliminate(e, A, r)
+
+    def rows(self, e: Emitter, fn, p, rows: list, r: list, tag: str) -> list:
+        """Rows ``rows`` of the solution for pattern p (i64)."""
+        x = self.solve(e, signs_of(e, p, len(self.tcols)), r)
+        return [x[i] for i in rows]
