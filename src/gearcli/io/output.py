@@ -28,6 +28,11 @@ from typing import IO, Iterable, Iterator
 from ..errors import GearcliError, Issue
 
 
+BINARY_BUFFER = 1 << 20
+"""Bytes buffered by a binary output file: pyarrow writes Parquet pages of ~160 kB; gathered
+into 1 MB writes, the kernel's copy of 0.92 GB into the page cache took ~20% less time."""
+
+
 class OutputError(GearcliError):
     """An output file cannot be written; ``issue`` says which and why."""
 
@@ -163,7 +168,8 @@ def atomic_output(path: str | os.PathLike, inputs: Iterable[str | os.PathLike] =
         raise OutputError(name, f"cannot create the file: {exc.strerror}") from None
     f = None
     try:
-        f = os.fdopen(fd, "wb") if binary else os.fdopen(fd, "w", encoding=encoding, newline="")
+        f = os.fdopen(fd, "wb", buffering=BINARY_BUFFER) if binary else \
+            os.fdopen(fd, "w", encoding=encoding, newline="")
         yield f
         f.flush()
         if tmp is None:
