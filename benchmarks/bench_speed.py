@@ -37,6 +37,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from cli_stages import print_stages, stage_times, startup_time  # noqa: E402 (benchmarks/cli_stages.py)
 from timing import load_line, median_time  # noqa: E402 (benchmarks/timing.py)
 from threadpoolctl import threadpool_info, threadpool_limits
 
@@ -251,7 +252,8 @@ def run_measured(code: str, args: list[str]) -> tuple[float, float]:
 
 def library_solve_time(mech: Path, traj: Path) -> float:
     """Seconds of gearcli.solve alone on the samples of ``traj`` (read and splined first),
-    in chunks of 20,000 like the CLI."""
+    in chunks of 20,000 like the CLI, with the CLI's default threads (``jobs=None``: all
+    cores; backend "auto")."""
     from gearcli import read_trajectory
 
     an = analyse(load_mechanism(mech))
@@ -271,7 +273,8 @@ def cli_section(n: int, old_format: bool, repeat: int = 1) -> None:
         traj = Path(d) / "traj.csv"
         bendix_trajectory(traj, n)
         lib = np.median([library_solve_time(mech, traj) for _ in range(repeat)])
-        rows = [("library `gearcli.solve` alone (same samples, chunks of 20,000)", lib, None, None)]
+        rows = [(f"library `gearcli.solve` alone (same samples, chunks of 20,000, default threads: "
+                 f"{os.cpu_count()} like the CLI's default --jobs)", lib, None, None)]
         runs = [("out.csv", CLI), ("out.parquet", CLI)]
         if old_format:
             runs.append(("old.csv", CLI_PY_FORMAT))
@@ -287,10 +290,12 @@ def cli_section(n: int, old_format: bool, repeat: int = 1) -> None:
             if code is CLI_PY_FORMAT:
                 label += ", CSV text by Python's `%` (the writer before issue 11)"
             rows.append((label, wall, rss, wall / lib))
+        stages, startup = stage_times(mech, traj), startup_time(mech, traj)
     print("| run | wall time | peak memory | / library solve |\n|---|---|---|---|")
     for label, wall, rss, ratio in rows:
-        print(f"| {label} | {wall:.1f} s | {'' if rss is None else f'{rss:,.0f} MB'} | "
+        print(f"| {label} | {wall:.2f} s | {'' if rss is None else f'{rss:,.0f} MB'} | "
               f"{'' if ratio is None else f'{ratio:.1f}x'} |")
+    print_stages(stages, startup, {out: float(np.median([m[0] for m in measured[out]])) for out in measured}, n)
 
 
 def format_section(n: int, repeat: int) -> None:
