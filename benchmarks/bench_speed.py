@@ -323,16 +323,22 @@ def links_section(n: int, repeat: int, sizes) -> None:
     from big_mechanisms import geared_chain
     from gearcli.io.yaml_reader import parse_mechanism
 
-    backends = ("kernel", "numpy") if "backend" in SOLVE_PARAMS else ("default",)
+    backends = ((("llvm",) if "llvm" in BACKENDS else ()) + ("kernel", "numpy")) if "backend" in SOLVE_PARAMS else ("default",)
     print(f"\n## Per-sample cost against mechanism size: geared chains (link i driven by a spur pinion on "
           f"link i-1), {n:,} samples, one worker, median of {repeat}\n")
-    print("| links (+ pinions) | " + " | ".join(f"{b} us/sample | {b} us/sample/link" for b in backends)
-          + " |\n|---|" + "---|---|" * len(backends))
+    llvm = "llvm" in backends
+    print("| links (+ pinions) | " + ("llvm first call (compile) | " if llvm else "")
+          + " | ".join(f"{b} us/sample | {b} us/sample/link" for b in backends)
+          + " |\n|---|" + ("---|" if llvm else "") + "---|---|" * len(backends))
     for links in sizes:
         an = analyse(parse_mechanism(geared_chain(links), f"geared{links}.yaml"))
         rng = np.random.default_rng(2)
         q, qd, qdd = (rng.uniform(-1.0, 1.0, size=(n, an.dof)) for _ in range(3))
         cells = []
+        if llvm:      # a fresh analysis: its first llvm solve generates and compiles the kernel
+            t0 = time.perf_counter()
+            solve(an, q[:10], qd[:10], qdd[:10], backend="llvm", jobs=1)
+            cells.append(f"{time.perf_counter() - t0:.2f} s")
         for b in backends:
             kw = {} if b == "default" else {"backend": b}
             if "jobs" in SOLVE_PARAMS:
@@ -372,7 +378,7 @@ print(float(np.median(times)))
 
 
 def samples_section(sizes) -> None:
-    backends = ("kernel", "numpy") if "backend" in SOLVE_PARAMS else ("default",)
+    backends = ((("llvm",) if "llvm" in BACKENDS else ()) + ("kernel", "numpy")) if "backend" in SOLVE_PARAMS else ("default",)
     print("\n## Per-sample cost and peak memory against the number of samples (Bendix wrist, library solve, "
           "one thread, in chunks of 100,000 generated samples, each N in a fresh process; below 1e5 the median "
           "of repeated solves covering 2e5 samples)\n")
