@@ -79,11 +79,27 @@ class Mutation:
         mutated copy is made to solve by the numpy path (:data:`NUMPY_DEFAULT`)."""
         return any(e[0] in NUMPY_ONLY for e in self.edits)
 
+    @property
+    def default_edits(self) -> tuple:
+        """The edit choosing the path the mutated code is on as "auto"'s: numpy for the
+        array implementation, the numba kernel for its modules, llvm for the generator's."""
+        if self.numpy_path:
+            return (NUMPY_DEFAULT,)
+        if any(e[0].startswith("dynamics/kernel") for e in self.edits):
+            return (KERNEL_DEFAULT,)
+        if any(e[0].startswith("dynamics/llvm") for e in self.edits):
+            return (LLVM_DEFAULT,)
+        return ()
+
 
 NUMPY_ONLY = {"dynamics/kinematics.py", "dynamics/inertia.py", "dynamics/equations.py"}
 # the edit that makes "auto" take the numpy path in a copy
-NUMPY_DEFAULT = ("dynamics/solve.py", 'if backend == "numpy" or (backend == "auto" and method == "full"):',
+NUMPY_DEFAULT = ("dynamics/backends.py", 'if backend == "numpy" or (backend == "auto" and method == "full"):',
                  'if backend in ("numpy", "auto") or method == "full":')
+# the edits that make "auto" take the numba kernel / the llvm kernel whenever it can
+KERNEL_DEFAULT = ("dynamics/backends.py", 'if backend == "auto" and _auto_llvm(sol, n):', "if False:")
+LLVM_DEFAULT = ("dynamics/backends.py", 'if backend == "auto" and _auto_llvm(sol, n):',
+                'if backend == "auto" and sol.llvm_available():')
 
 
 MUTATIONS = [
@@ -163,6 +179,17 @@ MUTATIONS = [
     Mutation("kernel-world-arm", "kernel: world-frame block, moment arm from the frame link's origin",
              (("dynamics/kernel_world.py", "o[X, 0] + P[0] - o[L, 0], o[X, 1] + P[1] - o[L, 1], o[X, 2] + P[2] - o[L, 2]",
                "P[0], P[1], P[2]"),)),
+    # the generated llvm kernel
+    Mutation("llvm-gravity-sign", "llvm: gravity with the wrong sign in the d'Alembert force",
+             (("dynamics/llvm_links.py", "F = e.scale(e.vsub(ac, _floats(g)), m)", "F = e.scale(e.vadd(ac, _floats(g)), m)"),)),
+    Mutation("llvm-propagation-sign", "llvm: a solved wrench passed on to a later link with the primary's sign",
+             (("dynamics/llvm_blocks.py", "1.0 if L == P else -1.0", "1.0"),)),
+    Mutation("llvm-child-basis-turn", "llvm: joint reaction turned to the child's basis by +q instead of -q",
+             (("dynamics/llvm_blocks.py", "e.add(e.mul(cq, x0), e.mul(sq, x1))", "e.sub(e.mul(cq, x0), e.mul(sq, x1))"),)),
+    Mutation("llvm-world-arm", "llvm: world-frame term, moment arm from the frame link's origin",
+             (("dynamics/llvm_blocks.py", "arm = e.vsub(e.vadd(s.o[X], P), s.o[L])", "arm = P"),)),
+    Mutation("llvm-sin-quadrant", "llvm: inline sin with the quadrant's sign flipped",
+             (("dynamics/llvm_trig.py", "b.select(sin_neg, e.neg(sin_mag), sin_mag)", "b.select(sin_neg, sin_mag, e.neg(sin_mag))"),)),
 ]
 
 
@@ -180,7 +207,7 @@ def copy_source(dest: Path) -> Path:
 
 def apply(src: Path, m: Mutation) -> None:
     """Apply m's edits to the copy ``src`` (…/gearcli); each old snippet must occur once."""
-    for rel, old, new in m.edits + ((NUMPY_DEFAULT,) if m.numpy_path else ()):
+    for rel, old, new in m.edits + m.default_edits:
         path = src / rel
         if not path.is_file():
             raise SnippetError(f"{m.name}: file src/gearcli/{rel} does not exist")

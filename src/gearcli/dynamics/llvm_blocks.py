@@ -115,37 +115,41 @@ def store(e: Emitter, s: Sample, rec, prog, x: list) -> None:
             s.sol[int(gcol[g0 + c0 + h + 1])] = e.sub(e.mul(cq, x1), e.mul(sq, x0))
 
 
-def blocks(e: Emitter, fn, s: Sample, prog, n, fail, sg_row) -> None:
-    """Every block of the schedule in order for sample n: ``fail`` (i64*) gets the first
+def _on_fail(e: Emitter, fail, n, b: int):
+    """The code that records block b as sample n's first failing block (if none before)."""
+    def emit():
+        old = e.load(fail, n)
+        e.b.store(e.b.select(e.b.icmp_signed("<", old, ir.Constant(I64, 0)), ir.Constant(I64, b), old),
+                  e.b.gep(fail, [n]))
+    return emit
+
+
+def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row) -> None:
+    """Block b of the schedule for sample n (kernel._blocks): ``fail`` (i64*) gets the first
     block with no consistent sign pattern (it comes filled with -1), ``sg_row`` (double*)
     the sign of each t used."""
-    brec, blinks, tcol, scol, prec = prog.ints[1], prog.ints[2], prog.ints[4], prog.ints[5], prog.ints[6]
-    ainv = prog.flts[4]
-    for b, rec in enumerate(brec):
-        F, lk0, B, nloc, m, t0, a0, p0, np_, k0, nt = (int(rec[i]) for i in (0, 1, 2, 3, 5, 6, 7, 8, 9, 12, 13))
-        nr = 6 * B
-        links = [int(v) for v in blinks[lk0:lk0 + B]]
-        tcols = [int(c) for c in tcol[t0:t0 + m]]
-        if F < 0:                       # world axes about each link's origin (kernel_world.world_gather)
-            r = [v for L in links for v in s.rhs[L]]
-            blk = WorldBlock(s, prog, k0, nt, nloc, tcols, term_wrench)
-        else:
-            r = gather(e, s, F, links)
-            maps = [ainv[a0 + k * nloc * nr:a0 + (k + 1) * nloc * nr].reshape(nloc, nr) for k in range(1 << m)]
-            blk = SignedBlock(e, maps, tcols, f"b{b}") if m else None
-        if m == 0:
-            x, sig = (blk.solve(e, [], r) if F < 0 else [e.dot(_floats(maps[0][i]), r) for i in range(nloc)]), []
-        else:
-            def on_fail(b=b):
-                old = e.load(fail, n)
-                e.b.store(e.b.select(e.b.icmp_signed("<", old, ir.Constant(I64, 0)), ir.Constant(I64, b), old),
-                          e.b.gep(fail, [n]))
-            x, p = resolve(e, fn, blk, r, tolerance(e, r), on_fail, f"b{b}")
-            sig = signs_of(e, p, m)
-            for i in range(m):
-                e.store(sig[i], sg_row, int(scol[t0 + i]))
-        if nt > 0:
-            propagate_terms(e, s, k0, nt, prog, x, sig)
-        else:
-            propagate(e, s, F, prec[p0:p0 + np_], prog, x)
-        store(e, s, rec, prog, x)
+    blinks, tcol, scol, prec, ainv = prog.ints[2], prog.ints[4], prog.ints[5], prog.ints[6], prog.flts[4]
+    rec = prog.ints[1][b]
+    F, lk0, B, nloc, m, t0, a0, p0, np_, k0, nt = (int(rec[i]) for i in (0, 1, 2, 3, 5, 6, 7, 8, 9, 12, 13))
+    nr = 6 * B
+    links = [int(v) for v in blinks[lk0:lk0 + B]]
+    tcols = [int(c) for c in tcol[t0:t0 + m]]
+    if F < 0:                       # world axes about each link's origin (kernel_world.world_gather)
+        r = [v for L in links for v in s.rhs[L]]
+        blk = WorldBlock(s, prog, k0, nt, nloc, tcols, term_wrench)
+    else:
+        r = gather(e, s, F, links)
+        maps = [ainv[a0 + k * nloc * nr:a0 + (k + 1) * nloc * nr].reshape(nloc, nr) for k in range(1 << m)]
+        blk = SignedBlock(e, maps, tcols, f"b{b}") if m else None
+    if m == 0:
+        x, sig = (blk.solve(e, [], r) if F < 0 else [e.dot(_floats(maps[0][i]), r) for i in range(nloc)]), []
+    else:
+        x, p = resolve(e, fn, blk, r, tolerance(e, r), _on_fail(e, fail, n, b), f"b{b}")
+        sig = signs_of(e, p, m)
+        for i in range(m):
+            e.store(sig[i], sg_row, int(scol[t0 + i]))
+    if nt > 0:
+        propagate_terms(e, s, k0, nt, prog, x, sig)
+    else:
+        propagate(e, s, F, prec[p0:p0 + np_], prog, x)
+    store(e, s, rec, prog, x)

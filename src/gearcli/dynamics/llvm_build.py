@@ -33,7 +33,6 @@ class Emitter:
     def __init__(self, builder: ir.IRBuilder, module: ir.Module):
         self.b = builder
         self.module = module
-        self._fns = {}
 
     @staticmethod
     def const(a) -> ir.Value:
@@ -42,9 +41,10 @@ class Emitter:
 
     def intrinsic(self, name: str, nargs: int = 1) -> ir.Function:
         """The declaration of ``llvm.<name>.f64`` (sin, cos, fabs, ...)."""
-        if name not in self._fns:
-            self._fns[name] = ir.Function(self.module, ir.FunctionType(D, [D] * nargs), f"llvm.{name}.f64")
-        return self._fns[name]
+        full = f"llvm.{name}.f64"
+        if full not in self.module.globals:
+            ir.Function(self.module, ir.FunctionType(D, [D] * nargs), full)
+        return self.module.globals[full]
 
     def add(self, a, b):
         if isinstance(a, float) and isinstance(b, float):

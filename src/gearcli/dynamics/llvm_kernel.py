@@ -20,9 +20,9 @@ from __future__ import annotations
 
 import llvmlite.ir as ir
 
-from .llvm_blocks import blocks
+from .llvm_blocks import block
 from .llvm_build import DP, I64, I64P, Emitter
-from .llvm_links import external, inertia, joint_space, kinematics
+from .llvm_links import at_rest, external, inertia, joint, joint_space
 from .llvm_outputs import OUTPUTS, widths, write_outputs
 
 ARGS = ("qi", "qdi", "qddi", "vals", "ldrow") + OUTPUTS + ("signs", "fail", "start", "stop")
@@ -45,12 +45,16 @@ def _sample(e: Emitter, fn, prog, loads, n) -> None:
     dof = S.shape[1]
     ind = [[e.load(e.row(a[k], n, dof), d) for d in range(dof)] for k in ("qi", "qdi", "qddi")]
     s = joint_space(e, S, *ind)
-    kinematics(e, s, prog.ints[0], prog.flts[0], int(prog.ints[11][0]))
+    at_rest(s, int(prog.ints[11][0]))
+    for k in range(prog.ints[0].shape[0]):
+        joint(e, s, prog.ints[0][k], prog.flts[0][k])
     for L in prog.ints[9]:
         inertia(e, s, int(L), prog.flts[1], prog.flts[3])
     external(e, s, loads, n, a["vals"], a["ldrow"])
     w = widths(prog)
-    blocks(e, fn, s, prog, n, a["fail"], e.row(a["signs"], n, max(w["signs"], 1)))
+    signs = e.row(a["signs"], n, max(w["signs"], 1))
+    for b in range(prog.ints[1].shape[0]):
+        block(e, fn, s, prog, b, n, a["fail"], signs)
     write_outputs(e, s, prog, ind[1], {k: e.row(a[k], n, max(w[k], 1)) for k in OUTPUTS})
 
 

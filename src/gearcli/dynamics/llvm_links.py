@@ -72,29 +72,33 @@ def _arm_accel(e: Emitter, a, dw, w, r):
     return e.vadd(a, e.vadd(e.cx(dw, r), e.cx(w, e.cx(w, r))))
 
 
-def kinematics(e: Emitter, s: Sample, jrec, jflt, base: int) -> None:
-    """Every link's R, o, w, dw, a (kernel_links.kinematics) and every joint's cos, sin."""
+def at_rest(s: Sample, base: int) -> None:
+    """The base link: identity axes, origin, velocities and accelerations zero (constants)."""
     s.R[base], s.o[base], s.w[base], s.dw[base], s.a[base] = EYE, ZERO3, ZERO3, ZERO3, ZERO3
-    for k in range(jrec.shape[0]):
-        ji, p, c, pr = (int(v) for v in jrec[k, :4])
-        f = _floats(jflt[k])
-        qdk, qddk = s.qd[ji], s.qdd[ji]
-        op, wp, dwp = s.o[p], s.w[p], s.dw[p]
-        Rj, oj, cq, sq = _joint_frame(e, f, s.R[p], op, s.q[ji], pr == 1)
-        s.cs[ji] = (cq, sq)
-        z = (Rj[2], Rj[5], Rj[8])
-        aj = _arm_accel(e, s.a[p], dwp, wp, e.vsub(oj, op))
-        if pr == 1:
-            wc, dwc = wp, dwp
-            aj = e.vadd(aj, e.vadd(e.scale(z, qddk), e.scale(e.cx(wp, e.scale(z, qdk)), 2.0)))
-        else:
-            wc = e.vadd(wp, e.scale(z, qdk))
-            dwc = e.vadd(e.vadd(dwp, e.scale(z, qddk)), e.scale(e.cx(wp, z), qdk))
-        s.R[c] = e.mm(Rj, f[12:21])
-        rc = e.mv(Rj, f[21:24])
-        s.o[c] = e.vadd(oj, rc)
-        s.a[c] = _arm_accel(e, aj, dwc, wc, rc)
-        s.w[c], s.dw[c] = wc, dwc
+
+
+def joint(e: Emitter, s: Sample, rec, flt) -> None:
+    """The child link of one joint record (``rec`` a row of ``jrec``, ``flt`` of ``jflt``):
+    its R, o, w, dw, a, and the joint's cos, sin (kernel_links._joint)."""
+    ji, p, c, pr = (int(v) for v in rec[:4])
+    f = _floats(flt)
+    qdk, qddk = s.qd[ji], s.qdd[ji]
+    op, wp, dwp = s.o[p], s.w[p], s.dw[p]
+    Rj, oj, cq, sq = _joint_frame(e, f, s.R[p], op, s.q[ji], pr == 1)
+    s.cs[ji] = (cq, sq)
+    z = (Rj[2], Rj[5], Rj[8])
+    aj = _arm_accel(e, s.a[p], dwp, wp, e.vsub(oj, op))
+    if pr == 1:
+        wc, dwc = wp, dwp
+        aj = e.vadd(aj, e.vadd(e.scale(z, qddk), e.scale(e.cx(wp, e.scale(z, qdk)), 2.0)))
+    else:
+        wc = e.vadd(wp, e.scale(z, qdk))
+        dwc = e.vadd(e.vadd(dwp, e.scale(z, qddk)), e.scale(e.cx(wp, z), qdk))
+    s.R[c] = e.mm(Rj, f[12:21])
+    rc = e.mv(Rj, f[21:24])
+    s.o[c] = e.vadd(oj, rc)
+    s.a[c] = _arm_accel(e, aj, dwc, wc, rc)
+    s.w[c], s.dw[c] = wc, dwc
 
 
 def inertia(e: Emitter, s: Sample, L: int, lflt, g) -> None:
