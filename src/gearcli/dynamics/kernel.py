@@ -29,7 +29,7 @@ from .signs import MAX_EXHAUSTIVE, TOL_SIGN
 # digest of their sources
 # (tests/test_kernel.py checks it) changes this file whenever they change, so that the
 # disk cache of ``run`` is never stale
-HELPERS_DIGEST = "c07e13a3fab39aa5"
+HELPERS_DIGEST = "cae330c1c4c7e310"
 HELPER_FILES = ("kernel_links.py", "kernel_math.py", "kernel_output.py", "kernel_world.py", "signs.py")
 
 
@@ -258,11 +258,12 @@ def run(ints, flts, ldrec, ldflt, vals, qi, qdi, qddi, start, stop, outs, scratc
     Compiled without numba's reference counting (``_nrt=False``: ~10 ns an array passed
     otherwise): nothing here allocates."""
     jrec, moving = ints[0], ints[9]
-    jflt, lflt, S, g = flts[0], flts[1], flts[2], flts[3]
+    jflt, lflt, g = flts[0], flts[1], flts[3]
+    sptr, sidx, sval = ints[15], ints[16], flts[10]
     R, o, w, dw, a, rhs, cs, q, qd, qdd, r, x, sig, A, xrow = scratch
     SG, fail = outs[8], outs[9]
     for n in range(start, stop):
-        joint_space(S, qi, qdi, qddi, n, q, qd, qdd)
+        joint_space(sptr, sidx, sval, qi, qdi, qddi, n, q, qd, qdd)
         kinematics(jrec, jflt, q, qd, qdd, R, o, w, dw, a, cs)
         for L in moving:
             inertia(L, lflt, g, R, w, dw, a, rhs)

@@ -22,14 +22,15 @@ def cross(ax, ay, az, bx, by, bz):
 
 
 @njit(**INLINE)
-def joint_space(S, qi, qdi, qddi, n, q, qd, qdd):
-    """Every real joint's q, qd, qdd (J,) of sample n from the independent ones (q = S q_ind)."""
-    for j in range(S.shape[0]):
+def joint_space(sptr, sidx, sval, qi, qdi, qddi, n, q, qd, qdd):
+    """Every real joint's q, qd, qdd (J,) of sample n from the independent ones (q = S q_ind,
+    S by rows of nonzeros: kernel_program._csr)."""
+    for j in range(sptr.shape[0] - 1):
         s0 = 0.0
         s1 = 0.0
         s2 = 0.0
-        for d in range(S.shape[1]):
-            s = S[j, d]
+        for e in range(sptr[j], sptr[j + 1]):
+            d, s = sidx[e], sval[e]
             s0 += qi[n, d] * s
             s1 += qdi[n, d] * s
             s2 += qddi[n, d] * s

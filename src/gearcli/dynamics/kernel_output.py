@@ -46,21 +46,22 @@ def _meshes(n, xrow, gcol, mflt, gear_t, sep, rad, ax):
 def write_outputs(n, xrow, qdi, ints, flts, outs):
     """Every output array's row n from the solution row ``xrow``."""
     jout, mcol, gcol = ints[12], ints[13], ints[14]
-    mflt, A = flts[8], flts[9]
+    mflt = flts[8]
     motor, tau, joint, gear_t, sep, rad, ax, speed = outs[0], outs[1], outs[2], outs[3], outs[4], outs[5], \
         outs[6], outs[7]
     _joints(n, xrow, jout, joint)
     _meshes(n, xrow, gcol, mflt, gear_t, sep, rad, ax)
-    M = motor.shape[1]
-    for m in range(M):
+    for m in range(motor.shape[1]):
         motor[n, m] = xrow[mcol[m]]
-    for d in range(A.shape[0]):
+    aptr, aidx, tptr, tidx = ints[17], ints[18], ints[19], ints[20]
+    aval, tval = flts[11], flts[12]
+    for d in range(aptr.shape[0] - 1):         # tau = A motor (A by rows of nonzeros)
         s = 0.0
-        for m in range(M):
-            s += A[d, m] * motor[n, m]
+        for e in range(aptr[d], aptr[d + 1]):
+            s += aval[e] * motor[n, aidx[e]]
         tau[n, d] = s
-    for m in range(M):
+    for m in range(tptr.shape[0] - 1):         # speed = A^T qd
         s = 0.0
-        for d in range(A.shape[0]):
-            s += qdi[n, d] * A[d, m]
+        for e in range(tptr[m], tptr[m + 1]):
+            s += qdi[n, tidx[e]] * tval[e]
         speed[n, m] = s

@@ -24,7 +24,10 @@ reading what to do from the arrays built here once per analysis (from the
   reactions solved in another link's basis, turned to the child's by -q of the joint, or
   by -(q @ row) with the (J,) row at the offset in ``turns`` (a basis carried by a third
   coaxial link, :mod:`.coaxial_frames`); ``meta`` [base link id];
-* the output maps of :func:`.kernel_output.output_constants` and the structure matrix A.
+* the output maps of :func:`.kernel_output.output_constants` and the structure matrix A;
+* last, S (q = S q_ind), A (tau = A motor) and A^T (motor speed = A^T qd) by rows of
+  nonzeros (:func:`_csr`): ``ints[15:21]`` their row pointers and column indices,
+  ``flts[10:13]`` their values.
 
 Blocks without a constant frame (F = -1 in ``brec``) are solved in world axes from the
 column terms of :mod:`.kernel_terms`; one whose matrix is nevertheless constant in its one
@@ -189,6 +192,19 @@ for m signed meshes (2^16 for 8 planets) would take minutes to make; such a mech
 left to the numpy path, which makes only the patterns a motion meets."""
 
 
+def _csr(M: np.ndarray) -> tuple:
+    """(row pointers (R+1,), column indices, values) of M's nonzero entries, row by row in
+    column order: a product over them adds exactly what the dense product adds (+0 terms
+    change no sum), in O(nonzeros) instead of O(R C) (S and A are one or two entries a row
+    for a chain of geared links, dense (J, dof) and (dof, M) otherwise)."""
+    rows, cols = np.nonzero(M)
+    ptr = np.zeros(M.shape[0] + 1, I64)
+    np.add.at(ptr, rows + 1, 1)
+    idx = cols.astype(I64)
+    return np.cumsum(ptr).astype(I64), (idx if idx.size else np.zeros(1, I64)), \
+        (M[rows, cols] if rows.size else np.zeros(1))
+
+
 def build_program(an, plans=None) -> Program:
     """The :class:`Program` of ``an`` (``plans`` from :func:`.blocks.make_plans`); not
     ``covered`` (and empty) when a constant block has more than :data:`MAX_PATTERNS` sign
@@ -218,8 +234,11 @@ def build_program(an, plans=None) -> Program:
             np.array(bd.prec, I64).reshape(-1, 7), np.array(bd.later + [0], I64),
             np.array(bd.cbrec, I64).reshape(-1, 3), np.array(an.tree.moving, I64), trec,
             np.array([an.tree.base], I64), jout, mcol, gcol)
-    flts = (jflt, _links(an), np.ascontiguousarray(an.S, float), np.asarray(an.mech.gravity, float),
+    S, A = np.asarray(an.S, float), np.asarray(an.A, float)
+    sparse = (_csr(S), _csr(A), _csr(A.T))
+    ints += tuple(a for ptr, idx, _ in sparse for a in (ptr, idx))
+    flts = (jflt, _links(an), np.ascontiguousarray(S), np.asarray(an.mech.gravity, float),
             cat(bd.ainv), cat(bd.cmat), tflt, np.array(bd.turns + [0.0]), mflt,
-            np.ascontiguousarray(an.A, float))
+            np.ascontiguousarray(A)) + tuple(val for *_, val in sparse)
     covered = all(p.F is not None or int(p.offs[-1]) == 6 * len(p.links) for p in plans)
     return Program(ints, flts, c, offsets, signed, [p.names for p in plans], covered)
