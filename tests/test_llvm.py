@@ -144,3 +144,15 @@ def test_inline_sincos_matches_libm():
     c, s = np.empty(3), np.empty(3)
     f(bad.ctypes.data, c.ctypes.data, s.ctypes.data, 3)
     assert np.isnan(c).all() and np.isnan(s).all()
+
+
+def test_auto_takes_llvm_when_numba_is_missing(monkeypatch):
+    """Without numba "auto" compiles the llvm kernel whatever it costs (numpy is ~20x slower)."""
+    an = analyse(parse_mechanism(serial_chain(40)))
+    sol = solver_for(an)
+    monkeypatch.setattr(backends, "numba_kernel_problem", lambda: "numba does not import")
+    monkeypatch.delitem(sys.modules, "gearcli.dynamics.kernel", raising=False)
+    assert backends.llvm_compile_estimate(an) > backends.NUMBA_START_SECONDS + 10 * backends.SAVED_SECONDS_PER_SAMPLE
+    assert sol.backend(n=10) == "llvm"
+    with pytest.raises(ValueError, match="backend 'kernel' unavailable: numba does not import"):
+        sol.backend(backend="kernel")

@@ -6,11 +6,13 @@ then saves about :data:`SAVED_SECONDS_PER_SAMPLE` a sample against the numba ker
 whose first use in a process costs :data:`NUMBA_START_SECONDS` (import and its disk
 cache).  So "auto" takes llvm once it is compiled, or when its estimated compile time
 (:func:`llvm_compile_estimate`) is at most what the numba kernel would cost extra for
-this call; else the numba kernel where it is available; else numpy.
+this call; else the numba kernel where it is available (numba imports); else llvm where it
+is available whatever its compile time; else numpy.
 """
 from __future__ import annotations
 
 import sys
+from functools import lru_cache
 
 BACKENDS = ("auto", "llvm", "kernel", "numpy")
 NUMBA_START_SECONDS = 0.4          # import numba and load the cached kernel (measured: 0.42 s)
@@ -23,8 +25,9 @@ def llvm_compile_estimate(an) -> float:
     return 0.015 * len(an.tree.moving) ** 1.5
 
 
+@lru_cache(maxsize=1)
 def numba_kernel_problem() -> str | None:
-    """Why the numba kernel cannot run in this process, or None (imports it)."""
+    """Why the numba kernel cannot run in this process, or None (imports it; once)."""
     try:
         from . import kernel_driver  # noqa: F401, PLC0415  (imports numba)
     except ImportError:
@@ -58,11 +61,11 @@ def choose(sol, method: str, backend: str, n: int | None) -> str:
         return "llvm"
     if backend == "auto" and _auto_llvm(sol, n):
         return "llvm"
+    numba = None
     if sol.kernel_program() is not None:
-        if sol.kernel_problem is None:
-            sol.kernel_problem = numba_kernel_problem()
-        if sol.kernel_problem is None:
+        numba = numba_kernel_problem()
+        if numba is None:
             return "kernel"
     if backend == "kernel":
-        raise ValueError(f"backend 'kernel' unavailable: {sol.kernel_problem}")
-    return "numpy"
+        raise ValueError(f"backend 'kernel' unavailable: {sol.kernel_problem or numba}")
+    return "llvm" if sol.llvm_available() else "numpy"     # llvm even where it costs more than numba would
