@@ -176,6 +176,8 @@ class Solver:
             raise ValueError(f"chunk must be at least 1, got {chunk}")
         path = self.backend(method, backend, q.shape[0])
         values = load_values(self.an.mech, q.shape[0], loads)
+        if path != "numpy" and not verify:     # no BLAS call: the limit would cost ~30 us a call
+            return self._by_kernel(path, q, qd, qdd, values, jobs, chunk, verify)
         # the operands are 3x3 to 48x48 matrices: BLAS threads only contend (2-3x slower
         # with a busy second core), so one BLAS thread, whatever the environment says
         with one_blas_thread():
