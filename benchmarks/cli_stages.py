@@ -29,7 +29,7 @@ SPLINE = "spline rates and accelerations (quintic, banded LAPACK)"
 SOLVE = "library solve (default threads)"
 TABLE = "output table, finiteness check, summary statistics"
 PARQUET = "Parquet writing (uncompressed, to the page cache)"
-CSV = "CSV writing (9 digits, compiled formatter)"
+CSV = "CSV writing (9 digits, compiled formatter, its loading included)"
 
 
 def startup_time(mech: Path, traj: Path, out_suffix: str = ".parquet") -> float:
