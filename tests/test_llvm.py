@@ -24,6 +24,9 @@ MECH = ROOT / "mechanisms"
 def test_compiled_once_per_solver_and_kept():
     an = analyse(load_mechanism(MECH / "paper_2dof.yaml"))
     q = np.zeros((5, an.dof))
+    solve(an, q, q, q, backend="numpy")
+    solve(an, q, q, q, method="full")
+    assert solver_for(an).samples_solved == 5            # counted for "auto" (block method only)
     solve(an, q, q, q, backend="llvm")
     k = solver_for(an).llvm_kernel()
     assert k is not None and k.build_seconds > 0 and k.compile_seconds > 0
@@ -47,6 +50,8 @@ def test_auto_policy(monkeypatch):
     big = solver_for(analyse(parse_mechanism(serial_chain(40))))
     assert backends.llvm_compile_estimate(big.an) > backends.NUMBA_START_SECONDS
     assert big.backend(n=10) == "kernel" and big.backend(n=10**7) == "llvm"
+    big.samples_solved = 10**7                           # solved before in many small calls
+    assert big.backend(n=10) == "llvm"
     monkeypatch.undo()
     q = np.zeros((3, an.dof))
     solve(an, q, q, q, backend="llvm")

@@ -6,7 +6,9 @@ then saves about :data:`SAVED_SECONDS_PER_SAMPLE` a sample against the numba ker
 whose first use in a process costs :data:`NUMBA_START_SECONDS` (import and its disk
 cache).  So "auto" takes llvm once it is compiled, or when its estimated compile time
 (:func:`llvm_compile_estimate`) is at most what the numba kernel would cost extra for
-this call; else the numba kernel where it is available (numba imports); else llvm where it
+this call and the samples this analysis solved before (rent-or-buy: a run of many small
+calls, like the CLI's chunks, switches to llvm once the kernel's extra time would have
+paid for the compile); else the numba kernel where it is available (numba imports); else llvm where it
 is available whatever its compile time; else numpy.
 """
 from __future__ import annotations
@@ -44,7 +46,8 @@ def _auto_llvm(sol, n: int | None) -> bool:
     if sol.compiled_llvm() or n is None:
         return True
     numba_extra = 0.0 if "gearcli.dynamics.kernel" in sys.modules else NUMBA_START_SECONDS
-    return llvm_compile_estimate(sol.an) <= numba_extra + n * SAVED_SECONDS_PER_SAMPLE
+    seen = n + sol.samples_solved          # a long run in many calls (the CLI's chunks) pays too
+    return llvm_compile_estimate(sol.an) <= numba_extra + seen * SAVED_SECONDS_PER_SAMPLE
 
 
 def choose(sol, method: str, backend: str, n: int | None) -> str:

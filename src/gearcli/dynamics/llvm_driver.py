@@ -36,8 +36,11 @@ def _target_machine():
     execution engine owns the target machine and frees it with itself)."""
     llvm = _llvm()
     target = llvm.Target.from_default_triple()
-    return llvm, target.create_target_machine(opt=3, cpu=llvm.get_host_cpu_name(),
-                                              features=llvm.get_host_cpu_features().flatten())
+    try:
+        features = llvm.get_host_cpu_features().flatten()
+    except RuntimeError:          # LLVM cannot list them on this host: the CPU name's defaults
+        features = ""
+    return llvm, target.create_target_machine(opt=3, cpu=llvm.get_host_cpu_name(), features=features)
 
 
 def mech_loads(an) -> list:

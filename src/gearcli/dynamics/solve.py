@@ -124,6 +124,7 @@ class Solver:
         self.kernel_problem: str | None = None
         self._llvm = None
         self.llvm_problem: str | None = None
+        self.samples_solved = 0          # by the block method, every backend ("auto"'s cost model)
 
     def kernel_program(self):
         """The compiled kernel's program of this mechanism (:mod:`.kernel_program`), or None
@@ -175,6 +176,8 @@ class Solver:
         if chunk < 1:
             raise ValueError(f"chunk must be at least 1, got {chunk}")
         path = self.backend(method, backend, q.shape[0])
+        if method == "block":
+            self.samples_solved += q.shape[0]
         values = load_values(self.an.mech, q.shape[0], loads)
         if path != "numpy" and not verify:     # no BLAS call: the limit would cost ~30 us a call
             return self._by_kernel(path, q, qd, qdd, values, jobs, chunk, verify)
