@@ -181,7 +181,7 @@ MUTATIONS = [
                "P[0], P[1], P[2]"),)),
     # the generated llvm kernel
     Mutation("llvm-gravity-sign", "llvm: gravity with the wrong sign in the d'Alembert force",
-             (("dynamics/llvm_links.py", "F = e.scale(e.vsub(ac, _floats(g)), m)", "F = e.scale(e.vadd(ac, _floats(g)), m)"),)),
+             (("dynamics/llvm_links.py", "F = e.scale(e.vsub(ac, floats(g)), m)", "F = e.scale(e.vadd(ac, floats(g)), m)"),)),
     Mutation("llvm-propagation-sign", "llvm: a solved wrench passed on to a later link with the primary's sign",
              (("dynamics/llvm_blocks.py", "1.0 if L == P else -1.0", "1.0"),)),
     Mutation("llvm-child-basis-turn", "llvm: joint reaction turned to the child's basis by +q instead of -q",

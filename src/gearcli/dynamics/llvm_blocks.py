@@ -14,7 +14,7 @@ from __future__ import annotations
 import llvmlite.ir as ir
 
 from .llvm_build import I64, Emitter
-from .llvm_links import Sample, _floats
+from .llvm_links import Sample, floats
 from .llvm_signs import SignedBlock, resolve, signs_of, tolerance
 from .llvm_trig import sincos
 from .llvm_world import WorldBlock
@@ -43,11 +43,11 @@ def _wrench_in_F(e: Emitter, rec, cmat, x: list):
     """C_plus x + C_sep |x| of one propagation record: (f, m) on its primary link, F axes."""
     c0, size, signed, co = (int(v) for v in rec[:4])
     xs = x[c0:c0 + size]
-    w = [e.dot(_floats(cmat[co + h * size:co + (h + 1) * size]), xs) for h in range(6)]
+    w = [e.dot(floats(cmat[co + h * size:co + (h + 1) * size]), xs) for h in range(6)]
     if signed:
         ax = [e.call("fabs", v) for v in xs]
         cs = co + 6 * size
-        w = [e.add(w[h], e.dot(_floats(cmat[cs + h * size:cs + (h + 1) * size]), ax)) for h in range(6)]
+        w = [e.add(w[h], e.dot(floats(cmat[cs + h * size:cs + (h + 1) * size]), ax)) for h in range(6)]
     return tuple(w[:3]), tuple(w[3:])
 
 
@@ -76,7 +76,7 @@ def term_wrench(e: Emitter, s: Sample, trec_k, tflt_k, L: int, sig: list):
     coef = float(tflt_k[0])
     if trec_k[5] >= 0:
         coef = e.mul(coef, sig[int(trec_k[5])])
-    f = _floats(tflt_k)
+    f = floats(tflt_k)
     d = e.mv(s.R[X], f[1:4])
     if trec_k[3] == 1:
         return (0.0, 0.0, 0.0) + e.scale(d, coef)
@@ -107,7 +107,7 @@ def store(e: Emitter, s: Sample, rec, prog, x: list) -> None:
         if j >= 0:
             cq, sq = s.cs[j]
         else:
-            angle = e.dot(s.q, _floats(turns[off:off + len(s.q)]))
+            angle = e.dot(s.q, floats(turns[off:off + len(s.q)]))
             cq, sq = sincos(e, angle)
         for h in (0, 3):
             x0, x1 = x[c0 + h], x[c0 + h + 1]
@@ -142,7 +142,7 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row) -> None:
         maps = [ainv[a0 + k * nloc * nr:a0 + (k + 1) * nloc * nr].reshape(nloc, nr) for k in range(1 << m)]
         blk = SignedBlock(e, maps, tcols, f"b{b}") if m else None
     if m == 0:
-        x, sig = (blk.solve(e, [], r) if F < 0 else [e.dot(_floats(maps[0][i]), r) for i in range(nloc)]), []
+        x, sig = (blk.solve(e, [], r) if F < 0 else [e.dot(floats(maps[0][i]), r) for i in range(nloc)]), []
     else:
         x, p = resolve(e, fn, blk, r, tolerance(e, r), _on_fail(e, fail, n, b), f"b{b}")
         sig = signs_of(e, p, m)

@@ -42,14 +42,15 @@ class Sample:
     sol: dict = field(default_factory=dict)
 
 
-def _floats(row) -> tuple:
+def floats(row) -> tuple:
+    """A row of program constants as Python floats (folded by :class:`~.llvm_build.Emitter`)."""
     return tuple(float(v) for v in row)
 
 
 def joint_space(e: Emitter, S, qi: list, qdi: list, qddi: list) -> Sample:
     """The sample's q, qd, qdd of every real joint = S times the independent ones
     (``qi, qdi, qddi``: the loaded independent values)."""
-    rows = [_floats(S[j]) for j in range(S.shape[0])]
+    rows = [floats(S[j]) for j in range(S.shape[0])]
     return Sample([e.dot(qi, s) for s in rows], [e.dot(qdi, s) for s in rows], [e.dot(qddi, s) for s in rows])
 
 
@@ -81,7 +82,7 @@ def joint(e: Emitter, s: Sample, rec, flt) -> None:
     """The child link of one joint record (``rec`` a row of ``jrec``, ``flt`` of ``jflt``):
     its R, o, w, dw, a, and the joint's cos, sin (kernel_links._joint)."""
     ji, p, c, pr = (int(v) for v in rec[:4])
-    f = _floats(flt)
+    f = floats(flt)
     qdk, qddk = s.qd[ji], s.qdd[ji]
     op, wp, dwp = s.o[p], s.w[p], s.dw[p]
     Rj, oj, cq, sq = _joint_frame(e, f, s.R[p], op, s.q[ji], pr == 1)
@@ -103,14 +104,14 @@ def joint(e: Emitter, s: Sample, rec, flt) -> None:
 
 def inertia(e: Emitter, s: Sample, L: int, lflt, g) -> None:
     """rhs[L] = the d'Alembert wrench of link L about o_L, base frame (Eqs. 17-18)."""
-    f = _floats(lflt[L])
+    f = floats(lflt[L])
     m, I, com = f[0], f[1:10], f[10:13]
     RL, wL, dwL = s.R[L], s.w[L], s.dw[L]
     wb = e.mtv(RL, wL)
     Nb = e.vadd(e.mv(I, e.mtv(RL, dwL)), e.cx(wb, e.mv(I, wb)))
     rc = e.mv(RL, com)
     ac = _arm_accel(e, s.a[L], dwL, wL, rc)
-    F = e.scale(e.vsub(ac, _floats(g)), m)
+    F = e.scale(e.vsub(ac, floats(g)), m)
     M = e.vadd(e.mv(RL, Nb), e.cx(rc, F))
     s.rhs[L] = F + M
 
@@ -129,7 +130,7 @@ def external(e: Emitter, s: Sample, loads, n, vals, ldrow) -> None:
         f, m = tuple(v[:3]), tuple(v[3:])
         if in_link:
             f, m = e.mv(s.R[L], f), e.mv(s.R[L], m)
-        arm = e.mv(s.R[L], _floats(point))
+        arm = e.mv(s.R[L], floats(point))
         mo = e.vadd(m, e.cx(arm, f))
         old = s.rhs[L]
         s.rhs[L] = tuple(e.sub(old[i], f[i]) for i in range(3)) + tuple(e.sub(old[3 + i], mo[i]) for i in range(3))

@@ -8,7 +8,7 @@ the tooth forces t with their separating, radial and axial components (the const
 from __future__ import annotations
 
 from .llvm_build import Emitter
-from .llvm_links import Sample, _floats
+from .llvm_links import Sample, floats
 
 OUTPUTS = ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial", "motor_speed")
 
@@ -34,7 +34,7 @@ def _meshes(e: Emitter, s: Sample, gcol, mflt, rows) -> None:
     gear_t, sep, rad, ax = rows
     for c in range(mflt.shape[0] - 1):
         t = s.sol[int(gcol[c])]
-        f = _floats(mflt[c])
+        f = floats(mflt[c])
         sp = e.mul(e.call("fabs", t), f[1]) if f[0] == 1.0 else 0.0
         e.store(t, gear_t, c)
         e.store(sp, sep, c)
@@ -54,6 +54,6 @@ def write_outputs(e: Emitter, s: Sample, prog, qdi: list, rows: dict) -> None:
     for i, v in enumerate(motor):
         e.store(v, rows["motor"], i)
     for d in range(A.shape[0]):
-        e.store(e.dot(_floats(A[d]), motor), rows["tau"], d)
+        e.store(e.dot(floats(A[d]), motor), rows["tau"], d)
     for i in range(len(motor)):
-        e.store(e.dot(qdi, _floats(A[:, i])), rows["motor_speed"], i)
+        e.store(e.dot(qdi, floats(A[:, i])), rows["motor_speed"], i)

@@ -1,8 +1,10 @@
 """Generated sign resolution of one block (paper Eq. 14; :func:`.signs.resolve_signs`).
 
-The sign search is the only control flow of the generated kernel: step 0 tries every t positive, steps 1..m the
-signs of the previous trial's own t, then every pattern in :func:`.signs.sign_patterns`
-order (m <= MAX_EXHAUSTIVE); a trial computes only the m signed t.  A trial and the
+The sign search is the only control flow of the generated kernel: step 0 tries every t
+positive, steps 1..m the signs of the previous trial's own t, then every pattern in
+:func:`.signs.sign_patterns` order (m <= MAX_EXHAUSTIVE), with the tolerance of the numpy
+path; a sample with no consistent pattern records its first failing block.  A trial of a
+constant-frame block computes only the m signed t.  A trial and the
 accepted pattern's full solution are a ``switch`` over the patterns into straight-line
 code with the constant Ainv entries, or, when 2^m patterns make that code too large
 (:data:`SWITCH_LIMIT`), row products reading a constant global array at the pattern's
@@ -14,7 +16,7 @@ import llvmlite.ir as ir
 import numpy as np
 
 from .llvm_build import D, I1, I64, Emitter
-from .llvm_links import _floats
+from .llvm_links import floats
 from .signs import MAX_EXHAUSTIVE, TOL_SIGN
 
 SWITCH_LIMIT = 8192
@@ -68,7 +70,7 @@ def _rows_switch(e: Emitter, fn, p, maps: list, rows: list, r: list, tag: str):
     for k, A in enumerate(maps):
         sw.add_case(ir.Constant(I64, k), cases[k])
         e.b.position_at_end(cases[k])
-        out.append([e.const(e.dot(_floats(A[i]), r)) for i in rows])
+        out.append([e.const(e.dot(floats(A[i]), r)) for i in rows])
         e.b.branch(merge)
     e.b.position_at_end(merge)
     vals = []
