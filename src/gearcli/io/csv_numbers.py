@@ -7,6 +7,7 @@ with ``np.loadtxt`` and reports the first bad cell.  Both parsers round correctl
 values are the same bits (``tests/test_text_lines.py`` checks it against ``loadtxt`` on
 random and hostile cells).  Empty cells are never read as missing values; a NaN cell
 gives None (pyarrow reads ``nan(1)``, which ``loadtxt`` refuses as not a number).
+:func:`parse_bytes` does the same on the bytes of the lines as read from the file.
 """
 from __future__ import annotations
 

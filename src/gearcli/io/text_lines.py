@@ -4,6 +4,8 @@
 ``read`` of 4 MB blocks split at newlines (a fraction of a microsecond a line), keeping
 what the loop checked: a line of ``max_line`` characters or more is refused (memory stays
 bounded whatever the file holds), blank (whitespace-only) lines are skipped but counted.
+:func:`plain_chunks` goes further for the usual file: chunks of plain lines (ASCII, not too
+long) as bytes, for pyarrow's parser, with no Python object per line.
 """
 from __future__ import annotations
 
