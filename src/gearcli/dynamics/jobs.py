@@ -1,13 +1,17 @@
 """Splitting a trajectory over threads, and the sign error of a compiled solve (no numba).
 
 Shared by the compiled backends (:mod:`.kernel_driver`, :mod:`.llvm_driver`): the samples
-are split into contiguous ranges that the threads take in turn; a compiled kernel releases
-the GIL and each sample's arithmetic does not depend on the split, so the results are
-bitwise identical for any number of jobs.
+are split into contiguous ranges that the threads take in turn (:func:`run_parts`: the
+calling thread and workers of a persistent pool, created on first use, so that a call pays
+no thread creation); a compiled kernel releases the GIL and each sample's arithmetic does
+not depend on the split, so the results are bitwise identical for any number of jobs.
 """
 from __future__ import annotations
 
+import itertools
 import os
+import threading
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -43,6 +47,57 @@ def job_ranges(n: int, jobs: int | None) -> list[tuple[int, int]]:
     parts = max(threads, min(8 * threads, n // MIN_SAMPLES_PER_JOB))
     cuts = [round(i * n / parts) for i in range(parts + 1)]
     return [(cuts[i], cuts[i + 1]) for i in range(parts)]
+
+
+_POOL: ThreadPoolExecutor | None = None
+_POOL_LOCK = threading.Lock()
+
+
+def _pool(workers: int) -> ThreadPoolExecutor:
+    """The persistent worker pool, with room for at least ``workers`` threads (one fewer
+    than the cores unless more are asked for: the calling thread works too).  Its threads
+    start on first use and then wait for work (daemon-like: they exit with the process)."""
+    global _POOL
+    with _POOL_LOCK:
+        if _POOL is None or _POOL._max_workers < workers:
+            old = _POOL
+            _POOL = ThreadPoolExecutor(max(workers, usable_cores() - 1), thread_name_prefix="gearcli-jobs")
+            if old is not None:
+                old.shutdown(wait=False)
+        return _POOL
+
+
+def run_parts(task, ranges: list, threads: int, local=lambda: None) -> int:
+    """Run ``task(start, stop, state)`` over every range on ``threads`` threads; the sum
+    of what the calls return.
+
+    The calling thread and ``threads - 1`` workers of the persistent pool take the next
+    range not yet taken until none is left (a thread slowed by a busy core takes fewer);
+    each calls ``local()`` once for its ``state`` (per-thread work arrays).  ``task`` must
+    release the GIL for the threads to run in parallel (a compiled kernel does).
+    """
+    if threads <= 1 or len(ranges) == 1:
+        state = local()
+        return sum(task(s, e, state) for s, e in ranges)
+    taken = itertools.count()            # next() on it is atomic (the GIL)
+
+    def take() -> int:
+        state, total = None, 0
+        for i in taken:
+            if i >= len(ranges):
+                return total
+            state = local() if state is None else state
+            total += task(*ranges[i], state)
+
+    pool = _pool(threads - 1)
+    futures = [pool.submit(take) for _ in range(threads - 1)]
+    try:
+        total = take()
+    finally:       # a worker not started yet finds nothing left; wait for the running ones
+        running = [f for f in futures if not f.cancel()]
+        for f in running:
+            f.exception()
+    return total + sum(f.result() for f in running)
 
 
 def sign_error(names: list, fail: np.ndarray, chunk: int) -> SignError:

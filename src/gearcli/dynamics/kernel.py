@@ -253,8 +253,8 @@ def run(ints, flts, ldrec, ldflt, vals, qi, qdi, qddi, start, stop, outs, scratc
     """Solve samples start..stop-1 of qi, qdi, qddi (N, dof) into the output arrays ``outs``
     (motor (N, M), tau (N, dof), joint (N, J*6), gear_t, gear_sep (N, G), gear_radial,
     gear_axial (N, G*2), motor speed (N, M), the sign of each t used (N, signed meshes) and
-    fail (N,): the first block with no consistent sign pattern, -1 if none, which must come
-    filled with -1).  ``scratch`` from :func:`~.kernel_driver.scratch` (one per thread).
+    fail (N,): the first block with no consistent sign pattern, -1 if none); returns how
+    many of these samples failed.  ``scratch`` from :func:`~.kernel_driver.scratch` (one per thread).
     Compiled without numba's reference counting (``_nrt=False``: ~10 ns an array passed
     otherwise): nothing here allocates."""
     jrec, moving = ints[0], ints[9]
@@ -262,7 +262,9 @@ def run(ints, flts, ldrec, ldflt, vals, qi, qdi, qddi, start, stop, outs, scratc
     sptr, sidx, sval = ints[15], ints[16], flts[10]
     R, o, w, dw, a, rhs, cs, q, qd, qdd, r, x, sig, A, xrow = scratch
     SG, fail = outs[8], outs[9]
+    failed = 0
     for n in range(start, stop):
+        fail[n] = -1
         joint_space(sptr, sidx, sval, qi, qdi, qddi, n, q, qd, qdd)
         kinematics(jrec, jflt, q, qd, qdd, R, o, w, dw, a, cs)
         for L in moving:
@@ -270,3 +272,6 @@ def run(ints, flts, ldrec, ldflt, vals, qi, qdi, qddi, start, stop, outs, scratc
         external(n, ldrec, ldflt, vals, R, rhs)
         _blocks(n, ints, flts, q, cs, R, o, rhs, r, x, sig, A, xrow, SG, fail)
         write_outputs(n, xrow, qdi, ints, flts, outs)
+        if fail[n] >= 0:
+            failed += 1
+    return failed

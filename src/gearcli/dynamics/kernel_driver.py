@@ -6,11 +6,9 @@ bitwise identical for any number of jobs.
 """
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
-
 import numpy as np
 
-from .jobs import job_ranges, sign_error, threads_for, usable_cores  # noqa: F401  (re-exported)
+from .jobs import job_ranges, run_parts, sign_error, threads_for, usable_cores  # noqa: F401  (re-exported)
 from .kernel import run
 from .kernel_program import Program, load_arrays
 
@@ -34,37 +32,30 @@ def scratch(prog: Program) -> tuple:
 OUTPUTS = ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial", "motor_speed")
 
 
-def kernel_solve(prog: Program, an, q, qd, qdd, values: dict, jobs: int | None, chunk: int):
-    """The loads of every sample, by the kernel.
+def kernel_solve(prog: Program, an, q, qd, qdd, values: dict, jobs: int | None, chunk: int, out: dict,
+                 work: tuple) -> dict:
+    """The loads of every sample, by the kernel, into ``out``.
 
     Parameters
     ----------
     q, qd, qdd : (N, dof) independent joint values.  values : {load name: (N, 6) or
     broadcast (1 row)} (:func:`.external.load_values`).  chunk : the numpy path's chunk
-    (the sample a :class:`SignError` names is the one that path would name).
+    (the sample a :class:`SignError` names is the one that path would name).  out :
+    {name: array} the fields of :class:`~.solve.Result` (``OUTPUTS``, shaped as there,
+    C-ordered float64), written.  work : (signs (N, max(1, signed meshes)), fail (N,)
+    int64) work arrays (:func:`.result_arrays.work_arrays`).
 
     Returns
     -------
-    ({name: array} the fields of :class:`~.solve.Result` (``OUTPUTS``, shaped as there),
-    {(kind, index): (N,) sign of t}).
+    {(kind, index): (N,) sign of t used}.
     """
-    n, dof = q.shape
-    J, G, M = len(an.mech.joints), len(an.circuits), len(an.motor_links)
-    out = {"motor": np.empty((n, M)), "tau": np.empty((n, dof)), "joint": np.empty((n, J, 6)),
-           "gear_t": np.empty((n, G)), "gear_sep": np.empty((n, G)), "gear_radial": np.empty((n, G, 2)),
-           "gear_axial": np.empty((n, G, 2)), "motor_speed": np.empty((n, M))}
-    SG = np.empty((n, len(prog.signed)))
-    fail = np.full(n, -1, np.int64)
-    outs = tuple(a.reshape(n, int(np.prod(a.shape[1:]))) for a in out.values()) + (SG, fail)
+    n = q.shape[0]
+    SG, fail = work
+    outs = tuple(out[k].reshape(n, int(np.prod(out[k].shape[1:]))) for k in OUTPUTS) + (SG, fail)
     ldrec, ldflt, vals = load_arrays(an, values, n)
     args = (prog.ints, prog.flts, ldrec, ldflt, vals, *(np.ascontiguousarray(a, float) for a in (q, qd, qdd)))
-    ranges = job_ranges(n, jobs)
-    if len(ranges) == 1:
-        run(*args, 0, n, outs, scratch(prog))
-    else:
-        with ThreadPoolExecutor(threads_for(n, jobs)) as pool:
-            for f in [pool.submit(run, *args, s, e, outs, scratch(prog)) for s, e in ranges]:
-                f.result()
-    if np.any(fail >= 0):
+    failed = run_parts(lambda s, e, scr: run(*args, s, e, outs, scr), job_ranges(n, jobs), threads_for(n, jobs),
+                       lambda: scratch(prog))
+    if failed:
         raise sign_error(prog.names, fail, chunk)
-    return out, {k: SG[:, i] for i, k in enumerate(prog.signed)}
+    return {k: SG[:, i] for i, k in enumerate(prog.signed)}

@@ -10,16 +10,15 @@ from __future__ import annotations
 
 import ctypes
 import time
-from concurrent.futures import ThreadPoolExecutor
 from functools import lru_cache
 
 import numpy as np
 
-from .jobs import job_ranges, sign_error, threads_for
+from .jobs import job_ranges, run_parts, sign_error, threads_for
 from .kernel_program import Program, load_arrays
 from .llvm_blocks import problem
 from .llvm_kernel import ARGS, build_module
-from .llvm_outputs import OUTPUTS, widths
+from .llvm_outputs import OUTPUTS
 
 
 @lru_cache(maxsize=1)
@@ -86,37 +85,25 @@ class LlvmKernel:
         module = build_module(prog, mech_loads(an))
         t1 = time.perf_counter()
         self.jit = Jit(module)
-        proto = ctypes.CFUNCTYPE(None, *([ctypes.c_void_p] * (len(ARGS) - 2) + [ctypes.c_int64] * 2))
+        proto = ctypes.CFUNCTYPE(ctypes.c_int64, *([ctypes.c_void_p] * (len(ARGS) - 2) + [ctypes.c_int64] * 2))
         self._run = proto(self.jit.address("run"))
         self.build_seconds, self.compile_seconds = t1 - t0, time.perf_counter() - t1
         self.prog = prog
 
-    def solve(self, an, q, qd, qdd, values: dict, jobs: int | None, chunk: int):
-        """The loads of every sample, as :func:`.kernel_driver.kernel_solve` returns them."""
+    def solve(self, an, q, qd, qdd, values: dict, jobs: int | None, chunk: int, out: dict, work: tuple) -> dict:
+        """The loads of every sample into ``out``, as :func:`.kernel_driver.kernel_solve` does."""
         prog = self.prog
-        n, dof = q.shape
-        J, G, M = len(an.mech.joints), len(an.circuits), len(an.motor_links)
-        out = {"motor": np.empty((n, M)), "tau": np.empty((n, dof)), "joint": np.empty((n, J, 6)),
-               "gear_t": np.empty((n, G)), "gear_sep": np.empty((n, G)), "gear_radial": np.empty((n, G, 2)),
-               "gear_axial": np.empty((n, G, 2)), "motor_speed": np.empty((n, M))}
-        w = widths(prog)
-        SG = np.empty((n, max(w["signs"], 1)))
-        fail = np.full(n, -1, np.int64)
+        n = q.shape[0]
+        SG, fail = work
         ldrec, _, vals = load_arrays(an, values, n)
         ldrow = np.ascontiguousarray(ldrec[:, 2:4] if len(ldrec) else np.zeros((1, 2), np.int64))
         keep = [np.ascontiguousarray(a, float) for a in (q, qd, qdd)] + [np.ascontiguousarray(vals, float), ldrow]
-        keep += [out[k] if out[k].size else np.empty((n, 1)) for k in OUTPUTS] + [SG, fail]
+        keep += [out[k] if out[k].size else np.empty((1, 1)) for k in OUTPUTS] + [SG, fail]
         ptrs = [a.ctypes.data for a in keep]
-        ranges = job_ranges(n, jobs)
-        if len(ranges) == 1:
-            self._run(*ptrs, 0, n)
-        else:
-            with ThreadPoolExecutor(threads_for(n, jobs)) as pool:
-                for f in [pool.submit(self._run, *ptrs, s, e) for s, e in ranges]:
-                    f.result()
-        if np.any(fail >= 0):
+        failed = run_parts(lambda s, e, _: self._run(*ptrs, s, e), job_ranges(n, jobs), threads_for(n, jobs))
+        if failed:
             raise sign_error(prog.names, fail, chunk)
-        return out, {k: SG[:, i] for i, k in enumerate(prog.signed)}
+        return {k: SG[:, i] for i, k in enumerate(prog.signed)}
 
 
 def llvm_problem(prog: Program) -> str | None:

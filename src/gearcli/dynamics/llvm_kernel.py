@@ -13,8 +13,9 @@ blocks in schedule order (:mod:`.llvm_blocks`, :mod:`.llvm_signs`) and the outpu
 (:mod:`.llvm_outputs`), straight-line except for the sign search.  Only the inputs (the
 independent q, qd, qdd (N, dof), C-ordered), the external load values with their row
 layout ``ldrow`` (per load [first row, 1 if one row a sample]) and the output arrays
-(C-ordered rows of :func:`.llvm_outputs.widths`; ``fail`` (N,) int64 filled with -1) are
-pointers.  Compiled by :mod:`.llvm_driver`.
+(C-ordered rows of :func:`.llvm_outputs.widths`; ``fail`` (N,) int64, which ``run`` sets
+to -1 or the sample's first failing block) are pointers.  ``run`` returns how many of its
+samples failed (the caller checks a sum, not ``fail``).  Compiled by :mod:`.llvm_driver`.
 """
 from __future__ import annotations
 
@@ -30,7 +31,7 @@ ARGS = ("qi", "qdi", "qddi", "vals", "ldrow") + OUTPUTS + ("signs", "fail", "sta
 
 def _signature(mod: ir.Module) -> ir.Function:
     types = [DP] * 4 + [I64P] + [DP] * (len(OUTPUTS) + 1) + [I64P, I64, I64]
-    fn = ir.Function(mod, ir.FunctionType(ir.VoidType(), types), "run")
+    fn = ir.Function(mod, ir.FunctionType(I64, types), "run")
     for arg, name in zip(fn.args, ARGS):
         arg.name = name
         if isinstance(arg.type, ir.PointerType):
@@ -43,6 +44,7 @@ def _sample(e: Emitter, fn, prog, loads, n) -> None:
     a = dict(zip(ARGS, fn.args))
     S = prog.flts[2]
     dof = S.shape[1]
+    e.b.store(ir.Constant(I64, -1), e.b.gep(a["fail"], [n]))
     ind = [[e.load(e.row(a[k], n, dof), d) for d in range(dof)] for k in ("qi", "qdi", "qddi")]
     s = joint_space(e, S, *ind)
     at_rest(s, int(prog.ints[11][0]))
@@ -68,12 +70,19 @@ def build_module(prog, loads) -> ir.Module:
     start, stop = fn.args[-2], fn.args[-1]
     b.cbranch(b.icmp_signed("<", start, stop), body, done)
     b.position_at_end(body)
-    n = b.phi(I64, "n")
+    n, bad = b.phi(I64, "n"), b.phi(I64, "bad")
     n.add_incoming(start, entry)
+    bad.add_incoming(ir.Constant(I64, 0), entry)
     _sample(Emitter(b, mod), fn, prog, loads, n)
-    n1 = b.add(n, ir.Constant(I64, 1))
-    n.add_incoming(n1, b.block)
+    failed = b.icmp_signed(">=", b.load(b.gep(fn.args[ARGS.index("fail")], [n])), ir.Constant(I64, 0))
+    n1, bad1 = b.add(n, ir.Constant(I64, 1)), b.add(bad, b.zext(failed, I64))
+    latch = b.block
+    n.add_incoming(n1, latch)
+    bad.add_incoming(bad1, latch)
     b.cbranch(b.icmp_signed("<", n1, stop), body, done)
     b.position_at_end(done)
-    b.ret_void()
+    total = b.phi(I64, "failed")
+    total.add_incoming(ir.Constant(I64, 0), entry)
+    total.add_incoming(bad1, latch)
+    b.ret(total)
     return mod

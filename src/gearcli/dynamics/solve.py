@@ -35,6 +35,7 @@ from .external import external_wrenches, load_values, subtract_external
 from .inertia import inertia_load
 from .kernel_program import build_program
 from .kinematics import forward
+from .result_arrays import check_out, copy_into, result_arrays, work_arrays
 from .signs import SignError, sign_violation
 
 DEFAULT_CHUNK = 20_000
@@ -168,35 +169,43 @@ class Solver:
 
     def solve(self, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK,
               verify: bool = False, loads: dict | None = None, backend: str = "auto",
-              jobs: int | None = None) -> Result:
+              jobs: int | None = None, out: Result | None = None) -> Result:
         """See :func:`solve`."""
         q, qd, qdd = _check_shapes(self.an, q, qd, qdd)
         if method not in ("block", "full"):
             raise ValueError(f"unknown method '{method}' (expected 'block' or 'full')")
         if chunk < 1:
             raise ValueError(f"chunk must be at least 1, got {chunk}")
+        if out is not None:
+            check_out(self.an, q.shape[0], out)
         path = self.backend(method, backend, q.shape[0])
         if method == "block":
             self.samples_solved += q.shape[0]
         values = load_values(self.an.mech, q.shape[0], loads)
         if path != "numpy" and not verify:     # no BLAS call: the limit would cost ~30 us a call
-            return self._by_kernel(path, q, qd, qdd, values, jobs, chunk, verify)
+            return self._by_kernel(path, q, qd, qdd, values, jobs, chunk, verify, out)
         # the operands are 3x3 to 48x48 matrices: BLAS threads only contend (2-3x slower
         # with a busy second core), so one BLAS thread, whatever the environment says
         with one_blas_thread():
             if path != "numpy":
-                return self._by_kernel(path, q, qd, qdd, values, jobs, chunk, verify)
+                return self._by_kernel(path, q, qd, qdd, values, jobs, chunk, verify, out)
             res = self._by_numpy(q, qd, qdd, method, chunk, verify, values)
         res.motor_speed = qd @ self.an.A
-        return res
+        if out is None:
+            return res
+        copy_into(out, res)
+        return out
 
-    def _by_kernel(self, path, q, qd, qdd, values, jobs, chunk, verify) -> Result:
+    def _by_kernel(self, path, q, qd, qdd, values, jobs, chunk, verify, out=None) -> Result:
+        arrays = result_arrays(self.an, q.shape[0], out)
+        work = work_arrays(q.shape[0], len(self.kernel_program().signed), out)
         if path == "llvm":
-            out, sig = self.llvm_kernel().solve(self.an, q, qd, qdd, values, jobs, chunk)
+            sig = self.llvm_kernel().solve(self.an, q, qd, qdd, values, jobs, chunk, arrays, work)
         else:
             from .kernel_driver import kernel_solve  # noqa: PLC0415  (imports numba)
-            out, sig = kernel_solve(self.kernel_program(), self.an, q, qd, qdd, values, jobs, chunk)
-        res = Result(**out)
+            sig = kernel_solve(self.kernel_program(), self.an, q, qd, qdd, values, jobs, chunk, arrays, work)
+        res = Result(**arrays) if out is None else out
+        res.residual = None
         if verify:
             x_all = _unknowns(self.an, res)
             worst = 0.0
@@ -260,7 +269,8 @@ def solver_for(an) -> Solver:
 
 
 def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, verify: bool = False,
-          loads: dict | None = None, backend: str = "auto", jobs: int | None = None) -> Result:
+          loads: dict | None = None, backend: str = "auto", jobs: int | None = None,
+          out: Result | None = None) -> Result:
     """Inverse dynamics along a trajectory.
 
     Parameters
@@ -294,17 +304,24 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
     jobs : int, optional
         Threads a compiled kernel splits the samples over (contiguous ranges; results
         bitwise identical for any number); None: every usable core.  The numpy path uses one.
+    out : Result, optional
+        A result of this mechanism with as many samples (e.g. the previous call's, when
+        streaming a trajectory in equal blocks): its arrays are overwritten with this
+        call's results (in place by the compiled kernels; copied by the numpy path) and
+        ``out`` itself is returned (if the call raises, ``out``'s contents are undefined).
+        Faster for large calls: no fresh pages for the operating system to zero, the
+        cost that does not scale with threads.
 
     Raises
     ------
     SignError
         when no sign pattern of the tooth forces is consistent at some sample (named).
     ValueError
-        for bad shapes, an unknown load name or a load value that is not finite, an unknown
+        for bad shapes (of ``out`` too), an unknown load name or a load value that is not finite, an unknown
         backend, or backend "llvm" or "kernel" where it is unavailable.
     """
     return solver_for(an).solve(q, qd, qdd, method=method, chunk=chunk, verify=verify, loads=loads,
-                                backend=backend, jobs=jobs)
+                                backend=backend, jobs=jobs, out=out)
 
 
 def residual(an, groups, cols, b, x_all, sig) -> float:

@@ -1,0 +1,65 @@
+"""The arrays a solve writes its results into: fresh ones, or those of a previous result.
+
+``solve(..., out=previous)`` writes into the arrays of a :class:`~.solve.Result` of the same
+mechanism and sample count (what a streaming caller does, as Pinocchio's
+``rneaInParallel`` writes into a preallocated tau): the compiled kernels then touch memory
+already mapped instead of fresh pages that the operating system must zero first, the cost
+that keeps two threads from doubling the speed on a large call.  The compiled kernels'
+work arrays (the sign of every t used, the failing block of every sample) are kept with
+``out`` for the next call.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+FIELDS = ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial", "motor_speed")
+
+
+def shapes(an, n: int) -> dict:
+    """{field: shape} of the result arrays of n samples of ``an``'s mechanism."""
+    J, G, M = len(an.mech.joints), len(an.circuits), len(an.motor_links)
+    return {"motor": (n, M), "tau": (n, an.dof), "joint": (n, J, 6), "gear_t": (n, G), "gear_sep": (n, G),
+            "gear_radial": (n, G, 2), "gear_axial": (n, G, 2), "motor_speed": (n, M)}
+
+
+def check_out(an, n: int, out) -> None:
+    """ValueError unless every array of ``out`` (a Result) can take n samples of ``an``'s
+    results in place: the shape of this mechanism, float64, C-ordered, writeable."""
+    for k, shape in shapes(an, n).items():
+        a = getattr(out, k, None)
+        if not isinstance(a, np.ndarray):
+            raise ValueError(f"out.{k} is {type(a).__name__}, not an array: out must be a Result of this "
+                             f"mechanism with {n} samples")
+        if a.shape != shape:
+            raise ValueError(f"out.{k} has shape {a.shape}, expected {shape}: out must be a Result of "
+                             f"this mechanism with {n} samples")
+        if a.dtype != np.float64 or not a.flags.c_contiguous or not a.flags.writeable:
+            raise ValueError(f"out.{k} must be a writeable C-ordered float64 array (got {a.dtype}, "
+                             f"C-ordered {a.flags.c_contiguous}, writeable {a.flags.writeable})")
+
+
+def result_arrays(an, n: int, out=None) -> dict:
+    """{field: array} for n samples: ``out``'s arrays (checked by :func:`check_out`), or
+    new uninitialised ones."""
+    if out is None:
+        return {k: np.empty(shape) for k, shape in shapes(an, n).items()}
+    check_out(an, n, out)
+    return {k: getattr(out, k) for k in FIELDS}
+
+
+def work_arrays(n: int, signed: int, out=None) -> tuple:
+    """(signs (n, max(signed, 1)), fail (n,) int64) for a compiled kernel: those kept with
+    ``out`` when they fit, else new ones (kept with ``out`` when given)."""
+    work = getattr(out, "_work", None) if out is not None else None
+    if work is None or work[0].shape != (n, max(signed, 1)):
+        work = (np.empty((n, max(signed, 1))), np.empty(n, np.int64))
+        if out is not None:
+            out._work = work
+    return work
+
+
+def copy_into(out, res) -> None:
+    """The numpy path's result ``res`` copied into ``out``'s arrays (checked before)."""
+    for k in FIELDS:
+        np.copyto(getattr(out, k), getattr(res, k))
+    out.residual = res.residual
