@@ -16,9 +16,11 @@ start and the end, thread counts stated):
 2. ``gearcli solve`` end to end on --cli-samples Bendix samples (positions only, rates by
    spline) to CSV and to Parquet, wall time and peak memory, against the library solve of
    the same samples; the CSV formatting of today (Python ``%``) against the compiled one;
-3. threads: one, two and the default (every core) interleaved on Bendix, on the machine as
-   it is and with a busy process on the other core (issue 11: >= 1.8x with two cores, the
-   default within 10% of one thread when a core is taken);
+3. threads (benchmarks/bench_threads.py): one, two and the default (every core)
+   interleaved on Bendix, llvm and numba kernel, 20,000 and 200,000 samples, fresh result
+   arrays and ``out=`` reuse, on the machine as it is and with a busy process on a core
+   (issue 11: >= 1.8x with two cores, the default within 10% of one thread when a core is
+   taken);
 4. per-sample cost against the size of a geared chain (2..64 links), and against the
    number of samples on Bendix (1e2..1e6, 1e7 with --big; one thread), each N in its own
    process with its peak resident memory.
@@ -37,6 +39,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from bench_threads import threads_table  # noqa: E402 (benchmarks/bench_threads.py)
 from cli_stages import print_stages, stage_times, startup_time  # noqa: E402 (benchmarks/cli_stages.py)
 from timing import load_line, median_time  # noqa: E402 (benchmarks/timing.py)
 from threadpoolctl import threadpool_info, threadpool_limits
@@ -395,58 +398,12 @@ def samples_section(sizes) -> None:
         print(f"| {n:,} | " + " | ".join(cells) + " |", flush=True)
 
 
-BUSY = "import time\nwhile True:\n    sum(range(1000))\n"
-"""A process keeping one core busy (another user's job)."""
-
-
-def interleaved(fns: dict, n: int, rounds: int) -> dict:
-    """{label: median samples/s}, the calls interleaved round by round (load drift hits all)."""
-    times = {k: [] for k in fns}
-    for f in fns.values():
-        f()                                   # warm-up: compilation, caches
-    for _ in range(rounds):
-        for k, f in fns.items():
-            t0 = time.perf_counter()
-            f()
-            times[k].append(time.perf_counter() - t0)
-    return {k: n / float(np.median(v)) for k, v in times.items()}
-
-
-def threads_section(n: int, rounds: int) -> None:
-    """Two threads against one, on a quiet machine and with a busy second core."""
-    print(f"\n## Threads: Bendix wrist, {n:,} random samples, backends interleaved 1 / 2 / default jobs, "
-          f"medians of {rounds} rounds\n")
-    an = analyse(load_mechanism(MECHS / "bendix_wrist.yaml"))
-    rng = np.random.default_rng(4)
-    q, qd, qdd = (rng.uniform(-1.5, 1.5, size=(n, an.dof)) for _ in range(3))
-    print("| backend | condition | jobs=1 | jobs=2 | default (every core) | 2 / 1 | default / 1 |\n|---|---|---|---|---|---|---|")
-    for backend in _threaded_backends(an):
-        fns = {j: (lambda j=j: solve(an, q, qd, qdd, backend=backend, jobs=j)) for j in (1, 2, None)}
-        for cond in ("quiet", "busy core"):
-            busy = subprocess.Popen([sys.executable, "-c", BUSY]) if cond == "busy core" else None
-            try:
-                with threadpool_limits(limits=1, user_api="blas"):
-                    r = interleaved(fns, n, rounds)
-            finally:
-                if busy is not None:
-                    busy.kill()
-                    busy.wait()
-            print(f"| {backend} | {cond} ({load_line()}) | {fmt_rate(r[1])} | {fmt_rate(r[2])} | "
-                  f"{fmt_rate(r[None])} | {r[2] / r[1]:.2f}x | {r[None] / r[1]:.2f}x |", flush=True)
-
-
-def _threaded_backends(an) -> list:
-    """The compiled backends this gearcli has (those taking ``jobs``)."""
+def threads_section(sizes: list, rounds: int) -> None:
+    """Two threads against one, quiet and with a busy core (benchmarks/bench_threads.py)."""
     if "jobs" not in SOLVE_PARAMS:
-        return []
-    out = []
-    for b in ("kernel", "llvm"):
-        try:
-            solve(an, np.zeros((2, an.dof)), np.zeros((2, an.dof)), np.zeros((2, an.dof)), backend=b, jobs=1)
-            out.append(b)
-        except ValueError:
-            pass
-    return out
+        print("\n## Threads: this gearcli's solve has no jobs parameter")
+        return
+    threads_table(sizes, rounds)
 
 
 def big_cli(n: int) -> None:
@@ -497,7 +454,7 @@ def main() -> None:
         cli_section(cli_n, old_format=not a.quick, repeat=a.cli_repeat)
         format_section(20_000 if a.quick else 100_000, repeat)
     if "threads" not in skip:
-        threads_section(50_000 if a.quick else 200_000, repeat)
+        threads_section([20_000] if a.quick else [20_000, 200_000], max(repeat, 7))
     if "links" not in skip:
         links_section(max(n // 4, 1000), repeat, (2, 4, 8, 16, 32, 64) if not a.quick else (2, 8, 32))
     if "n" not in skip:
