@@ -142,7 +142,7 @@ def test_general_blocks_are_exercised():
 def test_threads_change_no_bit(key, backend):
     an = analyse(mechanism(key))
     n = 20_001
-    assert threads_for(n, 2) == 2 and len(job_ranges(n, 2)) == 10     # taken in turn
+    assert threads_for(n, 2) == 2 and len(job_ranges(n, 2)) == 16     # taken in turn
     q, qd, qdd = trajectory(an, n, seed=3)
     loads = per_sample_loads(an, n)
     one = solve(an, q, qd, qdd, jobs=1, loads=loads, backend=backend)
