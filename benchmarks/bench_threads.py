@@ -48,14 +48,15 @@ def interleaved(fns: dict, n: int, rounds: int) -> dict:
 
 
 def calls(an, backend: str, n: int, reuse: bool) -> dict:
-    """{jobs: a solve of n samples} (``reuse``: each writes into its own previous result)."""
+    """{jobs: a solve of n samples} (``reuse``: all write into the one previous result, as
+    a streaming caller does)."""
     rng = np.random.default_rng(4)
     q, qd, qdd = (rng.uniform(-1.5, 1.5, size=(n, an.dof)) for _ in range(3))
-    kept: dict = {}
+    kept: list = [None]
 
     def one(j):
         if reuse:
-            kept[j] = solve(an, q, qd, qdd, backend=backend, jobs=j, out=kept.get(j))
+            kept[0] = solve(an, q, qd, qdd, backend=backend, jobs=j, out=kept[0])
         else:
             solve(an, q, qd, qdd, backend=backend, jobs=j)
     return {j: (lambda j=j: one(j)) for j in JOBS}

@@ -95,7 +95,7 @@ def _loads(an, values: dict, n: int):
         pts.append(np.asarray(ld.point, float))
         rows.append(w)
         off += w.shape[0]
-    vals = np.concatenate(rows) if rows else np.zeros((1, 6))
+    vals = (rows[0] if len(rows) == 1 else np.concatenate(rows)) if rows else np.zeros((1, 6))  # no copy of one
     return np.array(rec, I64).reshape(-1, 4), np.array(pts, float).reshape(-1, 3), vals
 
 
