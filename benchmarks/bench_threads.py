@@ -8,14 +8,16 @@ Bendix wrist, random samples.  For each condition (``quiet``: the machine as it 
 ``kernel``), size and output mode (``fresh``: new result arrays every call; ``out=``: the
 previous call's result reused, :func:`gearcli.solve`'s ``out``), one call each with jobs
 1, 2 and the default (every core) interleaved round by round (load drift hits all three),
-medians of --rounds; the ratios are from the same rows; each row states the load average
-when it ended.  Issue 11 asks >= 1.8x with two threads, and the default within 10% of one
+medians of --rounds; the ratios are from the same rows; each row states the cores other
+processes used while it ran (from /proc/stat: the busy process counts, ~1) and the load
+average when it ended.  Issue 11 asks >= 1.8x with two threads, and the default within 10% of one
 thread when the other core is busy.  Measure on a quiet machine (load average well below
 the core count): on 2 shared cores, another job takes the second thread's core.
 """
 from __future__ import annotations
 
 import argparse
+import os
 import subprocess
 import sys
 import time
@@ -33,18 +35,31 @@ BUSY = "import time\nwhile True:\n    sum(range(1000))\n"
 JOBS = (1, 2, None)
 
 
+def cpu_seconds() -> tuple:
+    """(CPU seconds every process of the machine has used, this process's), to tell how
+    many cores other jobs took meanwhile (Linux /proc/stat; the load average lags a minute)."""
+    with open("/proc/stat") as f:
+        fields = [int(x) for x in f.readline().split()[1:]]
+    machine = (sum(fields) - fields[3] - fields[4]) / os.sysconf("SC_CLK_TCK")     # not idle, not iowait
+    t = os.times()
+    return machine, t.user + t.system
+
+
 def interleaved(fns: dict, n: int, rounds: int) -> dict:
-    """{label: median samples/s}, the calls interleaved round by round (two warm-ups)."""
+    """{label: median samples/s}, the calls interleaved round by round (two warm-ups), and
+    "others": the cores other processes used meanwhile (mean)."""
     times = {k: [] for k in fns}
     for _ in range(2):
         for f in fns.values():
             f()                                   # compilation, caches, out='s work arrays
+    (m0, s0), w0 = cpu_seconds(), time.perf_counter()
     for _ in range(rounds):
         for k, f in fns.items():
             t0 = time.perf_counter()
             f()
             times[k].append(time.perf_counter() - t0)
-    return {k: n / float(np.median(v)) for k, v in times.items()}
+    (m1, s1), w1 = cpu_seconds(), time.perf_counter()
+    return {**{k: n / float(np.median(v)) for k, v in times.items()}, "others": ((m1 - m0) - (s1 - s0)) / (w1 - w0)}
 
 
 def calls(an, backend: str, n: int, reuse: bool) -> dict:
@@ -83,8 +98,8 @@ def threads_table(sizes, rounds: int, backends=("llvm", "kernel"), conditions=("
     an = analyse(load_mechanism(MECHS / "bendix_wrist.yaml"))
     print(f"\n## Threads: Bendix wrist, jobs 1 / 2 / default interleaved, medians of {rounds} rounds "
           f"(samples/s)\n")
-    print("| condition | backend | samples | outputs | jobs=1 | jobs=2 | default | 2 / 1 | default / 1 | load |\n"
-          "|---|---|---|---|---|---|---|---|---|---|")
+    print("| condition | backend | samples | outputs | jobs=1 | jobs=2 | default | 2 / 1 | default / 1 | "
+          "other jobs' cores | load |\n|---|---|---|---|---|---|---|---|---|---|---|")
     for cond in conditions:
         busy = subprocess.Popen([sys.executable, "-c", BUSY]) if cond == "busy" else None
         try:
@@ -95,7 +110,7 @@ def threads_table(sizes, rounds: int, backends=("llvm", "kernel"), conditions=("
                             r = interleaved(calls(an, backend, n, reuse), n, rounds)
                         print(f"| {cond} | {backend} | {n:,} | {'out=' if reuse else 'fresh'} | {fmt(r[1])} | "
                               f"{fmt(r[2])} | {fmt(r[None])} | {r[2] / r[1]:.2f}x | {r[None] / r[1]:.2f}x | "
-                              f"{load_line().removeprefix('load average ')} |", flush=True)
+                              f"{r['others']:.2f} | {load_line().removeprefix('load average ')} |", flush=True)
         finally:
             if busy is not None:
                 busy.kill()
