@@ -1,7 +1,7 @@
 """Two threads against one on the compiled backends (issue 11); prints figures, not a test.
 
     python benchmarks/bench_threads.py [--rounds 9] [--sizes 20000,200000] [--backends llvm,kernel]
-                                       [--conditions quiet,busy]
+                                       [--conditions quiet,busy] [--outputs fresh,out=]
 
 Bendix wrist, random samples.  For each condition (``quiet``: the machine as it is;
 ``busy``: a process spinning on a core, another user's job), backend (``llvm``, the numba
@@ -93,7 +93,8 @@ def fmt(r: float) -> str:
     return f"{r / 1e6:.2f}M" if r >= 1e6 else f"{r / 1e3:.0f}k"
 
 
-def threads_table(sizes, rounds: int, backends=("llvm", "kernel"), conditions=("quiet", "busy")) -> None:
+def threads_table(sizes, rounds: int, backends=("llvm", "kernel"), conditions=("quiet", "busy"),
+                  outputs=("fresh", "out=")) -> None:
     """The table (markdown) of every condition, backend, size and output mode."""
     an = analyse(load_mechanism(MECHS / "bendix_wrist.yaml"))
     print(f"\n## Threads: Bendix wrist, jobs 1 / 2 / default interleaved, medians of {rounds} rounds "
@@ -105,7 +106,7 @@ def threads_table(sizes, rounds: int, backends=("llvm", "kernel"), conditions=("
         try:
             for backend in available(an, list(backends)):
                 for n in sizes:
-                    for reuse in (False, True):
+                    for reuse in [o == "out=" for o in outputs]:
                         with threadpool_limits(limits=1, user_api="blas"):
                             r = interleaved(calls(an, backend, n, reuse), n, rounds)
                         print(f"| {cond} | {backend} | {n:,} | {'out=' if reuse else 'fresh'} | {fmt(r[1])} | "
@@ -123,9 +124,11 @@ def main() -> None:
     ap.add_argument("--sizes", default="20000,200000", help="comma list of sample counts")
     ap.add_argument("--backends", default="llvm,kernel", help="comma list: llvm, kernel")
     ap.add_argument("--conditions", default="quiet,busy", help="comma list: quiet, busy")
+    ap.add_argument("--outputs", default="fresh,out=", help="comma list: fresh, out= (an older gearcli: fresh)")
     a = ap.parse_args()
     print(f"# gearcli threads, {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; {load_line()} at start")
-    threads_table([int(s) for s in a.sizes.split(",")], a.rounds, a.backends.split(","), a.conditions.split(","))
+    threads_table([int(s) for s in a.sizes.split(",")], a.rounds, a.backends.split(","), a.conditions.split(","),
+                  a.outputs.split(","))
     print("\n" + load_line() + " at end")
 
 
