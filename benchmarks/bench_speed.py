@@ -358,6 +358,8 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 from gearcli import analyse, load_mechanism, solve
 n, backend = int(sys.argv[1]), sys.argv[2]
+reuse = backend.endswith("+out")         # stream: every chunk into the same output arrays
+backend = backend.removesuffix("+out")
 kw = {"jobs": 1} if backend == "default" else {"backend": backend, "jobs": 1}
 an = analyse(load_mechanism(sys.argv[3]))
 rng = np.random.default_rng(3)
@@ -368,12 +370,13 @@ q, qd, qdd = (rng.uniform(-1.5, 1.5, size=(step, an.dof)) for _ in range(3))
 rounds = max(5, 200_000 // n) if n < 100_000 else 1
 with threadpool_limits(limits=1, user_api="blas"):
     solve(an, q[:100], qd[:100], qdd[:100], **kw)
+    out = solve(an, q, qd, qdd, **kw) if reuse else None
     times = []
     for _ in range(rounds):
         t0 = time.perf_counter()
         for s in range(0, n, step):
             m = min(step, n - s)
-            res = solve(an, q[:m], qd[:m], qdd[:m], **kw)
+            res = solve(an, q[:m], qd[:m], qdd[:m], **kw, **({"out": out} if reuse and m == step else {}))
             del res
         times.append(time.perf_counter() - t0)
 print(float(np.median(times)))
@@ -381,10 +384,12 @@ print(float(np.median(times)))
 
 
 def samples_section(sizes) -> None:
-    backends = ((("llvm",) if "llvm" in BACKENDS else ()) + ("kernel", "numpy")) if "backend" in SOLVE_PARAMS else ("default",)
+    backends = ((("llvm", "llvm+out") if "llvm" in BACKENDS else ()) + ("kernel", "numpy")) if "backend" in SOLVE_PARAMS \
+        else ("default",)
     print("\n## Per-sample cost and peak memory against the number of samples (Bendix wrist, library solve, "
           "one thread, in chunks of 100,000 generated samples, each N in a fresh process; below 1e5 the median "
-          "of repeated solves covering 2e5 samples)\n")
+          "of repeated solves covering 2e5 samples; 'llvm+out': every chunk written into the same Result, "
+          "solve(..., out=res), as a streaming user does)\n")
     print("| samples | " + " | ".join(f"{b} us/sample | {b} peak memory" for b in backends)
           + " |\n|---|" + "---|---|" * len(backends))
     for n in sizes:
