@@ -9,6 +9,15 @@ from typer.testing import CliRunner
 MECH_DIR = Path(__file__).resolve().parents[1] / "mechanisms"
 
 
+@pytest.fixture(scope="session", autouse=True)
+def _own_kernel_cache(tmp_path_factory):
+    """The llvm kernels' disk cache of this test session: a fresh folder, not the user's."""
+    mp = pytest.MonkeyPatch()
+    mp.setenv("GEARCLI_CACHE_DIR", str(tmp_path_factory.mktemp("gearcli-cache")))
+    yield
+    mp.undo()
+
+
 @pytest.fixture(scope="session")
 def mech_dir() -> Path:
     """The directory of the bundled mechanism files."""

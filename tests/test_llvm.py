@@ -34,10 +34,12 @@ def test_compiled_once_per_solver_and_kept():
     assert solver_for(an).llvm_kernel() is k
 
 
-def test_auto_policy(monkeypatch):
+def test_auto_policy(monkeypatch, tmp_path):
     """"auto" takes llvm once compiled, or when its estimated compile time is at most what
     the numba kernel costs extra for the call (its start when not loaded, then ~1 us a
-    sample more than llvm); a large mechanism (40 links) keeps the kernel for a small call."""
+    sample more than llvm); a large mechanism (40 links) keeps the kernel for a small call
+    (an empty disk cache: nothing compiled before; see test_llvm_cache.py for a full one)."""
+    monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path))
     import gearcli.dynamics.kernel  # noqa: F401, PLC0415  (the numba kernel loaded)
     an = analyse(load_mechanism(MECH / "helical_reduction.yaml"))
     sol = solver_for(an)

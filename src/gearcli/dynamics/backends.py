@@ -1,7 +1,8 @@
 """Which implementation a solve takes: "llvm", "kernel" (numba) or "numpy" (the reference).
 
 "auto" follows a cost model: the generated llvm kernel is compiled once per analysis
-(:class:`~.llvm_driver.LlvmKernel`; ~0.15-0.3 s for 5-10 links, ~4 s for Talos' 44) and
+(:class:`~.llvm_driver.LlvmKernel`; ~0.15-0.3 s for 5-10 links, ~4 s for Talos' 44, or
+0.02-0.4 s when its machine code is in the disk cache, :func:`llvm_on_disk`) and
 then saves about :data:`SAVED_SECONDS_PER_SAMPLE` a sample against the numba kernel,
 whose first use in a process costs :data:`NUMBA_START_SECONDS` (import and its disk
 cache).  So "auto" takes llvm once it is compiled, or when its estimated compile time
@@ -21,10 +22,21 @@ NUMBA_START_SECONDS = 0.4          # import numba and load the cached kernel (me
 SAVED_SECONDS_PER_SAMPLE = 1e-6    # numba kernel minus llvm kernel, a sample (measured: 0.8-1.3 us)
 
 
-def llvm_compile_estimate(an) -> float:
+def llvm_compile_estimate(an, on_disk: bool = False) -> float:
     """Rough seconds to generate and compile the llvm kernel of ``an`` (measured: 0.14 s
-    for 5 moving links, 0.25 s for 8, 4.4 s for 44; superlinear in the code size)."""
-    return 0.015 * len(an.tree.moving) ** 1.5
+    for 5 moving links, 0.25 s for 8, 4.4 s for 44; superlinear in the code size), or with
+    ``on_disk`` (its machine code in the disk cache, :mod:`.llvm_cache`) to generate the IR
+    and load the code (measured: 0.02 s for 5 links, 0.04 s for 8, 0.4 s for 44)."""
+    n = len(an.tree.moving)
+    return 0.0012 * n ** 1.6 if on_disk else 0.015 * n ** 1.5
+
+
+def llvm_on_disk(sol) -> bool:
+    """True when the llvm kernel of the :class:`~.solve.Solver` ``sol`` is in the disk cache
+    for this host (keyed by its kernel program, so the IR need not be built to know)."""
+    from .llvm_driver import kernel_on_disk  # noqa: PLC0415  (llvmlite: imported by llvm_available)
+
+    return kernel_on_disk(sol.kernel_program(), sol.an)
 
 
 @lru_cache(maxsize=1)
@@ -47,7 +59,7 @@ def _auto_llvm(sol, n: int | None) -> bool:
         return True
     numba_extra = 0.0 if "gearcli.dynamics.kernel" in sys.modules else NUMBA_START_SECONDS
     seen = n + sol.samples_solved          # a long run in many calls (the CLI's chunks) pays too
-    return llvm_compile_estimate(sol.an) <= numba_extra + seen * SAVED_SECONDS_PER_SAMPLE
+    return llvm_compile_estimate(sol.an, llvm_on_disk(sol)) <= numba_extra + seen * SAVED_SECONDS_PER_SAMPLE
 
 
 def choose(sol, method: str, backend: str, n: int | None) -> str:

@@ -1,0 +1,166 @@
+"""The disk cache of the llvm kernels' machine code (dynamics/llvm_cache.py, Jit): a fresh
+process loads what another compiled, bitwise the same results as compiling in memory;
+corrupted, truncated or unwritable caches fall back to compiling; keys tell hosts apart."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("llvmlite")
+
+from big_mechanisms import serial_chain  # noqa: E402
+from gearcli import analyse, load_mechanism, parse_mechanism  # noqa: E402
+from gearcli.dynamics import backends, llvm_cache  # noqa: E402
+from gearcli.dynamics.solve import solve, solver_for  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+BENDIX = ROOT / "mechanisms" / "bendix_wrist.yaml"
+
+# A fresh process: solve 200 random samples with the llvm kernel (cache on or off), print
+# whether its code came from the cache, was stored, and every output array's bytes (hex).
+CHILD = """
+import json, sys, numpy as np
+from gearcli import analyse, load_mechanism
+from gearcli.dynamics.solve import solve, solver_for
+from gearcli.dynamics import llvm_driver
+if sys.argv[2] == "off":
+    jit = llvm_driver.Jit
+    llvm_driver.Jit = lambda module: jit(module, cache=False)
+an = analyse(load_mechanism(sys.argv[1]))
+rng = np.random.default_rng(7)
+q, qd, qdd = (rng.uniform(-2, 2, (200, an.dof)) for _ in range(3))
+r = solve(an, q, qd, qdd, backend="llvm", jobs=1)
+k = solver_for(an).llvm_kernel()
+arrays = {k2: v.tobytes().hex() for k2, v in sorted(vars(r).items()) if isinstance(v, np.ndarray)}
+print(json.dumps({"from_cache": k.jit.from_cache, "stored": k.jit.stored, "arrays": arrays}))
+"""
+
+
+def run_child(cache_dir, mode: str = "on") -> dict:
+    env = {"PYTHONPATH": str(ROOT / "src"), "PATH": "/usr/bin:/bin", "GEARCLI_CACHE_DIR": str(cache_dir)}
+    out = subprocess.run([sys.executable, "-c", CHILD, str(BENDIX), mode], capture_output=True, text=True,
+                         env=env, check=True)
+    assert out.stderr == ""                      # no warning, no traceback, whatever the cache
+    return json.loads(out.stdout)
+
+
+def objects(cache_dir) -> list[Path]:
+    return sorted((Path(cache_dir) / "llvm").glob("*.obj"))
+
+
+def test_second_process_loads_from_the_cache(tmp_path):
+    """First process compiles and stores, second loads (no LLVM pass), a third with the
+    cache off compiles in memory: the three give bitwise identical results."""
+    first, second = run_child(tmp_path), run_child(tmp_path)
+    memory = run_child(tmp_path / "unused", "off")
+    assert (first["from_cache"], first["stored"]) == (False, True)
+    assert (second["from_cache"], second["stored"]) == (True, False)
+    assert (memory["from_cache"], memory["stored"]) == (False, False)
+    assert not (tmp_path / "unused").exists()
+    assert len(first["arrays"]) > 3 and first["arrays"] == second["arrays"] == memory["arrays"]
+    assert len(objects(tmp_path)) == 1
+
+
+@pytest.mark.parametrize("damage", ["flip a byte", "truncate", "empty", "header only"])
+def test_a_damaged_entry_is_recompiled(tmp_path, damage):
+    reference = run_child(tmp_path)
+    (obj,) = objects(tmp_path)
+    data = bytearray(obj.read_bytes())
+    if damage == "flip a byte":
+        data[len(data) // 2] ^= 0x40
+    elif damage == "truncate":
+        data = data[: len(data) - 100]
+    elif damage == "empty":
+        data = bytearray()
+    else:
+        data = data[: len(llvm_cache.MAGIC) + 40]
+    obj.write_bytes(bytes(data))
+    again = run_child(tmp_path)
+    assert (again["from_cache"], again["stored"]) == (False, True)
+    assert again["arrays"] == reference["arrays"]
+    assert run_child(tmp_path)["from_cache"] is True       # the rewritten entry is whole
+
+
+@pytest.mark.skipif(hasattr(os, "geteuid") and os.geteuid() == 0, reason="root writes anywhere")
+def test_a_read_only_dir_compiles_in_memory(tmp_path):
+    (tmp_path / "llvm").mkdir()
+    os.chmod(tmp_path / "llvm", 0o500)
+    try:
+        got = run_child(tmp_path)
+    finally:
+        os.chmod(tmp_path / "llvm", 0o700)
+    assert (got["from_cache"], got["stored"]) == (False, False)
+
+
+@pytest.mark.parametrize("where", ["a file, not a folder", "below a file", "/proc: no folder can be made"])
+def test_an_unusable_location_compiles_in_memory(tmp_path, where):
+    """Works as root too (a file in the way cannot be a folder)."""
+    (tmp_path / "f").write_text("x")
+    cache = {"a file, not a folder": tmp_path / "f", "below a file": tmp_path / "f" / "deeper",
+             "/proc: no folder can be made": Path("/proc/gearcli-test")}[where]
+    got = run_child(cache)
+    assert (got["from_cache"], got["stored"]) == (False, False)
+    assert run_child(tmp_path / "ok")["arrays"] == got["arrays"]
+
+
+def test_keys_depend_on_ir_and_host():
+    ir = "define i64 @f() {\n  ret i64 1\n}\n"
+    host = "x86_64-unknown-linux-gnu|znver3|+avx2,+fma|0.44.0|(20, 1, 0)"
+    key = llvm_cache.object_key(ir, host)
+    assert len(key) == 64 and key == llvm_cache.object_key(ir, host)
+    assert key != llvm_cache.object_key(ir.replace("1", "2"), host)
+    assert key != llvm_cache.object_key(ir, host.replace("+avx2", "-avx2"))
+    assert key != llvm_cache.object_key(ir, host.replace("znver3", "skylake"))
+    assert key != llvm_cache.object_key(ir, host.replace("0.44.0", "0.45.0"))
+
+
+def test_program_key_follows_the_program_and_loads():
+    from gearcli.dynamics.llvm_driver import host_identity, mech_loads  # noqa: PLC0415
+
+    a, b = (solver_for(analyse(parse_mechanism(serial_chain(n)))) for n in (3, 3))
+    other = solver_for(analyse(parse_mechanism(serial_chain(4))))
+    host = host_identity()
+    key = llvm_cache.program_key(a.kernel_program(), mech_loads(a.an), host, "1")
+    assert key == llvm_cache.program_key(b.kernel_program(), mech_loads(b.an), host, "1")
+    assert key != llvm_cache.program_key(other.kernel_program(), mech_loads(other.an), host, "1")
+    assert key != llvm_cache.program_key(a.kernel_program(), mech_loads(a.an), host + "x", "1")
+    assert key != llvm_cache.program_key(a.kernel_program(), [(1, True, np.zeros(3))], host, "1")
+
+
+def test_auto_counts_a_cached_kernel_as_cheap(tmp_path, monkeypatch):
+    """A 15-link chain: estimated compile ~0.9 s, more than starting numba, so "auto" takes
+    the numba kernel for 10 samples; once its code is on disk (another analysis compiled
+    it) the estimate is ~0.1 s and "auto" takes llvm."""
+    monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path))
+    monkeypatch.delitem(sys.modules, "gearcli.dynamics.kernel", raising=False)
+    monkeypatch.setattr(backends, "numba_kernel_problem", lambda: None)
+    first = solver_for(analyse(parse_mechanism(serial_chain(15))))
+    assert not backends.llvm_on_disk(first)
+    assert backends.llvm_compile_estimate(first.an) > backends.NUMBA_START_SECONDS
+    assert first.backend(n=10) == "kernel"
+    q = np.zeros((2, first.an.dof))
+    solve(first.an, q, q, q, backend="llvm")
+    second = solver_for(analyse(parse_mechanism(serial_chain(15))))
+    assert backends.llvm_on_disk(second)
+    assert backends.llvm_compile_estimate(second.an, on_disk=True) < 0.2
+    assert second.backend(n=10) == "llvm"
+    assert second.llvm_kernel().jit.from_cache
+
+
+def test_prune_keeps_the_newest(tmp_path):
+    for i in range(6):
+        (tmp_path / f"{i:064x}.obj").write_bytes(b"x" * 100)
+        os.utime(tmp_path / f"{i:064x}.obj", (1000 + i, 1000 + i))
+    (tmp_path / ".tmp-a.part").write_bytes(b"")
+    os.utime(tmp_path / ".tmp-a.part", (1, 1))
+    llvm_cache.prune(tmp_path, max_entries=4, max_bytes=10**6)
+    assert sorted(p.stem[-1] for p in tmp_path.glob("*.obj")) == ["2", "3", "4", "5"]
+    llvm_cache.prune(tmp_path, max_entries=10, max_bytes=250)
+    assert sorted(p.stem[-1] for p in tmp_path.glob("*.obj")) == ["4", "5"]
+    assert not (tmp_path / ".tmp-a.part").exists()
