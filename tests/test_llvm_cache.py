@@ -157,10 +157,10 @@ def test_prune_keeps_the_newest(tmp_path):
     for i in range(6):
         (tmp_path / f"{i:064x}.obj").write_bytes(b"x" * 100)
         os.utime(tmp_path / f"{i:064x}.obj", (1000 + i, 1000 + i))
-    (tmp_path / ".tmp-a.part").write_bytes(b"")
-    os.utime(tmp_path / ".tmp-a.part", (1, 1))
+    (tmp_path / ".gearcli.a.tmp").write_bytes(b"")
+    os.utime(tmp_path / ".gearcli.a.tmp", (1, 1))
     llvm_cache.prune(tmp_path, max_entries=4, max_bytes=10**6)
     assert sorted(p.stem[-1] for p in tmp_path.glob("*.obj")) == ["2", "3", "4", "5"]
     llvm_cache.prune(tmp_path, max_entries=10, max_bytes=250)
     assert sorted(p.stem[-1] for p in tmp_path.glob("*.obj")) == ["4", "5"]
-    assert not (tmp_path / ".tmp-a.part").exists()
+    assert not (tmp_path / ".gearcli.a.tmp").exists()

@@ -9,8 +9,9 @@ optimising and generating it again.  The cache dir is ``$GEARCLI_CACHE_DIR`` if 
 
 * A location that cannot be created or written is no error: the kernel is compiled in
   memory as without a cache (every failure of this module is silent, by design).
-* Writes are atomic (a temporary file in the same folder, then :func:`os.replace`):
-  concurrent processes or threads storing the same key each leave a whole entry.
+* Writes are atomic (:func:`gearcli.io.output.atomic_output`: an anonymous file in the
+  same folder, named when whole): concurrent processes or threads storing the same key
+  each leave a whole entry.
 * An entry holds :data:`MAGIC`, its payload's length and SHA-256 before the payload; one
   that does not match (truncated, corrupted) is deleted and the kernel recompiled.
 * Bounded: after a write the oldest entries (by modification time, which a hit renews)
@@ -24,11 +25,12 @@ from __future__ import annotations
 
 import hashlib
 import os
-import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+
+from ..io.output import OutputError, atomic_output
 
 FORMAT = 1                          # ours: change when the entry layout or the key changes
 MAGIC = b"gearcli-llvm-obj\x00"
@@ -97,16 +99,10 @@ def _write(path: Path, data: bytes) -> bool:
     """``data`` into ``path`` atomically (False where that fails)."""
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".tmp-", suffix=".part")
-    except OSError:
-        return False
-    try:
-        with os.fdopen(fd, "wb") as f:
+        with atomic_output(path, binary=True) as f:
             f.write(data)
-        os.replace(tmp, path)
         return True
-    except OSError:
-        _remove(Path(tmp))
+    except (OSError, OutputError):
         return False
 
 
@@ -155,7 +151,7 @@ def prune(d: Path, max_entries: int = MAX_ENTRIES, max_bytes: int = MAX_BYTES) -
             if kept > max_entries or size > max_bytes:
                 _remove(path)
     for mtime, _, path in files:
-        if path.suffix == ".part" and now - mtime > _STALE_TEMP_SECONDS:
+        if path.name.startswith(".gearcli.") and now - mtime > _STALE_TEMP_SECONDS:
             _remove(path)
 
 
