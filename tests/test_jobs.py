@@ -1,6 +1,8 @@
 """The persistent worker pool of the compiled backends (:func:`gearcli.dynamics.jobs.run_parts`)."""
 from __future__ import annotations
 
+import multiprocessing
+import os
 import threading
 import time
 
@@ -56,3 +58,18 @@ def test_an_error_in_a_part_is_raised():
     with pytest.raises(RuntimeError, match="part"):
         run_parts(task, job_ranges(40_000, 2), 2)
     assert run_parts(lambda s, e, _: 1, job_ranges(40_000, 2), 2) == len(job_ranges(40_000, 2))
+
+
+def _threads_used(_=None) -> int:
+    log: list = []
+    run_parts(_recording(log), job_ranges(40_000, 2), 2)
+    return len({ident for _, _, ident, _ in log})
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="no fork here")
+def test_a_forked_child_gets_its_own_workers():
+    """The parent's pool threads do not exist in a forked child (a process pool): without a
+    new pool there the caller would do every part alone."""
+    assert _threads_used() == 2               # the parent's pool exists before the fork
+    with multiprocessing.get_context("fork").Pool(1) as pool:
+        assert pool.map(_threads_used, [0]) == [2]

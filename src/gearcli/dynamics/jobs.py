@@ -69,6 +69,16 @@ def _pool(workers: int) -> ThreadPoolExecutor:
         return _POOL
 
 
+def _forget_pool() -> None:
+    """In a forked child: the parent's pool threads do not exist there; start a new pool."""
+    global _POOL, _POOL_LOCK
+    _POOL, _POOL_LOCK = None, threading.Lock()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forget_pool)
+
+
 def run_parts(task, ranges: list, threads: int, local=lambda: None) -> int:
     """Run ``task(start, stop, state)`` over every range on ``threads`` threads; the sum
     of what the calls return.
