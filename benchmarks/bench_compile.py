@@ -1,25 +1,33 @@
 """What the generated llvm kernel costs to make, against the numba kernel's start; prints figures.
 
-    python benchmarks/bench_compile.py [--repeat 3]
+    python benchmarks/bench_compile.py [--repeat 3] [--startup-repeat 5]
 
 Per mechanism (paper_2dof, Bendix wrist, planetary_3p, UR5, Panda, Talos full), each
 measurement in a fresh Python process (medians over --repeat): the llvm kernel's IR
 generation and LLVM optimisation + machine code (``LlvmKernel.build_seconds``,
 ``compile_seconds``), the size of its IR, the first ``solve(backend="llvm")`` of 100
 samples (import of llvmlite included) and the first ``solve(backend="kernel")`` of 100
-samples (numba import and its compiled code from the disk cache), and the estimate
-"auto" uses (:func:`gearcli.dynamics.backends.llvm_compile_estimate`).  Load average at
-the start and the end.
+samples (numba import and its compiled code from the disk cache), and the estimates
+"auto" uses (:func:`gearcli.dynamics.backends.llvm_compile_estimate`, without and with the
+kernel on disk).  "cold": each process with an empty llvm disk cache (its own
+``GEARCLI_CACHE_DIR``); "cached": a fresh process whose cache holds the kernel (stored by
+the cold runs): the IR is still built, the O3 passes and code generation are a load.  Then
+the wall time of ``gearcli solve MECH traj.csv -o out.parquet`` on 100 samples (backend
+auto, fresh processes, cold and cached runs interleaved, medians).  Load average at the
+start and the end.
 """
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
+from cli_stages import startup_time  # noqa: E402 (benchmarks/cli_stages.py)
 from timing import load_line  # noqa: E402 (benchmarks/timing.py)
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -37,11 +45,11 @@ q = np.zeros((100, an.dof))
 t1 = time.perf_counter()
 solve(an, q, q, q, backend=backend, jobs=1)
 t2 = time.perf_counter()
-out = {"first": t2 - t1, "estimate": llvm_compile_estimate(an)}
+out = {"first": t2 - t1, "estimate": llvm_compile_estimate(an), "on_disk": llvm_compile_estimate(an, True)}
 if backend == "llvm":
     k = solver_for(an).llvm_kernel()
     out.update(build=k.build_seconds, compile=k.compile_seconds, ir_kb=len(k.jit.ir) / 1e3,
-               instructions=k.jit.ir.count("\\n  %"))
+               instructions=k.jit.ir.count("\\n  %"), from_cache=k.jit.from_cache)
 print(json.dumps(out))
 """
 
@@ -57,29 +65,64 @@ def subjects() -> list[tuple[str, Path]]:
     return out
 
 
-def child(path: Path, backend: str) -> dict:
+def child(path: Path, backend: str, cache: Path) -> dict:
     r = subprocess.run([sys.executable, "-c", CHILD, str(path), backend], capture_output=True, text=True, check=True,
-                       env={"PYTHONPATH": str(ROOT / "src"), "PATH": "/usr/bin:/bin"})
+                       env={"PYTHONPATH": str(ROOT / "src"), "PATH": "/usr/bin:/bin", "GEARCLI_CACHE_DIR": str(cache)})
     return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+def llvm_runs(path: Path, repeat: int, tmp: Path) -> tuple[dict, dict]:
+    """Medians of ``repeat`` cold processes (each an empty cache) and ``repeat`` cached ones."""
+    cold = [child(path, "llvm", tmp / f"cold{i}") for i in range(repeat)]
+    warm = [child(path, "llvm", tmp / "cold0") for _ in range(repeat)]
+    assert not any(r["from_cache"] for r in cold) and all(r["from_cache"] for r in warm)
+    return ({k: float(np.median([r[k] for r in runs])) for k in runs[0]} for runs in (cold, warm))
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--startup-repeat", type=int, default=5)
     args = ap.parse_args()
     print(f"# llvm kernel: compile cost, fresh processes, medians of {args.repeat}\n{load_line()} at start\n")
-    print("| mechanism | moving links | IR build | LLVM (O3) | IR size | instructions | first llvm solve | "
-          "first kernel solve (numba cache) | auto's estimate |\n|---|---|---|---|---|---|---|---|---|")
+    print("| mechanism | moving links | IR build | LLVM (O3), cold | IR text + load, cached | IR size | instructions | "
+          "first llvm solve, cold | first llvm solve, cached | first kernel solve (numba cache) | "
+          "auto's estimate, cold / cached |\n|---|---|---|---|---|---|---|---|---|---|---|")
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, path in subjects():
+            med, warm = llvm_runs(path, args.repeat, Path(tmp) / name)
+            kern = [child(path, "kernel", Path(tmp) / name / "cold0")["first"] for _ in range(args.repeat)]
+            from gearcli import analyse, load_mechanism  # noqa: PLC0415
+            links = len(analyse(load_mechanism(path)).tree.moving)
+            print(f"| {name} | {links} | {med['build']:.3f} s | {med['compile']:.3f} s | {warm['compile']:.3f} s | "
+                  f"{med['ir_kb']:.0f} kB | {med['instructions']:.0f} | {med['first']:.2f} s | {warm['first']:.2f} s | "
+                  f"{np.median(kern):.2f} s | {med['estimate']:.2f} / {med['on_disk']:.2f} s |", flush=True)
+    print(f"\n{load_line()}\n\n| `gearcli solve`, 100 samples | cold cache | cached | cached / cold |\n|---|---|---|---|")
     for name, path in subjects():
-        runs = [child(path, "llvm") for _ in range(args.repeat)]
-        kern = [child(path, "kernel")["first"] for _ in range(args.repeat)]
-        med = {k: float(np.median([r[k] for r in runs])) for k in runs[0]}
-        from gearcli import analyse, load_mechanism  # noqa: PLC0415
-        links = len(analyse(load_mechanism(path)).tree.moving)
-        print(f"| {name} | {links} | {med['build']:.3f} s | {med['compile']:.3f} s | {med['ir_kb']:.0f} kB | "
-              f"{med['instructions']:.0f} | {med['first']:.2f} s | {np.median(kern):.2f} s | {med['estimate']:.2f} s |",
-              flush=True)
+        if name in ("paper_2dof", "bendix_wrist", "Panda", "Talos full"):
+            cold, warm = startup_pair(path, args.startup_repeat)
+            print(f"| {name} | {cold:.2f} s | {warm:.2f} s | {warm / cold:.2f} |", flush=True)
     print(f"\n{load_line()} at end")
+
+
+def startup_pair(path: Path, repeat: int) -> tuple[float, float]:
+    """Median wall times of the command with an empty cache and with the kernel cached."""
+    from gearcli import analyse, load_mechanism  # noqa: PLC0415
+    names = analyse(load_mechanism(path)).independent_names
+    t = np.linspace(0.0, 1.0, 101)
+    q = 0.5 * np.sin(np.outer(t, np.arange(1, len(names) + 1)))
+    times = {"cold": [], "cached": []}
+    with tempfile.TemporaryDirectory() as d:
+        traj = Path(d) / "traj.csv"
+        np.savetxt(traj, np.column_stack([t, q]), delimiter=",", header=",".join(["t"] + [f"q:{n}" for n in names]),
+                   comments="")
+        child(path, "llvm", Path(d) / "warm")           # the kernel on disk (the command's auto decides)
+        for i in range(repeat):
+            for kind, cache in (("cold", Path(d) / f"cold{i}"), ("cached", Path(d) / "warm")):
+                os.environ["GEARCLI_CACHE_DIR"] = str(cache)
+                times[kind].append(startup_time(path, traj))
+        del os.environ["GEARCLI_CACHE_DIR"]
+    return float(np.median(times["cold"])), float(np.median(times["cached"]))
 
 
 if __name__ == "__main__":
