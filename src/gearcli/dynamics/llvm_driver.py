@@ -2,7 +2,8 @@
 
 LLVM through llvmlite: the IR is optimised at O3 for the host CPU (new pass manager) and
 compiled by MCJIT in memory, once per :class:`~.solve.Solver` (:class:`LlvmKernel` keeps
-the engine alive: freeing it frees the code).  Called through ctypes, which releases the
+the engine alive: freeing it frees the code); the machine code is also kept on disk
+(:mod:`.llvm_cache`), so a later process generating the same IR loads it instead.  Called through ctypes, which releases the
 GIL: the threads of :mod:`.jobs` run the samples in parallel, each sample's arithmetic
 independent of the split (bitwise identical results for any number of jobs).
 """
