@@ -22,7 +22,7 @@ from gearcli.dynamics.solve import solve, solver_for  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 BENDIX = ROOT / "mechanisms" / "bendix_wrist.yaml"
 
-# A fresh process: solve 200 random samples with the llvm kernel (cache on or off), print
+# A fresh process: solve 200 random samples (one with angles of 3e5 rad) with the llvm kernel (cache on or off), print
 # whether its code came from the cache, was stored, and every output array's bytes (hex).
 CHILD = """
 import json, sys, numpy as np
@@ -35,6 +35,7 @@ if sys.argv[2] == "off":
 an = analyse(load_mechanism(sys.argv[1]))
 rng = np.random.default_rng(7)
 q, qd, qdd = (rng.uniform(-2, 2, (200, an.dof)) for _ in range(3))
+q[0] = 3e5                       # beyond the inline sin/cos: calls libm (a relocation in the object code)
 r = solve(an, q, qd, qdd, backend="llvm", jobs=1)
 k = solver_for(an).llvm_kernel()
 arrays = {k2: v.tobytes().hex() for k2, v in sorted(vars(r).items()) if isinstance(v, np.ndarray)}
@@ -109,6 +110,26 @@ def test_an_unusable_location_compiles_in_memory(tmp_path, where):
     assert run_child(tmp_path / "ok")["arrays"] == got["arrays"]
 
 
+def test_concurrent_first_processes_both_store(tmp_path):
+    """Two processes compiling the same kernel into an empty cache at once: both store
+    (atomically), the entry left is whole, the results agree."""
+    env = {"PYTHONPATH": str(ROOT / "src"), "PATH": "/usr/bin:/bin", "GEARCLI_CACHE_DIR": str(tmp_path)}
+    procs = [subprocess.Popen([sys.executable, "-c", CHILD, str(BENDIX), "on"], stdout=subprocess.PIPE, env=env,
+                              text=True) for _ in range(2)]
+    outs = [json.loads(p.communicate()[0]) for p in procs]
+    assert [p.returncode for p in procs] == [0, 0]
+    assert outs[0]["arrays"] == outs[1]["arrays"]
+    assert len(objects(tmp_path)) == 1 and not list((tmp_path / "llvm").glob(".gearcli.*"))
+    assert run_child(tmp_path)["from_cache"] is True
+
+
+def test_host_identity_names_cpu_and_features():
+    from gearcli.dynamics.llvm_driver import _host, host_identity  # noqa: PLC0415
+
+    cpu, features = _host()
+    assert f"|{cpu}|{features}|" in host_identity() and cpu
+
+
 def test_keys_depend_on_ir_and_host():
     ir = "define i64 @f() {\n  ret i64 1\n}\n"
     host = "x86_64-unknown-linux-gnu|znver3|+avx2,+fma|0.44.0|(20, 1, 0)"
@@ -151,6 +172,7 @@ def test_auto_counts_a_cached_kernel_as_cheap(tmp_path, monkeypatch):
     assert backends.llvm_compile_estimate(second.an, on_disk=True) < 0.2
     assert second.backend(n=10) == "llvm"
     assert second.llvm_kernel().jit.from_cache
+    assert "run:" in second.llvm_kernel().jit.assembly()    # optimised again on demand
 
 
 def test_prune_keeps_the_newest(tmp_path):
