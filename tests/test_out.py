@@ -66,6 +66,11 @@ def test_out_of_another_shape_is_refused(backend):
     with pytest.raises(ValueError, match="out.tau .*float64"):
         solve(an, q, qd, qdd, backend=backend, out=res)
     res = solve(an, q, qd, qdd)
+    with pytest.raises(ValueError, match="out.tau shares memory with q"):
+        solve(an, res.tau, qd, qdd, backend=backend, out=res)      # tau (N, dof) like q
+    res.motor_speed = res.motor[::-1][::-1]                        # a view of motor
+    with pytest.raises(ValueError, match="out.motor shares memory with out.motor_speed"):
+        solve(an, q, qd, qdd, backend=backend, out=res)
     res.motor_speed = None
     with pytest.raises(ValueError, match="out.motor_speed is NoneType"):
         solve(an, q, qd, qdd, backend=backend, out=res)

@@ -176,12 +176,13 @@ class Solver:
             raise ValueError(f"unknown method '{method}' (expected 'block' or 'full')")
         if chunk < 1:
             raise ValueError(f"chunk must be at least 1, got {chunk}")
+        values = load_values(self.an.mech, q.shape[0], loads)
         if out is not None:
-            check_out(self.an, q.shape[0], out)
+            check_out(self.an, q.shape[0], out, {"q": q, "qd": qd, "qdd": qdd,
+                                                  **{f"load '{k}'": v for k, v in values.items()}})
         path = self.backend(method, backend, q.shape[0])
         if method == "block":
             self.samples_solved += q.shape[0]
-        values = load_values(self.an.mech, q.shape[0], loads)
         if path != "numpy" and not verify:     # no BLAS call: the limit would cost ~30 us a call
             return self._by_kernel(path, q, qd, qdd, values, jobs, chunk, verify, out)
         # the operands are 3x3 to 48x48 matrices: BLAS threads only contend (2-3x slower
@@ -305,7 +306,8 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
         Threads a compiled kernel splits the samples over (contiguous ranges; results
         bitwise identical for any number); None: every usable core.  The numpy path uses one.
     out : Result, optional
-        A result of this mechanism with as many samples (e.g. the previous call's, when
+        A result of this mechanism with as many samples (its arrays float64, C-ordered,
+        writeable, apart from each other and from the inputs; e.g. the previous call's, when
         streaming a trajectory in equal blocks): its arrays are overwritten with this
         call's results (in place by the compiled kernels; copied by the numpy path) and
         ``out`` itself is returned (if the call raises, ``out``'s contents are undefined).
