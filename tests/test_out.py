@@ -93,3 +93,23 @@ def test_out_after_a_sign_error(backend):
     solve(an, q, qd, qdd, backend=backend, jobs=2, out=out)
     for f in FIELDS:
         assert np.array_equal(getattr(out, f), getattr(fresh, f)), f
+
+
+@pytest.mark.parametrize("backend", ["kernel", "llvm"])
+def test_callers_on_several_threads_share_the_pool(backend):
+    """Two threads solving at once (one pool: a caller whose worker is taken does the parts
+    itself), each into its own out: the numbers of one-thread solves."""
+    from concurrent.futures import ThreadPoolExecutor   # noqa: PLC0415
+    an = analyse(mechanism("bendix_wrist.yaml"))
+    trajs = [trajectory(an, 9_000, seed=s) for s in (11, 12)]
+    refs = [solve(an, *t, backend=backend, jobs=1) for t in trajs]
+    outs = [solve(an, *t, backend=backend, jobs=1) for t in trajs[::-1]]
+
+    def stream(i):
+        for _ in range(4):
+            solve(an, *trajs[i], backend=backend, jobs=2, out=outs[i])
+    with ThreadPoolExecutor(2) as callers:
+        list(callers.map(stream, [0, 1]))
+    for ref, out in zip(refs, outs):
+        for f in FIELDS:
+            assert np.array_equal(getattr(out, f), getattr(ref, f)), f
