@@ -107,6 +107,28 @@ def test_reader_reports_the_same_error_with_and_without_the_fast_parser(tmp_path
     assert messages[0] == messages[1] and ":2502:" in messages[0], messages
 
 
+@pytest.mark.parametrize("row", [0, 1000])
+def test_a_byte_order_mark_opening_a_chunk_is_not_a_number(tmp_path, monkeypatch, row):
+    """pyarrow silently drops a UTF-8 byte-order mark at the start of what it parses: a data
+    row opening a chunk with one must still be refused, at its line, with or without the fast
+    parser (long fuzz, session 4: '\\ufeff1' was read as 1 there)."""
+    import gearcli.io.trajectory as trajectory
+    from gearcli.errors import TrajectoryError
+
+    t = np.arange(3000) * 1e-3
+    rows = [f"{float(a)!r},{float(np.sin(a))!r},{float(np.cos(a))!r}" for a in t]
+    rows[row] = "\ufeff" + rows[row]
+    path = tmp_path / "traj.csv"
+    path.write_text("t,q:J1,q:J2\n" + "\n".join(rows) + "\n", encoding="utf-8")
+    messages = []
+    for fast_rows in (500, 10**9):
+        monkeypatch.setattr(trajectory, "FAST_PARSE_ROWS", fast_rows)
+        with pytest.raises(TrajectoryError) as err:
+            trajectory.TrajectoryReader(path, ["J1", "J2"], chunk=1000).check()
+        messages.append(str(err.value))
+    assert messages[0] == messages[1] and f":{row + 2}:" in messages[0] and "not a number" in messages[0], messages
+
+
 ODD_LINES = ["", "  ", "\r", "1e999,0,0", "x,1,2", '"{t}",0.5,0.25', "{t},1\r,2", "{t},0.5,\u00e9",
              "{t},1,2,3", "{t};1;2", "{t},nan,0", "{t}," + "1" * 90 + ",0", "{t},1,2\r"]
 

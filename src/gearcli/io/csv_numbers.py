@@ -25,6 +25,8 @@ def parse_floats(lines: list[str], ncol: int, sep: str) -> np.ndarray | None:
 def parse_bytes(data: bytes, rows: int, ncol: int, sep: str) -> np.ndarray | None:
     """(rows, ncol) floats of the CSV text ``data`` (``rows`` lines, UTF-8, the last one
     with or without its newline), or None as :func:`parse_floats`."""
+    if data.startswith(b"\xef\xbb\xbf"):   # pyarrow drops a leading byte-order mark unseen:
+        return None                         # the cell is not a number (loadtxt says so)
     import pyarrow as pa  # noqa: PLC0415 (a dependency; imported when rows are read)
     import pyarrow.csv as pc  # noqa: PLC0415
 
