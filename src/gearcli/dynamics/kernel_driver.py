@@ -11,6 +11,7 @@ import numpy as np
 from .jobs import job_ranges, run_parts, sign_error, threads_for, usable_cores  # noqa: F401  (re-exported)
 from .kernel import run
 from .kernel_program import Program, load_arrays
+from .result_arrays import FIELDS as OUTPUTS
 
 
 def scratch(prog: Program) -> tuple:
@@ -27,9 +28,6 @@ def scratch(prog: Program) -> tuple:
             np.zeros((nL, 6)), np.zeros((J, 2)), np.zeros(J), np.zeros(J), np.zeros(J),
             np.zeros(nx), np.zeros(nx), np.ones(max([1] + [int(b) for b in brec[:, 5]])), np.zeros((nr, nx)),
             np.zeros(prog.ncols))
-
-
-OUTPUTS = ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial", "motor_speed")
 
 
 def kernel_solve(prog: Program, an, q, qd, qdd, values: dict, jobs: int | None, chunk: int, out: dict,

@@ -9,8 +9,7 @@ from __future__ import annotations
 
 from .llvm_build import Emitter
 from .llvm_links import Sample, floats
-
-OUTPUTS = ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial", "motor_speed")
+from .result_arrays import FIELDS as OUTPUTS
 
 
 def widths(prog) -> dict:
