@@ -40,7 +40,7 @@ from pathlib import Path
 
 import numpy as np
 from bench_threads import threads_table  # noqa: E402 (benchmarks/bench_threads.py)
-from cli_stages import print_stages, stage_times, startup_time  # noqa: E402 (benchmarks/cli_stages.py)
+from cli_stages import floor_times, print_floor, print_stages, stage_times, startup_time  # noqa: E402 (benchmarks/cli_stages.py)
 from timing import load_line, median_time  # noqa: E402 (benchmarks/timing.py)
 from threadpoolctl import threadpool_info, threadpool_limits
 
@@ -294,11 +294,13 @@ def cli_section(n: int, old_format: bool, repeat: int = 1) -> None:
                 label += ", CSV text by Python's `%` (the writer before issue 11)"
             rows.append((label, wall, rss, wall / lib))
         stages, startup = stage_times(mech, traj), startup_time(mech, traj)
+        floor = floor_times(int(size["out.parquet"] * 1e6), Path(d), max(repeat, 3))
     print("| run | wall time | peak memory | / library solve |\n|---|---|---|---|")
     for label, wall, rss, ratio in rows:
         print(f"| {label} | {wall:.2f} s | {'' if rss is None else f'{rss:,.0f} MB'} | "
               f"{'' if ratio is None else f'{ratio:.1f}x'} |")
     print_stages(stages, startup, {out: float(np.median([m[0] for m in measured[out]])) for out in measured}, n)
+    print_floor(floor, lib)
 
 
 def format_section(n: int, repeat: int) -> None:

@@ -16,6 +16,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
+
 from gearcli import __version__
 from gearcli.dynamics.solve import solve
 from gearcli.io.output import atomic_output
@@ -82,6 +84,41 @@ def _timed(out: dict, key: str, fn):
     r = fn()
     out[key] = out.get(key, 0.0) + time.perf_counter() - t0
     return r
+
+
+def floor_times(n_bytes: int, directory: Path, repeat: int = 3) -> dict[str, float]:
+    """Lower bounds of any ``gearcli solve`` to a binary file of ``n_bytes``, medians of
+    ``repeat``: a fresh Python importing only numpy and pyarrow.parquet (what any Parquet
+    writer in Python loads; no gearcli), and writing ``n_bytes`` of float64 from memory to a
+    new file in ``directory`` in 1 MB writes (no formatting, no pyarrow: the page-cache copy
+    alone, a new file each time like the command's temporary file)."""
+    imports, writes = [], []
+    block = np.random.default_rng(0).standard_normal(1 << 17)      # 1 MB
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-c", "import numpy, pyarrow, pyarrow.parquet"], check=True)
+        imports.append(time.perf_counter() - t0)
+        path = Path(directory) / "floor.bin"
+        t0 = time.perf_counter()
+        with open(path, "wb", buffering=0) as f:
+            left = n_bytes
+            while left > 0:
+                left -= f.write(memoryview(block).cast("B")[:min(left, block.nbytes)])
+        writes.append(time.perf_counter() - t0)
+        path.unlink()
+    return {"a fresh Python importing numpy and pyarrow.parquet": float(np.median(imports)),
+            f"writing the file's {n_bytes / 1e6:,.0f} MB from memory to a new file (1 MB writes)":
+                float(np.median(writes))}
+
+
+def print_floor(floor: dict[str, float], library: float) -> None:
+    """Markdown table of :func:`floor_times` against the library solve time (s)."""
+    print("\nLower bounds of any Python command writing this Parquet file (same run, medians):\n")
+    print("| part | seconds | / library solve |\n|---|---|---|")
+    for key, s in floor.items():
+        print(f"| {key} | {s:.2f} | {s / library:.1f}x |")
+    total = sum(floor.values())
+    print(f"| both, without reading, spline, solve or table | {total:.2f} | {total / library:.1f}x |")
 
 
 def print_stages(stages: dict[str, float], startup: float, cli: dict[str, float], n: int) -> None:
