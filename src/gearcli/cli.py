@@ -148,7 +148,7 @@ def load_analysis(path: Path) -> Analysis:
     Input problems the loader worked around (``Mechanism.warnings``) go to stderr, one
     line each, without changing the exit status.
     """
-    from .pipeline import analyse  # noqa: PLC0415  (keeps --help fast)
+    from .dynamics.determinacy import analyse  # noqa: PLC0415  (keeps --help fast; not the solver)
     from .io import load_mechanism  # noqa: PLC0415
 
     mech = load_mechanism(path)

@@ -16,18 +16,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
 from .dynamics.solve import BACKENDS, solve, solver_for
 from .analysis.graph import Analysis
-from .analysis.graph import analyse as analyse_graph
-from .dynamics.determinacy import check_determinate
+from .dynamics.determinacy import analyse
 from . import __version__
-from .errors import Collector, GearcliError, Issue, TrajectoryError
+from .errors import GearcliError, Issue, TrajectoryError
 from .io import load_mechanism
 from .io.output import OutputError, atomic_output, output_target
 from .io.trajectory import TrajectoryReader
-from .model.mechanism import Mechanism
 from .report.columns import Summary, column_names, column_units, first_non_finite, table
 from .report.table_files import CONVENTIONS, FORMATS, extension, format_of, open_table
 
@@ -38,22 +35,6 @@ first solve compiles the kernel (~0.25 s for the Bendix wrist); ~2 MB each of 20
 VERIFY_TOLERANCE = 1e-8
 """``--verify`` fails when the worst relative Newton-Euler residual exceeds this (or is
 not finite); a sound solve gives ~1e-15."""
-
-
-def analyse(mech: Mechanism) -> Analysis:
-    """Analyse ``mech`` and check that its loads are determined.
-
-    The graph analysis (:func:`gearcli.analysis.graph.analyse`: canonical graph, levels,
-    circuits, structure matrix, schedule) followed by the numerical determinacy check of the
-    load equations (:func:`gearcli.dynamics.determinacy.check_determinate`).  Raises
-    :class:`~gearcli.errors.MechanismError` listing every problem.
-    """
-    with threadpool_limits(limits=1, user_api="blas"):   # small matrices: threads only contend
-        an = analyse_graph(mech)
-        col = Collector(mech.source, mech.lines)
-        check_determinate(an, col)
-    col.raise_if_any()
-    return an
 
 
 def prismatic_independent(an: Analysis) -> list[str]:

@@ -1,15 +1,38 @@
-"""Numerical determinacy of the load equations (complements the structural schedule)."""
+"""Numerical determinacy of the load equations (complements the structural schedule), and
+:func:`analyse`: the graph analysis followed by that check (what every command needs)."""
 from __future__ import annotations
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
+from ..analysis.graph import Analysis
+from ..analysis.graph import analyse as analyse_graph
 from ..analysis.schedule import unknown_groups
 from ..errors import Collector
+from ..model.mechanism import Mechanism
 from .kinematics import forward
 from .equations import Columns
 from .sharing import mesh_weights, null_directions_without_t
 
 _RTOL = 1e-10
+
+
+def analyse(mech: Mechanism) -> Analysis:
+    """Analyse ``mech`` and check that its loads are determined.
+
+    The graph analysis (:func:`gearcli.analysis.graph.analyse`: canonical graph, levels,
+    circuits, structure matrix, schedule) followed by the numerical determinacy check of the
+    load equations (:func:`check_determinate`).  Raises
+    :class:`~gearcli.errors.MechanismError` listing every problem.  (Also
+    ``gearcli.analyse`` and ``gearcli.pipeline.analyse``; here, below the solver, so that
+    ``gearcli check`` and ``graph`` do not import it.)
+    """
+    with threadpool_limits(limits=1, user_api="blas"):   # small matrices: threads only contend
+        an = analyse_graph(mech)
+        col = Collector(mech.source, mech.lines)
+        check_determinate(an, col)
+    col.raise_if_any()
+    return an
 
 
 def block_unknowns(an) -> list[list]:

@@ -1,15 +1,14 @@
 """Input and output files: mechanism files (YAML, URDF), trajectories, output files.
 
 :func:`load_mechanism` is the one entry point for mechanism files; it picks the reader by
-the file's extension (``.urdf``/``.xml``: URDF, anything else: YAML).
+the file's extension (``.urdf``/``.xml``: URDF, anything else: YAML), importing only that
+reader (the URDF one imports lxml).
 """
 from __future__ import annotations
 
 from pathlib import Path
 
 from ..model.mechanism import Mechanism
-from .urdf_reader import load_urdf
-from .yaml_reader import load_yaml
 
 
 def load_mechanism(path: str | Path) -> Mechanism:
@@ -18,7 +17,11 @@ def load_mechanism(path: str | Path) -> Mechanism:
     Raises :class:`~gearcli.errors.MechanismError` listing every problem found.
     """
     if Path(path).suffix.lower() in (".urdf", ".xml"):
+        from .urdf_reader import load_urdf  # noqa: PLC0415  (lxml: only for URDF files)
+
         return load_urdf(path)
+    from .yaml_reader import load_yaml  # noqa: PLC0415
+
     return load_yaml(path)
 
 

@@ -12,8 +12,6 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from lxml import etree
-
 from ..errors import Collector, Issue, MechanismError
 from ..model.mechanism import Mechanism
 from ..model.ratings import (BEARING_FACTOR_DEFAULTS, STEEL_ELASTIC_COEFFICIENT, BearingRating, GearRating,
@@ -106,6 +104,8 @@ def attach_yaml_ratings(mech: Mechanism, data: dict, col: Collector) -> Mechanis
 def _urdf_spec(el, keys, required, path: str, add) -> dict | None:
     """Attributes of a rating element as a mapping: numbers parsed, ``type`` and ``name``
     kept as strings, ``locating`` as a boolean; None (with issues) when one is bad."""
+    from lxml import etree  # noqa: PLC0415  (URDF only: YAML mechanisms do not import lxml)
+
     spec: dict = {}
     ok = True
     for attr, text in el.attrib.items():

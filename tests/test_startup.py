@@ -1,0 +1,79 @@
+"""Start-up: each command imports only what its path needs (checked in ``sys.modules`` of a
+fresh process after the command ran; the times are in benchmarks/bench_startup.py)."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+MECH = ROOT / "mechanisms"
+
+RUN = """
+import json, sys
+from gearcli.cli import app
+sys.argv = ["gearcli", *json.loads(sys.argv[1])]
+try:
+    app()
+except SystemExit as exc:
+    code = exc.code
+else:
+    code = 0
+print(json.dumps({"code": code, "loaded": sorted(m for m in json.loads(WATCHED) if m in sys.modules)}))
+"""
+
+# modules a command may pull in only on the paths that need them
+SOLVER = ["gearcli.pipeline", "gearcli.dynamics.solve", "gearcli.dynamics.blocks", "gearcli.io.trajectory",
+          "gearcli.report.table_files"]
+KERNELS = ["llvmlite", "numba"]
+URDF = ["lxml", "gearcli.io.urdf_reader"]
+PYARROW = ["pyarrow"]
+WATCHED = SOLVER + KERNELS + URDF + PYARROW + ["gearcli.io.yaml_reader", "jsonschema", "scipy.sparse.csgraph"]
+
+
+def loaded_after(args, tmp_path) -> tuple[int, set[str]]:
+    """(exit status, the watched modules imported) of ``gearcli ARGS`` in a fresh process."""
+    code = RUN.replace("WATCHED", repr(json.dumps(WATCHED)))
+    out = subprocess.run([sys.executable, "-c", code, json.dumps([str(a) for a in args])], capture_output=True,
+                         text=True, check=True, cwd=tmp_path)
+    res = json.loads(out.stdout.strip().splitlines()[-1])
+    return res["code"], set(res["loaded"])
+
+
+@pytest.mark.parametrize("command", [["check"], ["graph"], ["graph", "--json"], ["graph", "--dot"]])
+def test_check_and_graph_do_not_import_the_solver(command, tmp_path):
+    code, loaded = loaded_after([*command, MECH / "bendix_wrist.yaml"], tmp_path)
+    assert code == 0
+    assert "scipy.sparse.csgraph" in loaded and "jsonschema" in loaded   # the analysis did run
+    assert not loaded & set(SOLVER + KERNELS + URDF + PYARROW), loaded
+
+
+def test_urdf_check_does_not_import_the_yaml_reader(tmp_path):
+    code, loaded = loaded_after(["check", MECH / "geared_arm.urdf"], tmp_path)
+    assert code == 0
+    assert "lxml" in loaded
+    assert not loaded & set(SOLVER + KERNELS + PYARROW + ["gearcli.io.yaml_reader"]), loaded
+
+
+def test_solve_of_a_yaml_mechanism_does_not_import_lxml(tmp_path):
+    traj = tmp_path / "small.csv"
+    with open(MECH / "bendix_wrist_traj.csv") as f:
+        traj.write_text("".join(line for _, line in zip(range(101), f)))
+    code, loaded = loaded_after(["solve", MECH / "bendix_wrist.yaml", traj, "-o", tmp_path / "x.csv"], tmp_path)
+    assert code == 0
+    assert "gearcli.dynamics.solve" in loaded
+    assert not loaded & set(URDF), loaded
+
+
+def test_bad_input_is_still_one_line_exit_2(tmp_path):
+    """The lazy imports do not change what bad input gives (exit 2, no traceback)."""
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("links: [\n")
+    out = subprocess.run([sys.executable, "-c", "from gearcli.cli import app; app()", "check", str(bad)],
+                         capture_output=True, text=True, cwd=tmp_path)
+    assert out.returncode == 2
+    assert "Traceback" not in out.stderr
+    assert str(bad) in out.stderr
