@@ -52,8 +52,8 @@ app = typer.Typer(
     pretty_exceptions_show_locals=False,
 )
 
-MECH_HELP = ("Mechanism file (YAML; see schemas/mechanism.schema.json).  Lengths in m, masses "
-             "in kg, inertias in kg*m^2, angles in rad (degrees in *_deg fields).")
+MECH_HELP = ("Mechanism file: YAML (schemas/mechanism.schema.json) or URDF (.urdf, .xml).  Lengths in m, "
+             "masses in kg, inertias in kg*m^2, angles in rad (degrees in *_deg fields).")
 
 
 # ---------------------------------------------------------------------------------------
@@ -225,14 +225,14 @@ def graph(
 
 # solve
 # ---------------------------------------------------------------------------------------
-TRAJ_HELP = ("Trajectory CSV: header t,q:<joint>,... for every independent joint (rad), "
-             "optional qd:/qdd: columns (rad/s, rad/s^2); time t in s, strictly increasing.")
+TRAJ_HELP = ("Trajectory CSV: header t,q:<joint>,... for every independent joint (rad; m if prismatic), optional "
+             "qd:/qdd: columns (rad/s, rad/s^2), load:<name>:fx..mz (N, N*m); time t in s, strictly increasing.")
 
 
-METHOD_OPTION = typer.Option("block", "--method", help="'block': level-by-level schedule (fast); 'full': cross-check.")
+METHOD_OPTION = typer.Option("block", "--method", metavar="block|full", help="'block': level-by-level schedule (fast); 'full': cross-check.")
 JOBS_OPTION = typer.Option(None, "--jobs", "-j", min=1,
                            help="Threads: solve and CSV (default: all cores; same results).")
-BACKEND_OPTION = typer.Option("auto", "--backend", help="'llvm', 'kernel' (numba), 'numpy' (reference) or 'auto'.")
+BACKEND_OPTION = typer.Option("auto", "--backend", metavar="auto|llvm|kernel|numpy", help="'llvm', 'kernel' (numba), 'numpy' (reference) or 'auto'.")
 
 
 @app.command()
@@ -269,7 +269,7 @@ def solve(
         err.width = max(err.width, 132)
     to_stdout = out == "-"
     progress = Progress(TextColumn("solving"), BarColumn(), TextColumn("{task.completed:,}/{task.total:,} samples"),
-                        TimeRemainingColumn(), console=err, transient=True)
+                        TimeRemainingColumn(), console=err, transient=True, disable=not err.is_terminal)
     task = None
     started = False
 

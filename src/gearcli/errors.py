@@ -40,6 +40,14 @@ def capped(text: str, limit: int) -> str:
 class GearcliError(Exception):
     """Base class of the errors gearcli reports as bad input (exit status 2)."""
 
+    def __str__(self) -> str:
+        """The message; a subclass that builds its lines itself (no message given to the
+        constructor) shows them, so that a traceback or ``str(exc)`` is never empty."""
+        text = super().__str__()
+        if text or type(self).lines is GearcliError.lines:
+            return text
+        return "\n".join(self.lines())
+
     def lines(self) -> list[str]:
         """One line per problem, ``file:line: place: what is wrong``."""
         return [str(self)]

@@ -39,7 +39,7 @@ def run_verify(manifest_path, *, jobs: int | None = None, dask_address: str | No
     """Run a manifest (already loaded with :func:`load_manifest` when ``manifest`` is given)
     and write the requested reports; ``progress(total=..)`` once, then ``progress()`` per job."""
     manifest = manifest or load_manifest(manifest_path)
-    check_outputs(manifest, junit, json_path, markdown_path)
+    check_outputs(manifest, {"--junit": junit, "--json": json_path, "--markdown": markdown_path})
     if plots_dir:
         make_plot_dir(Path(plots_dir))
     results = run_manifest(manifest, jobs=jobs, dask_address=dask_address, progress=progress)
@@ -55,12 +55,13 @@ def run_verify(manifest_path, *, jobs: int | None = None, dask_address: str | No
     return VerifyOutcome(rows, results, plots)
 
 
-def check_outputs(manifest, *paths) -> None:
-    """Refuse, before any work, report paths that cannot be written or name an input file."""
+def check_outputs(manifest, paths: dict) -> None:
+    """Refuse, before any work, report paths (``{option: path or None}``) that cannot be
+    written or name an input file; the message names the option."""
     inputs = [manifest.path] + [p for c in manifest.cases for p in (c.mechanism, *c.trajectories)]
-    for p in paths:
+    for option, p in paths.items():
         if p is not None:
-            output_target(p, inputs)
+            output_target(p, inputs, option)
 
 
 def make_plot_dir(directory: Path) -> None:

@@ -41,7 +41,6 @@ from .signs import SignError, sign_violation
 DEFAULT_CHUNK = 20_000
 
 
-
 @dataclass
 class Result:
     """Loads along a trajectory; every array has the samples first.
@@ -98,13 +97,14 @@ def joint_space(an, q_ind, qd_ind=None, qdd_ind=None):
 
 
 def _check_shapes(an, *arrays):
+    """q, qd, qdd as float arrays (N, dof); ValueError for a bad shape (values unchecked)."""
     out = []
-    for name, x in zip(("q", "qd", "qdd"), arrays):
-        x = np.asarray(x, float)
+    for name, given in zip(("q", "qd", "qdd"), arrays):
+        x = np.asarray(given, float)
         if x.ndim == 1:
             x = x[None, :]
         if x.ndim != 2 or x.shape[1] != an.dof:
-            raise ValueError(f"expected {name} with shape (N, {an.dof}), got {np.shape(x)}")
+            raise ValueError(f"expected {name} with shape (N, {an.dof}) or ({an.dof},), got {np.shape(given)}")
         out.append(x)
     if len({x.shape[0] for x in out}) != 1:
         raise ValueError(f"q, qd, qdd must have the same number of samples, got {[x.shape[0] for x in out]}")
@@ -213,8 +213,8 @@ class Solver:
             for s in range(0, q.shape[0], chunk):
                 sl = slice(s, s + chunk)
                 _, kin, b = self._loads(q[sl], qd[sl], qdd[sl], {k: v[sl] for k, v in values.items()})
-                worst = max(worst, residual(self.an, self.groups, Columns(self.an, kin), b,
-                                            {k: v[sl] for k, v in x_all.items()}, {k: v[sl] for k, v in sig.items()}))
+                worst = _worst(worst, residual(self.an, self.groups, Columns(self.an, kin), b,
+                                               {k: v[sl] for k, v in x_all.items()}, {k: v[sl] for k, v in sig.items()}))
             res.residual = worst
         return res
 
@@ -232,7 +232,7 @@ class Solver:
         else:
             res = Result(*(np.concatenate([getattr(p, f) for p in parts]) for f in
                            ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial")))
-            res.residual = max(p.residual for p in parts) if verify else None
+            res.residual = _worst(*(p.residual for p in parts)) if verify else None
         return res
 
     def _loads(self, q_ind, qd_ind, qdd_ind, values):
@@ -326,6 +326,11 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
                                 backend=backend, jobs=jobs, out=out)
 
 
+def _worst(*values: float) -> float:
+    """The largest value, NaN if any is NaN (Python's max would keep 0.0 against a NaN)."""
+    return float(np.max(values))
+
+
 def residual(an, groups, cols, b, x_all, sig) -> float:
     """Worst relative Newton-Euler residual over links and samples, and worst relative
     disagreement of a solved t with the sign used for its separating force."""
@@ -337,13 +342,13 @@ def residual(an, groups, cols, b, x_all, sig) -> float:
                 C = cols.group(g, L, sig.get((g.kind, g.index), 1.0))
                 tot = tot + np.einsum("nij,nj->ni", C, x_all[(g.kind, g.index)])
         scale = 1.0 + np.max(np.abs(b[L]), axis=1)
-        worst = max(worst, float(np.max(np.abs(tot).max(axis=1) / scale)))
+        worst = _worst(worst, float(np.max(np.abs(tot).max(axis=1) / scale)))
     signed = [(g.kind, g.index) for g in groups if is_geared(an, g)]
     if signed:
         t = np.column_stack([x_all[k][:, 0] for k in signed])
         signs = np.column_stack([np.broadcast_to(sig.get(k, 1.0), t.shape[:1]) for k in signed])
         scale = 1.0 + np.max(np.abs(np.concatenate([b[L] for L in an.tree.moving], axis=1)), axis=1)
-        worst = max(worst, sign_violation(t, signs, scale))
+        worst = _worst(worst, sign_violation(t, signs, scale))
     return worst
 
 

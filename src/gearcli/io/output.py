@@ -55,40 +55,42 @@ def _file_id(path: str) -> tuple[int, int] | None:
     return st.st_dev, st.st_ino
 
 
-def output_target(path: str | os.PathLike, inputs: Iterable[str | os.PathLike] = ()) -> str | None:
+def output_target(path: str | os.PathLike, inputs: Iterable[str | os.PathLike] = (),
+                  option: str = "-o") -> str | None:
     """The resolved file name to write for ``-o path`` (``None`` for ``"-"``, stdout).
 
-    Raises :class:`OutputError` when ``path`` is empty, names an input file (also through
-    a symlink, ``./``, or a hard link), is a directory, device, FIFO or socket, or lies in a
-    directory that does not exist or is not writable.
+    Raises :class:`OutputError` (naming ``option``, the command-line option that gave
+    ``path``) when ``path`` is empty, names an input file (also through a symlink, ``./``,
+    or a hard link), is a directory, device, FIFO or socket, or lies in a directory that
+    does not exist or is not writable.
     """
     name = os.fspath(path)
     if name == "-":
         return None
     if name == "":
-        raise OutputError("-o", "empty file name (give a file name, or '-' for stdout)", place="")
+        raise OutputError(option, "empty file name (give a file name, or '-' for stdout)", place="")
     real = os.path.realpath(name)
     ident = _file_id(real)
     for inp in inputs:
         inp = os.fspath(inp)
         if os.path.realpath(inp) == real or (ident is not None and _file_id(inp) == ident):
-            raise OutputError(name, f"is the input file '{inp}'; choose another output file name")
+            raise OutputError(name, f"is the input file '{inp}'; choose another output file name", option)
     if os.path.lexists(real):
         try:
             st = os.stat(real)
         except OSError as exc:
-            raise OutputError(name, f"cannot use it: {exc.strerror}") from None
+            raise OutputError(name, f"cannot use it: {exc.strerror}", option) from None
         if stat.S_ISDIR(st.st_mode):
-            raise OutputError(name, "is a directory (give a file name)")
+            raise OutputError(name, "is a directory (give a file name)", option)
         if not stat.S_ISREG(st.st_mode):
-            raise OutputError(name, "is not a regular file (a device, FIFO or socket); use '-' for stdout")
+            raise OutputError(name, "is not a regular file (a device, FIFO or socket); use '-' for stdout", option)
         if not os.access(real, os.W_OK):
-            raise OutputError(name, "file is not writable (permission denied)")
+            raise OutputError(name, "file is not writable (permission denied)", option)
     parent = os.path.dirname(real) or "."
     if not os.path.isdir(parent):
-        raise OutputError(name, f"directory '{parent}' does not exist")
+        raise OutputError(name, f"directory '{parent}' does not exist", option)
     if not os.access(parent, os.W_OK | os.X_OK):
-        raise OutputError(name, f"directory '{parent}' is not writable (permission denied)")
+        raise OutputError(name, f"directory '{parent}' is not writable (permission denied)", option)
     return real
 
 

@@ -7,6 +7,7 @@ Files are written through a temporary file and renamed; the format follows the e
 from __future__ import annotations
 
 import fnmatch
+import re
 import zipfile
 from pathlib import Path
 
@@ -44,7 +45,7 @@ def _save(fig, path: Path) -> None:
 def check_output_path(path: str | Path) -> Path:
     path = Path(path)
     if path.suffix.lower() not in FORMATS:
-        raise GearcliError(f"{path}: the figure format must be one of {', '.join(FORMATS)} (from the extension)")
+        raise GearcliError(f"{path}: -o: the figure format must be one of {', '.join(FORMATS)} (from the extension)")
     return path
 
 
@@ -135,6 +136,17 @@ def _is_float(text: str) -> bool:
         return False
 
 
+OUTPUT_COLUMN = re.compile(r"t|tau:[^:]+|motor:[^:]+(:speed|:power)?|gear:[^:]+:(t|sep|torque)"
+                           r"|gear:[^:]+:[^:]+:(radial|axial)|joint:[^:]+:(fx|fy|fz|mx|my|mz|radial|axial|bending)")
+
+
+def csv_unit(name: str) -> str:
+    """Unit of a CSV column from its name (a CSV carries none): that of the output column
+    of that name (N*m for tau:/motor: columns, also of a prismatic joint: only the binary
+    formats know), none ('') for a name that is not an output column (e.g. q:J1)."""
+    return column_unit(name) if OUTPUT_COLUMN.fullmatch(name) else ""
+
+
 def read_loads(path) -> tuple[list[str], np.ndarray, dict]:
     """Header, (N, ncol) data and units (column -> unit) of a loads file written by
     ``gearcli solve``: CSV (units from the column names), Parquet, Feather or NPZ (units
@@ -142,7 +154,7 @@ def read_loads(path) -> tuple[list[str], np.ndarray, dict]:
     fmt = format_of(str(path))
     if fmt in (None, "csv"):
         header, data = read_loads_csv(path)
-        return header, data, {n: column_unit(n) for n in header}
+        return header, data, {n: csv_unit(n) for n in header}
     try:
         if fmt == "npz":
             if not zipfile.is_zipfile(path):     # np.load: EOFError on an empty file, pickle talk on others

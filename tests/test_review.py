@@ -1,0 +1,108 @@
+"""Findings of a new user's review of the README and ``--help``: each test pins one fixed
+behaviour (library inputs, error messages, CLI options)."""
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+from gearcli import analyse, parse_mechanism, solve
+from gearcli.dynamics.signs import SignError
+
+BACKENDS = ["numpy", "kernel", "llvm"]
+
+# a 2 kg arm on a horizontal axis (y), driven directly: no gear, so no sign search
+ARM = """
+name: arm
+base: "0"
+end_effector: "1"
+links:
+  - name: "0"
+  - {name: "1", mass: 2.0, com: [0.3, 0, 0], inertia: [0.01, 0.02, 0.02]}
+joints:
+  - {name: J1, parent: "0", child: "1", origin: {xyz: [0, 0, 0]}, axis: [0, 1, 0]}
+motors:
+  - {name: m, link: "1"}
+"""
+
+
+@pytest.fixture(scope="module")
+def arm():
+    return analyse(parse_mechanism(ARM))
+
+
+def test_sign_error_says_what_and_where():
+    """str(SignError) was empty: a library traceback ended in a bare 'SignError'."""
+    exc = SignError(7, ["5-1", "3-4"])
+    assert "sample 7" in str(exc) and "5-1, 3-4" in str(exc)
+    assert str(exc) == exc.lines()[0]
+
+
+def test_one_dimensional_input_names_the_shape_given(arm):
+    with pytest.raises(ValueError, match=r"got \(4, 3\)$"):
+        solve(arm, np.zeros((4, 3)), np.zeros((4, 3)), np.zeros((4, 3)))
+    with pytest.raises(ValueError, match=r"got \(3,\)$"):
+        solve(arm, np.zeros(3), np.zeros(3), np.zeros(3))
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_verify_residual_is_not_finite_when_loads_are_not(arm, backend):
+    """A rate of 1e200 rad/s overflows (omega^2 = inf): the loads of that sample are not
+    finite, and the residual of verify=True must say so (it was 0.0: Python's max keeps
+    0.0 against a NaN)."""
+    q = np.zeros((3, 1))
+    qd = np.array([[0.0], [1e200], [0.0]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        res = solve(arm, q, qd, q, backend=backend, verify=True)
+    assert not np.isfinite(res.joint[1]).all()
+    assert not math.isfinite(res.residual)
+    # the finite samples alone: a sound solve, the static holding torque m g x_c
+    with warnings.catch_warnings():
+        res = solve(arm, q[[0, 2]], qd[[0, 2]], q[[0, 2]], backend=backend, verify=True)
+    assert res.residual < 1e-12
+    np.testing.assert_allclose(res.motor[:, 0], -2.0 * 9.81 * 0.3, rtol=1e-12)
+
+
+# --- the command line -------------------------------------------------------------------
+def test_progress_bar_leaves_a_non_terminal_stderr_empty(run_cli, mech_dir, tmp_path):
+    """The progress bar (more than 4 chunks) printed a stray blank line into a redirected
+    stderr (a CI log)."""
+    out = tmp_path / "loads.csv"
+    r = run_cli("solve", mech_dir / "paper_2dof.yaml", mech_dir / "paper_2dof_traj.csv", "-o", out,
+                "--chunk", "100")
+    assert r.exit_code == 0, r.stderr
+    assert r.stderr == ""
+    assert len(out.read_text().splitlines()) == 2002
+
+
+@pytest.mark.parametrize("option", ["--junit", "--json", "--markdown"])
+def test_verify_names_the_report_option_it_refuses(run_cli, mech_dir, tmp_path, option):
+    """A bad report path was reported as '-o', an option verify does not have."""
+    design = mech_dir.parent / "designs" / "ci_example.yaml"
+    r = run_cli("verify", design, option, tmp_path / "missing" / "r.out")
+    assert r.exit_code == 2
+    assert r.stderr == f"{tmp_path / 'missing' / 'r.out'}: {option}: directory '{tmp_path / 'missing'}' does not exist\n"
+    r = run_cli("verify", design, option, design)
+    assert r.exit_code == 2
+    assert r.stderr.startswith(f"{design}: {option}: is the input file")
+
+
+def test_mechanism_help_says_urdf_too(run_cli):
+    for command in ("check", "graph", "solve", "export"):
+        assert "URDF" in run_cli(command, "--help").stdout
+
+
+def test_plot_units_of_a_csv_come_only_from_output_column_names(tmp_path):
+    """A CSV column that is no output column (a trajectory's q:J1) was drawn on an axis in N."""
+    from gearcli.report.plots import read_loads
+
+    path = tmp_path / "mixed.csv"
+    path.write_text("t,q:J1,joint:J1:fx,joint:J1:bending,tau:J1,gear:g:p:radial,motor:m:speed,foo:bar:fx\n"
+                    "0,1,2,3,4,5,6,7\n1,1,2,3,4,5,6,7\n")
+    header, data, units = read_loads(path)
+    assert data.shape == (2, 8)
+    assert units == {"t": "s", "q:J1": "", "joint:J1:fx": "N", "joint:J1:bending": "N·m", "tau:J1": "N·m",
+                     "gear:g:p:radial": "N", "motor:m:speed": "rad/s", "foo:bar:fx": ""}
