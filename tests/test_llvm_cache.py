@@ -28,10 +28,12 @@ CHILD = """
 import json, sys, numpy as np
 from gearcli import analyse, load_mechanism
 from gearcli.dynamics.solve import solve, solver_for
-from gearcli.dynamics import llvm_driver
+from gearcli.dynamics import llvm_cache, llvm_driver
 if sys.argv[2] == "off":
     jit = llvm_driver.Jit
     llvm_driver.Jit = lambda module: jit(module, cache=False)
+if sys.argv[2] == "other generator":   # as if the IR generator's source had changed
+    llvm_driver.generator_digest = lambda: "0" * 64
 an = analyse(load_mechanism(sys.argv[1]))
 rng = np.random.default_rng(7)
 q, qd, qdd = (rng.uniform(-2, 2, (200, an.dof)) for _ in range(3))
@@ -39,7 +41,10 @@ q[0] = 3e5                       # beyond the inline sin/cos: calls libm (a relo
 r = solve(an, q, qd, qdd, backend="llvm", jobs=1)
 k = solver_for(an).llvm_kernel()
 arrays = {k2: v.tobytes().hex() for k2, v in sorted(vars(r).items()) if isinstance(v, np.ndarray)}
-print(json.dumps({"from_cache": k.jit.from_cache, "stored": k.jit.stored, "arrays": arrays}))
+built = k.build_seconds > 0
+key_of_ir = llvm_cache.object_key(k.jit.ir, llvm_driver.host_identity())   # the IR this code generates
+print(json.dumps({"from_cache": k.jit.from_cache, "stored": k.jit.stored, "by_program": k.jit.by_program,
+                  "built": built, "ir_is_key": key_of_ir == k.jit.key, "arrays": arrays}))
 """
 
 
@@ -66,6 +71,39 @@ def test_second_process_loads_from_the_cache(tmp_path):
     assert not (tmp_path / "unused").exists()
     assert len(first["arrays"]) > 3 and first["arrays"] == second["arrays"] == memory["arrays"]
     assert len(objects(tmp_path)) == 1
+    # the second found the code by program key without generating the IR; generated on
+    # demand afterwards, that IR is the one the stored code was compiled from
+    assert (first["by_program"], first["built"]) == (False, True)
+    assert (second["by_program"], second["built"]) == (True, False)
+    assert first["ir_is_key"] and second["ir_is_key"] and memory["ir_is_key"]
+
+
+def test_another_generator_source_does_not_load_by_program(tmp_path):
+    """The program key hashes the IR generator's source: with another digest the note is
+    not found, the IR is generated and its own key finds the same object code."""
+    first = run_child(tmp_path)
+    other = run_child(tmp_path, "other generator")
+    assert (other["from_cache"], other["by_program"], other["built"], other["stored"]) == (True, False, True, False)
+    assert other["arrays"] == first["arrays"] and other["ir_is_key"]
+    assert len(list((tmp_path / "llvm").glob("*.prog"))) == 2
+
+
+def test_generator_lists_every_module_the_ir_comes_from():
+    """Every module of gearcli.dynamics that a GENERATOR module imports is in GENERATOR,
+    except those whose output the program key hashes (the program, the cache's own key format)
+    or that only run the code (threads); so is every llvm_* module."""
+    import ast  # noqa: PLC0415
+
+    from gearcli.dynamics.llvm_driver import GENERATOR  # noqa: PLC0415
+
+    here = ROOT / "src" / "gearcli" / "dynamics"
+    exempt = {"llvm_cache", "kernel_program", "jobs"}
+    assert {p.stem for p in here.glob("llvm_*.py")} - exempt <= set(GENERATOR)
+    for name in GENERATOR:
+        for node in ast.walk(ast.parse((here / f"{name}.py").read_text())):
+            if isinstance(node, ast.ImportFrom) and node.level == 1:
+                used = [node.module] if node.module else [a.name for a in node.names]
+                assert set(used) - exempt <= set(GENERATOR), (name, used)
 
 
 @pytest.mark.parametrize("damage", ["flip a byte", "truncate", "empty", "header only"])
