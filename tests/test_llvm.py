@@ -21,7 +21,8 @@ ROOT = Path(__file__).resolve().parents[1]
 MECH = ROOT / "mechanisms"
 
 
-def test_compiled_once_per_solver_and_kept():
+def test_compiled_once_per_solver_and_kept(monkeypatch, tmp_path):
+    monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path))   # an empty disk cache: really generated and compiled
     an = analyse(load_mechanism(MECH / "paper_2dof.yaml"))
     q = np.zeros((5, an.dof))
     solve(an, q, q, q, backend="numpy")
