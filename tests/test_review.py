@@ -106,3 +106,15 @@ def test_plot_units_of_a_csv_come_only_from_output_column_names(tmp_path):
     assert data.shape == (2, 8)
     assert units == {"t": "s", "q:J1": "", "joint:J1:fx": "N", "joint:J1:bending": "N·m", "tau:J1": "N·m",
                      "gear:g:p:radial": "N", "motor:m:speed": "rad/s", "foo:bar:fx": ""}
+
+
+def test_reprs_stay_readable(mech_dir, tmp_path):
+    """repr(mech) printed the whole YAML path -> line map (hundreds of entries), and
+    repr(solve_file(...)) the whole analysis on top, in a notebook."""
+    from gearcli import load_mechanism, solve_file
+
+    mech = load_mechanism(mech_dir / "paper_2dof.yaml")
+    assert "links[0].name" not in repr(mech) and "paper_2dof" in repr(mech)
+    rep = solve_file(mech_dir / "paper_2dof.yaml", mech_dir / "paper_2dof_traj.csv", tmp_path / "l.csv")
+    assert "samples=2001" in repr(rep) and "Link(" not in repr(rep)
+    assert rep.analysis.mech.lines["links[1].mass"] == 14    # kept, only not shown

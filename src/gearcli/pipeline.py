@@ -12,7 +12,7 @@ import sys
 import threading
 import warnings
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -48,7 +48,7 @@ class SolveReport:
     """What :func:`solve_file` did: the analysis, the number of samples, the load summary,
     the worst residual (with ``verify``) and the output path (None: stdout or nothing)."""
 
-    analysis: Analysis
+    analysis: Analysis = field(repr=False)   # the whole mechanism: not in repr
     samples: int
     summary: Summary
     residual: float | None

@@ -130,7 +130,7 @@ class Mechanism:
     motors: tuple[Motor, ...] = ()
     gravity: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, -9.81]))
     source: str = "<memory>"
-    lines: dict = field(default_factory=dict)
+    lines: dict = field(default_factory=dict, repr=False)   # hundreds of entries: not in repr
     # "chain": the independent coordinates are the paper's equivalent open-loop chain
     # base -> end_effector.  "tree": they are the joints of every link that is not the
     # first link j of a gear pair or coupling (a branched robot, e.g. a URDF humanoid).
