@@ -118,3 +118,12 @@ def test_reprs_stay_readable(mech_dir, tmp_path):
     rep = solve_file(mech_dir / "paper_2dof.yaml", mech_dir / "paper_2dof_traj.csv", tmp_path / "l.csv")
     assert "samples=2001" in repr(rep) and "Link(" not in repr(rep)
     assert rep.analysis.mech.lines["links[1].mass"] == 14    # kept, only not shown
+
+
+def test_verify_refuses_jobs_with_dask(run_cli, mech_dir, tmp_path):
+    """-j was silently ignored with --dask (the cluster has its own workers)."""
+    design = mech_dir.parent / "designs" / "ci_example.yaml"
+    r = run_cli("verify", design, "-j", "2", "--dask", "tcp://127.0.0.1:9", "--junit", tmp_path / "r.xml")
+    assert r.exit_code == 2
+    assert r.stderr == "verify: give -j/--jobs or --dask, not both (a Dask cluster has its own workers)\n"
+    assert list(tmp_path.iterdir()) == []

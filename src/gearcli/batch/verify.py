@@ -37,7 +37,10 @@ def count_jobs(manifest) -> int:
 def run_verify(manifest_path, *, jobs: int | None = None, dask_address: str | None = None, junit=None,
                json_path=None, markdown_path=None, plots_dir=None, progress=None, manifest=None) -> VerifyOutcome:
     """Run a manifest (already loaded with :func:`load_manifest` when ``manifest`` is given)
-    and write the requested reports; ``progress(total=..)`` once, then ``progress()`` per job."""
+    and write the requested reports; ``progress(total=..)`` once, then ``progress()`` per job.
+    ``jobs`` and ``dask_address`` exclude each other (the cluster has its own workers)."""
+    if jobs is not None and dask_address is not None:
+        raise GearcliError("verify: give -j/--jobs or --dask, not both (a Dask cluster has its own workers)")
     manifest = manifest or load_manifest(manifest_path)
     check_outputs(manifest, {"--junit": junit, "--json": json_path, "--markdown": markdown_path})
     if plots_dir:
