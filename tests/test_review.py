@@ -127,3 +127,21 @@ def test_verify_refuses_jobs_with_dask(run_cli, mech_dir, tmp_path):
     assert r.exit_code == 2
     assert r.stderr == "verify: give -j/--jobs or --dask, not both (a Dask cluster has its own workers)\n"
     assert list(tmp_path.iterdir()) == []
+
+
+def test_verify_plot_of_a_joint_rate_says_it_draws_its_magnitude(monkeypatch, mech_dir, tmp_path):
+    """The plot of a tight velocity check draws |q_dot| and labelled it 'joint rate'."""
+    import gearcli.batch.verify as bv
+
+    drawn = []
+    monkeypatch.setattr(bv, "plot_check", lambda t, y, limit, path, title, ylabel, limit_label:
+                        drawn.append((np.asarray(y), limit, ylabel)))
+    design = tmp_path / "arm.yaml"    # geared_arm's elbow reaches 2.83 of its 3 rad/s: tight
+    design.write_text(f"name: arm\ncases:\n  - mechanism: {mech_dir / 'geared_arm.urdf'}\n"
+                      f"    trajectories: {mech_dir / 'geared_arm_traj.csv'}\n")
+    bv.run_verify(design, jobs=1, plots_dir=tmp_path / "plots")
+    rates = [d for d in drawn if "rate" in d[2]]
+    assert len(rates) == 1
+    y, limit, ylabel = rates[0]
+    assert ylabel == "|joint rate| [rad/s]" and limit == 3.0
+    assert y.min() >= 0 and 2.8 < y.max() < 3.0

@@ -12,7 +12,7 @@ from .manifest import load_manifest
 from .outputs import WARN_MARGIN, rows_of, write_json, write_junit, write_markdown
 from .runner import jobs_of, run_manifest, worst_samples
 
-SIGNAL_LABELS = {"abs": "|{}|", "col": "{}", "rate": "joint rate", "bearing_P": "dynamic equivalent load P",
+SIGNAL_LABELS = {"abs": "|{}|", "col": "{}", "rate": "|joint rate|", "bearing_P": "dynamic equivalent load P",
                  "bearing_P0": "static equivalent load P0", "bending": "Lewis root bending stress",
                  "contact": "Hertz contact stress"}
 LIMIT_LABELS = {"peak": "limit", "rms": "RMS limit", "safety": "allowable / required safety",
