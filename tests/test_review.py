@@ -145,3 +145,12 @@ def test_verify_plot_of_a_joint_rate_says_it_draws_its_magnitude(monkeypatch, me
     y, limit, ylabel = rates[0]
     assert ylabel == "|joint rate| [rad/s]" and limit == 3.0
     assert y.min() >= 0 and 2.8 < y.max() < 3.0
+
+
+def test_missing_position_column_of_a_prismatic_joint_gives_no_angle_unit(run_cli, mech_dir, tmp_path):
+    """The message said 'rad' for the rack axis's linear guide (q in m)."""
+    traj = tmp_path / "t.csv"
+    traj.write_text("t\n0\n1\n2\n")
+    r = run_cli("solve", mech_dir / "rack_axis.yaml", traj, "-o", tmp_path / "o.csv")
+    assert r.exit_code == 2
+    assert r.stderr == f"{traj}:1: missing column 'q:Jx' (independent joint 'Jx')\n"

@@ -127,7 +127,7 @@ def _columns(header: list[str], names: list[str], file: str, loads=()) -> dict:
         raise _fail(file, 1, "", "missing column 't' (time, s)")
     for n in names:
         if f"q:{n}" not in pos:
-            raise _fail(file, 1, "", f"missing column 'q:{show(n)}' (independent joint '{show(n)}', rad)")
+            raise _fail(file, 1, "", f"missing column 'q:{show(n)}' (independent joint '{show(n)}')")
     out = {"t": pos["t"], "load": lcols}
     for p in ("q", "qd", "qdd"):
         cols = [pos.get(f"{p}:{n}") for n in names]
