@@ -3,6 +3,7 @@ fresh process after the command ran; the times are in benchmarks/bench_startup.p
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -31,14 +32,17 @@ SOLVER = ["gearcli.pipeline", "gearcli.dynamics.solve", "gearcli.dynamics.blocks
 KERNELS = ["llvmlite", "numba"]
 URDF = ["lxml", "gearcli.io.urdf_reader"]
 PYARROW = ["pyarrow"]
-WATCHED = SOLVER + KERNELS + URDF + PYARROW + ["gearcli.io.yaml_reader", "jsonschema", "scipy.sparse.csgraph"]
+SCIPY = ["scipy", "scipy.sparse", "scipy.sparse.csgraph", "scipy.linalg"]
+WATCHED = SOLVER + KERNELS + URDF + PYARROW + SCIPY + ["gearcli.io.yaml_reader", "jsonschema"]
 
 
 def loaded_after(args, tmp_path) -> tuple[int, set[str]]:
-    """(exit status, the watched modules imported) of ``gearcli ARGS`` in a fresh process."""
+    """(exit status, the watched modules imported) of ``gearcli ARGS`` in a fresh process
+    whose disk caches are in ``tmp_path / "cache"``."""
     code = RUN.replace("WATCHED", repr(json.dumps(WATCHED)))
+    env = dict(os.environ, GEARCLI_CACHE_DIR=str(tmp_path / "cache"))
     out = subprocess.run([sys.executable, "-c", code, json.dumps([str(a) for a in args])], capture_output=True,
-                         text=True, check=True, cwd=tmp_path)
+                         text=True, check=True, cwd=tmp_path, env=env)
     res = json.loads(out.stdout.strip().splitlines()[-1])
     return res["code"], set(res["loaded"])
 
@@ -47,8 +51,18 @@ def loaded_after(args, tmp_path) -> tuple[int, set[str]]:
 def test_check_and_graph_do_not_import_the_solver(command, tmp_path):
     code, loaded = loaded_after([*command, MECH / "bendix_wrist.yaml"], tmp_path)
     assert code == 0
-    assert "scipy.sparse.csgraph" in loaded and "jsonschema" in loaded   # the analysis did run
+    assert "scipy.sparse.csgraph" in loaded and "jsonschema" in loaded   # an empty cache: the flow ran
     assert not loaded & set(SOLVER + KERNELS + URDF + PYARROW), loaded
+
+
+@pytest.mark.parametrize("command", [["check"], ["graph"]])
+def test_a_scheduled_mechanism_needs_no_scipy(command, tmp_path):
+    """Once a process found the mechanism's schedule (disk cache), check and graph import
+    no scipy module at all."""
+    first, _ = loaded_after(["check", MECH / "bendix_wrist.yaml"], tmp_path)
+    code, loaded = loaded_after([*command, MECH / "bendix_wrist.yaml"], tmp_path)
+    assert first == code == 0
+    assert "jsonschema" in loaded and not loaded & set(SCIPY + SOLVER), loaded
 
 
 def test_urdf_check_does_not_import_the_yaml_reader(tmp_path):

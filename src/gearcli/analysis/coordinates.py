@@ -14,7 +14,6 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from scipy.linalg import qr
 
 from ..errors import Collector
 from .context import Home
@@ -104,6 +103,8 @@ def circuit_rank(h: Home, circuits: list[Circuit]) -> CircuitRank:
     rank = int(np.sum(sv > RTOL_RANK * sv[0]))
     if rank == G:
         return CircuitRank(Gam, rank, list(range(G)), sv, np.zeros((G, 0)))
+    from scipy.linalg import qr  # noqa: PLC0415  (scipy.linalg: only when rows depend on others)
+
     U, sv, _ = np.linalg.svd(Gn)
     _, _, piv = qr(Gn.T, mode="economic", pivoting=True)
     return CircuitRank(Gam, rank, sorted(int(i) for i in piv[:rank]), sv, U)

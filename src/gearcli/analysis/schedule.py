@@ -9,6 +9,9 @@ the strongly connected components of the dependency graph); the blocks are the
 irreducible sets of links whose equations must be solved simultaneously.  Among the
 orders the dependencies allow, the paper's is taken: highest level first, a primary link
 before the secondary links of its level.
+
+A schedule is kept on disk (:mod:`.schedule_cache`): a later process scheduling the same
+incidence reads it and does not import scipy.sparse.csgraph (most of a ``gearcli check``).
 """
 from __future__ import annotations
 
@@ -16,10 +19,9 @@ import heapq
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import breadth_first_order, connected_components, maximum_flow
 
 from ..errors import Collector
+from . import schedule_cache
 
 
 @dataclass(frozen=True)
@@ -73,7 +75,9 @@ def solution_schedule(an, col: Collector | None = None) -> tuple[tuple[int, ...]
     algorithm, O(V^2 E), on the compressed network source -> link (6 equations) -> unknown
     group (``size`` scalars) -> sink), so the time stays polynomial (in practice linear) in
     the number of links.  The irreducible blocks and their partial order do not depend on
-    which perfect matching is found (Dulmage-Mendelsohn), so neither does the schedule.
+    which perfect matching is found (Dulmage-Mendelsohn), so neither does the schedule;
+    it is read from the disk cache (:mod:`.schedule_cache`) when an earlier process found
+    it, else found and stored (only schedules: a failure is found again each time).
     """
     tree = an.tree
     moving = tree.moving
@@ -84,6 +88,10 @@ def solution_schedule(an, col: Collector | None = None) -> tuple[tuple[int, ...]
         if col is not None:
             col.add("", f"{nrow} equations for {ncol} unknowns: the loads are not statically determinate")
         return ()
+    key = schedule_cache.schedule_key(moving, groups, an.redundant, an.level, an.primary)
+    cached = schedule_cache.load(key, moving)
+    if cached is not None:
+        return cached
     net = _Network(moving, groups)
     if net.value < nrow:
         if col is not None:
@@ -92,7 +100,9 @@ def solution_schedule(an, col: Collector | None = None) -> tuple[tuple[int, ...]
                     + ", ".join(f"'{tree.links[x]}'" for x in bad))
         return ()
     comp, after = net.blocks()
-    return _ordered_blocks(an, moving, comp, after)
+    order = _ordered_blocks(an, moving, comp, after)
+    schedule_cache.store(key, order)
+    return order
 
 
 class _Network:
@@ -101,6 +111,9 @@ class _Network:
     (capacity ``size`` to the sink), L+G+1 the sink."""
 
     def __init__(self, moving: list[int], groups: list[UnknownGroup]):
+        from scipy.sparse import csr_matrix  # noqa: PLC0415  (scipy.sparse: only without a cached schedule)
+        from scipy.sparse.csgraph import maximum_flow  # noqa: PLC0415
+
         L, G = len(moving), len(groups)
         self.L, self.G = L, G
         node = {x: 1 + i for i, x in enumerate(moving)}
@@ -136,6 +149,8 @@ class _Network:
         equations contain an unknown matched to b's) and, per component, the set of
         components it comes after.  The links of the under-determined part (more unknowns
         than equations: a redundant gear set) form one block per connected piece."""
+        from scipy.sparse.csgraph import connected_components  # noqa: PLC0415
+
         dep = (self.inc @ self.used.T).tocoo()  # dep[a, b] > 0: a uses an unknown solved with b
         _, comp = connected_components(dep.tocsr(), directed=True, connection="strong")
         H = self.horizontal()
@@ -155,6 +170,8 @@ class _Network:
         by an alternating path, i.e. the links that reach the sink in the residual network.
         No other link's equations contain their unknowns, so their blocks come after the
         blocks they depend on."""
+        from scipy.sparse.csgraph import breadth_first_order  # noqa: PLC0415
+
         residual = (self.cap - self.flow).tocsr()
         residual.data = (residual.data > 0).astype(np.int32)
         residual.eliminate_zeros()
@@ -168,6 +185,8 @@ class _Network:
         """Positions (in ``moving``) of the links whose equations cannot all be matched:
         the links reachable from the source in the residual network (the over-determined
         part of the Dulmage-Mendelsohn decomposition, the same for every maximum flow)."""
+        from scipy.sparse.csgraph import breadth_first_order  # noqa: PLC0415
+
         residual = (self.cap - self.flow).tocsr()
         residual.data = (residual.data > 0).astype(np.int32)
         residual.eliminate_zeros()

@@ -33,6 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..io.cache_root import cache_root
 from ..io.output import OutputError, atomic_output
 
 FORMAT = 1                          # ours: change when the entry layout or the key changes
@@ -45,11 +46,7 @@ _STALE_TEMP_SECONDS = 3600.0
 
 def cache_dir() -> Path:
     """The folder of the llvm entries (not created here)."""
-    root = os.environ.get("GEARCLI_CACHE_DIR")
-    if not root:
-        xdg = os.environ.get("XDG_CACHE_HOME")
-        root = os.path.join(xdg, "gearcli") if xdg else os.path.join(os.path.expanduser("~"), ".cache", "gearcli")
-    return Path(root) / "llvm"
+    return cache_root() / "llvm"
 
 
 def _sha(parts) -> str:
