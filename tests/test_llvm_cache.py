@@ -68,7 +68,7 @@ def test_second_process_loads_from_the_cache(tmp_path):
     assert (first["from_cache"], first["stored"]) == (False, True)
     assert (second["from_cache"], second["stored"]) == (True, False)
     assert (memory["from_cache"], memory["stored"]) == (False, False)
-    assert not (tmp_path / "unused").exists()
+    assert not (tmp_path / "unused" / "llvm").exists()     # (the schedule cache may use the folder)
     assert len(first["arrays"]) > 3 and first["arrays"] == second["arrays"] == memory["arrays"]
     assert len(objects(tmp_path)) == 1
     # the second found the code by program key without generating the IR; generated on
