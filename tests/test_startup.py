@@ -33,7 +33,8 @@ KERNELS = ["llvmlite", "numba"]
 URDF = ["lxml", "gearcli.io.urdf_reader"]
 PYARROW = ["pyarrow"]
 SCIPY = ["scipy", "scipy.sparse", "scipy.sparse.csgraph", "scipy.linalg"]
-WATCHED = SOLVER + KERNELS + URDF + PYARROW + SCIPY + ["gearcli.io.yaml_reader", "jsonschema"]
+RICH = ["rich", "rich.console", "rich.table"]
+WATCHED = SOLVER + KERNELS + URDF + PYARROW + SCIPY + RICH + ["numpy", "gearcli.io.yaml_reader", "jsonschema"]
 
 
 def loaded_after(args, tmp_path) -> tuple[int, set[str]]:
@@ -63,6 +64,20 @@ def test_a_scheduled_mechanism_needs_no_scipy(command, tmp_path):
     code, loaded = loaded_after([*command, MECH / "bendix_wrist.yaml"], tmp_path)
     assert first == code == 0
     assert "jsonschema" in loaded and not loaded & set(SCIPY + SOLVER), loaded
+
+
+@pytest.mark.parametrize("args", [["--help"], ["check", "--help"], ["solve", "--help"], ["--version"]])
+def test_help_imports_neither_numpy_nor_rich(args, tmp_path):
+    code, loaded = loaded_after(args, tmp_path)
+    assert code == 0 and not loaded, loaded
+
+
+@pytest.mark.parametrize("mech", ["bendix_wrist.yaml", "does_not_exist.yaml"])
+def test_check_prints_no_rich_table(mech, tmp_path):
+    """check prints plain lines (and bad input one line each): rich is not imported."""
+    code, loaded = loaded_after(["check", MECH / mech], tmp_path)
+    assert code == (0 if mech == "bendix_wrist.yaml" else 2)
+    assert not loaded & set(RICH), loaded
 
 
 def test_urdf_check_does_not_import_the_yaml_reader(tmp_path):

@@ -26,13 +26,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Iterator
 
 import typer
-from rich.console import Console
 
 from . import __version__
 from .errors import GearcliError
 from .report.features import feature_notes
 from .report.sharing import sharing_notes
-from .report.tables import JSON_DIGITS, print_graph_tables, round_sig, stdout_console, summary_table
+from .report.tables import JSON_DIGITS, print_graph_tables, round_sig, stderr_console, stdout_console, summary_table
 
 if TYPE_CHECKING:  # pragma: no cover
     from .analysis.graph import Analysis
@@ -264,9 +263,7 @@ def solve(
 
     an = check_solve_options(load_analysis(mech), method, backend)
     out = output if output is not None else str(traj.with_suffix(".loads.csv"))
-    err = Console(stderr=True, markup=False, highlight=False)
-    if not err.is_terminal:
-        err.width = max(err.width, 132)
+    err = stderr_console()
     to_stdout = out == "-"
     progress = Progress(TextColumn("solving"), BarColumn(), TextColumn("{task.completed:,}/{task.total:,} samples"),
                         TimeRemainingColumn(), console=err, transient=True, disable=not err.is_terminal)
@@ -317,9 +314,8 @@ def export(
     """Write a URDF of the mechanism: links with inertials, the joint tree, geared joints as
     <mimic> where a single leader exists, motors as <transmission>, and the full gear
     geometry in gearcli extension elements (namespace https://gearcli.dev/urdf/1)."""
-    from .report.urdf_writer import export_urdf  # noqa: PLC0415
-
     from .io.output import output_target  # noqa: PLC0415
+    from .report.urdf_writer import export_urdf  # noqa: PLC0415
 
     output_target(output, (mech,))   # refuse a bad -o before any work
     an = load_analysis(mech)
@@ -354,6 +350,7 @@ def verify(
     """Check motors (peak/RMS torque, speed, power), bearings (ISO 281 life, static safety,
     tilting moment), gear teeth (bending and contact stress) and column limits along every
     trajectory of each case.  Exit 0 when every check passes, 1 when any fails, 2 on bad input."""
+    from rich.console import Console  # noqa: PLC0415
     from rich.progress import BarColumn, Progress, TextColumn  # noqa: PLC0415
 
     from .batch.manifest import load_manifest  # noqa: PLC0415

@@ -2,19 +2,20 @@
 
 Numbers are shown to 6 significant digits (:func:`fmt_num`); the machine-readable forms are
 the JSON of :mod:`gearcli.report.graph_json` and the CSV of :mod:`gearcli.report.columns`.
+rich is imported when a table or console is made (``gearcli --help`` and ``check`` need none).
 """
 from __future__ import annotations
 
 import math
 from typing import TYPE_CHECKING
 
-from rich.console import Console
-from rich.table import Table
-
 from .features import feature_notes
 from .sharing import sharing_notes
 
 if TYPE_CHECKING:  # pragma: no cover
+    from rich.console import Console
+    from rich.table import Table
+
     from ..analysis.graph import Analysis
 
 JSON_DIGITS = 12  # significant digits of floats in JSON output
@@ -49,15 +50,35 @@ def format_blocks(blocks) -> str:
 def stdout_console() -> Console:
     """Console for tables: no markup parsing of user names, no auto-highlighting; plain
     lines (solve order, ...) are never wrapped, so they stay greppable."""
+    from rich.console import Console  # noqa: PLC0415
+
     console = Console(markup=False, highlight=False, soft_wrap=True)
     if not console.is_terminal:   # piped or redirected: do not squeeze tables into 80 columns
         console.width = max(console.width, 132)
     return console
 
 
+def _table(title: str, **options) -> Table:
+    """A rich table (rich imported here: only commands that print tables pay for it)."""
+    from rich.table import Table  # noqa: PLC0415
+
+    return Table(title=title, **options)
+
+
+def stderr_console() -> Console:
+    """Console on stderr (progress, or the summary when the table goes to stdout): no markup,
+    no highlighting; as wide as :func:`stdout_console`'s when not a terminal."""
+    from rich.console import Console  # noqa: PLC0415
+
+    err = Console(stderr=True, markup=False, highlight=False)
+    if not err.is_terminal:
+        err.width = max(err.width, 132)
+    return err
+
+
 def links_table(an: Analysis) -> Table:
     """One row per link: level, primary/secondary, carrier, axis label, real joint."""
-    t = Table(title="Links (canonical graph)", title_justify="left")
+    t = _table("Links (canonical graph)", title_justify="left")
     for col in ("link", "level", "role", "carrier", "axis", "real joint"):
         t.add_column(col)
     n, prim = an.names, set(an.primary)
@@ -74,7 +95,7 @@ def links_table(an: Analysis) -> Table:
 
 def gears_table(an: Analysis) -> Table:
     """One row per gear pair: links j, k, carrier c, kind, ratio e_kj and circuit equation."""
-    t = Table(title="Gear pairs (fundamental circuits: theta_j,c = e_kj * theta_k,c)",
+    t = _table("Gear pairs (fundamental circuits: theta_j,c = e_kj * theta_k,c)",
               title_justify="left")
     for col in ("pair", "j", "k", "carrier", "kind", "ratio e_kj", "equation"):
         t.add_column(col)
@@ -90,7 +111,7 @@ def gears_table(an: Analysis) -> Table:
 
 def groups_table(an: Analysis) -> Table:
     """Coaxial groups: a carrier and the links turning about one line relative to it."""
-    t = Table(title="Coaxial groups", title_justify="left")
+    t = _table("Coaxial groups", title_justify="left")
     for col in ("carrier", "axis", "coaxial links"):
         t.add_column(col)
     for g in an.groups:
@@ -101,7 +122,7 @@ def groups_table(an: Analysis) -> Table:
 
 def structure_table(an: Analysis) -> Table:
     """Structure matrix A: rows independent joints, columns motors (input = A^T x joint)."""
-    t = Table(title="Structure matrix A", title_justify="left",
+    t = _table("Structure matrix A", title_justify="left",
               caption="motor input rotations = A^T x independent joint rotations (rad)")
     t.add_column("joint \\ motor")
     for m in an.mech.motors:
@@ -131,7 +152,7 @@ def print_graph_tables(an: Analysis, console: Console) -> None:
 
 def summary_table(report) -> Table:
     """Peak magnitude, RMS and time of the peak of every motor, mesh and bearing load."""
-    table = Table(title=f"{report.analysis.mech.name}: {report.samples} samples")
+    table = _table(f"{report.analysis.mech.name}: {report.samples} samples")
     for col, just in (("load", "left"), ("unit", "left"), ("peak", "right"), ("RMS", "right"),
                       ("t at peak [s]", "right")):
         table.add_column(col, justify=just, no_wrap=(col == "load"))
