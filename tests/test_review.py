@@ -95,6 +95,14 @@ def test_mechanism_help_says_urdf_too(run_cli):
         assert "URDF" in run_cli(command, "--help").stdout
 
 
+def test_solve_help_shows_the_readme_usage(run_cli):
+    """The option values as the README's usage line writes them (was '<str>', '<int range>')."""
+    text = " ".join(run_cli("solve", "--help").stdout.split())
+    for usage in ("--method block|full", "--chunk N", "-j, --jobs N", "--backend auto|llvm|kernel|numpy",
+                  "--precision N"):
+        assert usage in text, usage
+
+
 def test_plot_units_of_a_csv_come_only_from_output_column_names(tmp_path):
     """A CSV column that is no output column (a trajectory's q:J1) was drawn on an axis in N."""
     from gearcli.report.plots import read_loads

@@ -229,7 +229,7 @@ TRAJ_HELP = ("Trajectory CSV: header t,q:<joint>,... for every independent joint
 
 
 METHOD_OPTION = typer.Option("block", "--method", metavar="block|full", help="'block': level-by-level schedule (fast); 'full': cross-check.")
-JOBS_OPTION = typer.Option(None, "--jobs", "-j", min=1,
+JOBS_OPTION = typer.Option(None, "--jobs", "-j", min=1, metavar="N",
                            help="Threads: solve and CSV (default: all cores; same results).")
 BACKEND_OPTION = typer.Option("auto", "--backend", metavar="auto|llvm|kernel|numpy", help="'llvm', 'kernel' (numba), 'numpy' (reference) or 'auto'.")
 
@@ -249,7 +249,7 @@ def solve(
     method: str = METHOD_OPTION,
     verify: bool = typer.Option(False, "--verify", help="Compute every link's Newton-Euler "
                                 "residual from the solved forces and print the worst (relative)."),
-    chunk: int = typer.Option(20_000, "--chunk", min=100, help="Samples processed at once (bounds memory)."),
+    chunk: int = typer.Option(20_000, "--chunk", min=100, metavar="N", help="Samples processed at once (bounds memory)."),
     jobs: int = JOBS_OPTION,
     backend: str = BACKEND_OPTION,
 ) -> None:
@@ -343,7 +343,7 @@ def verify(
     markdown: Path = typer.Option(None, "--markdown", metavar="FILE", help="Write a Markdown table (CI job summary)."),
     plots: Path = typer.Option(None, "--plots", metavar="DIR", help="Write a PNG of each failing or tight "
                                "(< 10 % margin) check along its worst trajectory."),
-    jobs: int = typer.Option(None, "-j", "--jobs", min=1, help="Worker processes (default: the number of cores)."),
+    jobs: int = typer.Option(None, "-j", "--jobs", min=1, metavar="N", help="Worker processes (default: the number of cores)."),
     dask: str = typer.Option(None, "--dask", metavar="ADDRESS", help="Run on an existing dask.distributed "
                              "cluster (scheduler address, e.g. tcp://host:8786)."),
 ) -> None:
