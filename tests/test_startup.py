@@ -106,3 +106,17 @@ def test_bad_input_is_still_one_line_exit_2(tmp_path):
     assert out.returncode == 2
     assert "Traceback" not in out.stderr
     assert str(bad) in out.stderr
+
+
+def test_verify_in_one_process_analyses_each_mechanism_once(monkeypatch):
+    """The manifest's preparation and the jobs run in this process share one analysis."""
+    from gearcli.batch import manifest, verify  # noqa: PLC0415
+    from gearcli.io import yaml_reader  # noqa: PLC0415
+
+    calls = []
+    real = yaml_reader.load_yaml
+    monkeypatch.setattr(yaml_reader, "load_yaml", lambda p: calls.append(p) or real(p))   # every mechanism read
+    manifest._analysis.cache_clear()
+    out = verify.run_verify(ROOT / "designs" / "ci_example.yaml", jobs=1)
+    assert len(out.rows) > 10
+    assert len(calls) == 1, calls

@@ -8,7 +8,9 @@ problems of the manifest and of every file it names are reported together (one l
 from __future__ import annotations
 
 import glob
+import os
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 
 import jsonschema
@@ -23,6 +25,21 @@ from ..io.schemas import packaged_schema
 
 REQUIREMENT_KEYS = ("cycles_per_hour", "bearing_life_h", "min_static_safety", "min_bending_safety",
                     "min_contact_safety")
+
+
+@lru_cache(maxsize=8)
+def _analysis(mech_path: str, mtime: float | None):
+    return analyse(load_mechanism(mech_path))
+
+
+def case_analysis(mech_path: str | Path):
+    """The analysed mechanism, cached per process (keyed by path and modification time):
+    the manifest's preparation and the jobs run in this process share it."""
+    try:
+        mtime = os.path.getmtime(mech_path)
+    except OSError:       # load_mechanism says what is wrong with it
+        mtime = None
+    return _analysis(str(mech_path), mtime)
 
 
 def design_schema() -> dict:
@@ -127,7 +144,7 @@ def _prepare_case(spec: dict, where: str, base: Path, col: Collector, issues: li
         col.add(f"{where}.bearing_life_h", "a bearing life in hours needs the duty's cycles_per_hour")
     trajs = _trajectory_paths(spec, where, base, col)
     try:
-        an = analyse(load_mechanism(mech_path))
+        an = case_analysis(mech_path)
     except GearcliError as exc:
         issues += exc.lines()
         return None

@@ -11,8 +11,6 @@ from __future__ import annotations
 import os
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
-from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 
@@ -20,11 +18,10 @@ from ..design.checks import build_checks
 from ..design.evaluate import Samples, Verdict, combine, partials, signal
 from ..dynamics.solve import solve
 from ..errors import Collector, GearcliError
-from ..io import load_mechanism
 from ..io.trajectory import read_trajectory
-from ..pipeline import analyse, prismatic_independent
+from ..pipeline import prismatic_independent
 from ..report.columns import named_columns
-from .manifest import Case, Manifest
+from .manifest import Case, Manifest, case_analysis
 
 
 @dataclass(frozen=True)
@@ -37,16 +34,6 @@ class Job:
     path: str
     degrees: bool
     req: object   # design.checks.Requirements
-
-
-@lru_cache(maxsize=8)
-def _analysis(mech_path: str, mtime: float):
-    return analyse(load_mechanism(mech_path))
-
-
-def case_analysis(mech_path: str | Path):
-    """The analysed mechanism, cached per process (keyed by path and modification time)."""
-    return _analysis(str(mech_path), os.path.getmtime(mech_path))
 
 
 def solve_samples(an, traj_path, degrees: bool, threads: int | None = None) -> Samples:
