@@ -3,6 +3,7 @@ behaviour (library inputs, error messages, CLI options)."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 import warnings
 
 import numpy as np
@@ -162,3 +163,19 @@ def test_missing_position_column_of_a_prismatic_joint_gives_no_angle_unit(run_cl
     r = run_cli("solve", mech_dir / "rack_axis.yaml", traj, "-o", tmp_path / "o.csv")
     assert r.exit_code == 2
     assert r.stderr == f"{traj}:1: missing column 'q:Jx' (independent joint 'Jx')\n"
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+@pytest.mark.parametrize("args", [["--help"], ["--version"], ["solve", "--help"]])
+def test_help_into_a_full_stdout_is_one_line_not_a_traceback(args):
+    """--help and --version (outside any command) wrote a traceback when stdout failed."""
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1] / "src")}
+    with open("/dev/full", "w") as full:
+        r = subprocess.run([sys.executable, "-c", "from gearcli.cli import app; app()", *args], stdout=full,
+                           stderr=subprocess.PIPE, text=True, env=env, timeout=120)
+    assert r.returncode == 2
+    assert r.stderr == "stdout: cannot write: No space left on device\n"

@@ -1,12 +1,6 @@
 """The ``gearcli`` command line (typer + rich).
 
-Commands::
-
-    gearcli check MECH               validate a mechanism file
-    gearcli graph MECH [--json|--dot] canonical graph, structure matrix, solve order
-    gearcli solve MECH TRAJ.csv [-o OUT.csv]  motor torques, bearing loads, tooth forces
-    gearcli verify DESIGN.yaml       design checks of rated mechanisms (exit 0/1/2)
-    gearcli plot LOADS.csv COLUMN... -o FIG.png   columns over time
+Commands: check, graph, solve, export, verify, plot (``gearcli COMMAND --help``; README).
 
 Every bad input (unreadable file, YAML or schema error, inconsistent geometry, ...) is
 reported as one line per problem on stderr, ``file:line: yaml.path: message``, with exit
@@ -41,7 +35,17 @@ EXIT_BROKEN_PIPE = 141    # 128 + SIGPIPE, what a shell reports for a writer kil
 EXIT_INTERRUPTED = 130    # 128 + SIGINT
 EXIT_TERMINATED = 143     # 128 + SIGTERM
 
-app = typer.Typer(
+class _App(typer.Typer):
+    """A failure outside a command (``--help`` into a full stdout) is one line too, no traceback."""
+    def __call__(self, *args, **kwargs):
+        try:
+            with bad_input_exits():
+                return super().__call__(*args, **kwargs)
+        except typer.Exit as exc:
+            sys.exit(exc.exit_code)
+
+
+app = _App(
     name="gearcli",
     help="Dynamics of geared robotic mechanisms: canonical graph, structure matrix, motor "
          "torques, bearing loads and gear tooth forces.  SI units: m, kg, kg*m^2, rad, N, N*m.",
@@ -226,7 +230,6 @@ def graph(
 # ---------------------------------------------------------------------------------------
 TRAJ_HELP = ("Trajectory CSV: header t,q:<joint>,... for every independent joint (rad; m if prismatic), optional "
              "qd:/qdd: columns (rad/s, rad/s^2), load:<name>:fx..mz (N, N*m); time t in s, strictly increasing.")
-
 
 METHOD_OPTION = typer.Option("block", "--method", metavar="block|full", help="'block': level-by-level schedule (fast); 'full': cross-check.")
 JOBS_OPTION = typer.Option(None, "--jobs", "-j", min=1, metavar="N",
