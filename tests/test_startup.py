@@ -34,7 +34,8 @@ URDF = ["lxml", "gearcli.io.urdf_reader"]
 PYARROW = ["pyarrow"]
 SCIPY = ["scipy", "scipy.sparse", "scipy.sparse.csgraph", "scipy.linalg"]
 RICH = ["rich", "rich.console", "rich.table"]
-WATCHED = SOLVER + KERNELS + URDF + PYARROW + SCIPY + RICH + ["numpy", "gearcli.io.yaml_reader", "jsonschema"]
+WATCHED = SOLVER + KERNELS + URDF + PYARROW + SCIPY + RICH + ["numpy", "numpy.random", "gearcli.io.yaml_reader",
+                                                          "jsonschema"]
 
 
 def loaded_after(args, tmp_path) -> tuple[int, set[str]]:
@@ -78,6 +79,19 @@ def test_check_prints_no_rich_table(mech, tmp_path):
     code, loaded = loaded_after(["check", MECH / mech], tmp_path)
     assert code == (0 if mech == "bendix_wrist.yaml" else 2)
     assert not loaded & set(RICH), loaded
+
+
+@pytest.mark.parametrize("mech, random", [("bendix_wrist.yaml", False), ("paper_2dof.yaml", False),
+                                          ("rack_axis.yaml", False), ("planetary_3p.yaml", True)])
+def test_random_configuration_only_when_home_is_not_enough(mech, random, tmp_path):
+    """The determinacy check draws its random configuration (numpy.random) only when the
+    home configuration does not settle the equations (the planetary set's redundant block is
+    checked at both).  The second run (the first imports scipy, which imports numpy.random);
+    only the redundant circuits need scipy then (the pivoted QR of coordinates.py)."""
+    loaded_after(["check", MECH / mech], tmp_path)
+    code, loaded = loaded_after(["check", MECH / mech], tmp_path)
+    assert code == 0
+    assert ("numpy.random" in loaded) == random and ("scipy" in loaded) == random, loaded
 
 
 def test_urdf_check_does_not_import_the_yaml_reader(tmp_path):

@@ -64,6 +64,25 @@ def _rank(A: np.ndarray) -> int:
     return int(np.sum(sv > _RTOL * sv[0])) if sv.size and sv[0] > 0 else 0
 
 
+class _Configurations:
+    """The equation columns at the home configuration and at a random one (seed 0), in that
+    order, each computed when first asked for: most mechanisms are checked at home alone
+    (and then numpy.random is not even imported)."""
+
+    def __init__(self, an):
+        self.an, self._cols = an, {}
+
+    def __getitem__(self, i: int) -> Columns:
+        if i not in self._cols:
+            an = self.an
+            q = np.zeros((1, an.dof)) if i == 0 else np.random.default_rng(0).uniform(-np.pi, np.pi, (1, an.dof))
+            self._cols[i] = Columns(an, forward(an.mech, an.tree, (q @ an.S.T).reshape(1, len(an.mech.joints))))
+        return self._cols[i]
+
+    def __iter__(self):
+        return (self[i] for i in range(2))
+
+
 def check_determinate(an, col: Collector) -> None:
     """Numerical check that the equations determine every load.
 
@@ -74,10 +93,7 @@ def check_determinate(an, col: Collector) -> None:
     a zero lever arm or a motor whose axis carries no load; this can.
     """
     owned = block_unknowns(an)
-    J = len(an.mech.joints)
-    rng = np.random.default_rng(0)
-    configs = [np.zeros((1, an.dof)), rng.uniform(-np.pi, np.pi, (1, an.dof))]
-    cols = [Columns(an, forward(an.mech, an.tree, (q @ an.S.T).reshape(1, J))) for q in configs]
+    cols = _Configurations(an)
     rank, total = 0, 0
     for blk, groups in zip(an.schedule, owned):
         n = sum(g.size for g in groups)
@@ -97,7 +113,7 @@ def check_determinate(an, col: Collector) -> None:
                 f"singular (rank {rank} of {total}); check the gear geometry and the motors")
 
 
-def _check_sharing(an, cols: list, blk: tuple, groups: list, col: Collector) -> None:
+def _check_sharing(an, cols: _Configurations, blk: tuple, groups: list, col: Collector) -> None:
     """A redundant block: its equations must be independent (full row rank) and every
     redundancy must change some tooth force, else the mesh-stiffness model cannot share it."""
     w = mesh_weights(an, groups)
