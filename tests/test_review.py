@@ -179,3 +179,17 @@ def test_help_into_a_full_stdout_is_one_line_not_a_traceback(args):
                            stderr=subprocess.PIPE, text=True, env=env, timeout=120)
     assert r.returncode == 2
     assert r.stderr == "stdout: cannot write: No space left on device\n"
+
+
+def test_urdf_under_another_name_is_named_xml_not_a_yaml_error(run_cli, mech_dir, tmp_path):
+    """A xacro file or a URDF named .txt gave 'YAML syntax error: mapping values are not allowed'."""
+    xacro = tmp_path / "arm.urdf.xacro"
+    xacro.write_bytes((mech_dir / "geared_arm.urdf").read_bytes())
+    r = run_cli("check", xacro)
+    assert r.exit_code == 2
+    assert r.stderr == (f"{xacro}:1: this is XML, not YAML: a URDF is read from a file named .urdf or .xml "
+                        "(expand a xacro file first)\n")
+    merge = tmp_path / "m.yaml"       # YAML opening with '<<' (a merge key) stays a YAML problem
+    merge.write_text("<<: *x\n")
+    r = run_cli("check", merge)
+    assert r.exit_code == 2 and "YAML syntax error" in r.stderr
