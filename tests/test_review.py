@@ -193,3 +193,21 @@ def test_urdf_under_another_name_is_named_xml_not_a_yaml_error(run_cli, mech_dir
     merge.write_text("<<: *x\n")
     r = run_cli("check", merge)
     assert r.exit_code == 2 and "YAML syntax error" in r.stderr
+
+
+@pytest.mark.parametrize("args", [["check", "{mech}"], ["solve", "{mech}", "{traj}", "-o", "{out}"], ["--help"]])
+def test_closed_stdout_is_one_line_not_a_traceback(args, mech_dir, tmp_path):
+    """With stdout closed (cron, '>&-') every command ended in an AttributeError traceback
+    (and solve -o FILE wrote its file first)."""
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1] / "src")}
+    names = {"mech": mech_dir / "paper_2dof.yaml", "traj": mech_dir / "paper_2dof_traj.csv", "out": tmp_path / "o.csv"}
+    code = "from gearcli.cli import app; app()"
+    r = subprocess.run([sys.executable, "-c", code, *(a.format(**names) for a in args)], stderr=subprocess.PIPE,
+                       text=True, env=env, timeout=120, preexec_fn=lambda: os.close(1))
+    assert r.returncode == 2
+    assert r.stderr == "stdout: cannot write: stdout is closed\n"
+    assert list(tmp_path.iterdir()) == []

@@ -1,6 +1,4 @@
-"""The ``gearcli`` command line (typer + rich).
-
-Commands: check, graph, solve, export, verify, plot (``gearcli COMMAND --help``; README).
+"""The ``gearcli`` command line (typer + rich): check, graph, solve, export, verify, plot.
 
 Every bad input (unreadable file, YAML or schema error, inconsistent geometry, ...) is
 reported as one line per problem on stderr, ``file:line: yaml.path: message``, with exit
@@ -40,6 +38,8 @@ class _App(typer.Typer):
     def __call__(self, *args, **kwargs):
         try:
             with bad_input_exits():
+                if sys.stdout is None:    # closed (>&-): refused like any Unix tool does
+                    raise OSError("stdout is closed")
                 return super().__call__(*args, **kwargs)
         except typer.Exit as exc:
             sys.exit(exc.exit_code)
