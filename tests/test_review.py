@@ -211,3 +211,34 @@ def test_closed_stdout_is_one_line_not_a_traceback(args, mech_dir, tmp_path):
     assert r.returncode == 2
     assert r.stderr == "stdout: cannot write: stdout is closed\n"
     assert list(tmp_path.iterdir()) == []
+
+
+_URDF_LINK = ('<link name="{0}"><inertial><mass value="1"/>'
+              '<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>')
+_URDF_TRANSMISSION = ('<transmission name="{0}"><type>transmission_interface/SimpleTransmission</type>'
+                      '<joint name="{1}"/><actuator name="{2}"><mechanicalReduction>10</mechanicalReduction>'
+                      '</actuator></transmission>')
+
+
+@pytest.mark.parametrize("mimic_of_j2, expected", [
+    ("j0", ["{f}:4: joint 'j1'.mimic: joint 'j1' mimics unknown joint 'j0'"]),
+    ("j1", ["{f}:4: joint 'j1'.mimic: mimic cycle: j1 -> j2 -> j1 (each joint follows the next; no joint leads)"]),
+])
+def test_urdf_lists_mimic_and_transmission_problems_together(run_cli, tmp_path, mimic_of_j2, expected):
+    """A bad <mimic> hid the transmissions' problems (shown only once it was fixed, as the
+    README's bad.urdf example did not); a joint left without its leader makes up no motor
+    (no 'duplicate motor name' against an actuator named like it)."""
+    lines = ['<robot name="r">', '<link name="base"/>', _URDF_LINK.format("l1") + _URDF_LINK.format("l2"),
+             '<joint name="j1" type="continuous"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>'
+             f'<mimic joint="{"j0" if mimic_of_j2 == "j0" else "j2"}"/></joint>',
+             '<joint name="j2" type="continuous"><parent link="base"/><child link="l2"/><origin xyz="1 0 0"/>'
+             f'<axis xyz="0 0 1"/>{"" if mimic_of_j2 == "j0" else "<mimic joint=" + chr(34) + "j1" + chr(34) + "/>"}</joint>',
+             _URDF_TRANSMISSION.format("t1", "j9", "a1"),
+             _URDF_TRANSMISSION.format("t2", "j2", "j1"),
+             "</robot>"]
+    f = tmp_path / "bad.urdf"
+    f.write_text("\n".join(lines) + "\n")
+    r = run_cli("check", f)
+    assert r.exit_code == 2
+    want = [e.format(f=f) for e in expected] + [f"{f}:6: transmission 't1': transmission 't1' names unknown joint 'j9'"]
+    assert r.stderr.splitlines() == want

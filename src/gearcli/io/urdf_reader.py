@@ -128,9 +128,11 @@ class _Reader(StructureChecks, Mimics, Extension, UrdfLoads):
         joints = self.movable_joints()
         self.col.raise_if_any()
         gears = self.couplings() + self.extension_gears(ext)
-        self.col.raise_if_any()
+        bad_pairs = bool(self.col.issues)   # go on to list the transmissions' problems too, with
+        if bad_pairs:                       # no joint following another and no direct drive made up
+            self.leader = {}
         joints = self.absorb_offsets(joints)
-        motors = self.motors(ext, bool(ext["gears"]))
+        motors = self.motors(ext, bool(ext["gears"]) or bad_pairs)
         loads = self.extension_loads(ext["loads"])
         self.col.raise_if_any()
         mech_el = ext["mechanism"]
