@@ -242,3 +242,12 @@ def test_urdf_lists_mimic_and_transmission_problems_together(run_cli, tmp_path, 
     assert r.exit_code == 2
     want = [e.format(f=f) for e in expected] + [f"{f}:6: transmission 't1': transmission 't1' names unknown joint 'j9'"]
     assert r.stderr.splitlines() == want
+
+
+def test_trajectory_column_of_a_dependent_joint_says_so(run_cli, mech_dir, tmp_path):
+    """q:J3 (paper_2dof's bevel shaft, driven through the gears) was only an 'unknown column'."""
+    traj = tmp_path / "t.csv"
+    traj.write_text("t,q:J1,q:J2,q:J3\n0,0,0,0\n1,0,0,0\n2,0,0,0\n")
+    r = run_cli("solve", mech_dir / "paper_2dof.yaml", traj, "-o", tmp_path / "o.csv")
+    assert r.exit_code == 2
+    assert r.stderr.startswith(f"{traj}:1: column 4 'q:J3': unknown column: 'J3' is not an independent joint (expected t, q:J1, q:J2")
