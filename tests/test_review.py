@@ -251,3 +251,16 @@ def test_trajectory_column_of_a_dependent_joint_says_so(run_cli, mech_dir, tmp_p
     r = run_cli("solve", mech_dir / "paper_2dof.yaml", traj, "-o", tmp_path / "o.csv")
     assert r.exit_code == 2
     assert r.stderr.startswith(f"{traj}:1: column 4 'q:J3': unknown column: 'J3' is not an independent joint (expected t, q:J1, q:J2")
+
+
+def test_named_columns_names_a_wrong_time_length(arm):
+    """A t of the wrong length gave numpy's 'cannot reshape array of size 20 into shape (9,newaxis)'."""
+    from gearcli import named_columns
+
+    q = np.zeros((10, 1))
+    res = solve(arm, q, q, q)
+    with pytest.raises(ValueError, match=r"^t has shape \(9,\), the result has 10 samples$"):
+        named_columns(arm, res, np.zeros(9))
+    cols = named_columns(arm, res, np.arange(10) * 0.1)
+    np.testing.assert_allclose(cols["motor:m"], -2.0 * 9.81 * 0.3, rtol=1e-12)
+    assert cols["t"][3] == pytest.approx(0.3)

@@ -88,6 +88,8 @@ def named_columns(an, res: Result, t: np.ndarray | None = None) -> dict[str, np.
     ``t`` defaults to the sample index."""
     if t is None:
         t = np.arange(res.motor.shape[0], dtype=float)
+    if np.shape(t) != res.motor.shape[:1]:
+        raise ValueError(f"t has shape {np.shape(t)}, the result has {res.motor.shape[0]} samples")
     tab = table(an, np.asarray(t, float), res)
     return {name: tab[:, i] for i, name in enumerate(column_names(an))}
 
