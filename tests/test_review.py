@@ -264,3 +264,11 @@ def test_named_columns_names_a_wrong_time_length(arm):
     cols = named_columns(arm, res, np.arange(10) * 0.1)
     np.testing.assert_allclose(cols["motor:m"], -2.0 * 9.81 * 0.3, rtol=1e-12)
     assert cols["t"][3] == pytest.approx(0.3)
+
+
+def test_solve_given_the_mechanism_instead_of_its_analysis_says_so():
+    """gearcli.solve(mech, ...) failed with "'Mechanism' object has no attribute 'mech'"."""
+    mech = parse_mechanism(ARM)
+    q = np.zeros((3, 1))
+    with pytest.raises(TypeError, match=r"^expected the Analysis of gearcli.analyse\(mechanism\), got a Mechanism$"):
+        solve(mech, q, q, q)

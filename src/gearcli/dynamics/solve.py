@@ -265,6 +265,8 @@ def solver_for(an) -> Solver:
     """The :class:`Solver` of ``an`` (built on first use, kept while ``an`` lives)."""
     sol = _SOLVERS.get(an)
     if sol is None:
+        if not hasattr(an, "schedule"):    # e.g. the Mechanism itself
+            raise TypeError(f"expected the Analysis of gearcli.analyse(mechanism), got a {type(an).__name__}")
         sol = _SOLVERS[an] = Solver(an)
     return sol
 
