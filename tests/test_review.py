@@ -272,3 +272,18 @@ def test_solve_given_the_mechanism_instead_of_its_analysis_says_so():
     q = np.zeros((3, 1))
     with pytest.raises(TypeError, match=r"^expected the Analysis of gearcli.analyse\(mechanism\), got a Mechanism$"):
         solve(mech, q, q, q)
+
+
+def test_verify_lines_of_a_unitless_check_have_no_stray_spaces(run_cli, mech_dir, tmp_path):
+    """A failing safety factor printed 'worst 49.38  against limit 1e+05 ' (an empty unit)."""
+    text = (mech_dir.parent / "designs" / "ci_example.yaml").read_text()
+    design = tmp_path / "d.yaml"
+    design.write_text(text.replace("min_static_safety: 2.0", "min_static_safety: 100000.0")
+                      .replace("../mechanisms/", f"{mech_dir}/"))
+    r = run_cli("verify", design, "--junit", tmp_path / "r.xml")
+    assert r.exit_code == 1
+    failed = [line for line in r.stdout.splitlines() if line.startswith("FAILED")]
+    assert failed and all("static safety s0: worst " in line for line in failed)
+    assert all("  " not in line and line.endswith(" against limit 1e+05") for line in failed)
+    junit = (tmp_path / "r.xml").read_text()
+    assert "(limit 1e+05), margin" in junit and " )" not in junit and "  (" not in junit

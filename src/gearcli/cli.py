@@ -357,7 +357,7 @@ def verify(
     from rich.progress import BarColumn, Progress, TextColumn  # noqa: PLC0415
 
     from .batch.manifest import load_manifest  # noqa: PLC0415
-    from .batch.outputs import rich_table  # noqa: PLC0415
+    from .batch.outputs import rich_table, with_unit  # noqa: PLC0415
     from .batch.verify import count_jobs, run_verify  # noqa: PLC0415
 
     manifest = load_manifest(design)
@@ -373,7 +373,7 @@ def verify(
     console.print(rich_table(outcome.rows))
     failed = [r for r in outcome.rows if not r.passed]
     for r in failed:
-        typer.echo(f"FAILED {r.case}: {r.name}: worst {r.value:.4g} {r.unit} against limit {r.limit:.4g} {r.unit}")
+        typer.echo(f"FAILED {r.case}: {r.name}: worst {with_unit(r.value, r.unit)} against limit {with_unit(r.limit, r.unit)}")
     typer.echo(f"{len(outcome.rows) - len(failed)} of {len(outcome.rows)} checks passed" +
                (f"; {len(outcome.plots)} plot(s) in {plots}" if plots else ""))
     if failed:

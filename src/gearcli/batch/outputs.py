@@ -55,6 +55,11 @@ def fmt(x: float) -> str:
     return "inf" if math.isinf(x) else f"{x:.4g}"
 
 
+def with_unit(x: float, unit: str) -> str:
+    """``x`` (:func:`fmt`) and its unit, if it has one (a safety factor has none)."""
+    return f"{fmt(x)} {unit}" if unit else fmt(x)
+
+
 def rich_table(rows: list[Row]) -> Table:
     table = Table(title="Design checks")
     for head, just in (("", "left"), ("case", "left"), ("component", "left"), ("quantity", "left"),
@@ -80,7 +85,7 @@ def write_junit(rows: list[Row], path, suite: str) -> None:
                            failures=str(sum(not r.passed for r in mine)), errors="0", skipped="0")
         for r in mine:
             tc = ET.SubElement(ts, "testcase", classname=f"{suite}.{case}", name=r.name, time="0")
-            text = (f"{r.name}: worst {fmt(r.value)} {r.unit} (limit {fmt(r.limit)} {r.unit}), margin "
+            text = (f"{r.name}: worst {with_unit(r.value, r.unit)} (limit {with_unit(r.limit, r.unit)}), margin "
                     f"{fmt(r.margin)} %, in {r.trajectory} at t = {r.time:.4g} s")
             if r.passed:
                 ET.SubElement(tc, "system-out").text = text
