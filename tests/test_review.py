@@ -287,3 +287,18 @@ def test_verify_lines_of_a_unitless_check_have_no_stray_spaces(run_cli, mech_dir
     assert all("  " not in line and line.endswith(" against limit 1e+05") for line in failed)
     junit = (tmp_path / "r.xml").read_text()
     assert "(limit 1e+05), margin" in junit and " )" not in junit and "  (" not in junit
+
+
+def test_a_manifest_given_to_check_and_a_mechanism_given_to_verify_are_named(run_cli, mech_dir):
+    """Each gave schema noise ("unknown key 'cases' (did you mean 'base'?)", four missing keys;
+    "Additional properties are not allowed ...")."""
+    design = mech_dir.parent / "designs" / "ci_example.yaml"
+    r = run_cli("check", design)
+    assert r.exit_code == 2
+    assert r.stderr.splitlines() == [f"{design}:4: this is a design manifest (it lists cases), not a mechanism "
+                                     "file: run gearcli verify on it"]
+    mech = mech_dir / "paper_2dof.yaml"
+    r = run_cli("verify", mech)
+    assert r.exit_code == 2
+    assert len(r.stderr.splitlines()) == 1
+    assert r.stderr.startswith(f"{mech}:5: this is a mechanism file, not a design manifest: a manifest lists cases")

@@ -104,7 +104,10 @@ def load_manifest(path: str | Path) -> Manifest:
     col = Collector(str(path), lines)
     if not isinstance(data, dict):
         col.add("", "a design manifest must be a YAML mapping with a list of cases")
-        col.raise_if_any()
+    elif "links" in data and "cases" not in data:
+        col.add("", "this is a mechanism file, not a design manifest: a manifest lists cases, each naming "
+                    "a mechanism and its trajectories (README, Design checks in CI)")
+    col.raise_if_any()
     _schema_issues(data, col)
     col.raise_if_any()
     issues: list[str] = []

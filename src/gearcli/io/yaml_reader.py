@@ -134,7 +134,9 @@ def parse_mechanism(text: str, file: str = "<string>") -> Mechanism:
     col = Collector(file, lines)
     if not isinstance(data, dict):
         col.add("", "a mechanism file must be a YAML mapping")
-        col.raise_if_any()
+    elif "cases" in data and "links" not in data:
+        col.add("", "this is a design manifest (it lists cases), not a mechanism file: run gearcli verify on it")
+    col.raise_if_any()
     _number_issues(data, col)
     _schema_issues(data, col, {i.path for i in col.issues})
     col.raise_if_any()
