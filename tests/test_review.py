@@ -302,3 +302,11 @@ def test_a_manifest_given_to_check_and_a_mechanism_given_to_verify_are_named(run
     assert r.exit_code == 2
     assert len(r.stderr.splitlines()) == 1
     assert r.stderr.startswith(f"{mech}:5: this is a mechanism file, not a design manifest: a manifest lists cases")
+
+
+def test_swapped_solve_arguments_point_at_the_order(run_cli, mech_dir):
+    traj = mech_dir / "paper_2dof_traj.csv"
+    r = run_cli("solve", traj, mech_dir / "paper_2dof.yaml")
+    assert r.exit_code == 2
+    assert r.stderr == (f"{traj}:1: a mechanism file must be a YAML mapping "
+                        "(a .csv is a trajectory: gearcli solve MECH TRAJ.csv)\n")

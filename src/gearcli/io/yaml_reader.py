@@ -133,7 +133,8 @@ def parse_mechanism(text: str, file: str = "<string>") -> Mechanism:
     data, lines = yaml_lines(text, file)
     col = Collector(file, lines)
     if not isinstance(data, dict):
-        col.add("", "a mechanism file must be a YAML mapping")
+        col.add("", "a mechanism file must be a YAML mapping" + (
+            " (a .csv is a trajectory: gearcli solve MECH TRAJ.csv)" if file.lower().endswith(".csv") else ""))
     elif "cases" in data and "links" not in data:
         col.add("", "this is a design manifest (it lists cases), not a mechanism file: run gearcli verify on it")
     col.raise_if_any()
