@@ -326,6 +326,7 @@ def test_fuzz_output_faults(fault, command, budget, tmpfile, ext):
              "traj.csv": short_csv("paper_2dof_traj.csv")}
     real_fdopen, real_replace = os.fdopen, os.replace
     saved_tmpfile = getattr(os, "O_TMPFILE", None)
+    saved_tmpfile_works = getattr(tempfile, "_O_TMPFILE_WORKS", False)
 
     def fdopen(fd, mode="r", **kw):
         FullDisk.budget = budget
@@ -342,18 +343,20 @@ def test_fuzz_output_faults(fault, command, budget, tmpfile, ext):
         for k, v in files.items():
             (work / k).write_bytes(v)
         own = "traj.csv" if command == "solve" else "mech.yaml"    # an input of the command
-        out = "out" + (ext if command == "solve" else ".csv")
+        sfx = "" if command == "solve" else ".urdf"     # export refuses a name it cannot read back
+        out = "out" + (ext if command == "solve" else sfx)
+        link, dangle = "link" + sfx, "dangle" + sfx
         target = {"input": work / own, "mech": work / "mech.yaml", "dot": f"{work}/./{own}",
                   "dir": work, "devnull": "/dev/null", "missing": work / "no" / out, "empty": "",
-                  "symlink": work / "link", "dangling": work / "dangle", "hardlink": work / "hard",
+                  "symlink": work / link, "dangling": work / dangle, "hardlink": work / "hard",
                   }.get(fault, work / out)
         extra = {}
         if fault == "symlink":
-            os.symlink("mech.yaml", work / "link")
-            extra["link"] = None
+            os.symlink("mech.yaml", work / link)
+            extra[link] = None
         elif fault == "dangling":
-            os.symlink("real.out", work / "dangle")
-            extra["dangle"] = None
+            os.symlink("real.out", work / dangle)
+            extra[dangle] = None
         elif fault == "hardlink":
             os.link(work / "mech.yaml", work / "hard")
         try:
@@ -362,7 +365,8 @@ def test_fuzz_output_faults(fault, command, budget, tmpfile, ext):
             if fault == "rename":
                 output.os.replace = replace
             if not tmpfile and saved_tmpfile is not None:
-                del os.O_TMPFILE
+                del os.O_TMPFILE    # a system without it, for tempfile too (numba's cache probe uses it)
+                tempfile._O_TMPFILE_WORKS = False
             args = (["solve", work / "mech.yaml", work / "traj.csv"] if command == "solve"
                     else ["export", work / "mech.yaml"]) + ["-o", target]
             result, hung = run_cli(args)
@@ -370,15 +374,16 @@ def test_fuzz_output_faults(fault, command, budget, tmpfile, ext):
             output.os.fdopen, output.os.replace = real_fdopen, real_replace
             if saved_tmpfile is not None:
                 os.O_TMPFILE = saved_tmpfile
+                tempfile._O_TMPFILE_WORKS = saved_tmpfile_works
         inputs = dict(files)
         if fault == "hardlink":
             inputs["hard"] = files["mech.yaml"]
-        allowed = {out, "real.out", "link", "dangle"}
+        allowed = {out, "real.out", link, dangle}
         found = problems(result, hung, work, inputs, allowed)
         if fault in ("input", "mech", "dot", "dir", "devnull", "missing", "empty", "symlink", "hardlink") \
                 and not hung and result.exit_code != 2:
             found.append(f"fault {fault} not refused (exit {result.exit_code})")
-        if fault in ("symlink", "dangling") and not (work / ("link" if fault == "symlink" else "dangle")).is_symlink():
+        if fault in ("symlink", "dangling") and not (work / (link if fault == "symlink" else dangle)).is_symlink():
             found.append("symlink replaced by a file")
         verdict("output", found, files, None if hung else result.exit_code)
 

@@ -213,15 +213,16 @@ def test_output_onto_an_input_is_refused(run_cli, work):
     ("", ("-o: empty file name",)),
     ("{work}", (": -o: is a directory",)),
     ("/dev/null", ("/dev/null: -o: is not a regular file",)),
-    ("{work}/missing/out.csv", ("out.csv: -o: directory", "missing' does not exist")),
+    ("{work}/missing/out.{ext}", ("out.{ext}: -o: directory", "missing' does not exist")),
 ])
 @pytest.mark.parametrize("command", ["solve", "export"])
 def test_bad_output_targets(run_cli, work, target, parts, command):
     (work / "traj.csv").write_text(SMOOTH)
     before = snapshot(work)
     args = [work / "mech.yaml"] + ([work / "traj.csv"] if command == "solve" else [])
-    r = run_cli(command, *args, "-o", target.format(work=work))
-    one_line_error(r, *parts)
+    ext = "csv" if command == "solve" else "urdf"
+    r = run_cli(command, *args, "-o", target.format(work=work, ext=ext))
+    one_line_error(r, *(p.format(ext=ext) for p in parts))
     assert snapshot(work) == before
     assert os.path.exists("/dev/null") and not os.path.isfile("/dev/null")
 
@@ -262,9 +263,10 @@ def test_unwritable_directory_is_refused(run_cli, work, monkeypatch):
     if os.geteuid() == 0:   # root writes anywhere: simulate what a user sees
         monkeypatch.setattr(os, "access", lambda p, m, **k: False if str(p) == str(ro) else real_access(p, m, **k))
     try:
-        for cmd in (("solve", work / "mech.yaml", work / "traj.csv"), ("export", work / "mech.yaml")):
-            r = run_cli(*cmd, "-o", ro / "out.x")
-            one_line_error(r, "out.x: -o: directory", "is not writable")
+        for cmd, name in ((("solve", work / "mech.yaml", work / "traj.csv"), "out.csv"),
+                          (("export", work / "mech.yaml"), "out.urdf")):
+            r = run_cli(*cmd, "-o", ro / name)
+            one_line_error(r, f"{name}: -o: directory", "is not writable")
         assert list(ro.iterdir()) == []
     finally:
         ro.chmod(0o755)
@@ -298,7 +300,7 @@ def test_full_disk_leaves_nothing(run_cli, work, monkeypatch, no_tmpfile, comman
 
     monkeypatch.setattr(output.os, "fdopen", fdopen)
     (work / "traj.csv").write_text(SMOOTH)
-    name = "out.csv" if command == "solve" else "out.x"   # solve's format comes from the extension
+    name = "out.csv" if command == "solve" else "out.urdf"   # the format comes from the extension
     (work / name).write_text("previous\n")
     before = snapshot(work)
     args = [work / "mech.yaml"] + ([work / "traj.csv"] if command == "solve" else [])
@@ -415,6 +417,40 @@ def test_stdout_output_checks_the_whole_trajectory_first(run_cli, work):
 def test_export_to_stdout(run_cli, work):
     r = run_cli("export", work / "mech.yaml", "-o", "-")
     assert r.exit_code == 0 and r.stdout.startswith("<?xml") and "</robot>" in r.stdout
+    assert sorted(p.name for p in work.iterdir()) == ["mech.yaml"]
+
+
+@pytest.mark.parametrize("name", ["robot.yaml", "robot.csv", "robot", "robot.urdf.bak", ".urdf", "old.yaml"])
+def test_export_refuses_a_name_it_cannot_read_back(run_cli, work, name):
+    """gearcli reads a mechanism file as URDF only when it is named .urdf or .xml: export
+    under another name wrote a URDF that ``gearcli check`` then failed to read as YAML."""
+    (work / "old.yaml").write_text("previous\n")
+    before = snapshot(work)
+    r = run_cli("export", work / "mech.yaml", "-o", work / name)
+    assert r.exit_code == 2
+    assert r.stderr == f"{work / name}: -o: export writes URDF; name the file .urdf or .xml\n"
+    assert r.stdout == ""
+    assert snapshot(work) == before
+    (work / "mech.yaml").write_text("links: [\n")       # refused before the mechanism is read
+    r = run_cli("export", work / "mech.yaml", "-o", work / name)
+    assert r.exit_code == 2 and r.stderr == f"{work / name}: -o: export writes URDF; name the file .urdf or .xml\n"
+
+
+@pytest.mark.parametrize("name", ["robot.urdf", "ROBOT.URDF", "robot.xml"])
+def test_export_names_that_read_back(run_cli, work, name):
+    r = run_cli("export", work / "mech.yaml", "-o", work / name)
+    assert r.exit_code == 0 and r.stdout == f"Wrote {work / name}\n", r.stderr
+    r = run_cli("check", work / name)
+    assert r.exit_code == 0 and r.stdout.startswith(f"{work / name}: OK (2 dof"), r.stderr
+
+
+def test_export_urdf_library_refuses_a_yaml_name(work):
+    from gearcli.io import load_mechanism
+    from gearcli.io.output import OutputError
+    from gearcli.report.urdf_writer import export_urdf
+
+    with pytest.raises(OutputError, match=r"r\.yaml: -o: export writes URDF; name the file \.urdf or \.xml$"):
+        export_urdf(load_mechanism(work / "mech.yaml"), work / "r.yaml")
     assert sorted(p.name for p in work.iterdir()) == ["mech.yaml"]
 
 

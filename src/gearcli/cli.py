@@ -311,16 +311,15 @@ def solve(
 def export(
     mech: Path = typer.Argument(..., metavar="MECH", help=MECH_HELP, show_default=False),
     output: str = typer.Option(..., "-o", "--output", metavar="OUT.urdf",
-                               help="URDF file to write (written to a temporary file, then renamed; "
+                               help="URDF file to write, named .urdf or .xml (written to a temporary file, then renamed; "
                                     "'-' for stdout)."),
 ) -> None:
     """Write a URDF of the mechanism: links with inertials, the joint tree, geared joints as
     <mimic> where a single leader exists, motors as <transmission>, and the full gear
     geometry in gearcli extension elements (namespace https://gearcli.dev/urdf/1)."""
-    from .io.output import output_target  # noqa: PLC0415
-    from .report.urdf_writer import export_urdf  # noqa: PLC0415
+    from .report.urdf_writer import export_urdf, urdf_target  # noqa: PLC0415
 
-    output_target(output, (mech,))   # refuse a bad -o before any work
+    urdf_target(output, (mech,))   # refuse a bad -o (also one not named .urdf/.xml) before any work
     an = load_analysis(mech)
     if output == "-":
         typer.echo(export_urdf(an), nl=False)

@@ -11,13 +11,16 @@ from pathlib import Path
 from ..errors import Issue, MechanismError
 from ..model.mechanism import Mechanism
 
+URDF_SUFFIXES = (".urdf", ".xml")
+"""Extensions (any case) of the mechanism files read as URDF; every other name is YAML."""
+
 
 def load_mechanism(path: str | Path) -> Mechanism:
     """Read a mechanism from a YAML file or a URDF (``.urdf``/``.xml``) file.
 
     Raises :class:`~gearcli.errors.MechanismError` listing every problem found.
     """
-    if Path(path).suffix.lower() in (".urdf", ".xml"):
+    if Path(path).suffix.lower() in URDF_SUFFIXES:
         from .urdf_reader import load_urdf  # noqa: PLC0415  (lxml: only for URDF files)
 
         return load_urdf(path)
@@ -41,4 +44,4 @@ def _looks_like_xml(path) -> bool:
     return head[:1] == b"<" and (head[1:2].isalpha() or head[1:2] in (b"?", b"!"))
 
 
-__all__ = ["load_mechanism"]
+__all__ = ["URDF_SUFFIXES", "load_mechanism"]

@@ -22,6 +22,7 @@ write):
 """
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -30,7 +31,8 @@ from lxml import etree
 from ..analysis.graph import Analysis, analyse
 from ..model.mechanism import Mechanism
 from ..spatial import align_z
-from ..io.output import output_target, write_text
+from ..io import URDF_SUFFIXES
+from ..io.output import OutputError, output_target, write_text
 from ..io.urdf_reader import NS, q
 from .urdf_ratings import add_rating_elements
 
@@ -63,12 +65,23 @@ def export_urdf(mech: Mechanism | Analysis, path: str | Path | None = None) -> s
     own source file)."""
     an = mech if isinstance(mech, Analysis) else analyse(mech)
     if path is not None:
-        output_target(path, _sources(an.mech))
+        urdf_target(path, _sources(an.mech))
     root = to_element(an)
     text = etree.tostring(root, pretty_print=True, xml_declaration=True, encoding="utf-8").decode("utf-8")
     if path is not None:
         write_text(path, text, _sources(an.mech))
     return text
+
+
+def urdf_target(path: str | os.PathLike, inputs=()) -> str | None:
+    """:func:`~gearcli.io.output.output_target` for a URDF: also refuses (``NAME: -o: ...``,
+    :class:`~gearcli.io.output.OutputError`) a name gearcli would not read back as URDF,
+    i.e. one not ending in ``.urdf`` or ``.xml`` (:data:`gearcli.io.URDF_SUFFIXES`)."""
+    target = output_target(path, inputs)
+    name = os.fspath(path)
+    if target is not None and Path(name).suffix.lower() not in URDF_SUFFIXES:
+        raise OutputError(name, "export writes URDF; name the file .urdf or .xml")
+    return target
 
 
 def _sources(mech: Mechanism) -> list[str]:
