@@ -393,6 +393,56 @@ def test_full_stdout_is_one_line_exit_2(mech_dir, args):
     assert r.stderr.strip().splitlines() == ["stdout: cannot write: No space left on device"], r.stderr
 
 
+@pytest.mark.parametrize("args, stdout_full, status", [
+    (("check", "BAD"), False, 2), (("graph", "--json", "BAD"), False, 2),
+    (("solve", "MECH", "BADTRAJ", "-o", "OUT"), False, 2), (("export", "BAD", "-o", "OUT.urdf"), False, 2),
+    (("check", "MECH"), False, 0), (("check", "MECH"), True, 2), (("check", "BAD"), True, 2)])
+def test_full_stderr_keeps_the_exit_status(work, args, stdout_full, status):
+    """``gearcli check bad.yaml 2>/dev/full`` exited 1 (the error printer's ENOSPC escaped):
+    bad input is status 2 whatever happens to stderr, and nothing is written."""
+    (work / "bad.yaml").write_text("links: [\n")
+    (work / "traj.csv").write_text("t,q:J1,q:J2\n0,0,oops\n")
+    names = {"BAD": work / "bad.yaml", "MECH": work / "mech.yaml", "BADTRAJ": work / "traj.csv",
+             "OUT": work / "out.csv", "OUT.urdf": work / "out.urdf"}
+    before = snapshot(work)
+    with open("/dev/full", "w") as full:
+        r = subprocess.run(gearcli_cmd(*[names.get(a, a) for a in args]), env=env(), timeout=120,
+                           stdout=full if stdout_full else subprocess.PIPE, stderr=full, text=True)
+    assert r.returncode == status
+    assert snapshot(work) == before
+    if not stdout_full:
+        assert r.stdout == ("" if status else f"{work / 'mech.yaml'}: OK (2 dof, 6 links, 3 gear pairs, 2 motors)\n")
+
+
+class UnwritableStream(io.TextIOBase):
+    """A stderr whose every write and flush fails (ENOSPC); the lines tried are kept."""
+
+    def __init__(self):
+        self.tried = []
+
+    def write(self, s):
+        self.tried.append(s)
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    def flush(self):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+
+def test_unwritable_stderr_is_no_traceback(work, monkeypatch):
+    """In-process: the failing error printer neither escapes as an exception nor changes
+    the status; the one line was tried."""
+    from gearcli.cli import app
+
+    (work / "bad.yaml").write_text("links: [\n")
+    err = UnwritableStream()
+    monkeypatch.setattr(sys, "stderr", err)
+    with pytest.raises(SystemExit) as exc:
+        app(["check", str(work / "bad.yaml")], prog_name="gearcli")
+    assert exc.value.code == 2
+    tried = "".join(t.decode() if isinstance(t, bytes) else t for t in err.tried)
+    assert tried.startswith(f"{work / 'bad.yaml'}:2: ") and tried.count("\n") == 1, tried
+
+
 def test_broken_pipe_exits_quietly(mech_dir):
     p = subprocess.Popen(gearcli_cmd("solve", mech_dir / "paper_2dof.yaml", mech_dir / "paper_2dof_traj.csv",
                                      "-o", "-"),

@@ -2,25 +2,22 @@
 
 Every bad input (unreadable file, YAML or schema error, inconsistent geometry, ...) is
 reported as one line per problem on stderr, ``file:line: yaml.path: message``, with exit
-status 2 and no traceback; commands get that behaviour from :func:`reports_bad_input`.
+status 2 and no traceback; commands get that behaviour from
+:func:`gearcli.exits.reports_bad_input`.
 SI units throughout: m, kg, kg*m^2, rad (degrees only in ``*_deg`` fields of input files).
 """
 from __future__ import annotations
 
-import functools
 import json
-import os
-import signal
 import sys
-import warnings
-from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING, Iterator
+from typing import TYPE_CHECKING
 
 import typer
 
 from . import __version__
 from .errors import GearcliError
+from .exits import EXIT_CHECK_FAILED, bad_input_exits, print_problems, reports_bad_input
 from .report.features import feature_notes
 from .report.sharing import sharing_notes
 from .report.tables import JSON_DIGITS, print_graph_tables, round_sig, stderr_console, stdout_console, summary_table
@@ -28,10 +25,6 @@ from .report.tables import JSON_DIGITS, print_graph_tables, round_sig, stderr_co
 if TYPE_CHECKING:  # pragma: no cover
     from .analysis.graph import Analysis
 
-EXIT_BAD_INPUT = 2
-EXIT_BROKEN_PIPE = 141    # 128 + SIGPIPE, what a shell reports for a writer killed by it
-EXIT_INTERRUPTED = 130    # 128 + SIGINT
-EXIT_TERMINATED = 143     # 128 + SIGTERM
 
 class _App(typer.Typer):
     """A failure outside a command (``--help`` into a full stdout) is one line too, no traceback."""
@@ -57,92 +50,6 @@ app = _App(
 
 MECH_HELP = ("Mechanism file: YAML (schemas/mechanism.schema.json) or URDF (.urdf, .xml).  Lengths in m, "
              "masses in kg, inertias in kg*m^2, angles in rad (degrees in *_deg fields).")
-
-
-# ---------------------------------------------------------------------------------------
-# bad input -> one line per problem on stderr, exit status 2
-# ---------------------------------------------------------------------------------------
-def print_problems(lines: list[str]) -> None:
-    """Write each problem line verbatim to stderr (no markup, no wrapping)."""
-    for line in lines:
-        typer.echo(line, err=True)
-
-
-class Terminated(BaseException):
-    """SIGTERM, raised as an exception so that every ``finally`` (temporary files) runs."""
-
-
-def _raise_terminated(signum, frame):
-    raise Terminated()
-
-
-@contextmanager
-def _sigterm_raises() -> Iterator[None]:
-    try:
-        old = signal.signal(signal.SIGTERM, _raise_terminated)
-    except ValueError:   # not the main thread: leave signals alone
-        yield
-        return
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, old)
-
-
-def _silence_stdout() -> None:
-    """Point the stdout descriptor at /dev/null, so that the interpreter's final flush of
-    a broken or full stdout does not print an error (no-op when stdout is not a file)."""
-    try:
-        fd = sys.stdout.fileno()
-    except (AttributeError, OSError, ValueError):
-        return
-    devnull = os.open(os.devnull, os.O_WRONLY)
-    os.dup2(devnull, fd)
-    os.close(devnull)
-
-
-@contextmanager
-def bad_input_exits() -> Iterator[None]:
-    """Turn every failure that is not a bug into one line on stderr and an exit status.
-
-    :class:`~gearcli.errors.GearcliError` (bad input, an unwritable output): its lines,
-    status 2.  A failing stdout (a full device): ``stdout: cannot write: ...``, status 2.
-    A closed pipe (``gearcli ... | head -1``): no message, status 141.  Ctrl-C: one line,
-    status 130; SIGTERM: one line, status 143 (temporary files are removed first).
-    """
-    try:
-        with _sigterm_raises(), warnings.catch_warnings():
-            # numpy's overflow/invalid-value warnings are not for users: every number
-            # written is checked finite, and a non-finite one is an error
-            warnings.simplefilter("ignore", RuntimeWarning)
-            yield
-            sys.stdout.flush()
-    except GearcliError as exc:
-        print_problems(exc.lines())
-        raise typer.Exit(EXIT_BAD_INPUT) from None
-    except BrokenPipeError:
-        _silence_stdout()
-        raise typer.Exit(EXIT_BROKEN_PIPE) from None
-    except OSError as exc:   # readers report their own files; what is left is stdout
-        _silence_stdout()
-        where = f"{exc.filename}: cannot access" if exc.filename else "stdout: cannot write"
-        print_problems([f"{where}: {exc.strerror or exc}"])
-        raise typer.Exit(EXIT_BAD_INPUT) from None
-    except KeyboardInterrupt:
-        print_problems(["gearcli: interrupted"])
-        raise typer.Exit(EXIT_INTERRUPTED) from None
-    except Terminated:
-        print_problems(["gearcli: terminated (SIGTERM)"])
-        raise typer.Exit(EXIT_TERMINATED) from None
-
-
-def reports_bad_input(command):
-    """Decorator for commands: bad input is reported by :func:`bad_input_exits`."""
-    @functools.wraps(command)
-    def wrapper(*args, **kwargs):
-        with bad_input_exits():
-            return command(*args, **kwargs)
-    return wrapper
 
 
 def load_analysis(path: Path) -> Analysis:
@@ -331,9 +238,6 @@ def export(
 # ---------------------------------------------------------------------------------------
 # verify, plot
 # ---------------------------------------------------------------------------------------
-EXIT_CHECK_FAILED = 1
-
-
 @app.command()
 @reports_bad_input
 def verify(
