@@ -469,13 +469,13 @@ def test_mesh_stiffness_not_positive_or_finite(run_cli, tmp_path, value):
 def test_one_motor_missing(run_cli, tmp_path):
     text = replaced('  - name: motor5\n    link: "5"\n', "")
     assert_bad(run_cli, tmp_path, text, [("motors", line_of(text, "motors:"),
-                                          r"^1 motor\(s\) for 2 degree\(s\) of freedom")])
+                                          r"^1 motor for 2 degrees of freedom")])
 
 
 def test_one_motor_extra(run_cli, tmp_path):
     text = PAPER + '  - {name: motor4, link: "4"}\n'
     assert_bad(run_cli, tmp_path, text, [("motors", line_of(text, "motors:"),
-                                          r"^3 motor\(s\) for 2 degree\(s\) of freedom")])
+                                          r"^3 motors for 2 degrees of freedom")])
 
 
 def test_motors_not_driving_every_dof(run_cli, tmp_path):

@@ -226,7 +226,7 @@ def test_redundant_planets(run_cli, tmp_path, angles, digits):
     res = run_cli("check", path)
     assert res.exit_code == 0, res.stderr
     lines = res.stdout.splitlines()
-    assert lines[0] == f"{path}: OK (1 dof, {3 + len(angles)} links, {2 * len(angles)} gear pairs, 1 motors)"
+    assert lines[0] == f"{path}: OK (1 dof, {3 + len(angles)} links, {2 * len(angles)} gear pairs, 1 motor)"
     pairs = ", ".join(f"'S-P{i}', 'P{i}-R'" for i in range(len(angles)))
     assert lines[1:] == [f"note: redundant gear set {pairs}: load shared by mesh stiffness, min sum t^2/k "
                          "(equal stiffness)"]

@@ -206,7 +206,7 @@ def test_check_graph_and_solve_list_loads_racks_and_helical_pairs(run_cli, mech_
     r = run_cli("check", rack)
     assert r.exit_code == 0
     lines = r.stdout.splitlines()
-    assert lines[0] == f"{rack}: OK (1 dof, 3 links, 1 gear pairs, 1 motors)"
+    assert lines[0] == f"{rack}: OK (1 dof, 3 links, 1 gear pair, 1 motor)"
     assert lines[1] == ("load 'payload' on link 'carriage' (frame base): force [-80, 0, -49.05] N, "
                         "moment [0, 0, 0] N*m at [0.05, -0.04, 0.08] m (link frame)")
     assert lines[2] == ("rack pair 'rack': pinion 'pinion' (pitch radius 0.024 m) drives rack 'carriage': "

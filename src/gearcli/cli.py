@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 import typer
 
 from . import __version__
-from .errors import GearcliError
+from .errors import GearcliError, counted
 from .exits import EXIT_CHECK_FAILED, bad_input_exits, print_problems, reports_bad_input
 from .report.features import feature_notes
 from .report.sharing import sharing_notes
@@ -95,8 +95,8 @@ def check(mech: Path = typer.Argument(..., metavar="MECH", help=MECH_HELP, show_
     static determinacy of the loads.  Prints a one-line summary; exit 2 on bad input."""
     an = load_analysis(mech)
     m = an.mech
-    typer.echo(f"{mech}: OK ({an.dof} dof, {len(m.links)} links, {len(an.circuits)} gear pairs, "
-               f"{len(m.motors)} motors)")
+    typer.echo(f"{mech}: OK ({an.dof} dof, {counted(len(m.links), 'link')}, {counted(len(an.circuits), 'gear pair')}, "
+               f"{counted(len(m.motors), 'motor')})")
     for line in feature_notes(an) + sharing_notes(an):
         typer.echo(line)
 
@@ -207,7 +207,7 @@ def solve(
     if verify:
         console.print(f"Worst Newton-Euler residual (relative): {report.residual:.3g}")
     if not to_stdout:
-        console.print(f"Wrote {report.samples} rows to {out}")
+        console.print(f"Wrote {counted(report.samples, 'row')} to {out}")
 
 
 # ---------------------------------------------------------------------------------------
@@ -277,8 +277,8 @@ def verify(
     failed = [r for r in outcome.rows if not r.passed]
     for r in failed:
         typer.echo(f"FAILED {r.case}: {r.name}: worst {with_unit(r.value, r.unit)} against limit {with_unit(r.limit, r.unit)}")
-    typer.echo(f"{len(outcome.rows) - len(failed)} of {len(outcome.rows)} checks passed" +
-               (f"; {len(outcome.plots)} plot(s) in {plots}" if plots else ""))
+    typer.echo(f"{len(outcome.rows) - len(failed)} of {counted(len(outcome.rows), 'check')} passed" +
+               (f"; {counted(len(outcome.plots), 'plot')} in {plots}" if plots else ""))
     if failed:
         raise typer.Exit(EXIT_CHECK_FAILED)
 
@@ -296,7 +296,7 @@ def plot(
     from .report.plots import plot_loads_csv  # noqa: PLC0415
 
     n = plot_loads_csv(loads, columns, output)
-    typer.echo(f"Wrote {output} ({n} columns)")
+    typer.echo(f"Wrote {output} ({counted(n, 'column')})")
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -37,6 +37,17 @@ def capped(text: str, limit: int) -> str:
     return text if len(text) <= limit else text[:limit - 1] + "…"
 
 
+def plural(n: int, noun: str, nouns: str | None = None) -> str:
+    """``noun`` in the number of ``n``: ``plural(1, "joint")`` is ``joint``, ``plural(2,
+    "joint")`` is ``joints`` (``nouns``: an irregular plural)."""
+    return noun if n == 1 else nouns or noun + "s"
+
+
+def counted(n: int, noun: str, nouns: str | None = None) -> str:
+    """``n`` and its noun agreeing: ``1 gear pair``, ``3 gear pairs``, ``0 samples``."""
+    return f"{n} {plural(n, noun, nouns)}"
+
+
 class GearcliError(Exception):
     """Base class of the errors gearcli reports as bad input (exit status 2)."""
 

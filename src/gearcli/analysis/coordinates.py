@@ -15,7 +15,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import Collector
+from ..errors import Collector, counted, plural
 from .context import Home
 from .types import Circuit
 
@@ -180,10 +180,11 @@ def _contradiction(h: Home, circuits: list[Circuit], cr: CircuitRank, excess: in
 def _dof_mismatch(h: Home, primary, chain, dof: int, rank: int, open_loop: str, col: Collector) -> None:
     G = len(chain)
     if open_loop == "tree":
-        col.add("gears", f"the mechanism has {dof} degrees of freedom ({h.J} joints - {rank} independent "
-                f"gear pairs and couplings) but {G} joints are not made dependent by a pair")
+        col.add("gears", f"the mechanism has {counted(dof, 'degree')} of freedom ({counted(h.J, 'joint')} - {rank} "
+                f"independent gear pairs and couplings) but {counted(G, 'joint')} {plural(G, 'is', 'are')} not made "
+                "dependent by a pair")
     else:
-        col.add("end_effector", f"the mechanism has {dof} degrees of freedom ({h.J} joints - {rank} "
+        col.add("end_effector", f"the mechanism has {counted(dof, 'degree')} of freedom ({counted(h.J, 'joint')} - {rank} "
                 f"independent gear pairs) but its equivalent open-loop chain "
-                f"{' -> '.join(h.tree.links[i] for i in primary)} has {G} joints")
+                f"{' -> '.join(h.tree.links[i] for i in primary)} has {counted(G, 'joint')}")
     col.raise_if_any()

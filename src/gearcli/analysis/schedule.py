@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import Collector
+from ..errors import Collector, counted
 from . import schedule_cache
 
 
@@ -86,7 +86,8 @@ def solution_schedule(an, col: Collector | None = None) -> tuple[tuple[int, ...]
     ncol = sum(g.size for g in groups)
     if ncol < nrow or (ncol > nrow and not an.redundant):
         if col is not None:
-            col.add("", f"{nrow} equations for {ncol} unknowns: the loads are not statically determinate")
+            col.add("", f"{counted(nrow, 'equation')} for {counted(ncol, 'unknown')}: "
+                    "the loads are not statically determinate")
         return ()
     key = schedule_cache.schedule_key(moving, groups, an.redundant, an.level, an.primary)
     cached = schedule_cache.load(key, moving)

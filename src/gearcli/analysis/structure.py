@@ -6,7 +6,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import Collector
+from ..errors import Collector, counted
 from .circuits import groups_of, relative_rotation
 from .context import Home
 from .types import Circuit, CoaxialGroup
@@ -25,7 +25,7 @@ def motors(h: Home, cparent: list, groups: list[CoaxialGroup], canon: np.ndarray
             col: Collector) -> Motors:
     """Input rotation of every motor as a row over real joint angles (one motor per dof)."""
     if len(h.mech.motors) != dof:
-        col.add("motors", f"{len(h.mech.motors)} motor(s) for {dof} degree(s) of freedom: "
+        col.add("motors", f"{counted(len(h.mech.motors), 'motor')} for {counted(dof, 'degree')} of freedom: "
                 "a mechanism needs one motor per degree of freedom")
     found = []
     for m in h.mech.motors:

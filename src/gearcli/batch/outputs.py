@@ -16,6 +16,7 @@ from pathlib import Path
 from rich.table import Table
 from rich.text import Text
 
+from ..errors import counted
 from ..io.output import write_text
 
 WARN_MARGIN = 10.0
@@ -110,7 +111,8 @@ def write_json(rows: list[Row], path, manifest: str) -> None:
 def markdown(rows: list[Row], manifest: str) -> str:
     failed = sum(not r.passed for r in rows)
     head = (f"## Design checks: {manifest}\n\n"
-            + (f"**{failed} of {len(rows)} checks failed.**\n\n" if failed else f"All {len(rows)} checks passed.\n\n"))
+            + (f"**{failed} of {counted(len(rows), 'check')} failed.**\n\n" if failed else
+               f"{'All ' if len(rows) > 1 else ''}{counted(len(rows), 'check')} passed.\n\n"))
     lines = ["| | case | component | quantity | worst | limit | unit | margin % | trajectory | t [s] |",
              "|---|---|---|---|---:|---:|---|---:|---|---:|"]
     for r in rows:

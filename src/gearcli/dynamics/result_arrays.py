@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import counted
+
 FIELDS = ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial", "motor_speed")
 
 
@@ -30,10 +32,10 @@ def check_out(an, n: int, out, inputs: dict) -> None:
         a = getattr(out, k, None)
         if not isinstance(a, np.ndarray):
             raise ValueError(f"out.{k} is {type(a).__name__}, not an array: out must be a Result of this "
-                             f"mechanism with {n} samples")
+                             f"mechanism with {counted(n, 'sample')}")
         if a.shape != shape:
             raise ValueError(f"out.{k} has shape {a.shape}, expected {shape}: out must be a Result of "
-                             f"this mechanism with {n} samples")
+                             f"this mechanism with {counted(n, 'sample')}")
         if a.dtype != np.float64 or not a.flags.c_contiguous or not a.flags.writeable:
             raise ValueError(f"out.{k} must be a writeable C-ordered float64 array (got {a.dtype}, "
                              f"C-ordered {a.flags.c_contiguous}, writeable {a.flags.writeable})")

@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import counted
+
 K = 5          # spline degree
 MIN_SAMPLES = K + 1
 
@@ -122,7 +124,7 @@ def spline_derivatives(x: np.ndarray, y: np.ndarray, order: int = 2) -> list[np.
     x = np.asarray(x, dtype=float)
     n = len(x)
     if n < MIN_SAMPLES:
-        raise ValueError(f"{n} samples: the quintic spline needs at least {MIN_SAMPLES}")
+        raise ValueError(f"{counted(n, 'sample')}: the quintic spline needs at least {MIN_SAMPLES}")
     if not np.all(x[1:] > x[:-1]):
         raise ValueError("the sites must increase strictly")
     t = _knots(x)
@@ -146,7 +148,7 @@ def derivatives(t: np.ndarray, y: np.ndarray, order: int = 2) -> list[np.ndarray
     n = len(t)
     k = min(5, n - 1)
     if k < order:
-        raise ValueError(f"{n} samples allow a spline of degree {k} < {order}")
+        raise ValueError(f"{counted(n, 'sample')} allow{'s' if n == 1 else ''} a spline of degree {k} < {order}")
     if k == 5:
         return spline_derivatives(t, y, order)     # the same values as scipy's, without importing it
     from scipy.interpolate import make_interp_spline  # noqa: PLC0415  (2 to 5 samples only)

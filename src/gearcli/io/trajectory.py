@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import Issue, TrajectoryError
+from ..errors import Issue, TrajectoryError, counted
 from .csv_numbers import parse_bytes, parse_floats
 from .load_columns import load_columns, load_samples
 from .spline import derivatives
@@ -145,7 +145,7 @@ def _bad_cell(lines: list[str], linenos: list[int], header: list[str], sep: str,
     for text, ln in zip(lines, linenos):
         cells = _split(text, sep)
         if len(cells) != len(header):
-            return _fail(file, ln, "", f"row has {len(cells)} columns, the header has {len(header)} "
+            return _fail(file, ln, "", f"row has {counted(len(cells), 'column')}, the header has {len(header)} "
                          f"(separator '{show(sep)}')")
         for c, cell in enumerate(cells):
             if not _NUMBER.fullmatch(cell):

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 from lxml import etree
 
+from ..errors import counted, plural
 from ..model.mechanism import GearPair, Motor
 from ..model.validate import gear_pair_problems
 from .urdf_transmissions import KINDS as TRANSMISSION_KINDS
@@ -159,7 +160,8 @@ class Extension:
             out = [self.extension_motor(el) for el in ext["motors"]]
             plain = [t for t in self.root.findall("transmission") if t.get(q("derived")) != "true"]
             if plain:
-                self.warn("", f"{len(plain)} <transmission> element(s) are ignored: the gearcli:motor "
+                n = len(plain)
+                self.warn("", f"{counted(n, '<transmission> element')} {plural(n, 'is', 'are')} ignored: the gearcli:motor "
                           "elements define the motors")
             return [m for m in out if m is not None]
         driven: dict[str, str] = {}
@@ -205,7 +207,7 @@ class Extension:
                 continue
             fixed = [j for j in spec.joints if j not in self.movable]
             if fixed:
-                self.warn(path, f"transmission '{spec.name}' drives fixed joint(s) {', '.join(fixed)}: ignored", el)
+                self.warn(path, f"transmission '{spec.name}' drives fixed {plural(len(fixed), 'joint')} {', '.join(fixed)}: ignored", el)
                 continue
             kept.append((spec, el))
         return kept
@@ -219,8 +221,10 @@ class Extension:
         for spec, el in kept:
             followers = [j for j in spec.joints if j in self.leader]
             if followers and all(self.chain_leader(j) in own for j in followers):
-                self.warn(spec.path, f"transmission '{spec.name}' drives joint(s) {', '.join(followers)}, which "
-                          "follow another joint through <mimic> whose actuator drives them: ignored", el)
+                n = len(followers)
+                self.warn(spec.path, f"transmission '{spec.name}' drives {plural(n, 'joint')} {', '.join(followers)}, "
+                          f"which {plural(n, 'follows', 'follow')} another joint through <mimic> "
+                          f"whose actuator drives {plural(n, 'it', 'them')}: ignored", el)
                 continue
             clash = [j for j in spec.joints if j in driven]
             if clash:

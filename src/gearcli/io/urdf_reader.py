@@ -46,7 +46,7 @@ from pathlib import Path
 import numpy as np
 from lxml import etree
 
-from ..errors import Collector, Issue, MechanismError
+from ..errors import Collector, Issue, MechanismError, plural
 from ..model.mechanism import Joint, Link, Mechanism
 from ..model.validate import check_inertia
 from ..spatial import align_z, matrix_rpy
@@ -254,7 +254,7 @@ class _Reader(StructureChecks, Mimics, Extension, UrdfLoads):
                                 JOINT_TYPES[yj.type], label, source, path))
         if dyn:
             more = f" and {len(dyn) - 4} more" if len(dyn) > 5 else ""
-            self.warn("", f"<dynamics> damping and friction of joint(s) {', '.join(dyn[:4] if more else dyn)}{more} are ignored "
+            self.warn("", f"<dynamics> damping and friction of {plural(len(dyn), 'joint')} {', '.join(dyn[:4] if more else dyn)}{more} are ignored "
                       "(gearcli computes the loads of rigid, frictionless joints)")
         if not joints:
             self.add("", "the robot has no movable joints: nothing to analyse", self.root)

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..dynamics.solve import Result
+from ..errors import counted
 
 
 def column_names(an) -> list[str]:
@@ -89,7 +90,7 @@ def named_columns(an, res: Result, t: np.ndarray | None = None) -> dict[str, np.
     if t is None:
         t = np.arange(res.motor.shape[0], dtype=float)
     if np.shape(t) != res.motor.shape[:1]:
-        raise ValueError(f"t has shape {np.shape(t)}, the result has {res.motor.shape[0]} samples")
+        raise ValueError(f"t has shape {np.shape(t)}, the result has {counted(res.motor.shape[0], 'sample')}")
     tab = table(an, np.asarray(t, float), res)
     return {name: tab[:, i] for i, name in enumerate(column_names(an))}
 

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import GearcliError
+from ..errors import GearcliError, counted
 from ..io.output import atomic_output, output_target
 from .columns import column_unit
 from .table_files import format_of
@@ -117,7 +117,7 @@ def read_loads_csv(path: str | Path) -> tuple[list[str], np.ndarray]:
     for i, line in enumerate(lines[1:], start=2):
         cells = line.split(",")
         if len(cells) != len(header):
-            raise GearcliError(f"{path}:{i}: {len(cells)} cells, the header has {len(header)}")
+            raise GearcliError(f"{path}:{i}: {counted(len(cells), 'cell')}, the header has {len(header)}")
         try:
             rows.append([float(c) for c in cells])
         except ValueError:

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
+from ..errors import counted
 from .features import feature_notes
 from .sharing import sharing_notes
 
@@ -152,7 +153,7 @@ def print_graph_tables(an: Analysis, console: Console) -> None:
 
 def summary_table(report) -> Table:
     """Peak magnitude, RMS and time of the peak of every motor, mesh and bearing load."""
-    table = _table(f"{report.analysis.mech.name}: {report.samples} samples")
+    table = _table(f"{report.analysis.mech.name}: {counted(report.samples, 'sample')}")
     for col, just in (("load", "left"), ("unit", "left"), ("peak", "right"), ("RMS", "right"),
                       ("t at peak [s]", "right")):
         table.add_column(col, justify=just, no_wrap=(col == "load"))
