@@ -414,6 +414,18 @@ def test_full_stderr_keeps_the_exit_status(work, args, stdout_full, status):
         assert r.stdout == ("" if status else f"{work / 'mech.yaml'}: OK (2 dof, 6 links, 3 gear pairs, 2 motors)\n")
 
 
+def test_full_stderr_does_not_fail_a_solve_to_stdout(mech_dir):
+    """``solve ... -o - 2>/dev/full``: the table went whole to stdout, only the summary (on
+    stderr) was lost; that exited 2 with 'stdout: cannot write' (unseen), now 0."""
+    args = gearcli_cmd("solve", mech_dir / "paper_2dof.yaml", mech_dir / "paper_2dof_traj.csv", "-o", "-")
+    ok = subprocess.run(args, env=env(), capture_output=True, text=True, timeout=120)
+    assert ok.returncode == 0 and "paper_2dof: 2001 samples" in ok.stderr, ok.stderr
+    with open("/dev/full", "w") as full:
+        r = subprocess.run(args, env=env(), stdout=subprocess.PIPE, stderr=full, text=True, timeout=120)
+    assert r.returncode == 0
+    assert r.stdout == ok.stdout and r.stdout.count("\n") == 2002
+
+
 class UnwritableStream(io.TextIOBase):
     """A stderr whose every write and flush fails (ENOSPC); the lines tried are kept."""
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import sys
+from contextlib import nullcontext
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -17,7 +18,7 @@ import typer
 
 from . import __version__
 from .errors import GearcliError, counted
-from .exits import EXIT_CHECK_FAILED, bad_input_exits, print_problems, reports_bad_input
+from .exits import EXIT_CHECK_FAILED, bad_input_exits, print_problems, reports_bad_input, stderr_may_fail
 from .report.features import feature_notes
 from .report.sharing import sharing_notes
 from .report.tables import JSON_DIGITS, print_graph_tables, round_sig, stderr_console, stdout_console, summary_table
@@ -197,7 +198,15 @@ def solve(
     finally:
         if started:
             progress.stop()
-    console = err if to_stdout else stdout_console()
+    with stderr_may_fail() if to_stdout else nullcontext():   # the table is out: stderr is for information
+        _print_summary(err if to_stdout else stdout_console(), report, verify)
+    if not to_stdout:
+        stdout_console().print(f"Wrote {counted(report.samples, 'row')} to {out}")
+
+
+def _print_summary(console, report, verify: bool) -> None:
+    """Peak/RMS table of a solve, ideal pairs, feature notes, the residual (``--verify``)."""
+    an = report.analysis
     console.print(summary_table(report))
     ideal = [an.mech.gears[c.gear].name for c in an.circuits if c.geometry is None]
     if ideal:
@@ -206,8 +215,6 @@ def solve(
         console.print(line, markup=False)
     if verify:
         console.print(f"Worst Newton-Euler residual (relative): {report.residual:.3g}")
-    if not to_stdout:
-        console.print(f"Wrote {counted(report.samples, 'row')} to {out}")
 
 
 # ---------------------------------------------------------------------------------------

@@ -41,6 +41,17 @@ def print_problems(lines: list[str]) -> None:
         _silence(sys.stderr)
 
 
+@contextmanager
+def stderr_may_fail() -> Iterator[None]:
+    """For a block that writes only informative text to stderr (the summary of a table
+    written to stdout): a stderr that fails ends the block quietly (the stream pointed at
+    /dev/null) instead of failing a run whose output was written."""
+    try:
+        yield
+    except (OSError, ValueError):   # ENOSPC, EIO, EPIPE; ValueError: a closed file
+        _silence(sys.stderr)
+
+
 class Terminated(BaseException):
     """SIGTERM, raised as an exception so that every ``finally`` (temporary files) runs."""
 
