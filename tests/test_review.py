@@ -253,6 +253,20 @@ def test_trajectory_column_of_a_dependent_joint_says_so(run_cli, mech_dir, tmp_p
     assert r.stderr.startswith(f"{traj}:1: column 4 'q:J3': unknown column: 'J3' is not an independent joint (expected t, q:J1, q:J2")
 
 
+@pytest.mark.parametrize("cell", ["q", "qd", "qdd", "q:", "qd:"])
+def test_trajectory_bare_kind_column_is_one_line(run_cli, mech_dir, tmp_path, cell):
+    """A header cell 'q' (no ':joint') raised IndexError in the dependent-joint message above
+    (found by the long fuzz run): an unknown column, one line, exit 2, no output file."""
+    traj = tmp_path / "t.csv"
+    traj.write_text(f"t,q:J1,q:J2,{cell}\n0,0,0,0\n1,0,0,0\n2,0,0,0\n")
+    r = run_cli("solve", mech_dir / "paper_2dof.yaml", traj, "-o", tmp_path / "o.csv")
+    assert r.exit_code == 2
+    assert r.stderr == f"{traj}:1: column 4 '{cell}': unknown column (expected t, q:J1, q:J2"  \
+        + r.stderr.split("q:J2", 1)[1]
+    assert "Traceback" not in r.stderr and r.stderr.count("\n") <= 1
+    assert not (tmp_path / "o.csv").exists()
+
+
 def test_named_columns_names_a_wrong_time_length(arm):
     """A t of the wrong length gave numpy's 'cannot reshape array of size 20 into shape (9,newaxis)'."""
     from gearcli import named_columns

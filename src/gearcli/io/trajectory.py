@@ -121,7 +121,7 @@ def _columns(header: list[str], names: list[str], file: str, loads=()) -> dict:
     known |= {h for h in pos if h.startswith("load:")}
     for h, i in pos.items():
         if h not in known:
-            joint = h.split(":", 1)[1] if h.split(":")[0] in ("q", "qd", "qdd") else ""   # e.g. a gear shaft
+            joint = h.partition(":")[2] if h.partition(":")[0] in ("q", "qd", "qdd") else ""   # e.g. a gear shaft
             what = ("unknown column" + (f": '{show(joint)}' is not an independent joint" if joint else "")) if h else "empty column name"
             raise _fail(file, 1, _place(header, i), f"{what} ({_expected(names)})")
     if "t" not in pos:
