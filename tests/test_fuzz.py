@@ -205,7 +205,10 @@ def non_finite_in(path: Path) -> list[str]:
     """A problem when an output file holds a NaN or an infinity (or cannot be read back)."""
     import numpy as np
     if path.suffix.lower() not in (".parquet", ".feather", ".npz"):
-        return [f"non-finite number written to {path.name}"] if NON_FINITE.search(path.read_bytes()) else []
+        text = path.read_bytes()
+        if path.suffix.lower() == ".csv":       # the header holds the file's names ('5-inf' is a fine gear name)
+            text = text.partition(b"\n")[2]
+        return [f"non-finite number written to {path.name}"] if NON_FINITE.search(text) else []
     try:
         cols = table_of(path)
     except Exception as exc:   # noqa: BLE001 (any failure to read it back is the finding)
@@ -233,6 +236,16 @@ def run_case(target: str, files: dict, args_of, outputs=("out.csv",)) -> None:
             (work / name).write_bytes(data)
         result, hung = run_cli(args_of(work))
         verdict(target, problems(result, hung, work, files, outputs), files, None if hung else result.exit_code)
+
+
+def test_non_finite_oracle_reads_csv_data_not_names(tmp_path):
+    """The oracle flags a NaN/inf in the data rows of a CSV output, not a name in its header
+    (a long run's only finding was a gear renamed '5-inf', whose columns are 'gear:5-inf:t')."""
+    ok, bad = tmp_path / "ok.csv", tmp_path / "bad.csv"
+    ok.write_text("t,gear:5-inf:t,gear:nan:t\n0,1.5,2\n0.1,1e+300,-3\n")
+    bad.write_text("t,gear:5-1:t\n0,1.5\n0.1,-inf\n")
+    assert non_finite_in(ok) == []
+    assert non_finite_in(bad) == ["non-finite number written to bad.csv"]
 
 
 # --- targets ----------------------------------------------------------------------------
