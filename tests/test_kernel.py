@@ -153,7 +153,7 @@ def test_threads_change_no_bit(key, backend):
 
 def _sign_error(an, q, qd, qdd, backend, chunk):
     with pytest.raises(SignError) as info, np.errstate(all="ignore"):
-        solve(an, q, qd, qdd, backend=backend, chunk=chunk, jobs=2)
+        solve(an, q, qd, qdd, backend=backend, chunk=chunk, jobs=2, check_finite=False)   # the NaN reaches the kernel
     return info.value.sample, info.value.meshes
 
 

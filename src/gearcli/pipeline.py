@@ -111,7 +111,7 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
             for part in parts:
                 with np.errstate(all="ignore"):
                     res = solve(an, part.q, part.qd, part.qdd, method=method, chunk=chunk, verify=verify,
-                                loads=part.loads, backend=backend, jobs=jobs)
+                                loads=part.loads, backend=backend, jobs=jobs, check_finite=False)  # read checked
                     tab = table(an, part.t, res)
                 record(table_file, part, tab, res)
 

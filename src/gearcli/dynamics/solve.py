@@ -33,6 +33,7 @@ from .equations import Columns
 from .general import is_geared, solve_full
 from .external import external_wrenches, load_values, subtract_external
 from .inertia import inertia_load
+from .inputs import motion_arrays
 from .kernel_program import build_program
 from .kinematics import forward
 from .result_arrays import check_out, copy_into, result_arrays, work_arrays
@@ -96,21 +97,6 @@ def joint_space(an, q_ind, qd_ind=None, qdd_ind=None):
     return q, qd, qdd
 
 
-def _check_shapes(an, *arrays):
-    """q, qd, qdd as float arrays (N, dof); ValueError for a bad shape (values unchecked)."""
-    out = []
-    for name, given in zip(("q", "qd", "qdd"), arrays):
-        x = np.asarray(given, float)
-        if x.ndim == 1:
-            x = x[None, :]
-        if x.ndim != 2 or x.shape[1] != an.dof:
-            raise ValueError(f"expected {name} with shape (N, {an.dof}) or ({an.dof},), got {np.shape(given)}")
-        out.append(x)
-    if len({x.shape[0] for x in out}) != 1:
-        raise ValueError(f"q, qd, qdd must have the same number of samples, got {[x.shape[0] for x in out]}")
-    return out
-
-
 class Solver:
     """Inverse dynamics of one analysed mechanism: owns the precomputed block plans.
 
@@ -169,9 +155,9 @@ class Solver:
 
     def solve(self, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK,
               verify: bool = False, loads: dict | None = None, backend: str = "auto",
-              jobs: int | None = None, out: Result | None = None) -> Result:
+              jobs: int | None = None, out: Result | None = None, check_finite: bool = True) -> Result:
         """See :func:`solve`."""
-        q, qd, qdd = _check_shapes(self.an, q, qd, qdd)
+        q, qd, qdd = motion_arrays(self.an, q, qd, qdd, check_finite)
         if method not in ("block", "full"):
             raise ValueError(f"unknown method '{method}' (expected 'block' or 'full')")
         if chunk < 1:
@@ -273,7 +259,7 @@ def solver_for(an) -> Solver:
 
 def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, verify: bool = False,
           loads: dict | None = None, backend: str = "auto", jobs: int | None = None,
-          out: Result | None = None) -> Result:
+          out: Result | None = None, check_finite: bool = True) -> Result:
     """Inverse dynamics along a trajectory.
 
     Parameters
@@ -315,17 +301,21 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
         ``out`` itself is returned (if the call raises, ``out``'s contents are undefined).
         Faster for large calls: no fresh pages for the operating system to zero, the
         cost that does not scale with threads.
+    check_finite : bool
+        Refuse a NaN or infinite ``q``, ``qd`` or ``qdd`` (default; ValueError naming the
+        sample and joint); False skips the check, for inputs already checked (:mod:`.inputs`).
 
     Raises
     ------
     SignError
         when no sign pattern of the tooth forces is consistent at some sample (named).
     ValueError
-        for bad shapes (of ``out`` too), an unknown load name or a load value that is not finite, an unknown
+        for bad shapes (of ``out`` too), a non-finite motion value, an unknown load name or a
+        load value that is not finite, an unknown
         backend, or backend "llvm" or "kernel" where it is unavailable.
     """
     return solver_for(an).solve(q, qd, qdd, method=method, chunk=chunk, verify=verify, loads=loads,
-                                backend=backend, jobs=jobs, out=out)
+                                backend=backend, jobs=jobs, out=out, check_finite=check_finite)
 
 
 def _worst(*values: float) -> float:
