@@ -263,7 +263,6 @@ def verify(
     """Check motors (peak/RMS torque, speed, power), bearings (ISO 281 life, static safety,
     tilting moment), gear teeth (bending and contact stress) and column limits along every
     trajectory of each case.  Exit 0 when every check passes, 1 when any fails, 2 on bad input."""
-    from rich.console import Console  # noqa: PLC0415
     from rich.progress import BarColumn, Progress, TextColumn  # noqa: PLC0415
 
     from .batch.manifest import load_manifest  # noqa: PLC0415
@@ -271,7 +270,7 @@ def verify(
     from .batch.verify import count_jobs, run_verify  # noqa: PLC0415
 
     manifest = load_manifest(design)
-    err = Console(stderr=True, markup=False, highlight=False)
+    err = stderr_console()
     progress = Progress(TextColumn("verifying"), BarColumn(), TextColumn("{task.completed}/{task.total} trajectories"),
                         console=err, transient=True, disable=not err.is_terminal)
     task = progress.add_task("verify", total=count_jobs(manifest))
