@@ -132,6 +132,25 @@ def test_deep_nesting(run_cli, tmp_path):
     bad(run_cli, tmp_path, text, 2, "", r"YAML nesting deeper than 64 levels")
 
 
+@pytest.mark.parametrize("depth", [65, 999, 1001, 5000])
+def test_deep_nesting_message_is_gearclis_at_any_depth(run_cli, tmp_path, depth):
+    """libyaml's scanner reads flow collections ahead and has had a nesting limit of its own
+    (1,000) since PyYAML 6.0.4: gearcli's guard must speak first at every depth, also for a
+    collection that starts on the next line, behind a tag or an anchor."""
+    text = "name: x\nlinks:\n  - !!seq &a " + "[" * depth + "]" * depth + "\n"
+    bad(run_cli, tmp_path, text, 3, "", r"^YAML nesting deeper than 64 levels$")
+
+
+@pytest.mark.parametrize("value", ["'" + "[" * 80 + "'", '"' + '\\"' + "{" * 80 + '"', "a" + "[" * 80,
+                                   "x # " + "[" * 80])
+def test_brackets_in_scalars_and_comments_are_not_nesting(value):
+    """The guard counts only brackets that open a flow collection."""
+    from gearcli.io.yaml_safe import flow_depth_guard, yaml_lines
+    text = f"name: {value}\nlinks: []\n"
+    flow_depth_guard(text, "f.yaml")
+    assert yaml_lines(text, "f.yaml")[0]["links"] == []
+
+
 def test_deep_nesting_subprocess(tmp_path):
     text = "name: x\nlinks: " + "[" * 200000 + "]" * 200000 + "\n"
     bad_subprocess(tmp_path, text, 2, "", r"YAML nesting deeper than 64 levels")

@@ -191,9 +191,80 @@ class _Composer:
             _fail(self.file, event.start_mark, f"more than {MAX_NODES:,} YAML nodes")
 
 
+_FLOW_TOKEN = re.compile(r"""[\[\]{}'"#\n]""")
+_BLOCK_VALUE_START = re.compile(r"""(?:^|[:?-][ \t])[ \t]*(?:[!&][^ \t]*[ \t]+)*$""", re.M)
+
+
+def flow_depth_guard(text: str, file: str) -> None:
+    """Refuse flow nesting (``[[[[...``) deeper than :data:`MAX_DEPTH` before any YAML
+    parser sees the text.
+
+    libyaml's scanner reads a flow collection ahead of the events it emits (to find
+    simple keys), so its own nesting limit (1,000 levels since PyYAML 6.0.4, none before)
+    would fire before the composer's depth check; this guard makes the message gearcli's
+    whatever the PyYAML version.  It counts ``[``/``{`` that open a flow collection: any
+    inside a flow collection, and in block context one that starts a value (after
+    indentation, ``key:``, ``-``, ``?``, a tag or an anchor).  Quoted scalars and comments
+    are skipped.  Block nesting is left to the composer (the parser streams it)."""
+    if text.count("[") + text.count("{") <= MAX_DEPTH:
+        return
+    depth, pos, line = 0, 0, 1
+    n = len(text)
+    while pos < n:
+        m = _FLOW_TOKEN.search(text, pos)
+        if m is None:
+            return
+        c, i = m.group(), m.start()
+        pos = i + 1
+        if c == "\n":
+            line += 1
+        elif c == "#":
+            if i == 0 or text[i - 1] in " \t\n":
+                j = text.find("\n", i)
+                pos = n if j < 0 else j
+        elif c in "'\"":
+            if depth == 0 and not _BLOCK_VALUE_START.search(text, text.rfind("\n", 0, i) + 1, i):
+                continue
+            pos, line = _skip_quoted(text, i, c, line)
+        elif c in "[{":
+            if depth == 0 and not _BLOCK_VALUE_START.search(text, text.rfind("\n", 0, i) + 1, i):
+                continue
+            depth += 1
+            if depth > MAX_DEPTH:
+                raise MechanismError([Issue(file, "", line, f"YAML nesting deeper than {MAX_DEPTH} levels")])
+        elif depth > 0:  # ] or }
+            depth -= 1
+
+
+def _skip_quoted(text: str, start: int, quote: str, line: int) -> tuple[int, int]:
+    """Position after the quoted scalar opening at ``start``, and the line there."""
+    i = start + 1
+    n = len(text)
+    while i < n:
+        j = text.find(quote, i)
+        if j < 0:
+            j = n
+        if quote == '"':
+            k = j - 1
+            while k >= i and text[k] == "\\":
+                k -= 1
+            if (j - 1 - k) % 2 == 1 and j < n:   # an escaped quote
+                line += text.count("\n", i, j + 1)
+                i = j + 1
+                continue
+        elif j + 1 < n and text[j + 1] == "'":   # '' inside a single-quoted scalar
+            line += text.count("\n", i, j + 2)
+            i = j + 2
+            continue
+        line += text.count("\n", i, j)
+        return j + 1, line
+    return n, line
+
+
 def compose(text: str, file: str):
     """Root node of the single YAML document in ``text`` (None if empty), within the
     limits of the module docstring; raises MechanismError."""
+    flow_depth_guard(text, file)
     loader = Loader(text)
     try:
         with _gc_paused():
