@@ -90,3 +90,36 @@ def test_bad_helical(run_cli, tmp_path, edit, field, pattern):
     assert re.search(pattern, first), first
     with pytest.raises(MechanismError):
         load_mechanism(path)
+
+
+@pytest.mark.parametrize("deg,ok", [(60, False), ("60.0", False), (60.5, False), (-1, False),
+                                    (59.99999999, True), (59.999999999999, True), (0.001, True)])
+def test_helix_angle_range_in_degrees(run_cli, tmp_path, deg, ok):
+    """The documented range [0, 60) is checked on the degrees as written: 60 itself is
+    refused (it was accepted: radians(60) compared with a literal a few ulps above it)."""
+    text = HELICAL.replace("helix_angle_deg: 20", f"helix_angle_deg: {deg}").replace("HAND", "right")
+    path = tmp_path / "h.yaml"
+    path.write_text(text)
+    r = run_cli("check", path)
+    if ok:
+        assert r.exit_code == 0, r.stderr
+        return
+    line = 1 + next(i for i, ln in enumerate(text.splitlines()) if "mesh_point" in ln)
+    assert r.exit_code == 2 and r.stderr.splitlines() == [
+        f"{path}:{line}: gears[0].helix_angle_deg: helix angle must be in [0, 60) degrees, got {float(deg):g}"]
+
+
+@pytest.mark.parametrize("attr,ok", [('helix_angle_deg="60"', False), ('helix_angle_deg="59.99999999"', True),
+                                     ('helix_angle="1.0471976"', False), ('helix_angle="1.0471975"', True)])
+def test_helix_angle_range_urdf(tmp_path, attr, ok):
+    """The same range in a URDF's gearcli:gear, in degrees or radians (pi/3 = 1.04719755...)."""
+    path = tmp_path / "h.urdf"
+    export_urdf(helical("right"), path)
+    text = path.read_text()
+    assert text.count('helix_angle="') == 1
+    path.write_text(re.sub(r'helix_angle="[^"]*"', attr, text))
+    if ok:
+        load_mechanism(path)
+        return
+    with pytest.raises(MechanismError, match=r"helix angle must be in \[0, 60\) degrees, got 60$"):
+        load_mechanism(path)

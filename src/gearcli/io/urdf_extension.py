@@ -3,6 +3,8 @@
 actuators, direct drives).  A mixin of the reader in :mod:`gearcli.io.urdf_reader`."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from lxml import etree
 
@@ -11,11 +13,20 @@ from ..model.mechanism import GearPair, Motor
 from ..model.validate import gear_pair_problems
 from .urdf_transmissions import KINDS as TRANSMISSION_KINDS
 from .urdf_transmissions import read_transmissions
-from .urdf_xml import NS, q
+from .urdf_xml import NS, floats, q
 
 GEAR_ATTRS = ("name", "j", "k", "kind", "ratio", "teeth", "carrier", "mesh_point", "pressure_angle",
               "pressure_angle_deg", "cone_angles", "cone_angles_deg", "helix_angle", "helix_angle_deg", "hand",
               "stiffness", "derived")
+
+
+def _helix_deg(el, kw: dict) -> float | None:
+    """The helix angle in degrees as written (``helix_angle_deg``), else the degrees of
+    ``helix_angle`` (rad); None when not given or unreadable (reported already)."""
+    if "helix_angle" not in kw:
+        return None
+    given = floats(el.get("helix_angle_deg"), 1) if el.get("helix_angle") is None else None
+    return float(given[0]) if given is not None else math.degrees(kw["helix_angle"])
 
 
 class Extension:
@@ -118,7 +129,7 @@ class Extension:
         ``j``/``k`` None when unknown (already reported)."""
         same = j is not None and j == k
         for _, message in gear_pair_problems("j", "j" if same else "k", kw["kind"], ratio, "teeth" in kw,
-                                             "mesh_point" in kw, "cone_angles" in kw, kw.get("helix_angle"),
+                                             "mesh_point" in kw, "cone_angles" in kw, _helix_deg(el, kw),
                                              kw.get("hand")):
             self.add(path, message, el)
 

@@ -268,8 +268,9 @@ def _gears(data: dict, col: Collector, links: _Names) -> list[GearPair]:
         kind, cones = spec.get("kind", "external"), spec.get("cone_angles_deg")
         ratio = float(spec["ratio"]) if "ratio" in spec else None
         helix = float(np.deg2rad(spec["helix_angle_deg"])) if "helix_angle_deg" in spec else None
+        helix_deg = float(spec["helix_angle_deg"]) if "helix_angle_deg" in spec else None
         for field, message in gear_pair_problems(j, k, kind, ratio, "teeth" in spec, "mesh_point" in spec,
-                                                 cones is not None, helix, spec.get("hand")):
+                                                 cones is not None, helix_deg, spec.get("hand")):
             col.add(path + _GEAR_FIELD[field], message)
         gears.append(GearPair(
             spec.get("name", f"{j}-{k}"), j, k, kind, ratio,

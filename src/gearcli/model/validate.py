@@ -56,13 +56,15 @@ def number_problem(x) -> str | None:
 
 
 def gear_pair_problems(j: str, k: str, kind: str, ratio: float | None, has_teeth: bool,
-                       has_mesh_point: bool, has_cones: bool, helix: float | None = None,
+                       has_mesh_point: bool, has_cones: bool, helix_deg: float | None = None,
                        hand: str | None = None) -> list[tuple[str, str]]:
     """Problems of a gear pair's declaration, whatever file it comes from: (field, message)
     with field ``""`` (the pair), ``"links"``, ``"kind"``, ``"ratio"``, ``"cone_angles"``,
-    ``"helix_angle"``, ``"hand"`` or ``"teeth"``; ``ratio`` and ``helix`` (rad) None when not given.
+    ``"helix_angle"``, ``"hand"`` or ``"teeth"``; ``ratio`` and ``helix_deg`` (the helix angle in
+    degrees, as the user wrote it: the range is checked on that number, not on a conversion)
+    None when not given.
     (The geometric checks are in :mod:`gearcli.model.gears`.)"""
-    out: list[tuple[str, str]] = _helix_problems(kind, has_mesh_point, helix, hand)
+    out: list[tuple[str, str]] = _helix_problems(kind, has_mesh_point, helix_deg, hand)
     if kind not in GEAR_KINDS:
         out.append(("kind", f"unknown gear kind '{kind}' (expected {', '.join(GEAR_KINDS)})"))
     if j == k:
@@ -90,10 +92,15 @@ def _rack_problems(has_teeth: bool, has_mesh_point: bool) -> list[tuple[str, str
     return out
 
 
+HELIX_MAX_DEG = 60.0
+"""Helix angles are accepted in [0, HELIX_MAX_DEG) degrees."""
+
+
 def _helix_problems(kind: str, has_mesh_point: bool, helix: float | None, hand: str | None) -> list:
+    """``helix`` in degrees (compared as given: 60 is refused, 59.99999999 accepted)."""
     out = []
-    if helix is not None and not 0.0 <= helix < 1.0471975511965979:
-        out.append(("helix_angle", f"helix angle must be in [0, 60) degrees, got {np.degrees(helix):g}"))
+    if helix is not None and not 0.0 <= helix < HELIX_MAX_DEG:
+        out.append(("helix_angle", f"helix angle must be in [0, {HELIX_MAX_DEG:g}) degrees, got {helix:g}"))
     if helix and kind not in ("external", "internal"):
         out.append(("helix_angle", f"a helix angle is only for external and internal parallel-axis pairs, "
                     f"this pair is {kind}"))
