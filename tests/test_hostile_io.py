@@ -227,6 +227,23 @@ def test_bad_output_targets(run_cli, work, target, parts, command):
     assert os.path.exists("/dev/null") and not os.path.isfile("/dev/null")
 
 
+@pytest.mark.parametrize("suffix", ["/", "/.", "//"])
+def test_output_name_ending_in_a_slash_is_refused(run_cli, work, suffix):
+    """``-o out.csv/`` names a directory: refused by every command with -o (the system
+    would strip the '/' and write out.csv), one line, exit 2, nothing written."""
+    (work / "traj.csv").write_text(SMOOTH)
+    assert run_cli("solve", work / "mech.yaml", work / "traj.csv", "-o", work / "loads.csv").exit_code == 0
+    before = snapshot(work)
+    for args, name in [(("solve", work / "mech.yaml", work / "traj.csv"), "out.csv"),
+                       (("solve", work / "mech.yaml", work / "traj.csv"), "out.parquet"),
+                       (("export", work / "mech.yaml"), "out.urdf"),
+                       (("plot", work / "loads.csv", "motor:*"), "out.png")]:
+        target = f"{work}/{name}{suffix}"
+        r = run_cli(*args, "-o", target)
+        assert one_line_error(r) == f"{target}: -o: names a directory (ends with '/'); give a file name"
+        assert snapshot(work) == before
+
+
 def test_output_through_a_symlink_writes_its_target_and_keeps_the_link(run_cli, work):
     (work / "traj.csv").write_text(SMOOTH)
     os.symlink("real.csv", work / "link.csv")            # dangling: real.csv does not exist yet

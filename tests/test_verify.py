@@ -285,6 +285,15 @@ def test_unwritable_reports_are_refused_before_running(run_cli, tmp_path):
     assert r.exit_code == 2 and "Design checks" not in r.stdout
 
 
+@pytest.mark.parametrize("option", ["--junit", "--json", "--markdown"])
+def test_report_name_ending_in_a_slash_is_refused(run_cli, tmp_path, option):
+    target = f"{tmp_path}/r.out/"
+    r = run_cli("verify", DESIGNS / "ci_example.yaml", option, target)
+    assert r.exit_code == 2 and r.stderr.splitlines() == [
+        f"{target}: {option}: names a directory (ends with '/'); give a file name"]
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_bad_trajectory_rows_are_listed_with_the_other_problems(run_cli, tmp_path):
     case = write_rotor_case(tmp_path, "[{name: x, position: 0, C: 3000, C0: 3000, type: ball}]")
     lines = (tmp_path / "rotor.csv").read_text().splitlines()

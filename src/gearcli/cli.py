@@ -251,9 +251,9 @@ def verify(
     design: Path = typer.Argument(..., metavar="DESIGN.yaml", show_default=False,
                                   help="Design manifest (schemas/design.schema.json): cases of rated "
                                        "mechanisms, trajectories and limits."),
-    junit: Path = typer.Option(None, "--junit", metavar="FILE", help="Write JUnit XML (one testcase per check)."),
-    json_out: Path = typer.Option(None, "--json", metavar="FILE", help="Write the checks as JSON."),
-    markdown: Path = typer.Option(None, "--markdown", metavar="FILE", help="Write a Markdown table (CI job summary)."),
+    junit: str = typer.Option(None, "--junit", metavar="FILE", help="Write JUnit XML (one testcase per check)."),
+    json_out: str = typer.Option(None, "--json", metavar="FILE", help="Write the checks as JSON."),
+    markdown: str = typer.Option(None, "--markdown", metavar="FILE", help="Write a Markdown table (CI job summary)."),
     plots: Path = typer.Option(None, "--plots", metavar="DIR", help="Write a PNG of each failing or tight "
                                "(< 10 % margin) check along its worst trajectory."),
     jobs: int = typer.Option(None, "-j", "--jobs", min=1, metavar="N", help="Worker processes (default: the number of cores)."),
@@ -296,7 +296,7 @@ def plot(
                                  help="A loads file written by gearcli solve (.csv, .parquet, .feather, .npz)."),
     columns: list[str] = typer.Argument(..., metavar="COLUMN_OR_GLOB...", show_default=False,
                                         help="Column names or shell patterns, e.g. 'motor:*' 'gear:5-1:t'."),
-    output: Path = typer.Option(..., "-o", "--output", metavar="FIG.png|svg|pdf", help="Figure to write."),
+    output: str = typer.Option(..., "-o", "--output", metavar="FIG.png|svg|pdf", help="Figure to write."),
 ) -> None:
     """Draw columns of a loads file over time (one axis per unit: N, N*m, rad/s, W)."""
     from .report.plots import plot_loads_csv  # noqa: PLC0415

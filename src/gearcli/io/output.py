@@ -60,7 +60,8 @@ def output_target(path: str | os.PathLike, inputs: Iterable[str | os.PathLike] =
     """The resolved file name to write for ``-o path`` (``None`` for ``"-"``, stdout).
 
     Raises :class:`OutputError` (naming ``option``, the command-line option that gave
-    ``path``) when ``path`` is empty, names an input file (also through a symlink, ``./``,
+    ``path``) when ``path`` is empty, ends with ``/`` (or is ``.``/``..``: a directory's
+    name, which the operating system would quietly strip to ``out.csv``), names an input file (also through a symlink, ``./``,
     or a hard link), is a directory, device, FIFO or socket, or lies in a directory that
     does not exist or is not writable.
     """
@@ -69,6 +70,8 @@ def output_target(path: str | os.PathLike, inputs: Iterable[str | os.PathLike] =
         return None
     if name == "":
         raise OutputError(option, "empty file name (give a file name, or '-' for stdout)", place="")
+    if name.endswith(("/", os.sep)) or os.path.basename(name) in (".", ".."):
+        raise OutputError(name, "names a directory (ends with '/'); give a file name", option)
     real = os.path.realpath(name)
     ident = _file_id(real)
     for inp in inputs:

@@ -184,8 +184,9 @@ def _read_arrow(path, fmt: str):
 def plot_loads_csv(path, patterns: list[str], out) -> int:
     """Plot the columns of a loads file (CSV, Parquet, Feather, NPZ) matching
     ``patterns`` into ``out``; returns their count."""
-    out = check_output_path(out)
-    output_target(out, [path])
+    name, out = out, check_output_path(out)
+    output_target(name, [path])   # the name as given: Path('fig.png/') would drop the '/'
+
     header, data, units = read_loads(path)
     names = select_columns(header, patterns, str(path))
     series = {n: data[:, header.index(n)] for n in names}
