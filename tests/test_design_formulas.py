@@ -10,7 +10,9 @@ import pytest
 
 from gearcli.design import bearings as B
 from gearcli.design import gears as G
-from gearcli.design import motors as Mo
+from gearcli.design import iso281 as I
+from gearcli.model.ratings import BEARING_FACTOR_DEFAULTS
+from gearcli.report import rms as Rms
 
 LBF = 4.4482216152605      # N
 INCH = 0.0254              # m
@@ -19,7 +21,7 @@ PSI = LBF / INCH**2        # Pa
 
 def test_dynamic_equivalent_load_switches_at_e():
     # ISO 281: P = Fr when Fa/Fr <= e, else X Fr + Y Fa.  By hand: 0.56*1000 + 1.6*500 = 1360.
-    P = B.equivalent_dynamic_load([1000.0, 1000.0, 0.0, -1000.0], [500.0, 200.0, 300.0, -270.0], 0.56, 1.6, 0.27)
+    P = I.dynamic_equivalent_load([1000.0, 1000.0, 0.0, -1000.0], [500.0, 200.0, 300.0, -270.0], 0.56, 1.6, 0.27)
     assert P == pytest.approx([1360.0, 1000.0, 480.0, 1000.0])
 
 
@@ -27,12 +29,11 @@ def test_l10_closed_form_at_constant_load_and_speed():
     # Constant load P at constant speed n: L10h = (C/P)^3 1e6 / (60 n[rpm]) for a ball bearing.
     C, P, rpm, T = 12_000.0, 1_500.0, 900.0, 4.0          # N, N, rev/min, cycle length s
     t = np.linspace(0.0, T, 4001)
-    rate = np.full_like(t, rpm * 2 * math.pi / 60)
-    dt = B.sample_weights(t)
-    Peq = B.duty_equivalent_load(np.full_like(t, P), rate, dt, 3.0)
+    n = B.revolutions(np.full_like(t, rpm * 2 * math.pi / 60), t)
+    assert n.sum() == pytest.approx(rpm / 60 * T, rel=1e-12)                 # 60 rev by hand
+    Peq = B.equivalent_load(B.life_sum(np.full_like(t, P), n, 3.0), n.sum(), 3.0)
     assert Peq == pytest.approx(P, rel=1e-12)
-    revs_per_cycle = np.sum(rate * dt) / (2 * math.pi)
-    life = B.rating_life_hours(B.rating_life_mrev(C, Peq, 3.0), revs_per_cycle * 3600.0 / T)
+    life = B.rating_life_hours(B.rating_life_mrev(C, Peq, 3.0), n.sum() * 3600.0 / T)
     assert life == pytest.approx((C / P) ** 3 * 1e6 / (60 * rpm), rel=1e-9)   # 8^3 * 1e6 / 54000 = 9481.5 h by hand
     assert life == pytest.approx(9481.48, rel=1e-6)
 
@@ -47,22 +48,23 @@ def test_catalogue_rating_example_shigley_11_1():
 
 
 def test_duty_equivalent_load_weights_by_revolutions():
-    # Two steps: P1 = 2 kN for n1 = 300 rev, P2 = 1 kN for n2 = 900 rev (rates 30 and 90
-    # rad/s*2pi over equal times).  P_eq = ((n1 P1^3 + n2 P2^3)/(n1 + n2))^(1/3) by hand.
-    dt = np.full(200, 0.05)
-    rate = np.r_[np.full(100, 2 * math.pi * 60.0), np.full(100, -2 * math.pi * 180.0)]
+    # Two steps: P1 = 2 kN for n1 = 300 rev, P2 = 1 kN for n2 = 900 rev.
+    # P_eq = ((n1 P1^3 + n2 P2^3)/(n1 + n2))^(1/3) by hand.
+    n = np.r_[np.full(100, 3.0), np.full(100, 9.0)]
     P = np.r_[np.full(100, 2000.0), np.full(100, 1000.0)]
-    n1, n2 = 60.0 * 5.0, 180.0 * 5.0
-    ref = ((n1 * 2000.0**3 + n2 * 1000.0**3) / (n1 + n2)) ** (1 / 3)
-    assert B.duty_equivalent_load(P, rate, dt, 3.0) == pytest.approx(ref, rel=1e-12)
-    assert B.duty_equivalent_load(P, np.zeros(200), dt, 3.0) == 0.0
+    ref = ((300 * 2000.0**3 + 900 * 1000.0**3) / 1200) ** (1 / 3)
+    assert B.equivalent_load(B.life_sum(P, n, 3.0), n.sum(), 3.0) == pytest.approx(ref, rel=1e-12)
+    assert B.equivalent_load(0.0, 0.0, 3.0) == 0.0
+    # a life modification factor divides each revolution's damage (Palmgren-Miner)
+    assert B.life_sum(P, n, 3.0, np.r_[np.full(100, 2.0), np.full(100, 1.0)]) == \
+        pytest.approx(300 * 2000.0**3 / 2 + 900 * 1000.0**3, rel=1e-12)
 
 
 def test_static_safety_iso76_by_hand():
     # P0 = max(X0 Fr + Y0 Fa, Fr): (2000, 1000) -> max(1700, 2000) = 2000; (1000, 3000) -> 2100.
     P0 = B.static_equivalent_load([2000.0, 1000.0], [1000.0, -3000.0], 0.6, 0.5)
     assert P0 == pytest.approx([2000.0, 2100.0])
-    assert B.static_safety(10_000.0, P0) == pytest.approx(10_000.0 / 2100.0)
+    assert B.static_safety(10_000.0, float(P0.max())) == pytest.approx(10_000.0 / 2100.0)
 
 
 def test_two_bearing_split_is_the_simply_supported_shaft():
@@ -82,10 +84,10 @@ def test_two_bearing_split_is_the_simply_supported_shaft():
 
 
 def test_iso_factor_defaults_are_the_documented_ones():
-    r = B.FACTOR_DEFAULTS["roller"]
+    r = BEARING_FACTOR_DEFAULTS["tapered_roller"]
     tan15 = math.tan(math.radians(15))
     assert r["e"] == pytest.approx(1.5 * tan15, abs=0.005) and r["Y"] == pytest.approx(0.4 / tan15, abs=0.005)
-    assert B.LIFE_EXPONENT == {"ball": 3.0, "roller": pytest.approx(10 / 3)}
+    assert [I.life_exponent(k) for k in BEARING_FACTOR_DEFAULTS] == [3.0] + [pytest.approx(10 / 3)] * 3
 
 
 def test_lewis_example_shigley_14_1():
@@ -136,9 +138,89 @@ def test_steel_elastic_coefficient_from_its_definition():
     assert G.STEEL_ELASTIC_COEFFICIENT == pytest.approx(ref, rel=1e-3)
 
 
-def test_motor_rms_of_a_sine_over_whole_periods():
+def test_rms_of_a_sine_over_whole_periods():
     t = np.linspace(0, 3.0, 3001)                    # three periods of 1 s
     tau = 4.0 * np.sin(2 * math.pi * t) + 1.0        # RMS^2 = 1 + 16/2 by hand
-    assert Mo.rms(tau, B.sample_weights(t)) == pytest.approx(3.0, rel=1e-9)
-    assert Mo.mechanical_power([2.0, -2.0], [3.0, 3.0]) == pytest.approx([6.0, -6.0])
-    assert B.sample_weights(t).sum() == pytest.approx(3.0)
+    assert Rms.rms(tau, t) == pytest.approx(3.0, rel=1e-9)
+    assert Rms.trapezoid_weights(t).sum() == pytest.approx(3.0)
+
+
+# -- ISO 281 ------------------------------------------------------------------------------
+ISO281_TABLE3 = [  # ISO 281:2007 Table 3, single-row deep-groove ball bearings: f0 Fa/C0, e, Y
+    (0.172, 0.19, 2.30), (0.345, 0.22, 1.99), (0.689, 0.26, 1.71), (1.03, 0.28, 1.55), (1.38, 0.30, 1.45),
+    (2.07, 0.34, 1.31), (3.45, 0.38, 1.15), (5.17, 0.42, 1.04), (6.89, 0.44, 1.00)]
+
+
+@pytest.mark.parametrize("x, e, Y", ISO281_TABLE3)
+def test_iso281_ball_factors_at_the_tabulated_points(x, e, Y):
+    f0, C0 = 13.0, 5200.0
+    e_k, Y_k = I.ball_factors(np.array([x * C0 / f0]), C0, f0)
+    assert (e_k[0], Y_k[0]) == (pytest.approx(e, abs=1e-12), pytest.approx(Y, abs=1e-12))
+
+
+def test_iso281_ball_factors_interpolate_linearly_and_hold_the_end_rows():
+    f0, C0 = 15.0, 3000.0
+    x = np.array([0.0, 0.05, (1.03 + 1.38) / 2, 6.89, 20.0])       # f0 Fa / C0
+    e, Y = I.ball_factors(x * C0 / f0, C0, f0)
+    assert e == pytest.approx([0.19, 0.19, 0.29, 0.44, 0.44]) and Y == pytest.approx([2.30, 2.30, 1.50, 1.00, 1.00])
+    # a plausible wrong table: entering at Fa/C0 with the f0 column (f0 forgotten) gives e = 0.19
+    assert I.ball_factors(np.array([1.03 * C0 / f0]), C0, f0)[0][0] == pytest.approx(0.28)
+
+
+def test_iso281_l10_shigley_example_11_7():
+    # Budynas & Nisbett, Shigley's Mechanical Engineering Design, 9th ed., Example 11-7: an
+    # SKF 6210 ball bearing, Fa = 400 lbf, Fr = 500 lbf (outer ring stationary, V = 1),
+    # C0 = 4450 lbf, C10 = 7900 lbf, 720 rev/min.  Fa/C0 = 0.090 -> Table 11-1 interpolated
+    # e = 0.285, Y2 = 1.527; Fa/Fr = 0.8 > e: Fe = 0.56 (500) + 1.527 (400) = 890.8 lbf;
+    # L10 = (7900/890.8)^3 10^6 / (60 * 720) = 16 150 h (printed).
+    e, Y = I.ball_factors(np.array([400 * LBF]), 4450 * LBF)        # no f0: the catalogue Fa/C0 column
+    assert (round(e[0], 3), round(Y[0], 3)) == (0.285, 1.527)
+    P = I.dynamic_equivalent_load(np.array([500 * LBF]), np.array([400 * LBF]), I.BALL_X, Y, e)
+    assert P[0] / LBF == pytest.approx(890.8, abs=0.2)     # Y printed to 3 decimals: 400 * 0.0005 = 0.2 lbf
+    life = B.rating_life_hours(B.rating_life_mrev(7900 * LBF, float(P[0]), I.life_exponent("ball")), 720 * 60)
+    assert life == pytest.approx(16_150, rel=0.005)
+    # the old fixed factors (X 0.56, Y 1.6, e 0.27) would give 890.8 -> 920 lbf: 9 % shorter,
+    # but at small Fa/C0 they give longer lives than the table: see the next test
+
+
+def test_iso281_table_is_not_less_conservative_than_the_old_fixed_factors():
+    # The issue's J1 ball bearing (C 9.5 kN, C0 5.2 kN, f0 13) at a small axial load:
+    # f0 Fa/C0 = 13 * 60 / 5200 = 0.15 -> first row, e = 0.19, Y = 2.30 (not 1.6).
+    Fr, Fa = np.array([100.0]), np.array([60.0])
+    e, Y = I.ball_factors(Fa, 5200.0, 13.0)
+    P_table = I.dynamic_equivalent_load(Fr, Fa, I.BALL_X, Y, e)[0]
+    assert P_table == pytest.approx(0.56 * 100 + 2.30 * 60)
+    assert P_table > I.dynamic_equivalent_load(Fr, Fa, 0.56, 1.6, 0.27)[0]
+
+
+def test_bearing_equivalent_load_uses_given_factors_over_the_table():
+    from gearcli.model.ratings import BearingRating
+
+    b = BearingRating("b", 0.0, 9500.0, 5200.0, "ball", None, 1.8, None, 0.6, 0.5, f0=13.0)
+    Fr, Fa = np.array([100.0, 100.0]), np.array([60.0, 10.0])
+    # Y given (1.8), X = 0.56 and e from the table (0.19 at f0 Fa/C0 = 0.15 and 0.025)
+    assert I.bearing_equivalent_load(b, Fr, Fa) == pytest.approx([0.56 * 100 + 1.8 * 60, 100.0])
+    cyl = BearingRating("c", 0.0, 9500.0, 5200.0, "cylindrical_roller", *BEARING_FACTOR_DEFAULTS[
+        "cylindrical_roller"].values())
+    assert I.bearing_equivalent_load(cyl, Fr, Fa) == pytest.approx([100.0, 100.0])     # P = Fr
+
+
+def test_a_iso_formulas_by_hand_continuity_and_limits():
+    # ISO 281:2007 9.3, ball bearing, kappa = 1 (third row): a = 0.1 [1 - (2.5671 - 1.9987)^0.83
+    # x^(1/3)]^-9.3 with x = e_C Cu / P = 0.5 * 400 / 2000 = 0.1, by hand:
+    x = 0.1
+    ref = 0.1 * (1 - (2.5671 - 1.9987) ** 0.83 * x ** (1 / 3)) ** -9.3
+    assert I.a_iso(np.array([2000.0]), "ball", 1.0, 0.5, 400.0)[0] == pytest.approx(ref, rel=1e-12)
+    # roller, kappa = 0.5 (second row): 0.1 [1 - (1.5859 - 1.2348/0.5^0.19087) x^0.4]^-9.185
+    ref = 0.1 * (1 - (1.5859 - 1.2348 / 0.5 ** 0.19087) * x ** 0.4) ** -9.185
+    assert I.a_iso(np.array([2000.0]), "tapered_roller", 0.5, 0.5, 400.0)[0] == pytest.approx(ref, rel=1e-12)
+    # the rows meet at kappa = 0.4 and 1 (to the constants' 5 digits, amplified by the power
+    # -9.3: 4e-4 here); a row taken from the wrong range would miss by far more; capped at 50
+    for k in (0.4, 1.0):
+        lo, hi = (I.a_iso(np.array([2000.0]), "ball", k * s, 0.5, 400.0)[0] for s in (1 - 1e-12, 1.0))
+        assert lo == pytest.approx(hi, rel=1e-3)
+    assert I.a_iso(np.array([2000.0]), "ball", 0.3, 0.5, 400.0)[0] < I.a_iso(np.array([2000.0]), "ball", 0.5, 0.5, 400.0)[0]
+    assert I.a_iso(np.array([10.0, 0.0]), "ball", 4.0, 1.0, 400.0) == pytest.approx([50.0, 50.0])
+    assert I.a_iso(np.array([2000.0]), "ball", 9.0, 0.5, 400.0) == I.a_iso(np.array([2000.0]), "ball", 4.0, 0.5, 400.0)
+    with pytest.raises(ValueError):
+        I.a_iso(np.array([2000.0]), "ball", 0.05, 0.5, 400.0)

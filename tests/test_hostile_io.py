@@ -612,14 +612,17 @@ def test_absurd_mechanism_numbers_never_leak_warnings_or_nan(run_cli, work, edit
 
 
 def test_summary_rms_of_huge_loads_does_not_overflow():
-    from gearcli.report.columns import Stat
+    from gearcli.report.columns import Stat, Summary
 
-    st = Stat("x", "N")
-    for chunk in (np.full(10, 1e200), np.full(10, 3e200), np.full(5, 1.0)):
-        st.add_squares(chunk)
-        st.n += len(chunk)
-    expect = 1e200 * np.sqrt((10 * 1 + 10 * 9) / 25)
-    assert np.isclose(st.rms, expect, rtol=1e-12)
+    summ = Summary([1], [Stat("x", "N")])
+    t = np.arange(25.0)
+    x = np.r_[np.full(10, 1e200), np.full(10, 3e200), np.full(5, 1.0)]
+    for a, b in ((0, 10), (10, 20), (20, 25)):          # three chunks, joined by their end rows
+        summ.add(np.column_stack([t[a:b], x[a:b]]))
+    # trapezoid integral of x^2 in units of 1e400, by hand: 9 steps at 1, the step 1 -> 9
+    # (1 + 9)/2, 9 steps at 9, the step 9 -> 0 (9 + 0)/2, then ~0; over 24 s
+    expect = 1e200 * np.sqrt((9 * 1 + 5 + 9 * 9 + 4.5) / 24)
+    assert np.isclose(summ.stats[0].rms, expect, rtol=1e-12)
 
 
 def test_every_module_imports_and_no_private_atomic_writer_is_left():

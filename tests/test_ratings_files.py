@@ -35,7 +35,9 @@ def test_yaml_ratings_with_documented_defaults(mech_dir):
     assert [b.locating for b in j1.bearings] == [True, False] and j1.bearings[1].position == 0.05
     g = mech.gears[1].rating
     assert (g.module, g.face_width, g.elastic_coefficient, g.application_factor) == (0.002, 0.008, 189.8e3, 1.0)
-    assert BEARING_FACTOR_DEFAULTS["ball"] == {"X": 0.56, "Y": 1.6, "e": 0.27, "X0": 0.6, "Y0": 0.5}
+    # deep-groove ball: X, Y, e from ISO 281 Table 3 per sample (None), ISO 76 X0, Y0 fixed
+    assert BEARING_FACTOR_DEFAULTS["ball"] == {"X": None, "Y": None, "e": None, "X0": 0.6, "Y0": 0.5}
+    assert BEARING_FACTOR_DEFAULTS["roller"] == BEARING_FACTOR_DEFAULTS["tapered_roller"]
 
 
 def test_urdf_limits_and_rating_elements(tmp_path):
@@ -84,7 +86,7 @@ def test_urdf_module_disagreeing_with_the_mesh_names_the_rating_element(run_cli,
 
 
 @pytest.mark.parametrize("edit, message", [
-    (('type="ball" Y="1.8"', 'type="balls" Y="1.8"'), "gearcli:bearing[1].type: bearing type must be 'ball' or 'roller', got 'balls'"),
+    (('type="ball" Y="1.8"', 'type="balls" Y="1.8"'), "gearcli:bearing[1].type: bearing type must be one of ball, cylindrical_roller, tapered_roller, roller, got 'balls'"),
     (('C0="5000" type="ball" Y', 'C0="5e3" tipe="ball" Y'), "unknown attribute 'tipe'"),
     (('locating="true"', 'locating="false"'), "with two bearings, exactly one needs 'locating: true'"),
     (('motor="elbow_motor"', 'motor="elbow"'), "unknown motor 'elbow' (known: shoulder_motor, elbow_motor, gripper_motor)"),
@@ -105,7 +107,7 @@ def test_urdf_rating_errors(run_cli, tmp_path, edit, message):
 
 @pytest.mark.parametrize("edit, message", [
     ("{name: xrb, position: 0.0, C: 2900, C0: 3300, type: roller, M: 15}",
-     "joints[2].bearings[0].type: 'rolling' is not one of ['ball', 'roller']"),
+     "joints[2].bearings[0].type: 'rolling' is not one of ['ball', 'cylindrical_roller', 'tapered_roller', 'roller']"),
     ("rating: {peak_torque: 0.5, rms_torque: 0.3, max_speed: 15, max_power: 5}}",
      "motors[0].rating.rms_torque: rms_torque 0.9 exceeds peak_torque 0.5"),
 ])

@@ -76,7 +76,9 @@ def test_two_bearing_rotor_life_and_static_safety_by_hand(run_cli, tmp_path):
     z_star = H + G / W**2
     Fr_b = Fr_total * z_star / L                  # 12.81 N
     Fr_a = abs(Fr_total * (L - z_star) / L)       # 2.81 N (the resultant acts beyond b)
-    P_a = 0.56 * Fr_a + 1.6 * Fa                  # Fa/Fr > e = 0.27: X Fr + Y Fa
+    # ISO 281 Table 3 (catalogue column, no f0): Fa/C0 = 19.62/2000 = 0.0098 is below the
+    # first row 0.014, whose e = 0.19 and Y = 2.30 are held; Fa/Fr = 7 > e: X Fr + Y Fa
+    P_a = 0.56 * Fr_a + 2.30 * Fa
     P_b = Fr_b                                    # no axial load on the floating bearing
     life_a = checks[("rotor", "bearing J/a", "L10 life")]["value"]
     life_b = checks[("rotor", "bearing J/b", "L10 life")]["value"]
@@ -362,3 +364,56 @@ def test_a_requirement_that_checks_nothing_is_refused(run_cli, tmp_path, key, ne
     assert r.exit_code == 2 and doc is None
     assert f"design.yaml:2: cases[0].{key}: checks nothing: 'rotor.yaml' has no {needs}" in r.stderr
     assert "Traceback" not in r.stderr
+
+
+def test_rms_on_a_non_uniform_grid_is_the_time_integral_in_verify_and_the_solve_summary(run_cli, tmp_path):
+    # The rotor driven with qdd = A sin(2 pi t / P) over two whole periods, sampled on a
+    # grid much denser where |sin| is small: the motor torque is tau = J qdd with
+    # J = Izz + m r^2 (no other moment about the vertical axis), so its RMS over time is
+    # J A / sqrt(2) exactly; a plain mean over the samples gives 10 % less here.
+    A, P, Tt = 3.0, 1.0, 2.0
+    u = np.linspace(0.0, 1.0, 1201)
+    t = Tt * (u - 0.9 * np.sin(4 * np.pi * u) / (4 * np.pi))          # strictly increasing, uneven steps
+    qdd = A * np.sin(2 * np.pi * t / P)
+    qd = A * P / (2 * np.pi) * (1 - np.cos(2 * np.pi * t / P))
+    q = A * P / (2 * np.pi) * (t - P / (2 * np.pi) * np.sin(2 * np.pi * t / P))
+    (tmp_path / "rotor.yaml").write_text(rotor_yaml("[{name: x, position: 0, C: 3000, C0: 3000, type: ball}]"))
+    np.savetxt(tmp_path / "rotor.csv", np.column_stack([t, q, qd, qdd]), delimiter=",",
+               header="t,q:J,qd:J,qdd:J", comments="")
+    J = 0.02 + M * R**2
+    tau = J * qdd
+    hand = 0.0                                                        # trapezoid by hand, sample by sample
+    for k in range(len(t) - 1):
+        hand += (tau[k] ** 2 + tau[k + 1] ** 2) / 2 * (t[k + 1] - t[k])
+    hand = math.sqrt(hand / (t[-1] - t[0]))
+    assert hand == pytest.approx(J * A / math.sqrt(2), rel=1e-4)       # the exact time RMS
+    assert np.sqrt(np.mean(tau**2)) < 0.95 * hand                      # the plain mean is far off
+    r, doc = run_json(run_cli, tmp_path, "cases:\n  - {name: rotor, mechanism: rotor.yaml, trajectories: [rotor.csv]}\n")
+    assert r.exit_code in (0, 1), r.stderr
+    verify_rms = by_name(doc)[("rotor", "motor m", "RMS torque")]["value"]
+    assert verify_rms == pytest.approx(hand, rel=1e-9)
+    # the solve summary (chunks of 100 samples: the trapezoid runs across chunk boundaries)
+    r = run_cli("solve", tmp_path / "rotor.yaml", tmp_path / "rotor.csv", "-o", tmp_path / "out.csv", "--chunk", "100")
+    assert r.exit_code == 0, r.stderr
+    rows = [[c.strip() for c in line.split("│")] for line in (r.stdout + r.stderr).splitlines()]
+    (row,) = [c for c in rows if len(c) > 4 and c[1] == "motor m"]
+    assert float(row[4]) == pytest.approx(verify_rms, rel=1e-5)        # the RMS column, printed to 6 digits
+
+
+def test_a_iso_multiplies_the_life_and_names_the_modified_life(run_cli, tmp_path):
+    base = "{name: x, position: 0, C: 3000, C0: 3000, type: tapered_roller"
+    r, doc = run_json(run_cli, tmp_path, "cases:\n" + write_rotor_case(tmp_path, f"[{base}}}]"))
+    l10 = by_name(doc)[("rotor", "bearing J/x", "L10 life")]["value"]
+    r, doc = run_json(run_cli, tmp_path, "cases:\n" + write_rotor_case(tmp_path, f"[{base}, a_ISO: 2.5}}]"))
+    assert by_name(doc)[("rotor", "bearing J/x", "Lnm life (a_ISO)")]["value"] == pytest.approx(2.5 * l10, rel=1e-12)
+
+
+@pytest.mark.parametrize("extra, message", [
+    ("kappa: 1, e_C: 0.5", "bearings[0].kappa: a_ISO from kappa, e_C, Cu needs all three: Cu missing"),
+    ("a_ISO: 2, kappa: 1, e_C: 0.5, Cu: 100", "bearings[0].a_ISO: give a_ISO or kappa, e_C, Cu to compute it, not both"),
+    ("kappa: 0.05, e_C: 0.5, Cu: 100", "bearings[0].kappa: kappa 0.05 is below 0.1, outside ISO 281's a_ISO method"),
+])
+def test_bad_life_factor_keys_are_one_line_each(run_cli, tmp_path, extra, message):
+    (tmp_path / "rotor.yaml").write_text(rotor_yaml(f"[{{name: x, position: 0, C: 3000, C0: 3000, type: ball, {extra}}}]"))
+    r = run_cli("check", tmp_path / "rotor.yaml")
+    assert r.exit_code == 2 and len(r.stderr.strip().splitlines()) == 1 and message in r.stderr, r.stderr

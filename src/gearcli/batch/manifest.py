@@ -178,7 +178,7 @@ REQUIREMENT_CHECKS = {"bearing_life_h": ("L10 life", "joints[].bearings with C")
 
 def _unused_requirements(spec: dict, where: str, checks, col: Collector) -> None:
     """A requirement the case gives but no check uses is an error, not a silent no-op."""
-    quantities = {c.quantity for c in checks}
+    quantities = {c.quantity for c in checks} | ({"L10 life"} if any(c.kind == "life" for c in checks) else set())
     for key, (quantity, needs) in REQUIREMENT_CHECKS.items():
         if key in spec and quantity not in quantities:
             col.add(f"{where}.{key}", f"checks nothing: '{spec['mechanism']}' has no {needs} "

@@ -5,14 +5,14 @@ in N*m, positions in m, rates in rad/s, times in s.
 
 Sources
 -------
-* ISO 281:2007, *Rolling bearings -- Dynamic load ratings and rating life*: dynamic
-  equivalent radial load P = X Fr + Y Fa (with P = Fr when Fa/Fr <= e), basic rating life
-  L10 = (C/P)^p million revolutions, p = 3 for ball and 10/3 for roller bearings (clauses
-  6.2, 7.2).
+* ISO 281:2007, *Rolling bearings -- Dynamic load ratings and rating life*: basic rating
+  life L10 = (C/P)^p million revolutions, p = 3 for ball and 10/3 for roller bearings
+  (clause 7.2); the dynamic equivalent load P and its factors are in :mod:`.iso281`.
 * Equivalent load of a varying duty (e.g. Harris & Kotzalas, *Essential Concepts of
   Bearing Technology*, 5th ed., ch. 11; SKF catalogue, "Fluctuating bearing load"): the
-  load weighted by the revolutions turned under it,
-  P_eq = (sum |w_k| dt_k P_k^p / sum |w_k| dt_k)^(1/p).
+  load weighted by the revolutions n_k turned under it, P_eq = (sum n_k P_k^p / sum n_k)^(1/p)
+  (:func:`life_sum`, :func:`equivalent_load`; with a life modification factor per sample,
+  the Palmgren-Miner sum of ISO 281 section 9.3.3).
 * ISO 76:2006, *Rolling bearings -- Static load ratings*: static equivalent load
   P0 = X0 Fr + Y0 Fa, not less than Fr (clause 6), static safety s0 = C0 / P0.
 * The split of a joint reaction between two bearings is the statics of a shaft on two
@@ -25,62 +25,26 @@ import math
 
 import numpy as np
 
-from ..model.ratings import BEARING_FACTOR_DEFAULTS
-
-LIFE_EXPONENT = {"ball": 3.0, "roller": 10.0 / 3.0}
-"""p of ISO 281: L10 = (C/P)^p."""
-
-FACTOR_DEFAULTS = BEARING_FACTOR_DEFAULTS
-"""Default X, Y, e, X0, Y0 by bearing type (see :mod:`gearcli.model.ratings`)."""
+from ..report.rms import trapezoid_weights
 
 
-def equivalent_dynamic_load(Fr, Fa, X: float, Y: float, e: float) -> np.ndarray:
-    """ISO 281 dynamic equivalent radial load of each sample.
-
-    Parameters
-    ----------
-    Fr, Fa : array_like, shape (N,)
-        Radial and axial load on the bearing, N (signs ignored).
-    X, Y, e : float
-        Radial and axial load factors and the limit e of Fa/Fr.
-
-    Returns
-    -------
-    ndarray, shape (N,)
-        P = Fr when Fa/Fr <= e, else X Fr + Y Fa (N).  With Fr = 0 and Fa > 0, Fa/Fr is
-        infinite, so P = Y Fa.
-    """
-    Fr, Fa = np.abs(np.asarray(Fr, float)), np.abs(np.asarray(Fa, float))
-    small = Fa <= e * Fr
-    return np.where(small, Fr, X * Fr + Y * Fa)
+def revolutions(rate, t) -> np.ndarray:
+    """Revolutions turned at each sample, |rate_k| w_k / 2 pi (w the trapezoid weights of
+    :func:`gearcli.design.rms.trapezoid_weights`), shape (N,); rate in rad/s, t in s."""
+    return np.abs(np.asarray(rate, float)) * trapezoid_weights(t) / (2 * math.pi)
 
 
-def duty_equivalent_load(P, rate, dt, p: float) -> float:
-    """Equivalent load of a duty cycle, weighted by the revolutions turned under each load.
+def life_sum(P, revs, p: float, a=1.0) -> float:
+    """Palmgren-Miner sum of a duty, sum_k n_k P_k^p / a_k (rev N^p): each revolution at P_k
+    uses up (P_k/C)^p / a_k of a million-revolution life (a_k the life modification factor,
+    1 for the basic rating life)."""
+    return float(np.sum(np.asarray(revs, float) * np.asarray(P, float) ** p / a))
 
-    P_eq = (sum |rate_k| dt_k P_k^p / sum |rate_k| dt_k)^(1/p).
 
-    Parameters
-    ----------
-    P : array_like, shape (N,)
-        Dynamic equivalent load at each sample, N.
-    rate : array_like, shape (N,)
-        Relative rotation rate of the bearing rings (the joint rate), rad/s.
-    dt : array_like, shape (N,)
-        Time weight of each sample, s (see :func:`sample_weights`).
-    p : float
-        Life exponent (3 for ball, 10/3 for roller bearings).
-
-    Returns
-    -------
-    float
-        P_eq in N; 0 when the bearing never turns.
-    """
-    w = np.abs(np.asarray(rate, float)) * np.asarray(dt, float)
-    total = float(np.sum(w))
-    if total == 0.0:
-        return 0.0
-    return float((np.sum(w * np.asarray(P, float) ** p) / total) ** (1.0 / p))
+def equivalent_load(total: float, revs: float, p: float) -> float:
+    """Equivalent load of a varying duty, weighted by the revolutions turned under each load:
+    P_eq = (life_sum / revolutions)^(1/p), N; 0 when the bearing never turns."""
+    return (total / revs) ** (1.0 / p) if revs > 0 else 0.0
 
 
 def rating_life_mrev(C: float, P_eq: float, p: float) -> float:
@@ -108,10 +72,10 @@ def static_equivalent_load(Fr, Fa, X0: float, Y0: float) -> np.ndarray:
     return np.maximum(X0 * Fr + Y0 * Fa, Fr)
 
 
-def static_safety(C0: float, P0) -> float:
-    """Static safety factor s0 = C0 / max_k P0_k (inf when unloaded)."""
-    peak = float(np.max(P0)) if np.size(P0) else 0.0
-    return math.inf if peak <= 0 else C0 / peak
+def static_safety(allowable: float, peak: float) -> float:
+    """Safety factor s = allowable / peak (ISO 76 s0 = C0 / max P0; the same ratio for tooth
+    stresses); inf when unloaded."""
+    return math.inf if peak <= 0 else allowable / peak
 
 
 def split_two_bearings(F, M, z1: float, z2: float) -> tuple[np.ndarray, np.ndarray]:
@@ -144,19 +108,3 @@ def split_two_bearings(F, M, z1: float, z2: float) -> tuple[np.ndarray, np.ndarr
     m = np.stack([M[:, 1], -M[:, 0]], axis=1)
     R2 = (m - z1 * F[:, :2]) / (z2 - z1)
     return F[:, :2] - R2, R2
-
-
-def sample_weights(t) -> np.ndarray:
-    """Time weight of each sample for sums over a trajectory (trapezoid rule), s.
-
-    dt_k = (t_{k+1} - t_{k-1}) / 2 inside, half a step at the two ends; sums to t_N - t_1.
-    A single sample gets weight 0.
-    """
-    t = np.asarray(t, float)
-    if t.size < 2:
-        return np.zeros_like(t)
-    d = np.diff(t)
-    w = np.empty_like(t)
-    w[0], w[-1] = d[0] / 2, d[-1] / 2
-    w[1:-1] = (d[:-1] + d[1:]) / 2
-    return w

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 from ..errors import Collector
 from ..report.columns import column_names, column_unit
-from .bearings import LIFE_EXPONENT
+from .iso281 import life_exponent
 from .gears import lewis_form_factor, virtual_helical_teeth, virtual_spur
 
 MODULE_RTOL = 0.01
@@ -92,8 +92,9 @@ def _bearing_checks(an, req: Requirements, col: Collector) -> list[Check]:
         for bi, b in enumerate(jt.bearings):
             c = f"bearing {jt.name}/{b.name}"
             if req.bearing_life_h is not None:
-                out.append(Check(c, "L10 life", "h", req.bearing_life_h, "life", ("bearing_P", ji, bi), "N",
-                                 rating=b.C, exponent=LIFE_EXPONENT[b.type]))
+                life = "L10 life" if b.a_ISO is None and b.kappa is None else "Lnm life (a_ISO)"
+                out.append(Check(c, life, "h", req.bearing_life_h, "life", ("bearing_P", ji, bi), "N",
+                                 rating=b.C, exponent=life_exponent(b.type)))
             out.append(Check(c, "static safety s0", "", req.min_static_safety, "safety", ("bearing_P0", ji, bi),
                              "N", rating=b.C0))
             if b.M is not None:

@@ -13,7 +13,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import bearings as B
+from . import iso281
 from .checks import Check
+from ..report.rms import running_rms, rms_of, square_integral
 from .gears import hertz_contact_stress, lewis_bending_stress
 
 
@@ -53,12 +55,14 @@ def signal(check: Check, s: Samples, mech) -> np.ndarray:
         return s.cols[check.signal[1]]
     if kind == "rate":
         return np.abs(s.rates[:, check.signal[1]])
+    if kind == "running_rms":
+        return running_rms(s.cols[check.signal[1]], s.t, check.signal[2])
     if kind in ("bearing_P", "bearing_P0"):
         jt = mech.joints[check.signal[1]]
         b = jt.bearings[check.signal[2]]
         Fr, Fa = bearing_loads(s, jt.name, jt.bearings, check.signal[2])
         if kind == "bearing_P":
-            return B.equivalent_dynamic_load(Fr, Fa, b.X, b.Y, b.e)
+            return iso281.bearing_equivalent_load(b, Fr, Fa)
         return B.static_equivalent_load(Fr, Fa, b.X0, b.Y0)
     x, ft = check.extra, s.cols[f"gear:{check.signal[1]}:t"]
     if kind == "bending":
@@ -69,19 +73,21 @@ def signal(check: Check, s: Samples, mech) -> np.ndarray:
     raise ValueError(f"unknown signal {check.signal!r}")
 
 
-def weight_rate(check: Check, s: Samples) -> np.ndarray:
-    """|relative rotation rate| of a life check's bearing (its joint rate), rad/s."""
-    return np.abs(s.rates[:, check.signal[1]])
+def bearing_of(check: Check, mech):
+    """The :class:`~gearcli.model.ratings.BearingRating` of a life check."""
+    return mech.joints[check.signal[1]].bearings[check.signal[2]]
 
 
 def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
     """Per check, the trajectory's (peak, t at peak, sum, weight sum, revolutions, score).
 
-    ``sum``/``weight`` are sum x^2 dt / sum dt (rms) or sum |w| dt P^p / sum |w| dt (life);
-    ``score`` ranks trajectories for "worst trajectory" (peak, RMS or equivalent load).
+    ``sum``/``weight`` are the trapezoid integral of x^2 and the time span (rms,
+    :mod:`gearcli.design.rms`), or the Palmgren-Miner sum n_k P_k^p / a_ISO and the
+    revolutions (life, :func:`gearcli.design.bearings.life_sum`); ``score`` ranks
+    trajectories for "worst trajectory" (peak, RMS or equivalent load).
     """
-    dt = B.sample_weights(s.t)
     out = []
+    span = float(s.t[-1] - s.t[0]) if s.t.size else 0.0
     for ch in checks:
         x = signal(ch, s, mech)
         k = int(np.argmax(np.abs(x))) if x.size else 0
@@ -89,12 +95,13 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
         total = wsum = revs = 0.0
         score = peak
         if ch.kind == "rms":
-            total, wsum = float(np.sum(x * x * dt)), float(np.sum(dt))
-            score = math.sqrt(total / wsum) if wsum > 0 else 0.0
+            total, wsum = float(square_integral(x, s.t)), span
+            score = rms_of(total, wsum, peak)
         elif ch.kind == "life":
-            w = weight_rate(ch, s) * dt
-            total, wsum, revs = float(np.sum(w * x ** ch.exponent)), float(np.sum(w)), float(np.sum(w)) / (2 * math.pi)
-            score = (total / wsum) ** (1 / ch.exponent) if wsum > 0 else 0.0
+            n = B.revolutions(s.rates[:, ch.signal[1]], s.t)
+            total = B.life_sum(x, n, ch.exponent, iso281.life_factor(bearing_of(ch, mech), x))
+            wsum = revs = float(np.sum(n))
+            score = B.equivalent_load(total, wsum, ch.exponent)
         out.append((peak, tp, total, wsum, revs, score))
     return out
 
@@ -121,15 +128,13 @@ def combine(check: Check, parts: list[tuple], cycles_per_hour: float | None) -> 
     if check.kind == "peak":
         value, sig_lim = peak, check.limit
     elif check.kind == "rms":
-        wsum = sum(p[3] for p in parts)
-        value = math.sqrt(sum(p[2] for p in parts) / wsum) if wsum > 0 else 0.0
+        value = rms_of(sum(p[2] for p in parts), sum(p[3] for p in parts), peak)
         sig_lim = check.limit
     elif check.kind == "safety":
-        value = math.inf if peak <= 0 else check.rating / peak
+        value = B.static_safety(check.rating, peak)
         sig_lim = check.rating / check.limit
     else:
-        wsum = sum(p[3] for p in parts)
-        P_eq = (sum(p[2] for p in parts) / wsum) ** (1 / check.exponent) if wsum > 0 else 0.0
+        P_eq = B.equivalent_load(sum(p[2] for p in parts), sum(p[3] for p in parts), check.exponent)
         rev_h = sum(p[4] for p in parts) * (cycles_per_hour or 0.0)
         value = B.rating_life_hours(B.rating_life_mrev(check.rating, P_eq, check.exponent), rev_h)
         sig_lim = B.required_equivalent_load(check.rating, check.limit, rev_h, check.exponent)

@@ -20,7 +20,9 @@ from .planets import item_path
 
 NS = "https://gearcli.dev/urdf/1"
 MOTOR_KEYS = ("peak_torque", "rms_torque", "max_speed", "max_power")
-BEARING_KEYS = ("name", "position", "C", "C0", "type", "X", "Y", "e", "X0", "Y0", "locating", "M")
+BEARING_KEYS = ("name", "position", "C", "C0", "type", "X", "Y", "e", "X0", "Y0", "locating", "M", "f0", "a_ISO",
+                "kappa", "e_C", "Cu")
+LIFE_FACTOR_KEYS = ("kappa", "e_C", "Cu")
 GEAR_KEYS = ("module", "face_width", "bending_stress_limit", "contact_stress_limit",
              "elastic_coefficient", "application_factor", "load_sharing_factor")
 
@@ -47,16 +49,18 @@ def bearing_ratings(specs: list[dict], path: str, add) -> tuple[BearingRating, .
     out = []
     for i, spec in enumerate(specs):
         p = f"{path}[{i}]"
-        _positive(spec, ("C", "C0", "X", "Y", "e", "M"), p, add)
+        _positive(spec, ("C", "C0", "X", "Y", "e", "M", "f0", "a_ISO", "kappa", "e_C", "Cu"), p, add)
         f = {**BEARING_FACTOR_DEFAULTS[spec["type"]], **{k: spec[k] for k in ("X", "Y", "e", "X0", "Y0") if k in spec}}
         if spec.get("M") is not None and len(specs) == 2:
             add(f"{p}.M", "a moment rating M is for a single bearing (two bearings carry the moment as radial loads)")
         if len(specs) == 1 and spec.get("locating") is False:
             add(f"{p}.locating", "a joint's only bearing takes the axial load: it cannot be non-locating")
+        _life_factor_keys(spec, p, add)
+        opt = {k: None if spec.get(k) is None else float(spec[k]) for k in ("M", "f0", "a_ISO") + LIFE_FACTOR_KEYS}
         out.append(BearingRating(spec["name"], float(spec["position"]), float(spec["C"]), float(spec["C0"]),
-                                 spec["type"], float(f["X"]), float(f["Y"]), float(f["e"]), float(f["X0"]),
-                                 float(f["Y0"]), bool(spec.get("locating", len(specs) == 1)),
-                                 None if spec.get("M") is None else float(spec["M"]), p))
+                                 spec["type"], *(None if f[k] is None else float(f[k]) for k in ("X", "Y", "e")),
+                                 float(f["X0"]), float(f["Y0"]), bool(spec.get("locating", len(specs) == 1)),
+                                 path=p, **opt))
     if len(out) == 2:
         if out[0].name == out[1].name:
             add(f"{path}[1].name", f"duplicate bearing name '{out[1].name}'")
@@ -65,6 +69,22 @@ def bearing_ratings(specs: list[dict], path: str, add) -> tuple[BearingRating, .
         if sum(b.locating for b in out) != 1:
             add(path, "with two bearings, exactly one needs 'locating: true' (the one that takes the axial load)")
     return tuple(out)
+
+
+def _life_factor_keys(spec: dict, p: str, add) -> None:
+    """a_ISO is given, or computed from all of kappa, e_C, Cu (ISO 281 section 9.3), not both."""
+    given = [k for k in LIFE_FACTOR_KEYS if k in spec]
+    if given and "a_ISO" in spec:
+        add(f"{p}.a_ISO", f"give a_ISO or {', '.join(LIFE_FACTOR_KEYS)} to compute it, not both")
+    elif given and len(given) < len(LIFE_FACTOR_KEYS):
+        missing = [k for k in LIFE_FACTOR_KEYS if k not in spec]
+        add(f"{p}.{given[0]}", f"a_ISO from {', '.join(LIFE_FACTOR_KEYS)} needs all three: {', '.join(missing)} missing")
+    if isinstance(spec.get("kappa"), (int, float)) and 0 < spec["kappa"] < 0.1:
+        add(f"{p}.kappa", f"kappa {spec['kappa']:g} is below 0.1, outside ISO 281's a_ISO method")
+    if isinstance(spec.get("e_C"), (int, float)) and spec["e_C"] > 1:
+        add(f"{p}.e_C", f"the contamination factor e_C is at most 1, got {spec['e_C']:g}")
+    if "f0" in spec and spec.get("type") != "ball":
+        add(f"{p}.f0", f"f0 enters the ISO 281 table of deep-groove ball bearings, not a {spec.get('type')} bearing")
 
 
 def gear_rating(spec: dict, path: str, add) -> GearRating:
@@ -117,7 +137,7 @@ def _urdf_spec(el, keys, required, path: str, add) -> dict | None:
             spec[key] = text
         elif key == "type":
             if text not in BEARING_FACTOR_DEFAULTS:
-                add(f"{path}.type", f"bearing type must be 'ball' or 'roller', got '{text}'")
+                add(f"{path}.type", f"bearing type must be one of {', '.join(BEARING_FACTOR_DEFAULTS)}, got '{text}'")
                 ok = False
             spec[key] = text
         elif key == "locating":

@@ -13,17 +13,21 @@ STEEL_ELASTIC_COEFFICIENT = 189.8e3
 """Z_E of steel on steel (E = 206 GPa, nu = 0.3), sqrt(Pa) (ISO 6336-2): the default."""
 
 _ALPHA = math.radians(15.0)
+_TAPERED = {"X": 0.4, "Y": round(0.4 / math.tan(_ALPHA), 2), "e": round(1.5 * math.tan(_ALPHA), 2),
+            "X0": 0.5, "Y0": round(0.22 / math.tan(_ALPHA), 2)}
 BEARING_FACTOR_DEFAULTS = {
-    "ball": {"X": 0.56, "Y": 1.6, "e": 0.27, "X0": 0.6, "Y0": 0.5},
-    "roller": {"X": 0.4, "Y": round(0.4 / math.tan(_ALPHA), 2), "e": round(1.5 * math.tan(_ALPHA), 2),
-               "X0": 0.5, "Y0": round(0.22 / math.tan(_ALPHA), 2)},
+    "ball": {"X": None, "Y": None, "e": None, "X0": 0.6, "Y0": 0.5},
+    "cylindrical_roller": {"X": 1.0, "Y": 0.0, "e": 0.0, "X0": 1.0, "Y0": 0.0},
+    "tapered_roller": _TAPERED,
+    "roller": _TAPERED,
 }
-"""Default ISO 281 (X, Y, e) and ISO 76 (X0, Y0) factors by bearing type (README,
-"Bearings"): ISO 281 Table 3 for a radial deep-groove ball bearing at Fa/C0 ~ 0.07 (normal
-clearance); for a roller bearing the factors of a single-row tapered roller bearing with a
-contact angle of 15 deg (ISO 281 Table 4: e = 1.5 tan a, X = 0.4, Y = 0.4 cot a; ISO 76:
-X0 = 0.5, Y0 = 0.22 cot a)."""
-
+"""Default ISO 281 (X, Y, e) and ISO 76 (X0, Y0) factors by rolling-element type (README,
+"Bearings"); None: from ISO 281 Table 3 at each sample's f0 Fa/C0
+(:func:`gearcli.design.iso281.ball_factors`).  Deep-groove ball: X = 0.56 with the table's
+e and Y, ISO 76 X0 = 0.6, Y0 = 0.5.  Cylindrical roller (contact angle 0): no axial load
+on the rollers, P = Fr and P0 = Fr.  Tapered roller (and ``roller``, its older name),
+single row, contact angle 15 deg: ISO 281 Table 4 e = 1.5 tan a, X = 0.4, Y = 0.4 cot a;
+ISO 76 X0 = 0.5, Y0 = 0.22 cot a."""
 
 @dataclass(frozen=True)
 class MotorRating:
@@ -42,10 +46,13 @@ class BearingRating:
     """A rolling bearing of a joint.
 
     ``position``: m along the joint axis from the joint origin; ``C``, ``C0``: dynamic and
-    static load ratings, N; ``type``: ``"ball"`` or ``"roller"``; ISO 281 factors ``X``,
-    ``Y``, ``e`` and ISO 76 factors ``X0``, ``Y0``; ``locating``: takes the axial load
-    (one of two bearings); ``M``: tilting-moment rating, N*m (a single crossed-roller or
-    four-point bearing), or None.
+    static load ratings, N; ``type``: a key of :data:`BEARING_FACTOR_DEFAULTS`; ISO 281
+    factors ``X``, ``Y``, ``e`` (None: ISO 281 Table 3 per sample) and ISO 76 factors
+    ``X0``, ``Y0``; ``locating``: takes the axial load (one of two bearings); ``M``:
+    tilting-moment rating, N*m (a single crossed-roller or four-point bearing), or None;
+    ``f0``: the ball bearing's factor f0 for the table (None: the catalogue Fa/C0 column);
+    ``a_ISO``: a given life modification factor, or ``kappa``, ``e_C`` and ``Cu`` (N) to
+    compute it (:func:`gearcli.design.iso281.a_iso`); all None: basic rating life.
     """
 
     name: str
@@ -53,14 +60,19 @@ class BearingRating:
     C: float
     C0: float
     type: str
-    X: float
-    Y: float
-    e: float
+    X: float | None
+    Y: float | None
+    e: float | None
     X0: float
     Y0: float
     locating: bool = True
     M: float | None = None
     path: str = field(default="", compare=False)   # where it was read (for messages)
+    f0: float | None = None
+    a_ISO: float | None = None
+    kappa: float | None = None
+    e_C: float | None = None
+    Cu: float | None = None
 
 
 @dataclass(frozen=True)

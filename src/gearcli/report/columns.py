@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..dynamics.solve import Result
+from .rms import rms_of, square_integral
 from ..errors import counted
 
 
@@ -132,43 +133,48 @@ def column_units(an) -> list[str]:
 
 @dataclass
 class Stat:
-    """Peak magnitude, time of the peak and running RMS of one load column (SI unit ``unit``)."""
+    """Peak magnitude, time of the peak and time-weighted RMS of one load column (SI unit
+    ``unit``); the RMS is :mod:`gearcli.report.rms`'s (trapezoid rule over time)."""
 
     name: str
     unit: str
     peak: float = 0.0
     t_peak: float = float("nan")
-    scale: float = 0.0    # sum of squares = scale**2 * ssq (no overflow for huge loads)
+    scale: float = 0.0    # integral of x^2 dt = scale**2 * ssq (no overflow for huge loads)
     ssq: float = 0.0
+    span: float = 0.0     # s, the time the integral covers
     n: int = 0
+    plain: float = 0.0    # sum of (x/scale)^2 over the samples: the RMS of a single instant
 
     @property
     def rms(self) -> float:
-        return self.scale * math.sqrt(self.ssq / self.n) if self.n else float("nan")
+        if not self.n:
+            return float("nan")
+        return self.scale * rms_of(self.ssq, self.span, math.sqrt(self.plain / self.n))
 
-    def add_squares(self, x: np.ndarray) -> None:
-        """Accumulate the squares of ``x`` (N,) >= 0, scaled as in LAPACK's dnrm2."""
-        m = float(x.max()) if x.size else 0.0
-        if m != 0.0:
-            self.add_scaled(m, float(np.dot(x / m, x / m)))
-
-    def add_scaled(self, m: float, s: float) -> None:
-        """Accumulate squares whose largest is ``m**2`` > 0 and whose sum is ``s * m**2``."""
+    def add_scaled(self, m: float, s: float, plain: float = 0.0) -> None:
+        """Accumulate an integral whose largest |x| is ``m`` > 0 and which is ``s * m**2``
+        (``plain``: the samples' sum of squares / m**2)."""
         if m == 0.0:
             return
         if m > self.scale:
-            self.ssq = self.ssq * (self.scale / m) ** 2 + s
+            r = (self.scale / m) ** 2
+            self.ssq, self.plain = self.ssq * r + s, self.plain * r + plain
             self.scale = m
         else:
-            self.ssq += s * (m / self.scale) ** 2
+            r = (m / self.scale) ** 2
+            self.ssq += s * r
+            self.plain += plain * r
 
 
 @dataclass
 class Summary:
-    """Peak magnitude, RMS and time of the peak of the main loads, accumulated by chunks."""
+    """Peak magnitude, RMS and time of the peak of the main loads, accumulated by chunks
+    (the last row of a chunk is kept for the trapezoid interval to the next one)."""
 
     columns: list[int]
     stats: list[Stat] = field(default_factory=list)
+    _last: np.ndarray | None = None      # (1 + columns,) t and |x| of the previous chunk's last row
 
     @classmethod
     def for_mechanism(cls, an) -> "Summary":
@@ -190,18 +196,27 @@ class Summary:
 
     def add(self, tab: np.ndarray) -> None:
         """Accumulate a chunk ``tab`` (N, columns) of the output table (column 0 is t, s)."""
+        if not tab.shape[0]:
+            return
         t = tab[:, 0]
         X = np.abs(tab[:, self.columns])
         imax = np.argmax(X, axis=0)
         peak = X[imax, np.arange(X.shape[1])]
-        Y = X / np.where(peak > 0.0, peak, 1.0)     # scaled columns (no overflow when squared)
-        ssq = np.einsum("ij,ij->j", Y, Y)
+        rows = X if self._last is None else np.vstack([self._last[1:], X])
+        tt = t if self._last is None else np.r_[self._last[0], t]
+        m = np.maximum(peak, rows[0])
+        Y = rows / np.where(m > 0.0, m, 1.0)        # scaled columns (no overflow when squared)
+        integral = square_integral(Y, tt)
+        plain = np.einsum("ij,ij->j", Y[-X.shape[0]:], Y[-X.shape[0]:])
+        span = float(tt[-1] - tt[0])
         for k, st in enumerate(self.stats):
             v = peak[k]
             if v > st.peak or st.n == 0:
                 st.peak, st.t_peak = float(v), float(t[imax[k]])
-            st.add_scaled(float(v), float(ssq[k]))
+            st.add_scaled(float(m[k]), float(integral[k]), float(plain[k]))
+            st.span += span
             st.n += X.shape[0]
+        self._last = np.r_[t[-1], X[-1]]
 
 
 def _motor_linear(an, name: str) -> bool:
