@@ -21,9 +21,10 @@ from .coaxial_frames import coaxial_links, turn_row
 from .equations import Columns
 from .general import is_geared, mesh_names, solve_general
 from .kinematics import Kinematics, forward
+from .losses import relative_rate
 from .pattern_maps import PatternMaps
 from .sharing import mesh_weights
-from .signs import MAX_EXHAUSTIVE, pattern_index, resolve_signs, sign_patterns
+from .signs import MAX_EXHAUSTIVE, SignError, pattern_index, resolve_signs, sign_patterns
 
 
 @dataclass(frozen=True, eq=False)
@@ -45,6 +46,13 @@ class BlockPlan:
     # group position -> (J,) row: a joint basis carried by a third coaxial link F
     # (:mod:`.coaxial_frames`), turned to the child's by -(q_all @ row) instead of -q
     turn: dict = field(default_factory=dict)
+    # Mesh friction (:mod:`.losses`): (m, 6B) the friction couples of each signed mesh per
+    # unit of sigma s_v t in F (zero rows for a lossless mesh), None when no mesh of the
+    # block loses power; group position -> (6, 1) the couple on the primary side in F.
+    fric: np.ndarray | None = None
+    fric_C: dict = field(default_factory=dict)
+    # s_v pattern (tuple of -1/0/1 per signed mesh) -> PatternMaps, made on first use
+    fric_maps: dict = field(default_factory=dict)
 
 
 def _spread(an, g) -> bool:
@@ -133,6 +141,25 @@ def _propagation_columns(an, F, gs, signed, to_F, cols) -> tuple[dict, dict]:
     return C, parent_side
 
 
+def _friction_columns(an, blk, gs, signed, to_F, cols) -> tuple[np.ndarray | None, dict]:
+    """Mesh friction of a constant block (:mod:`.losses`): the (m, 6B) couples of its signed
+    meshes per unit of sigma s_v t in F (None if no mesh loses power) and, per lossy group,
+    its (6, 1) couple on the primary side (j) in F."""
+    fric = np.zeros((len(signed), 6 * len(blk)))
+    fric_C = {}
+    for n, gi in enumerate(signed):
+        g = gs[gi]
+        if cols.mesh_friction(g.index, _primary_side(an, g)) is None:
+            continue
+        for L in g.links:
+            if L in blk:
+                r0 = 6 * blk.index(L)
+                fric[n, r0:r0 + 6] = to_F(cols.mesh_friction(g.index, L), L)[:, 0]
+        P = _primary_side(an, g)
+        fric_C[gi] = to_F(cols.mesh_friction(g.index, P), P)
+    return (fric if fric_C else None), fric_C
+
+
 def _frame(an, gs, common: set) -> tuple[int | None, dict]:
     """The frame link F of a block among the ``common`` candidates (the base first: no
     rotation; then links that carry every joint basis as its parent or child) and the turn
@@ -179,9 +206,10 @@ def make_plans(an) -> tuple[BlockPlan, ...]:
 
         Ainv = _constant_matrices(an, blk, gs, offs, signed, to_F, cols)
         C, parent_side = _propagation_columns(an, F, gs, signed, to_F, cols)
+        fric, fric_C = _friction_columns(an, blk, gs, signed, to_F, cols)
         pats = sign_patterns(len(signed)) if len(signed) <= MAX_EXHAUSTIVE else []
         plans.append(BlockPlan(tuple(blk), gs, F, signed, offs, pats, Ainv, names,
-                               C, parent_side, turn))
+                               C, parent_side, turn, fric, fric_C))
     return tuple(plans)
 
 
@@ -232,13 +260,47 @@ def _constant_block(an, p: BlockPlan, kin: Kinematics, rhs: dict):
     r = np.concatenate(parts, axis=1) if len(parts) > 1 else parts[0]   # (N, 6B) in F about o_F
     N = r.shape[0]
     if not p.signed:
-        return r @ p.Ainv[0].T, np.zeros((N, 0))
-
-    def solve_pattern(signs, idx):
-        return (r if idx.size == N else r[idx]) @ p.Ainv[pattern_index(signs)].T
-
+        return r @ p.Ainv[0].T, np.zeros((N, 0)), None
     scale = 1.0 + np.abs(r).max(axis=1)
-    return resolve_signs(solve_pattern, len(p.signed), [int(p.offs[gi]) for gi in p.signed], N, scale, p.names)
+    t_cols = [int(p.offs[gi]) for gi in p.signed]
+    if p.fric is None:
+        def solve_pattern(signs, idx):
+            return (r if idx.size == N else r[idx]) @ p.Ainv[pattern_index(signs)].T
+        return (*resolve_signs(solve_pattern, len(p.signed), t_cols, N, scale, p.names), None)
+    # lossy meshes: the block matrix depends on s_v too; one set of maps per s_v pattern met
+    sv = np.column_stack([np.sign(relative_rate(an, kin, p.groups[gi].index)) if gi in p.fric_C
+                          else np.zeros(N) for gi in p.signed])
+    x, signs, first_bad = None, np.empty((N, len(p.signed))), None
+    for rows in _rows_by_pattern(sv):
+        key = tuple(sv[rows[0]])
+        maps = p.fric_maps.get(key)
+        if maps is None:            # the signed columns gain s_v times their friction couple
+            maps = p.fric_maps[key] = PatternMaps(p.Ainv.A_mid, p.Ainv.halves + np.array(key)[:, None] * p.fric,
+                                                  p.Ainv.cols, p.Ainv.w) if any(key) else p.Ainv
+        rr = r[rows]
+
+        def solve_pattern(sg, idx, rr=rr, maps=maps):
+            return (rr if idx.size == rr.shape[0] else rr[idx]) @ maps[pattern_index(sg)].T
+        try:
+            xs, ss = resolve_signs(solve_pattern, len(p.signed), t_cols, rows.size, scale[rows], p.names)
+        except SignError as exc:
+            bad = int(rows[exc.sample])
+            first_bad = bad if first_bad is None else min(first_bad, bad)
+            continue
+        if x is None:
+            x = np.empty((N, xs.shape[1]))
+        x[rows], signs[rows] = xs, ss
+    if first_bad is not None:
+        raise SignError(first_bad, p.names)
+    return x, signs, sv
+
+
+def _rows_by_pattern(sv: np.ndarray) -> list[np.ndarray]:
+    """Indices of the rows of ``sv`` (N, m) of -1/0/+1 grouped by equal rows (a motion
+    meets few s_v patterns: a loop over patterns, not samples)."""
+    _, which = np.unique(sv, axis=0, return_inverse=True)
+    which = which.reshape(-1)
+    return [np.flatnonzero(which == u) for u in range(which.max() + 1)]
 
 
 def _child_basis(x: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -267,13 +329,15 @@ def solve_blocks(an, plans, kin: Kinematics, b: dict, q_all: np.ndarray):
             cols = cols if cols is not None else Columns(an, kin)
             _general_block(an, p, cols, rhs, later, x_all, sig_all)
             continue
-        x, signs = _constant_block(an, p, kin, rhs)
+        x, signs, sv = _constant_block(an, p, kin, rhs)
         at_rest = p.F == an.tree.base
         for gi, g in enumerate(p.groups):
             xg = x[:, p.offs[gi]:p.offs[gi + 1]]
             if later[gi]:
                 Cp, Cs = p.C[gi]
                 wF = xg @ Cp.T if Cs is None else xg @ Cp.T + np.abs(xg) @ Cs.T
+                if gi in p.fric_C:     # friction couple, sigma s_v t = s_v |t|
+                    wF = wF + (np.abs(xg) * sv[:, p.signed.index(gi), None]) @ p.fric_C[gi].T
                 w = wF if at_rest else _rotate(kin.R[p.F], wF)           # world axes, about o_F
                 P = _primary_side(an, g)
                 for L in later[gi]:

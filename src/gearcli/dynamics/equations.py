@@ -34,6 +34,7 @@ import numpy as np
 from ..model.gears import helical_terms
 from ..spatial import cross, mv
 from .kinematics import Kinematics
+from .losses import mesh_friction_moment, relative_rate
 
 
 def tooth_force_direction(ut: np.ndarray, us: np.ndarray, sigma, tan_phi: float,
@@ -87,6 +88,9 @@ class Columns:
                 self.world[ci] = dict(P=oc + mv(Rc, gm.P), ut=mv(Rc, gm.ut), us=mv(Rc, gm.us),
                                       ax=mv(Rc, a) if gp.helix_angle else None)
                 self.tan_phi[ci] = tan_t
+                fr = mesh_friction_moment(an, ci)
+                if fr is not None:     # friction couple on j per unit sigma s_v t, and s_v
+                    self.world[ci].update(fr=mv(Rc, fr), sv=np.sign(relative_rate(an, kin, ci)))
             else:
                 self.world[ci] = dict(zj=mv(Rc, c.zj), zk=mv(Rc, c.zk))
 
@@ -131,8 +135,18 @@ class Columns:
             col = _moment(z)
         return sign * col[:, :, None]
 
+    def mesh_friction(self, ci: int, L: int) -> np.ndarray | None:
+        """(N, 6, 1) friction couple of geared mesh ``ci`` on link L per unit of sigma s_v t
+        (:mod:`.losses`: on j, the opposite on k), None for a lossless mesh."""
+        wv = self.world.get(ci, {})
+        if "fr" not in wv:
+            return None
+        sign = 1.0 if L == self.an.circuits[ci].j else -1.0
+        return sign * _moment(wv["fr"])[:, :, None]
+
     def mesh(self, ci: int, L: int, sigma) -> np.ndarray:
-        """(N, 6, 1) column of mesh unknown ``ci`` on link L; ``sigma`` = sign(t), (N,) or scalar."""
+        """(N, 6, 1) column of mesh unknown ``ci`` on link L; ``sigma`` = sign(t), (N,) or
+        scalar.  A lossy mesh adds its friction couple sigma s_v (:meth:`mesh_friction`)."""
         c = self.an.circuits[ci]
         if c.joints is not None:
             b, a = c.joints
@@ -142,7 +156,11 @@ class Columns:
         if c.geometry is not None:
             sign = 1.0 if L == c.j else -1.0
             d = tooth_force_direction(wv["ut"], wv["us"], sigma, self.tan_phi[ci], wv["ax"])
-            return sign * _force_at(d, wv["P"], o)[:, :, None]
+            col = sign * _force_at(d, wv["P"], o)
+            if "fr" in wv:
+                sv = np.asarray(sigma, float).reshape(-1, 1) * wv["sv"][:, None]
+                col[:, 3:] += sign * sv * wv["fr"]
+            return col[:, :, None]
         col = 0.0
         if L == c.j:
             col = col + _moment(wv["zj"])

@@ -18,6 +18,7 @@ import jsonschema
 import numpy as np
 
 from ..errors import Collector
+from ..model.friction import JointFriction
 from ..model.mechanism import GearPair, Joint, Link, Mechanism, Motor
 from .loads_reader import yaml_loads
 from .planets import expand_planets, item_path
@@ -246,8 +247,51 @@ def _joints(data: dict, col: Collector, links: _Names) -> list[Joint]:
         R_pj, p_pj, R_jc, p_jc = joint_geometry(spec, col, path)
         source = {k: spec[k] for k in ("dh", "origin", "axis") if k in spec}
         joints.append(Joint(spec["name"], spec["parent"], spec["child"], R_pj, p_pj, R_jc, p_jc,
-                            spec.get("type", "revolute"), spec.get("label"), source, path))
+                            spec.get("type", "revolute"), spec.get("label"), source, path,
+                            friction=joint_friction(spec, col, path)))
     return joints
+
+
+def joint_friction(spec: dict, col: Collector, path: str) -> JointFriction | None:
+    """``joints[].friction`` ({coulomb, viscous}, both >= 0; finite: checked before)."""
+    if "friction" not in spec:
+        return None
+    fr = spec["friction"]
+    unit = {"coulomb": ("N", "N*m"), "viscous": ("N*s/m", "N*m*s/rad")}
+    values = {}
+    for key in ("coulomb", "viscous"):
+        v = float(fr.get(key, 0.0))
+        if not v >= 0:
+            u = unit[key][0 if spec.get("type") == "prismatic" else 1]
+            col.add(f"{path}.friction.{key}", f"{key} friction must be >= 0, got {v:g} {u}")
+        values[key] = v
+    return JointFriction(**values)
+
+
+def mesh_loss_factor(spec: dict, col: Collector, path: str) -> float:
+    """``gears[].efficiency`` eta in (0, 1] or ``gears[].loss_factor`` c in [0, 1) (at most
+    one of them; finite: checked before) as the loss factor c = 1 - eta; 0 when neither."""
+    if "efficiency" in spec and "loss_factor" in spec:
+        col.add(f"{path}.loss_factor", "give efficiency or loss_factor (= 1 - efficiency), not both")
+        return 0.0
+    if "efficiency" in spec:
+        eta = float(spec["efficiency"])
+        if not 0.0 < eta <= 1.0:
+            col.add(f"{path}.efficiency", f"mesh efficiency must be in (0, 1], got {eta:g}")
+            return 0.0
+        c = 1.0 - eta
+    elif "loss_factor" in spec:
+        c = float(spec["loss_factor"])
+        if not 0.0 <= c < 1.0:
+            col.add(f"{path}.loss_factor", f"mesh loss factor must be in [0, 1), got {c:g}")
+            return 0.0
+    else:
+        return 0.0
+    if c and "mesh_point" not in spec:
+        key = "efficiency" if "efficiency" in spec else "loss_factor"
+        col.add(f"{path}.{key}", "a mesh loss needs the tooth geometry (mesh_point): the loss is "
+                "|t| times the pitch-line speed")
+    return c
 
 
 _GEAR_FIELD = {"": "", "links": ".links", "kind": ".kind", "ratio": ".ratio", "cone_angles": ".cone_angles_deg",
@@ -280,6 +324,7 @@ def _gears(data: dict, col: Collector, links: _Names) -> list[GearPair]:
             float(np.deg2rad(spec.get("pressure_angle_deg", 20.0))),
             tuple(np.deg2rad(cones)) if cones is not None else None,
             path, helix_angle=helix or 0.0, hand=spec.get("hand"), stiffness=_stiffness(spec, col, path),
+            loss_factor=mesh_loss_factor(spec, col, path),
         ))
     return gears
 

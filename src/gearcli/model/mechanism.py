@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .friction import JointFriction
 from .loads import Load
 from .ratings import BearingRating, GearRating, JointLimit, MotorRating
 
@@ -57,6 +58,7 @@ class Joint:
     path: str = ""
     bearings: tuple[BearingRating, ...] | None = None   # rated bearings (design checks)
     limit: JointLimit | None = None                     # URDF <limit effort velocity>
+    friction: JointFriction | None = None               # joints[].friction (model.friction)
 
 
 GEAR_KINDS = ("external", "internal", "bevel", "rack")
@@ -98,6 +100,10 @@ class GearPair:
     # Mesh stiffness k, N/m (N*m/rad for an ideal coupling): the weight 1/k of the pair's
     # tooth force in a redundant gear set's load sharing (min sum t^2/k); None: equal.
     stiffness: float | None = None
+    # Mesh loss factor c = 1 - efficiency in [0, 1) (gears[].loss_factor or .efficiency): the
+    # mesh dissipates c |t| v_p, v_p the pitch-line speed relative to the carrier
+    # (dynamics.losses.mesh_couple); 0 = lossless.
+    loss_factor: float = 0.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -137,6 +143,12 @@ class Mechanism:
     open_loop: str = "chain"
     warnings: tuple[str, ...] = ()  # input problems that were worked around (e.g. URDF)
     loads: tuple[Load, ...] = ()    # external loads on links (model.loads)
+
+    @property
+    def has_losses(self) -> bool:
+        """True when any gear pair has a loss factor or any joint has friction."""
+        return any(g.loss_factor for g in self.gears) or any(
+            j.friction is not None and j.friction.active for j in self.joints)
 
     def link(self, name: str) -> Link:
         """The link called ``name``."""

@@ -1,0 +1,107 @@
+"""Power losses of a drive: mesh friction and joint friction (README, "Losses").
+
+Mesh friction of pair p (gears j, k, carrier c; any kind with tooth geometry)
+-----------------------------------------------------------------------------
+With t_p the tangential tooth force (Eq. 14), c_p = 1 - eta_p the loss factor and
+theta'_{j,c} the rate of gear j relative to the carrier about its axis z_j, the mesh
+dissipates
+
+    P_p = c_p |t_p| v_p,   v_p = |theta'_{j,c}| r_j            (pitch-line speed, m/s)
+
+as an internal couple pair along the gears' relative angular velocity
+omega_jk = omega_j - omega_k = theta'_{j,c} z_j - theta'_{k,c} z_k: -C_p u on gear j and
++C_p u on gear k, u = omega_jk / |omega_jk|, C_p = P_p / |omega_jk|.  The pair's net force
+and moment stay zero, and the couples' power is -C_p u.(omega_j - omega_k) = -P_p.
+
+With the ratio fixed, theta'_{k,c} = theta'_{j,c} / e (e = theta_{j,c} / theta_{k,c}), so
+omega_jk = theta'_{j,c} u0 with the constant carrier-frame vector u0 = z_j - z_k / e (a rack
+does not turn: u0 = z_j), and the couple on j is
+
+    -C_p u = -c_p |t_p| s_v r_j u0 / |u0|^2 = -(sigma_p s_v) t_p * c_p r_j u0 / |u0|^2,
+
+sigma_p = sign(t_p), s_v = sign(theta'_{j,c}) (0 at rest: no couple).  It is linear in t_p
+for given signs, exactly like the separating force |t| tan(phi) of Eq. 14, so the block
+solves and the sign rule carry over: the column of t_p gains sigma_p s_v times the moment
+:func:`mesh_friction_moment` (on j; minus it on k).  For an external spur pair
+r_j |u0|^-2 |u0| = r_j r_k / (r_j + r_k), for an internal pair r_j r_k / |r_k - r_j|, for a
+rack r_j: the classic friction arm.
+
+Joint friction (load-independent, the robotics convention)
+----------------------------------------------------------
+On the joint's child -F_c sign(q'_J) - F_v q'_J about (along) the axis, reversed on the
+parent, q'_J the joint's own rate; it dissipates F_c |q'_J| + F_v q'_J^2.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..spatial import cross, mv
+
+
+def mesh_friction_moment(an, ci: int) -> np.ndarray | None:
+    """The friction couple on gear j of circuit ``ci`` per unit of sigma_p s_v t_p,
+    -c_p r_j u0 / |u0|^2 (carrier frame; N*m per N, i.e. m), module docstring; gear k
+    receives the opposite.  None for a lossless pair or one without tooth geometry."""
+    c = an.circuits[ci]
+    loss = an.mech.gears[c.gear].loss_factor
+    if not loss or c.geometry is None or c.joints is not None:
+        return None
+    gm = c.geometry
+    u0 = gm.zj if not np.isfinite(gm.r_k) else gm.zj - gm.zk / c.ratio
+    return -loss * gm.r_j * u0 / float(u0 @ u0)
+
+
+def relative_rate(an, kin, ci: int) -> np.ndarray:
+    """theta'_{j,c} (N,): rate of gear j relative to its carrier about j's axis, rad/s."""
+    c = an.circuits[ci]
+    zj = mv(kin.R[c.carrier], c.geometry.zj)
+    return np.sum((kin.w[c.j] - kin.w[c.carrier]) * zj, axis=1)
+
+
+def mesh_loss(an, kin, ci: int, t: np.ndarray) -> np.ndarray:
+    """Mesh power loss P_p = c_p |t_p| |theta'_{j,c}| r_j (N,), W."""
+    c = an.circuits[ci]
+    loss = an.mech.gears[c.gear].loss_factor
+    if not loss or c.geometry is None:
+        return np.zeros_like(t)
+    return loss * np.abs(t) * np.abs(relative_rate(an, kin, ci)) * c.geometry.r_j
+
+
+def joint_friction_force(jt, qd: np.ndarray) -> np.ndarray:
+    """Friction generalised force on the joint's child, -F_c sign(qd) - F_v qd (N,); N*m
+    (revolute) or N (prismatic); zeros without friction."""
+    fr = jt.friction
+    if fr is None:
+        return np.zeros_like(qd)
+    return -fr.coulomb * np.sign(qd) - fr.viscous * qd
+
+
+def joint_axis_wrench(an, kin, ji: int, L: int) -> np.ndarray:
+    """(N, 6) wrench on link L, base frame, about o_L, of a unit generalised force of joint
+    ``ji`` on its child (reversed on its parent; zero on other links): a moment about the
+    axis (revolute) or a force along it through the joint origin (prismatic)."""
+    jt = an.mech.joints[ji]
+    sign = float(an.tree.index[jt.child] == L) - float(an.tree.index[jt.parent] == L)
+    z = kin.Rj[ji][:, :, 2]
+    if jt.type == "prismatic":
+        return sign * np.concatenate([z, cross(kin.oj[ji] - kin.o[L], z)], axis=1)
+    return sign * np.concatenate([np.zeros_like(z), z], axis=1)
+
+
+def subtract_joint_friction(an, kin, b: dict, qd_all: np.ndarray) -> None:
+    """b_L -= the joint friction wrenches on L (known from the joint rates ``qd_all`` (N, J)),
+    in place: friction is a known load, moved to the right-hand side like gravity."""
+    moving = set(an.tree.moving)
+    for ji, jt in enumerate(an.mech.joints):
+        if jt.friction is None or not jt.friction.active:
+            continue
+        Q = joint_friction_force(jt, qd_all[:, ji])
+        for name in (jt.child, jt.parent):
+            L = an.tree.index[name]
+            if L in moving:
+                b[L] -= Q[:, None] * joint_axis_wrench(an, kin, ji, L)
+
+
+def joint_loss(jt, qd: np.ndarray) -> np.ndarray:
+    """Joint friction power loss F_c |qd| + F_v qd^2 (N,), W (= -friction force * qd)."""
+    return -joint_friction_force(jt, qd) * qd
