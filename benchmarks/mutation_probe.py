@@ -58,6 +58,9 @@ TESTS = [
     "tests/test_helical_bundled.py::test_static_reduction_by_hand",
     "tests/test_helical_bundled.py::test_bearing_radial_and_axial_loads_by_hand",
     "tests/test_helical_bundled.py::test_power_balance_along_bundled_trajectory",
+    "tests/test_losses.py::test_spur_pair_lifting_then_lowering",
+    "tests/test_losses.py::test_rack_axis_with_carriage_friction",
+    "tests/test_losses.py::test_three_planet_planetary_efficiency_by_hand",
     "tests/test_helical_bundled.py::test_pinocchio_rnea_per_shaft_with_tooth_forces",
     "tests/test_load_sharing.py::test_each_planet_carries_one_nth_of_the_lumped_planet",
     "tests/test_load_sharing.py::test_unequal_stiffness_shares_in_proportion",
@@ -92,7 +95,7 @@ class Mutation:
         return ()
 
 
-NUMPY_ONLY = {"dynamics/kinematics.py", "dynamics/inertia.py", "dynamics/equations.py"}
+NUMPY_ONLY = {"dynamics/kinematics.py", "dynamics/inertia.py", "dynamics/equations.py", "dynamics/losses.py"}
 # the edit that makes "auto" take the numpy path in a copy
 NUMPY_DEFAULT = ("dynamics/backends.py", 'if backend == "numpy" or (backend == "auto" and method == "full"):',
                  'if backend in ("numpy", "auto") or method == "full":')
@@ -164,6 +167,16 @@ MUTATIONS = [
              (("dynamics/sharing.py", "w.append(scale.get(g.index, 1.0))", "w.append(1.0)"),)),
     Mutation("sharing-weights-inverted", "min sum k t^2 instead of min sum t^2 / k",
              (("dynamics/sharing.py", "else kmin / x for i, x", "else x / kmin for i, x"),)),
+    # issue 19: losses (the numpy reference solves every lossy mechanism)
+    Mutation("loss-couple-reversed", "mesh friction couple along the relative angular velocity instead of against it",
+             (("dynamics/losses.py", "return -loss * gm.r_j * u0 / float(u0 @ u0)",
+               "return loss * gm.r_j * u0 / float(u0 @ u0)"),)),
+    Mutation("loss-arm-pitch-radius", "mesh friction arm r_j instead of r_j / |u0| (rho = r_j r_k / (r_j + r_k))",
+             (("dynamics/losses.py", "return -loss * gm.r_j * u0 / float(u0 @ u0)",
+               "return -loss * gm.r_j * u0 / float(np.sqrt(u0 @ u0))"),)),
+    Mutation("loss-coulomb-sign", "joint Coulomb friction with the rate instead of against it",
+             (("dynamics/losses.py", "return -fr.coulomb * np.sign(qd) - fr.viscous * qd",
+               "return fr.coulomb * np.sign(qd) - fr.viscous * qd"),)),
     # the compiled kernel (backend "auto" takes it for every bundled mechanism)
     Mutation("kernel-gravity-sign", "kernel: gravity with the wrong sign in the d'Alembert force",
              (("dynamics/kernel_links.py", "F = scale(sub(ac, (g[0], g[1], g[2])), m)",

@@ -213,6 +213,9 @@ def _print_summary(console, report, verify: bool) -> None:
         console.print("Ideal pairs (no mesh geometry; mesh torque instead of tooth forces): " + ", ".join(ideal))
     for line in feature_notes(an) + sharing_notes(an):
         console.print(line, markup=False)
+    if report.losses is not None:
+        for line in report.losses.lines():
+            console.print(line, markup=False)
     if verify:
         console.print(f"Worst Newton-Euler residual (relative): {report.residual:.3g}")
 

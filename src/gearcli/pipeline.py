@@ -25,6 +25,7 @@ from .errors import GearcliError, Issue, TrajectoryError
 from .io import load_mechanism
 from .io.output import OutputError, atomic_output, output_target
 from .io.trajectory import TrajectoryReader
+from .report.loss_summary import LossSummary, lossless_twin
 from .report.columns import Summary, column_names, column_units, first_non_finite, table
 from .report.table_files import CONVENTIONS, FORMATS, extension, format_of, open_table
 
@@ -53,6 +54,7 @@ class SolveReport:
     summary: Summary
     residual: float | None
     output: Path | None
+    losses: LossSummary | None = None   # a mechanism with losses: energy lost, line efficiencies
 
 
 def check_solve_options(an: Analysis, method: str, backend: str) -> Analysis:
@@ -99,6 +101,8 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
     if progress is not None:
         progress(total=rows)
     summary = Summary.for_mechanism(an)
+    losses = LossSummary.for_mechanism(an) if an.mech.has_losses else None
+    twin = analyse(lossless_twin(an.mech)) if losses is not None else None
     names = column_names(an)
     worst = 0.0
     n = 0
@@ -113,6 +117,10 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
                     res = solve(an, part.q, part.qd, part.qdd, method=method, chunk=chunk, verify=verify,
                                 loads=part.loads, backend=backend, jobs=jobs, check_finite=False)  # read checked
                     tab = table(an, part.t, res)
+                    if losses is not None:    # the same motion without losses: the lines' output
+                        ideal = solve(twin, part.q, part.qd, part.qdd, method=method, chunk=chunk,
+                                      loads=part.loads, backend=backend, jobs=jobs, check_finite=False)
+                        losses.add(an, part.t, res, ideal.motor)
                 record(table_file, part, tab, res)
 
     def record(table_file, part, tab, res):
@@ -142,7 +150,7 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
     else:
         with atomic_output(out, (mech_path, traj_path), binary=fmt != "csv") as f:
             _run(solve_chunks, opened(f))
-    return SolveReport(an, n, summary, worst if verify else None, out)
+    return SolveReport(an, n, summary, worst if verify else None, out, losses)
 
 
 def _run(solve_chunks, table_file) -> None:

@@ -18,7 +18,12 @@ Columns, in order (units SI):
   ``joint:<joint>:radial`` = hypot(fx, fy), ``axial`` = |fz|, ``bending`` = hypot(mx, my);
 * per motor ``motor:<motor>:speed`` (rad/s, m/s for a prismatic input: the motor's input
   rate A^T qd) and ``motor:<motor>:power`` (W, torque x speed, negative when braking),
-  appended last so that the columns above keep their positions.
+  appended last so that the columns above keep their positions;
+* only for a mechanism with losses (``gears[].efficiency``, ``joints[].friction``), appended
+  after those: per gear pair with geometry ``gear:<pair>:loss`` (W, mesh power loss), then
+  per real joint ``joint:<joint>:friction`` (N*m, N for a prismatic joint: the friction on
+  the child about (along) the axis; not included in ``mz``/``fz``) and ``joint:<joint>:loss``
+  (W).
 """
 from __future__ import annotations
 
@@ -52,6 +57,10 @@ def column_names(an) -> list[str]:
         cols += [f"joint:{jt.name}:{c}" for c in ("fx", "fy", "fz", "mx", "my", "mz", "radial", "axial", "bending")]
     for m in mech.motors:
         cols += [f"motor:{m.name}:speed", f"motor:{m.name}:power"]
+    if mech.has_losses:
+        cols += [f"gear:{mech.gears[c.gear].name}:loss" for c in an.circuits if c.geometry is not None]
+        for jt in mech.joints:
+            cols += [f"joint:{jt.name}:friction", f"joint:{jt.name}:loss"]
     return cols
 
 
@@ -82,6 +91,14 @@ def table(an, t: np.ndarray, res: Result) -> np.ndarray:
         put(w, np.hypot(w[:, 0], w[:, 1]), np.abs(w[:, 2]), np.hypot(w[:, 3], w[:, 4]))
     for mi in range(res.motor_speed.shape[1]):
         put(res.motor_speed[:, mi], res.motor[:, mi] * res.motor_speed[:, mi])
+    if an.mech.has_losses:
+        if res.gear_loss is None:
+            raise ValueError("Result.gear_loss is missing (results of a lossy mechanism come from gearcli.solve)")
+        for ci, circ in enumerate(an.circuits):
+            if circ.geometry is not None:
+                put(res.gear_loss[:, ci])
+        for ji in range(res.joint.shape[1]):
+            put(res.joint_friction[:, ji], res.joint_loss[:, ji])
     return out
 
 
@@ -102,6 +119,8 @@ def column_unit(name: str) -> str:
     last = name.rsplit(":", 1)[-1]
     if name.startswith("motor:"):
         return {"speed": "rad/s", "power": "W"}.get(last, "N·m") if name.count(":") == 2 else "N·m"
+    if last == "loss" and name.startswith(("gear:", "joint:")):
+        return "W"
     if name == "t":
         return "s"
     if name.startswith("tau:") or last in ("torque", "mx", "my", "mz", "bending"):
@@ -117,6 +136,7 @@ def column_units(an) -> list[str]:
     sliding = {n for n, ji in zip(an.independent_names, an.independent)
                if ji >= 0 and an.mech.joints[ji].type == "prismatic"}
     ideal = {an.mech.gears[c.gear].name: _ideal_unit(an, c) for c in an.circuits if c.geometry is None}
+    joint_type = {jt.name: jt.type for jt in an.mech.joints}
     units = []
     for name in column_names(an):
         kind, _, rest = name.partition(":")
@@ -127,6 +147,8 @@ def column_units(an) -> list[str]:
             unit = "N"
         elif kind == "gear" and name.endswith(":torque"):
             unit = ideal[rest[:-len(":torque")]]
+        elif kind == "joint" and name.endswith(":friction"):
+            unit = "N" if joint_type[rest[:-len(":friction")]] == "prismatic" else "N·m"
         units.append(unit)
     return units
 

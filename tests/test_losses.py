@@ -1,0 +1,341 @@
+"""Losses (mesh friction, joint friction): power balances and hand cases.
+
+The references share no code with the solver's equations (Columns, blocks, losses):
+
+* the power balance takes the rate of kinetic energy, the power of gravity and of the
+  external loads from link velocities and accelerations of the kinematics alone (the velocity
+  of a link origin is the acceleration recursion run with zero rates and q'' := q', i.e.
+  J(q) q'), and the losses from their definitions (c |t| |theta'_jc| r_j, F_c |q'| + F_v q'^2);
+* the hand cases are one-line statics of a gear pair, a planetary and a rack, written here
+  from the model statement of the README ("Losses").
+"""
+from __future__ import annotations
+
+import dataclasses
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gearcli import analyse, load_mechanism, parse_mechanism, solve
+from gearcli.dynamics.kinematics import forward
+from gearcli.model.friction import JointFriction
+from gearcli.report.columns import named_columns
+
+MECH = Path(__file__).resolve().parents[1] / "mechanisms"
+BUNDLED = sorted(p.name for p in MECH.glob("*.yaml")) + ["geared_arm.urdf"]
+
+
+def with_losses(mech, c=0.03, coulomb=0.05, viscous=0.002):
+    """``mech`` with a loss factor on every pair with tooth geometry and friction on every joint."""
+    gears = tuple(dataclasses.replace(g, loss_factor=c) if g.mesh_point is not None and g.joints is None else g
+                  for g in mech.gears)
+    joints = tuple(dataclasses.replace(j, friction=JointFriction(coulomb, viscous)) for j in mech.joints)
+    return dataclasses.replace(mech, gears=gears, joints=joints)
+
+
+def random_motion(dof, n=60, seed=3):
+    rng = np.random.default_rng(seed)
+    return rng.uniform(-np.pi, np.pi, (n, dof)), rng.uniform(-3, 3, (n, dof)), rng.uniform(-8, 8, (n, dof))
+
+
+def energy_terms(an, q, qd, qdd):
+    """(dT/dt, power of gravity, power of the external loads) (N,) from kinematics only."""
+    mech, tree = an.mech, an.tree
+    qa, qda, qdda = q @ an.S.T, qd @ an.S.T, qdd @ an.S.T
+    kin = forward(mech, tree, qa, qda, qdda)
+    vel = forward(mech, tree, qa, np.zeros_like(qa), qda)   # a := J q', dw := J_w q' = omega
+    dT = np.zeros(q.shape[0])
+    Pg = np.zeros(q.shape[0])
+    for L in tree.moving:
+        link = mech.link(tree.links[L])
+        R, w, dw = kin.R[L], kin.w[L], kin.dw[L]
+        assert np.allclose(vel.dw[L], w, atol=1e-12 * (1 + np.abs(w).max()))
+        r = np.einsum("nij,j->ni", R, link.com)
+        v = vel.a[L] + np.cross(w, r)
+        a = kin.a[L] + np.cross(dw, r) + np.cross(w, np.cross(w, r))
+        Iw = R @ link.inertia @ R.transpose(0, 2, 1)
+        dT += link.mass * np.sum(v * a, axis=1) + np.einsum("ni,nij,nj->n", w, Iw, dw)
+        Pg += link.mass * (v @ mech.gravity)
+    Pe = np.zeros(q.shape[0])
+    for ld in mech.loads:
+        L = tree.index[ld.link]
+        R, w = kin.R[L], kin.w[L]
+        r = np.einsum("nij,j->ni", R, ld.point)
+        v = vel.a[L] + np.cross(w, r)
+        F, M = np.asarray(ld.force, float), np.asarray(ld.moment, float)
+        if ld.frame == "link":
+            F, M = np.einsum("nij,j->ni", R, F), np.einsum("nij,j->ni", R, M)
+        Pe += np.sum(F * v, axis=-1) + np.sum(M * w, axis=-1)
+    return dT, Pg, Pe
+
+
+def own_losses(an, q, qd, res):
+    """Sum of the losses from their definitions (N,), and each one (for the sign test)."""
+    mech, tree = an.mech, an.tree
+    qa, qda = q @ an.S.T, qd @ an.S.T
+    kin = forward(mech, tree, qa, qda)
+    parts = []
+    for ci, c in enumerate(an.circuits):
+        gp = mech.gears[c.gear]
+        if not gp.loss_factor:
+            continue
+        zj = np.einsum("nij,j->ni", kin.R[c.carrier], c.geometry.zj)
+        rate = np.sum((kin.w[c.j] - kin.w[c.carrier]) * zj, axis=1)
+        parts.append(gp.loss_factor * np.abs(res.gear_t[:, ci]) * np.abs(rate) * c.geometry.r_j)
+    for ji, jt in enumerate(mech.joints):
+        parts.append(jt.friction.coulomb * np.abs(qda[:, ji]) + jt.friction.viscous * qda[:, ji] ** 2)
+    return np.sum(parts, axis=0), parts
+
+
+def _load(name):
+    return load_mechanism(MECH / name)
+
+
+@pytest.mark.parametrize("name", BUNDLED)
+@pytest.mark.parametrize("method", ["block", "full"])
+def test_power_balance_with_losses(name, method):
+    """Sum of motor power = dT/dt - P_gravity - P_loads + sum of losses, per sample, to 1e-9,
+    on every bundled mechanism with losses switched on; the losses the solver reports equal
+    their definitions and are >= 0, and they are real (the lossless balance is off by them)."""
+    an = analyse(with_losses(_load(name)))
+    q, qd, qdd = random_motion(an.dof)
+    res = solve(an, q, qd, qdd, method=method, verify=True)
+    assert res.residual < 1e-10
+    dT, Pg, Pe = energy_terms(an, q, qd, qdd)
+    total, parts = own_losses(an, q, qd, res)
+    P_motor = np.sum(res.motor * res.motor_speed, axis=1)
+    scale = 1.0 + np.abs(P_motor) + np.abs(dT) + np.abs(Pg) + np.abs(Pe) + total
+    assert np.max(np.abs(P_motor - (dT - Pg - Pe + total)) / scale) < 1e-9
+    assert all(np.all(p >= 0) for p in parts)
+    reported = res.gear_loss.sum(axis=1) + res.joint_loss.sum(axis=1)
+    assert np.max(np.abs(reported - total) / scale) < 1e-12
+    assert np.min(total) > 0 and np.max(np.abs(P_motor - (dT - Pg - Pe)) / scale) > 1e-4
+
+
+@pytest.mark.parametrize("name", BUNDLED)
+def test_lossless_mechanism_outputs_unchanged_and_without_loss_columns(name):
+    """Efficiency 1 and zero friction written out: every output equals the file without them,
+    bit for bit, and no loss column appears."""
+    mech = _load(name)
+    zero = dataclasses.replace(mech, gears=tuple(dataclasses.replace(g, loss_factor=0.0) for g in mech.gears),
+                               joints=tuple(dataclasses.replace(j, friction=JointFriction(0.0, 0.0))
+                                            for j in mech.joints))
+    a0, a1 = analyse(mech), analyse(zero)
+    q, qd, qdd = random_motion(a0.dof, n=20)
+    c0 = named_columns(a0, solve(a0, q, qd, qdd, backend="numpy"))
+    c1 = named_columns(a1, solve(a1, q, qd, qdd, backend="numpy"))
+    assert list(c0) == list(c1) and not any(k.endswith((":loss", ":friction")) for k in c1)
+    for k in c0:
+        assert np.array_equal(c0[k], c1[k]), k
+
+
+# --- hand cases ----------------------------------------------------------------------------------
+
+SPUR = """
+name: spur_hoist
+gravity: [0, 0, 0]
+base: base
+end_effector: drum
+links:
+  - {{name: base}}
+  - {{name: pinion, mass: 0.1, inertia: [1.0e-5, 1.0e-5, 1.0e-5]}}
+  - {{name: drum, mass: 1.0, inertia: [1.0e-3, 1.0e-3, 1.0e-3]}}
+joints:
+  - {{name: JP, parent: base, child: pinion, origin: {{xyz: [0, 0, 0]}}, axis: [0, 0, 1]}}
+  - {{name: JD, parent: base, child: drum, origin: {{xyz: [0.075, 0, 0]}}, axis: [0, 0, 1]}}
+gears:
+  - {{name: stage, links: [pinion, drum], teeth: [15, 60], mesh_point: [0.015, 0, 0], efficiency: {eta}}}
+motors:
+  - {{name: m, link: pinion}}
+loads:
+  - {{name: rope, link: drum, frame: base, moment: [0, 0, {ML}]}}
+"""
+
+
+@pytest.mark.parametrize("eta", [0.97, 0.9])
+def test_spur_pair_lifting_then_lowering(eta):
+    """A 15/60 mm spur pair holding a load moment M_L on the drum, at constant speed.
+    Lifting (the pinion drives): T = M_L (r_j + c rho) / (r_k - c rho); lowering (the load
+    drives back, the motor brakes): T = M_L (r_j - c rho) / (r_k + c rho), rho = r_j r_k /
+    (r_j + r_k): the friction couple opposes the motion both ways, so the motor needs more
+    torque to lift than the lossless M_L r_j / r_k and less to hold back the lowering load."""
+    ML, rj, rk, c = -4.0, 0.015, 0.06, 1.0 - eta     # the rope pulls the drum about -z
+    an = analyse(parse_mechanism(SPUR.format(eta=eta, ML=ML)))
+    rho = rj * rk / (rj + rk)
+    w_pinion = 10.0
+    qd_drum = np.array([[w_pinion * rj / rk]])      # the drum turns +z (lifting): the pinion -z
+    lift = solve(an, [[0.0]], qd_drum, [[0.0]])
+    lower = solve(an, [[0.0]], -qd_drum, [[0.0]])
+    T_lift = abs(ML) * (rj + c * rho) / (rk - c * rho)
+    T_lower = abs(ML) * (rj - c * rho) / (rk + c * rho)
+    assert lift.motor_speed[0, 0] == pytest.approx(-w_pinion, rel=1e-12)
+    assert lift.motor[0, 0] == pytest.approx(-T_lift, rel=1e-12)     # about -z, with the motion
+    assert lower.motor[0, 0] == pytest.approx(-T_lower, rel=1e-12)   # about -z, against the motion
+    ideal = abs(ML) * rj / rk
+    assert T_lower < ideal < T_lift
+    # the measured ratio: output / input power when lifting (0.9707 for eta = 0.97)
+    ratio = ideal / T_lift
+    assert ratio == pytest.approx((rk - c * rho) * rj / ((rj + c * rho) * rk), rel=1e-12)
+    if eta == 0.97:
+        assert round(ratio, 4) == 0.9707
+    # loss reported = c |t| v_p, and = input - output power
+    t = lift.gear_t[0, 0]
+    assert lift.gear_loss[0, 0] == pytest.approx(c * abs(t) * w_pinion * rj, rel=1e-12)
+    assert lift.gear_loss[0, 0] == pytest.approx((T_lift - ideal) * w_pinion, rel=1e-12)
+    assert lower.gear_loss[0, 0] == pytest.approx((ideal - T_lower) * w_pinion, rel=1e-12)
+
+
+RACK = """
+name: rack_hand
+gravity: [0, 0, 0]
+base: frame
+end_effector: carriage
+links:
+  - {{name: frame}}
+  - {{name: pinion, mass: 0.2, inertia: [1.0e-4, 1.0e-4, 1.0e-4]}}
+  - {{name: carriage, mass: 3.0, inertia: [0.01, 0.01, 0.01]}}
+joints:
+  - {{name: JP, parent: frame, child: pinion, origin: {{xyz: [0, 0, 0]}}, axis: [0, 0, 1]}}
+  - {{name: JX, parent: frame, child: carriage, type: prismatic, origin: {{xyz: [0, -0.02, 0]}}, axis: [1, 0, 0],
+      friction: {{coulomb: {Fc}, viscous: {Fv}}}}}
+gears:
+  - {{name: rack, kind: rack, links: [pinion, carriage], mesh_point: [0, -0.02, 0], efficiency: {eta}}}
+motors:
+  - {{name: m, link: pinion}}
+loads:
+  - {{name: push, link: carriage, frame: base, force: [{F}, 0, 0]}}
+"""
+
+
+def test_rack_axis_with_carriage_friction():
+    """Pinion r = 20 mm drives a carriage against a load F at constant speed v, with Coulomb
+    + viscous carriage friction and mesh efficiency eta: the rack needs a drive force
+    |F| + F_c + F_v v, and the pinion torque r (1 + c) times that (the couple c |t| r on the
+    pinion); the measured power ratio is 1 / (1 + c); the joint reports its friction and loss."""
+    r, Fc, Fv, eta, F, v = 0.02, 12.0, 30.0, 0.9, -50.0, 0.25
+    c = 1 - eta
+    an = analyse(parse_mechanism(RACK.format(Fc=Fc, Fv=Fv, eta=eta, F=F)))
+    res = solve(an, [[0.0]], [[v]], [[0.0]])
+    drive = abs(F) + Fc + Fv * v
+    assert res.motor_speed[0, 0] == pytest.approx(v / r, rel=1e-12)
+    assert res.motor[0, 0] == pytest.approx(drive * r * (1 + c), rel=1e-12)
+    jx = [j.name for j in an.mech.joints].index("JX")
+    assert res.joint_friction[0, jx] == pytest.approx(-(Fc + Fv * v), rel=1e-12)
+    assert res.joint_loss[0, jx] == pytest.approx(Fc * v + Fv * v * v, rel=1e-12)
+    assert res.joint[0, jx, 2] == 0.0                      # friction is not in fz
+    assert drive * v / (res.motor[0, 0] * v / r) == pytest.approx(1 / (1 + c), rel=1e-12)
+    back = solve(an, [[0.0]], [[-v]], [[0.0]])            # reversed: friction reverses
+    assert back.motor[0, 0] == pytest.approx((abs(F) - Fc - Fv * v) * r * (1 - c), rel=1e-12)
+
+
+PLANETARY = """
+name: planetary_hand
+gravity: [0, 0, 0]
+base: housing
+end_effector: carrier
+links:
+  - {{name: housing}}
+  - {{name: sun, mass: 0.1, inertia: [1.0e-5, 1.0e-5, 1.0e-5]}}
+  - {{name: carrier, mass: 0.5, inertia: [1.0e-3, 1.0e-3, 1.0e-3]}}
+  - {{name: planet, mass: 0.05, inertia: [1.0e-6, 1.0e-6, 1.0e-6]}}
+joints:
+  - {{name: JS, parent: housing, child: sun, origin: {{xyz: [0, 0, 0]}}, axis: [0, 0, 1]}}
+  - {{name: JC, parent: housing, child: carrier, origin: {{xyz: [0, 0, 0]}}, axis: [0, 0, 1]}}
+  - {{name: JP, parent: carrier, child: planet, origin: {{xyz: [{a}, 0, 0]}}, axis: [0, 0, 1], planets: 3}}
+gears:
+  - {{name: sp, links: [sun, planet], teeth: [12, 18], mesh_point: [{rs}, 0, 0], efficiency: {eta}}}
+  - {{name: pr, links: [planet, housing], kind: internal, teeth: [18, 48], mesh_point: [{rr}, 0, 0], efficiency: {eta}}}
+motors:
+  - {{name: m, link: sun}}
+loads:
+  - {{name: out, link: carrier, frame: base, moment: [0, 0, {Tc}]}}
+"""
+
+
+def test_three_planet_planetary_efficiency_by_hand():
+    """Sun input, ring fixed, carrier output against a load moment, constant speed, no
+    gravity, equal mesh efficiencies.  By hand (each planet alike, tangential tooth forces F1
+    from the sun and F2 from the ring, both pushing the planet the same way):
+      carrier:  3 a (F1 + F2) = T_out;
+      planet about its pin: r_p (F1 - F2) = C1 + C2 (both couples resist the planet's
+        rotation relative to the carrier when the sun drives), C1 = c F1 rho1,
+        C2 = c F2 rho2, rho1 = r_s r_p / (r_s + r_p), rho2 = r_p r_r / (r_r - r_p);
+      sun: T_in = 3 (F1 r_s + C1).
+    Efficiency T_out w_c / (T_in w_s), w_c / w_s = r_s / (r_s + r_r)."""
+    rs, rp, eta, Tout = 0.012, 0.018, 0.98, 3.0
+    rr, a, c = rs + 2 * rp, rs + rp, 1 - eta
+    an = analyse(parse_mechanism(PLANETARY.format(a=a, rs=rs, rr=rr, eta=eta, Tc=-Tout)))
+    rho1, rho2 = rs * rp / (rs + rp), rp * rr / (rr - rp)
+    # r_p (F1 - F2) = c (F1 rho1 + F2 rho2); F1 + F2 = Tout / (3 a)
+    A = np.array([[rp - c * rho1, -(rp + c * rho2)], [1.0, 1.0]])
+    F1, F2 = np.linalg.solve(A, [0.0, Tout / (3 * a)])
+    T_in = 3 * (F1 * rs + c * F1 * rho1)
+    w_c = 2.0
+    res = solve(an, [[0.0]], [[w_c]], [[0.0]])
+    w_s = res.motor_speed[0, 0]
+    assert w_s == pytest.approx(w_c * (rs + rr) / rs, rel=1e-12)
+    assert res.motor[0, 0] == pytest.approx(T_in, rel=1e-11)
+    assert Tout * w_c / (res.motor[0, 0] * w_s) == pytest.approx(Tout * rs / (T_in * (rs + rr)), rel=1e-11)
+    sp = [an.mech.gears[cc.gear].name for cc in an.circuits].index("sp1")
+    assert abs(res.gear_t[0, sp]) == pytest.approx(F1, rel=1e-11)
+
+
+def test_zero_relative_speed_gives_no_mesh_couple():
+    """sign(0) = 0: at rest the mesh loses nothing and the motor holds the lossless torque."""
+    an = analyse(parse_mechanism(SPUR.format(eta=0.9, ML=-4.0)))
+    res = solve(an, [[0.0]], [[0.0]], [[0.0]])
+    assert res.motor[0, 0] == pytest.approx(-4.0 * 0.015 / 0.06, rel=1e-12)
+    assert res.gear_loss[0, 0] == 0.0
+
+
+# --- input ---------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("extra,place,message", [
+    ("efficiency: 0", "gears[0].efficiency", "mesh efficiency must be in (0, 1], got 0"),
+    ("efficiency: 1.2", "gears[0].efficiency", "mesh efficiency must be in (0, 1], got 1.2"),
+    ("loss_factor: 1", "gears[0].loss_factor", "mesh loss factor must be in [0, 1), got 1"),
+    ("loss_factor: -0.1", "gears[0].loss_factor", "mesh loss factor must be in [0, 1), got -0.1"),
+    ("{efficiency: 0.9, loss_factor: 0.1}", "gears[0].loss_factor", "give efficiency or loss_factor"),
+])
+def test_bad_mesh_loss_input(run_cli, tmp_path, extra, place, message):
+    text = SPUR.format(eta=0.97, ML=-4.0)
+    if extra.startswith("{"):
+        text = text.replace("efficiency: 0.97", extra[1:-1])
+    else:
+        text = text.replace("efficiency: 0.97", extra)
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    res = run_cli("check", path)
+    assert res.exit_code == 2
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and f"bad.yaml:{_line(text, place.split('.')[-1])}: {place}: " in lines[0]
+    assert message in lines[0]
+
+
+def _line(text: str, key: str) -> int:
+    return next(i for i, ln in enumerate(text.splitlines(), 1) if f"{key}:" in ln and "name: stage" in ln)
+
+
+def test_bad_joint_friction_and_loss_without_geometry(run_cli, tmp_path):
+    text = RACK.format(Fc=-1.0, Fv=2.0, eta=0.9, F=-50.0)
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    res = run_cli("check", path)
+    assert res.exit_code == 2
+    assert "joints[1].friction.coulomb: coulomb friction must be >= 0, got -1 N" in res.stderr
+    ideal = textwrap.dedent("""
+        name: ideal
+        base: b
+        end_effector: y
+        links: [{name: b}, {name: x, mass: 1, inertia: [1, 1, 1]}, {name: y, mass: 1, inertia: [1, 1, 1]}]
+        joints:
+          - {name: J1, parent: b, child: x, origin: {xyz: [0, 0, 0]}, axis: [0, 0, 1]}
+          - {name: J2, parent: b, child: y, origin: {xyz: [1, 0, 0]}, axis: [0, 0, 1]}
+        gears: [{name: p, links: [x, y], ratio: -2, efficiency: 0.9}]
+        motors: [{name: m, link: x}]
+        """)
+    path.write_text(ideal)
+    res = run_cli("check", path)
+    assert res.exit_code == 2 and "gears[0].efficiency: a mesh loss needs the tooth geometry" in res.stderr
