@@ -339,3 +339,39 @@ def test_bad_joint_friction_and_loss_without_geometry(run_cli, tmp_path):
     path.write_text(ideal)
     res = run_cli("check", path)
     assert res.exit_code == 2 and "gears[0].efficiency: a mesh loss needs the tooth geometry" in res.stderr
+
+
+@pytest.mark.parametrize("name", ["planetary_3p.yaml", "rack_axis.yaml", "helical_reduction.yaml", "bendix_wrist.yaml"])
+def test_urdf_export_keeps_losses(tmp_path, name):
+    """Loss factors and joint friction survive export to URDF and reading back, and the
+    solve of the read-back file equals the original's."""
+    from gearcli.report.urdf_writer import export_urdf
+    mech = with_losses(_load(name), c=0.025, coulomb=0.07, viscous=0.003)
+    path = tmp_path / "lossy.urdf"
+    export_urdf(mech, path)
+    back = load_mechanism(path)
+    assert [g.loss_factor for g in back.gears] == [g.loss_factor for g in mech.gears]
+    assert [j.friction for j in back.joints] == [j.friction for j in mech.joints]
+    a0, a1 = analyse(mech), analyse(back)
+    q, qd, qdd = random_motion(a0.dof, n=10)
+    r0, r1 = solve(a0, q, qd, qdd), solve(a1, q, qd, qdd)
+    assert np.max(np.abs(r0.motor - r1.motor)) <= 1e-12 * (1 + np.max(np.abs(r0.motor)))
+    assert np.max(np.abs(r0.gear_loss - r1.gear_loss)) <= 1e-12 * (1 + np.max(np.abs(r0.gear_loss)))
+
+
+def test_urdf_bad_loss_input(run_cli, tmp_path):
+    from gearcli.report.urdf_writer import export_urdf
+    mech = with_losses(_load("rack_axis.yaml"))
+    good = tmp_path / "lossy.urdf"
+    export_urdf(mech, good)
+    text = good.read_text()
+    for old, new, message in [('loss_factor="0.03"', 'efficiency="1.5"', "mesh efficiency must be in (0, 1], got 1.5"),
+                              ('loss_factor="0.03"', 'loss_factor="0.03" efficiency="0.9"', "give efficiency or loss_factor"),
+                              ('coulomb="0.05"', 'coulomb="-2"', "coulomb friction must be >= 0, got -2 N*m"),
+                              ('viscous="0.002"', 'viscous="0.002" stiction="1"', "unknown attribute 'stiction'")]:
+        bad = tmp_path / "bad.urdf"
+        bad.write_text(text.replace(old, new, 1))
+        res = run_cli("check", bad)
+        assert res.exit_code == 2, new
+        lines = res.stderr.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith(f"{bad}:") and message in lines[0], lines

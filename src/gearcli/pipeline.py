@@ -117,10 +117,8 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
                     res = solve(an, part.q, part.qd, part.qdd, method=method, chunk=chunk, verify=verify,
                                 loads=part.loads, backend=backend, jobs=jobs, check_finite=False)  # read checked
                     tab = table(an, part.t, res)
-                    if losses is not None:    # the same motion without losses: the lines' output
-                        ideal = solve(twin, part.q, part.qd, part.qdd, method=method, chunk=chunk,
-                                      loads=part.loads, backend=backend, jobs=jobs, check_finite=False)
-                        losses.add(an, part.t, res, ideal.motor)
+                    if losses is not None:
+                        losses.add(an, part.t, res, lossless_motor(twin, part, method, chunk, backend, jobs))
                 record(table_file, part, tab, res)
 
     def record(table_file, part, tab, res):
@@ -151,6 +149,13 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
         with atomic_output(out, (mech_path, traj_path), binary=fmt != "csv") as f:
             _run(solve_chunks, opened(f))
     return SolveReport(an, n, summary, worst if verify else None, out, losses)
+
+
+def lossless_motor(twin: Analysis, part, method: str, chunk: int, backend: str, jobs) -> np.ndarray:
+    """Motor torques (N, M) of a chunk's motion without losses (the lines' output power for
+    the summary's line efficiencies, :mod:`gearcli.report.loss_summary`)."""
+    return solve(twin, part.q, part.qd, part.qdd, method=method, chunk=chunk, loads=part.loads,
+                 backend=backend, jobs=jobs, check_finite=False).motor
 
 
 def _run(solve_chunks, table_file) -> None:

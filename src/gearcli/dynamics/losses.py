@@ -105,3 +105,22 @@ def subtract_joint_friction(an, kin, b: dict, qd_all: np.ndarray) -> None:
 def joint_loss(jt, qd: np.ndarray) -> np.ndarray:
     """Joint friction power loss F_c |qd| + F_v qd^2 (N,), W (= -friction force * qd)."""
     return -joint_friction_force(jt, qd) * qd
+
+
+LOSS_FIELDS = ("gear_loss", "joint_friction", "joint_loss")   # Result fields of a lossy mechanism
+
+
+def fill_losses(an, kin, qd_all: np.ndarray, res) -> None:
+    """Set the loss fields of the :class:`~.solve.Result` ``res`` from its tooth forces and
+    the joint rates ``qd_all`` (N, J): ``gear_loss`` (N, G) mesh power loss, W (0 for an
+    ideal pair); ``joint_friction`` (N, J) the friction on each joint's child about (along)
+    its axis, N*m (N); ``joint_loss`` (N, J) its power loss, W.  Nothing for a lossless
+    mechanism (the fields stay None)."""
+    if not an.mech.has_losses:
+        return
+    N = qd_all.shape[0]
+    res.gear_loss = np.column_stack([mesh_loss(an, kin, ci, res.gear_t[:, ci]) for ci in range(len(an.circuits))]
+                                    ) if an.circuits else np.zeros((N, 0))
+    joints = an.mech.joints
+    res.joint_friction = np.column_stack([joint_friction_force(jt, qd_all[:, ji]) for ji, jt in enumerate(joints)])
+    res.joint_loss = np.column_stack([joint_loss(jt, qd_all[:, ji]) for ji, jt in enumerate(joints)])

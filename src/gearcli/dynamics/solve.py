@@ -36,7 +36,7 @@ from .inertia import inertia_load
 from .inputs import motion_arrays
 from .kernel_program import build_program
 from .kinematics import forward
-from .losses import joint_friction_force, joint_loss, mesh_loss, subtract_joint_friction
+from .losses import LOSS_FIELDS, fill_losses, subtract_joint_friction
 from .result_arrays import check_out, copy_into, result_arrays, work_arrays
 from .signs import SignError, sign_violation
 
@@ -75,9 +75,7 @@ class Result:
     gear_axial: np.ndarray
     residual: float | None = None
     motor_speed: np.ndarray | None = None   # (N, M) motor speeds A^T qd, rad/s (m/s linear)
-    # Losses (None for a lossless mechanism; :mod:`.losses`): ``gear_loss`` (N, G) mesh power
-    # loss, W; ``joint_friction`` (N, J) the joint's friction on its child about (along) its
-    # axis, N*m (N), not included in ``joint``'s mz (fz); ``joint_loss`` (N, J) its power, W.
+    # Losses, None for a lossless mechanism (:func:`.losses.fill_losses`; W, N*m or N, W).
     gear_loss: np.ndarray | None = None
     joint_friction: np.ndarray | None = None
     joint_loss: np.ndarray | None = None
@@ -115,7 +113,8 @@ class Solver:
         self.groups = unknown_groups(an)
         self.plans = make_plans(an)
         self._program = None
-        self.kernel_problem: str | None = None
+        self.kernel_problem: str | None = "the mechanism has losses, which only the numpy reference solves so far" \
+            if an.mech.has_losses else None
         self._llvm = None
         self.llvm_problem: str | None = None
         self.samples_solved = 0          # by the block method, every backend ("auto"'s cost model)
@@ -125,10 +124,6 @@ class Solver:
         when the kernel cannot be used here (``self.kernel_problem`` says why); built on
         first use."""
         if self._program is None and self.kernel_problem is None:
-            if self.an.mech.has_losses:
-                self.kernel_problem = ("the mechanism has losses (gears[].efficiency, joints[].friction), "
-                                       "which the numpy reference solves so far")
-                return None
             self._program = build_program(self.an, self.plans)
             if not self._program.covered:
                 self.kernel_problem = ("a redundant gear set of this mechanism has no constant frame, or a block "
@@ -230,9 +225,8 @@ class Solver:
             res = Result(*(np.concatenate([getattr(p, f) for p in parts]) for f in
                            ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial")))
             res.residual = _worst(*(p.residual for p in parts)) if verify else None
-            for f in LOSS_FIELDS:
-                if getattr(parts[0], f) is not None:
-                    setattr(res, f, np.concatenate([getattr(p, f) for p in parts]))
+            for f in LOSS_FIELDS if parts[0].gear_loss is not None else ():
+                setattr(res, f, np.concatenate([getattr(p, f) for p in parts]))
         return res
 
     def _loads(self, q_ind, qd_ind, qdd_ind, values):
@@ -242,8 +236,7 @@ class Solver:
         kin = forward(an.mech, an.tree, q, qd, qdd)
         b = inertia_load(an, kin)
         subtract_external(b, external_wrenches(an, kin, values))
-        if an.mech.has_losses:
-            subtract_joint_friction(an, kin, b, qd)
+        subtract_joint_friction(an, kin, b, qd)
         return q, kin, b
 
     def _chunk(self, q_ind, qd_ind, qdd_ind, method, verify, values) -> Result:
@@ -255,8 +248,7 @@ class Solver:
         else:
             x, sig = solve_full(an, cols, b)
         res = _result(an, self.groups, x)
-        if an.mech.has_losses:
-            _losses(an, kin, np.asarray(qd_ind, float) @ an.S.T, res)
+        fill_losses(an, kin, np.asarray(qd_ind, float) @ an.S.T, res)
         if verify:
             res.residual = residual(an, self.groups, cols, b, x, sig)
         return res
@@ -370,18 +362,6 @@ def _unknowns(an, res: Result) -> dict:
     for ji, jt in enumerate(an.mech.joints):
         x[("joint", ji)] = res.joint[:, ji, [0, 1, 3, 4, 5] if jt.type == "prismatic" else [0, 1, 2, 3, 4]]
     return x
-
-
-LOSS_FIELDS = ("gear_loss", "joint_friction", "joint_loss")
-
-
-def _losses(an, kin, qd_all: np.ndarray, res: Result) -> None:
-    """Fill the loss fields of ``res`` (:mod:`.losses`) from its tooth forces and the rates."""
-    res.gear_loss = np.column_stack([mesh_loss(an, kin, ci, res.gear_t[:, ci]) for ci in range(len(an.circuits))]
-                                    ) if an.circuits else np.zeros((qd_all.shape[0], 0))
-    joints = an.mech.joints
-    res.joint_friction = np.column_stack([joint_friction_force(jt, qd_all[:, ji]) for ji, jt in enumerate(joints)])
-    res.joint_loss = np.column_stack([joint_loss(jt, qd_all[:, ji]) for ji, jt in enumerate(joints)])
 
 
 def _result(an, groups, x_all) -> Result:

@@ -9,6 +9,7 @@ import numpy as np
 from lxml import etree
 
 from ..errors import counted, plural
+from ..model.friction import JointFriction
 from ..model.mechanism import GearPair, Motor
 from ..model.validate import gear_pair_problems
 from .urdf_transmissions import KINDS as TRANSMISSION_KINDS
@@ -17,7 +18,7 @@ from .urdf_xml import NS, floats, q
 
 GEAR_ATTRS = ("name", "j", "k", "kind", "ratio", "teeth", "carrier", "mesh_point", "pressure_angle",
               "pressure_angle_deg", "cone_angles", "cone_angles_deg", "helix_angle", "helix_angle_deg", "hand",
-              "stiffness", "derived")
+              "stiffness", "derived", "efficiency", "loss_factor")
 
 
 def _helix_deg(el, kw: dict) -> float | None:
@@ -112,6 +113,9 @@ class Extension:
                 self.add(path, f"mesh stiffness must be positive, got {k[0]:g} N/m", el)
             elif k is not None:
                 kw["stiffness"] = float(k[0])
+        loss = self.mesh_loss_factor(el, path)
+        if loss:
+            kw["loss_factor"] = loss
         for key in ("pressure_angle", "cone_angles", "helix_angle"):
             n = 2 if key == "cone_angles" else 1
             if el.get(key) is not None and el.get(f"{key}_deg") is not None:
@@ -123,6 +127,37 @@ class Extension:
             if v is not None:
                 kw[key] = float(v[0]) if n == 1 else (float(v[0]), float(v[1]))
         return kw
+
+    def mesh_loss_factor(self, el, path: str) -> float:
+        """``efficiency`` eta in (0, 1] or ``loss_factor`` c in [0, 1) of a gearcli:gear (at most
+        one; it needs ``mesh_point``) as the loss factor c = 1 - eta; 0 when neither."""
+        eta, c = self.vector(el, "efficiency", path, n=1), self.vector(el, "loss_factor", path, n=1)
+        if eta is not None and c is not None:
+            self.add(path, "give efficiency or loss_factor (= 1 - efficiency), not both", el)
+            return 0.0
+        if eta is not None and not 0.0 < eta[0] <= 1.0:
+            self.add(path, f"mesh efficiency must be in (0, 1], got {eta[0]:g}", el)
+            return 0.0
+        if c is not None and not 0.0 <= c[0] < 1.0:
+            self.add(path, f"mesh loss factor must be in [0, 1), got {c[0]:g}", el)
+            return 0.0
+        loss = 1.0 - float(eta[0]) if eta is not None else (float(c[0]) if c is not None else 0.0)
+        if loss and el.get("mesh_point") is None:
+            self.add(path, "a mesh loss needs the tooth geometry (mesh_point): the loss is |t| times the "
+                     "pitch-line speed", el)
+        return loss
+
+    def joint_friction(self, el, path: str, prismatic: bool) -> JointFriction:
+        """A gearcli:friction element inside a joint: ``coulomb`` and ``viscous``, both >= 0."""
+        self.unknown_attrs(el, ("coulomb", "viscous"), f"{path}.gearcli:friction")
+        values = {}
+        for key, units in (("coulomb", ("N*m", "N")), ("viscous", ("N*m*s/rad", "N*s/m"))):
+            v = self.vector(el, key, path, n=1)
+            v = 0.0 if v is None else float(v[0])
+            if not v >= 0:
+                self.add(f"{path}.gearcli:friction", f"{key} friction must be >= 0, got {v:g} {units[prismatic]}", el)
+            values[key] = v
+        return JointFriction(**values)
 
     def check_gear_pair(self, el, path: str, j: str | None, k: str | None, kw: dict, ratio) -> None:
         """The checks every gear pair declaration gets (:func:`gearcli.model.validate.gear_pair_problems`);

@@ -224,7 +224,7 @@ class _Reader(StructureChecks, Mimics, Extension, UrdfLoads):
             axis = np.asarray(yj.axis, float)
             axis = axis / np.linalg.norm(axis)
             A = align_z(axis)
-            label = None
+            label = friction = None
             for sub in el:
                 if not isinstance(sub.tag, str) or etree.QName(sub).namespace != NS:
                     continue
@@ -234,9 +234,11 @@ class _Reader(StructureChecks, Mimics, Extension, UrdfLoads):
                     self.unknown_attrs(sub, ("label",), path)
                 elif local == "bearing":
                     continue  # read by io.ratings_reader
+                elif local == "friction":
+                    friction = self.joint_friction(sub, path, JOINT_TYPES[yj.type] == "prismatic")
                 elif local != "gear":
-                    self.add(path, f"unknown element gearcli:{local} in a joint (expected gearcli:joint "
-                             "or gearcli:gear)", sub)
+                    self.add(path, f"unknown element gearcli:{local} in a joint (expected gearcli:joint, "
+                             "gearcli:friction or gearcli:gear)", sub)
                 elif el.find("mimic") is None:
                     self.add(path, "gearcli:gear inside a joint gives the geometry of its <mimic> "
                              "coupling, but the joint has no <mimic>", sub)
@@ -251,11 +253,11 @@ class _Reader(StructureChecks, Mimics, Extension, UrdfLoads):
                                      for x in (d.damping, d.friction) if x is not None):
                 dyn.append(name)
             joints.append(Joint(name, parent, yj.child, T[:3, :3] @ A, T[:3, 3].copy(), A.T, np.zeros(3),
-                                JOINT_TYPES[yj.type], label, source, path))
+                                JOINT_TYPES[yj.type], label, source, path, friction=friction))
         if dyn:
             more = f" and {len(dyn) - 4} more" if len(dyn) > 5 else ""
             self.warn("", f"<dynamics> damping and friction of {plural(len(dyn), 'joint')} {', '.join(dyn[:4] if more else dyn)}{more} are ignored "
-                      "(gearcli computes the loads of rigid, frictionless joints)")
+                      "(gearcli reads joint friction from <gearcli:friction coulomb viscous/> only)")
         if not joints:
             self.add("", "the robot has no movable joints: nothing to analyse", self.root)
         self.movable = {j.name: j for j in joints}

@@ -18,7 +18,8 @@ write):
 * the exact gearcli data in extension elements (namespace :data:`gearcli.urdf.NS`):
   ``gearcli:mechanism`` (end effector, gravity, open loop), ``gearcli:gear`` (full gear
   geometry; angles in rad), ``gearcli:motor`` (link, stator, transmission coefficients),
-  ``gearcli:load`` (external loads, in the URDF link frame) and ``gearcli:joint`` (axis labels).
+  ``gearcli:load`` (external loads, in the URDF link frame), ``gearcli:joint`` (axis labels)
+  and ``gearcli:friction`` (joint friction; a gear's loss factor is a ``gearcli:gear`` attribute).
 """
 from __future__ import annotations
 
@@ -193,6 +194,9 @@ def _add_mimics(an: Analysis, jel: dict, corr: dict) -> None:
     for jt in mech.joints:
         if jt.label is not None:
             etree.SubElement(jel[jt.name], q("joint"), label=str(jt.label))
+        if jt.friction is not None and jt.friction.active:
+            etree.SubElement(jel[jt.name], q("friction"), coulomb=_num(jt.friction.coulomb),
+                             viscous=_num(jt.friction.viscous))
 
 
 def _add_transmissions(an: Analysis, root) -> None:
@@ -262,3 +266,5 @@ def _gear_attrs(el, gp, mesh_point) -> None:
         el.set("hand", str(gp.hand))
     if gp.stiffness is not None:
         el.set("stiffness", _num(gp.stiffness))
+    if gp.loss_factor:
+        el.set("loss_factor", _num(gp.loss_factor))
