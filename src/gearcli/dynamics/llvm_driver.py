@@ -24,6 +24,7 @@ from .jobs import job_ranges, run_parts, sign_error, threads_for
 from .kernel_program import Program, load_arrays
 from .llvm_blocks import problem
 from .llvm_kernel import ARGS, build_module
+from .llvm_links import load_groups
 from .llvm_outputs import OUTPUTS
 
 
@@ -196,15 +197,20 @@ class LlvmKernel:
         self.build_seconds = source.seconds
         self.compile_seconds = time.perf_counter() - t0 - source.seconds
         self.prog = prog
+        self._load_order, groups = load_groups(loads)
+        self._load_groups = np.array([[k0, k1] for _, k0, k1 in groups] or [[0, 0]], np.int64)
 
     def solve(self, an, q, qd, qdd, values: dict, jobs: int | None, chunk: int, out: dict, work: tuple) -> dict:
         """The loads of every sample into ``out``, as :func:`.kernel_driver.kernel_solve` does."""
         prog = self.prog
         n = q.shape[0]
         SG, fail = work
-        ldrec, _, vals = load_arrays(an, values, n)
-        ldrow = np.ascontiguousarray(ldrec[:, 2:4] if len(ldrec) else np.zeros((1, 2), np.int64))
-        keep = [np.ascontiguousarray(a, float) for a in (q, qd, qdd)] + [np.ascontiguousarray(vals, float), ldrow]
+        ldrec, ldpt, vals = load_arrays(an, values, n)
+        order = self._load_order
+        ldrow = np.ascontiguousarray(ldrec[order][:, [2, 3, 1]] if order else np.zeros((1, 3), np.int64))
+        ldpt = np.ascontiguousarray(ldpt[order] if order else np.zeros((1, 3)))
+        keep = [np.ascontiguousarray(a, float) for a in (q, qd, qdd)] + [np.ascontiguousarray(vals, float), ldpt,
+                                                                       ldrow, self._load_groups]
         keep += [out[k] if out[k].size else np.empty((1, 1)) for k in OUTPUTS] + [SG, fail]
         ptrs = [a.ctypes.data for a in keep]
         failed = run_parts(lambda s, e, _: self._run(*ptrs, s, e), job_ranges(n, jobs), threads_for(n, jobs))

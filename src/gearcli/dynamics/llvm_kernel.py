@@ -2,7 +2,7 @@
 
 :func:`build_module` writes, from a :class:`~.kernel_program.Program`, one function
 
-    run(qi, qdi, qddi, vals, ldrow, motor, tau, joint, gear_t, gear_sep, gear_radial,
+    run(qi, qdi, qddi, vals, ldpt, ldrow, ldgrp, motor, tau, joint, gear_t, gear_sep, gear_radial,
         gear_axial, motor_speed, signs, fail, start, stop)
 
 whose loop over the samples start..stop-1 does what :func:`.kernel.run` does per sample,
@@ -11,8 +11,9 @@ masses, inertias, inverse block matrices, propagation columns, output coefficien
 the code: joint space, kinematics, inertia and external loads (:mod:`.llvm_links`), the
 blocks in schedule order (:mod:`.llvm_blocks`, :mod:`.llvm_signs`) and the outputs
 (:mod:`.llvm_outputs`), straight-line except for the sign search.  Only the inputs (the
-independent q, qd, qdd (N, dof), C-ordered), the external load values with their row
-layout ``ldrow`` (per load [first row, 1 if one row a sample]) and the output arrays
+independent q, qd, qdd (N, dof), C-ordered), the external loads (their values, points
+``ldpt``, records ``ldrow`` and per loaded link the range ``ldgrp``, :func:`.llvm_links.external`: one loop per loaded link,
+whatever the number of loads) and the output arrays
 (C-ordered rows of :func:`.llvm_outputs.widths`; ``fail`` (N,) int64, which ``run`` sets
 to -1 or the sample's first failing block) are pointers.  ``run`` returns how many of its
 samples failed (the caller checks a sum, not ``fail``).  Compiled by :mod:`.llvm_driver`.
@@ -23,14 +24,14 @@ import llvmlite.ir as ir
 
 from .llvm_blocks import block
 from .llvm_build import DP, I64, I64P, Emitter
-from .llvm_links import at_rest, external, inertia, joint, joint_space
+from .llvm_links import at_rest, external, inertia, joint, joint_space, load_groups
 from .llvm_outputs import OUTPUTS, widths, write_outputs
 
-ARGS = ("qi", "qdi", "qddi", "vals", "ldrow") + OUTPUTS + ("signs", "fail", "start", "stop")
+ARGS = ("qi", "qdi", "qddi", "vals", "ldpt", "ldrow", "ldgrp") + OUTPUTS + ("signs", "fail", "start", "stop")
 
 
 def _signature(mod: ir.Module) -> ir.Function:
-    types = [DP] * 4 + [I64P] + [DP] * (len(OUTPUTS) + 1) + [I64P, I64, I64]
+    types = [DP] * 5 + [I64P] * 2 + [DP] * (len(OUTPUTS) + 1) + [I64P, I64, I64]
     fn = ir.Function(mod, ir.FunctionType(I64, types), "run")
     for arg, name in zip(fn.args, ARGS):
         arg.name = name
@@ -52,7 +53,7 @@ def _sample(e: Emitter, fn, prog, loads, n) -> None:
         joint(e, s, prog.ints[0][k], prog.flts[0][k])
     for L in prog.ints[9]:
         inertia(e, s, int(L), prog.flts[1], prog.flts[3])
-    external(e, s, loads, n, a["vals"], a["ldrow"])
+    external(e, s, fn, [L for L, _, _ in load_groups(loads)[1]], n, a["vals"], a["ldrow"], a["ldpt"], a["ldgrp"])
     w = widths(prog)
     signs = e.row(a["signs"], n, max(w["signs"], 1))
     for b in range(prog.ints[1].shape[0]):
@@ -62,7 +63,7 @@ def _sample(e: Emitter, fn, prog, loads, n) -> None:
 
 def build_module(prog, loads) -> ir.Module:
     """The IR module of ``prog``'s kernel (``loads``: per external load of the mechanism,
-    (link id, True if its values are in link axes, load point (3,) in the link frame))."""
+    its link id first (:func:`.llvm_driver.mech_loads`); only their links shape the code))."""
     mod = ir.Module(name="gearcli_kernel")
     fn = _signature(mod)
     entry, body, done = fn.append_basic_block("entry"), fn.append_basic_block("sample"), fn.append_basic_block("done")

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import llvmlite.ir as ir
 
-from .llvm_build import I64, Emitter
+from .llvm_build import D, I64, Emitter
 from .llvm_trig import sincos
 
 EYE = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
@@ -116,21 +116,59 @@ def inertia(e: Emitter, s: Sample, L: int, lflt, g) -> None:
     s.rhs[L] = F + M
 
 
-def external(e: Emitter, s: Sample, loads, n, vals, ldrow) -> None:
-    """rhs[L] -= every external load on L at sample n (kernel_links.external).
+def load_groups(loads) -> tuple[list, list]:
+    """(order, groups) of the external loads ``loads`` (per load its link first): ``order``
+    the load indices grouped by link (first appearance), ``groups`` per loaded link
+    (link, first, end) in that order.  The kernel's code holds one loop per loaded link;
+    the loads themselves (points, frames, values) are run-time arrays, so the code does not
+    grow with their number (1,000 constant loads compiled in minutes when they were
+    straight-line constants; the loop bounds are run-time data too: one code, and one disk
+    cache entry, for any number of loads on the same links)."""
+    by_link: dict = {}
+    for k, ld in enumerate(loads):
+        by_link.setdefault(int(ld[0]), []).append(k)
+    order, groups = [], []
+    for L, ks in by_link.items():
+        groups.append((L, len(order), len(order) + len(ks)))
+        order += ks
+    return order, groups
 
-    ``loads``: per load (link, 1 if in link axes, load point (3,)); ``vals`` the stacked
-    values (rows of 6) and ``ldrow`` per load [first row, 1 if one row a sample]: given at
-    run time (a load's values may be constant or per sample from call to call)."""
-    for k, (L, in_link, point) in enumerate(loads):
-        per = e.load(ldrow, 2 * k + 1)
-        row = e.b.add(e.load(ldrow, 2 * k), e.b.mul(n, per))
+
+def external(e: Emitter, s: Sample, fn, links, n, vals, ldrow, ldpt, ldgrp) -> None:
+    """rhs[L] -= the sum of the external loads on L at sample n (:func:`.external.external_wrenches`).
+
+    ``links``: the loaded links in the order of :func:`load_groups`, ``ldgrp`` per loaded
+    link [first, end] of its loads; per load k (in that order) ``ldrow`` [first row of its values in ``vals`` (rows of 6), 1 if one row a
+    sample, 1 if in link axes] and ``ldpt`` its point (link frame): given at run time.
+    Each load: W = [f ; m + (R_L p) x f] (f, m turned to base axes by R_L when in link
+    axes), summed in load order, then subtracted, as the numpy path does."""
+    one = ir.Constant(I64, 1)
+    for g, L in enumerate(links):
+        k0, k1 = e.load(ldgrp, 2 * g), e.load(ldgrp, 2 * g + 1)
+        pre = e.b.block
+        loop, done = fn.append_basic_block(f"load{L}"), fn.append_basic_block(f"load{L}_done")
+        e.b.branch(loop)
+        e.b.position_at_end(loop)
+        k = e.b.phi(I64)
+        acc = [e.b.phi(D) for _ in range(6)]
+        rec = e.b.mul(k, ir.Constant(I64, 3))
+        per = e.load(ldrow, e.b.add(rec, one))
+        in_link = e.b.icmp_signed("!=", e.load(ldrow, e.b.add(rec, ir.Constant(I64, 2))), ir.Constant(I64, 0))
+        row = e.b.add(e.load(ldrow, rec), e.b.mul(n, per))
         base = e.b.mul(row, ir.Constant(I64, 6))
         v = [e.load(vals, e.b.add(base, ir.Constant(I64, i))) for i in range(6)]
         f, m = tuple(v[:3]), tuple(v[3:])
-        if in_link:
-            f, m = e.mv(s.R[L], f), e.mv(s.R[L], m)
-        arm = e.mv(s.R[L], floats(point))
-        mo = e.vadd(m, e.cx(arm, f))
-        old = s.rhs[L]
-        s.rhs[L] = tuple(e.sub(old[i], f[i]) for i in range(3)) + tuple(e.sub(old[3 + i], mo[i]) for i in range(3))
+        f = tuple(e.b.select(in_link, e.const(a), b) for a, b in zip(e.mv(s.R[L], f), f))
+        m = tuple(e.b.select(in_link, e.const(a), b) for a, b in zip(e.mv(s.R[L], m), m))
+        point = tuple(e.load(ldpt, e.b.add(rec, ir.Constant(I64, i))) for i in range(3))
+        mo = e.vadd(m, e.cx(e.mv(s.R[L], point), f))
+        new = [e.const(e.add(a, w)) for a, w in zip(acc, f + mo)]
+        k_next = e.b.add(k, one)
+        e.b.cbranch(e.b.icmp_signed("<", k_next, k1), loop, done)
+        k.add_incoming(k0, pre)
+        k.add_incoming(k_next, loop)
+        for ph, nv in zip(acc, new):
+            ph.add_incoming(ir.Constant(D, 0.0), pre)
+            ph.add_incoming(nv, loop)
+        e.b.position_at_end(done)
+        s.rhs[L] = tuple(e.sub(s.rhs[L][i], new[i]) for i in range(6))
