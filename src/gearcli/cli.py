@@ -53,18 +53,37 @@ MECH_HELP = ("Mechanism file: YAML (schemas/mechanism.schema.json) or URDF (.urd
              "masses in kg, inertias in kg*m^2, angles in rad (degrees in *_deg fields).")
 
 
-def load_analysis(path: Path) -> Analysis:
+def load_analysis(path: Path, strict: bool = False) -> Analysis:
     """Load and analyse a mechanism file (raises GearcliError on bad input).
 
-    Input problems the loader worked around (``Mechanism.warnings``) go to stderr, one
-    line each, without changing the exit status.
+    Input problems the loader worked around (``Mechanism.warnings``) and implausible values
+    (:mod:`gearcli.model.plausibility`: a mechanism in mm, ...) go to stderr, one line each,
+    without changing the exit status; with ``strict`` they are errors (exit status 2).
     """
     from .dynamics.determinacy import analyse  # noqa: PLC0415  (keeps --help fast; not the solver)
     from .io import load_mechanism  # noqa: PLC0415
 
     mech = load_mechanism(path)
-    print_problems([f"warning: {w}" for w in getattr(mech, "warnings", ())])
-    return analyse(mech)
+    an = analyse(mech)
+    report_mechanism_warnings(an, strict)
+    return an
+
+
+def report_mechanism_warnings(an: Analysis, strict: bool) -> None:
+    """Print the loader's warnings and the plausibility findings of ``an``; with ``strict``
+    raise them instead (:class:`~gearcli.report.unit_warnings.StrictError`)."""
+    from .report.unit_warnings import StrictError, mechanism_issues, warning_lines  # noqa: PLC0415
+
+    loader = list(getattr(an.mech, "warnings", ()))
+    issues = mechanism_issues(an)
+    if strict and (loader or issues):
+        raise StrictError(issues, loader)
+    print_problems([f"warning: {w}" for w in loader] + warning_lines(issues))
+
+
+STRICT_OPTION = typer.Option(False, "--strict", help="Warnings are errors (exit 2): implausible values "
+                             "(a mechanism in mm, a trajectory in degrees read as rad; README, Plausibility "
+                             "warnings) and input the reader worked around.")
 
 
 # ---------------------------------------------------------------------------------------
@@ -90,16 +109,33 @@ def main(
 
 @app.command()
 @reports_bad_input
-def check(mech: Path = typer.Argument(..., metavar="MECH", help=MECH_HELP, show_default=False)) -> None:
+def check(mech: Path = typer.Argument(..., metavar="MECH", help=MECH_HELP, show_default=False),
+          strict: bool = STRICT_OPTION) -> None:
     """Validate a mechanism file: schema, names, masses and inertias, joint tree, gear
     geometry (pitch radii in m, cone angles), motors against the degrees of freedom, and
-    static determinacy of the loads.  Prints a one-line summary; exit 2 on bad input."""
-    an = load_analysis(mech)
+    static determinacy of the loads, ratings against the geometry, and the plausibility of
+    the values (warnings).  Prints a one-line summary; exit 2 on bad input."""
+    an = load_analysis(mech, strict)
+    _check_ratings(an)
     m = an.mech
     typer.echo(f"{mech}: OK ({an.dof} dof, {counted(len(m.links), 'link')}, {counted(len(an.circuits), 'gear pair')}, "
                f"{counted(len(m.motors), 'motor')})")
     for line in feature_notes(an) + sharing_notes(an):
         typer.echo(line)
+
+
+def _check_ratings(an: Analysis) -> None:
+    """The ratings against the mechanism, as ``verify`` checks them (a module that
+    contradicts the pitch radii, ...): raises :class:`~gearcli.errors.MechanismError`."""
+    m = an.mech
+    if not any(g.rating for g in m.gears):   # the other ratings are checked by the readers
+        return
+    from .design.checks import Requirements, build_checks  # noqa: PLC0415
+    from .errors import Collector  # noqa: PLC0415
+
+    col = Collector(m.source, m.lines)
+    build_checks(an, Requirements(), col)
+    col.raise_if_any()
 
 
 @app.command()
@@ -112,6 +148,7 @@ def graph(
                                 "(render with: dot -Tsvg)."),
     real_joints: bool = typer.Option(False, "--real-joints", help="With --dot: draw the real "
                                      "joints (bearings) instead of the canonical thin edges."),
+    strict: bool = STRICT_OPTION,
 ) -> None:
     """Show the graph analysis: links with level, primary/secondary, carrier and axis label;
     gear pairs with their fundamental-circuit equations; coaxial groups; transmission lines;
@@ -121,7 +158,7 @@ def graph(
         raise GearcliError("graph: give at most one of --json and --dot")
     if real_joints and not as_dot:
         raise GearcliError("graph: --real-joints only applies to --dot")
-    an = load_analysis(mech)
+    an = load_analysis(mech, strict)
     if as_json:
         from .report.graph_json import analysis_dict  # noqa: PLC0415
 
@@ -163,6 +200,7 @@ def solve(
     chunk: int = typer.Option(20_000, "--chunk", min=100, metavar="N", help="Samples processed at once (bounds memory)."),
     jobs: int = JOBS_OPTION,
     backend: str = BACKEND_OPTION,
+    strict: bool = STRICT_OPTION,
 ) -> None:
     """Motor torques (N*m), bearing reaction wrenches (N, N*m, parent on child, joint frame)
     and gear tooth forces (N) at every sample of a trajectory.  Writes a table (CSV, Parquet,
@@ -172,7 +210,7 @@ def solve(
 
     from .pipeline import check_solve_options, solve_file  # noqa: PLC0415
 
-    an = check_solve_options(load_analysis(mech), method, backend)
+    an = check_solve_options(load_analysis(mech, strict), method, backend)
     out = output if output is not None else str(traj.with_suffix(".loads.csv"))
     err = stderr_console()
     to_stdout = out == "-"
@@ -194,10 +232,13 @@ def solve(
     try:
         report = solve_file(mech, traj, out, degrees=degrees, method=method, verify=verify,
                             chunk=chunk, progress=tick, analysis=an, precision=precision,
-                            backend=backend, jobs=jobs)
+                            backend=backend, jobs=jobs, strict=strict)
     finally:
         if started:
             progress.stop()
+    from .report.unit_warnings import warning_lines  # noqa: PLC0415
+
+    print_problems(warning_lines(report.warnings))
     with stderr_may_fail() if to_stdout else nullcontext():   # the table is out: stderr is for information
         _print_summary(err if to_stdout else stdout_console(), report, verify)
     if not to_stdout:
@@ -230,6 +271,7 @@ def export(
     output: str = typer.Option(..., "-o", "--output", metavar="OUT.urdf",
                                help="URDF file to write, named .urdf or .xml (written to a temporary file, then renamed; "
                                     "'-' for stdout)."),
+    strict: bool = STRICT_OPTION,
 ) -> None:
     """Write a URDF of the mechanism: links with inertials, the joint tree, geared joints as
     <mimic> where a single leader exists, motors as <transmission>, and the full gear
@@ -237,7 +279,7 @@ def export(
     from .report.urdf_writer import export_urdf, urdf_target  # noqa: PLC0415
 
     urdf_target(output, (mech,))   # refuse a bad -o (also one not named .urdf/.xml) before any work
-    an = load_analysis(mech)
+    an = load_analysis(mech, strict)
     if output == "-":
         typer.echo(export_urdf(an), nl=False)
         return
@@ -262,6 +304,7 @@ def verify(
     jobs: int = typer.Option(None, "-j", "--jobs", min=1, metavar="N", help="Worker processes (default: the number of cores)."),
     dask: str = typer.Option(None, "--dask", metavar="ADDRESS", help="Run on an existing dask.distributed "
                              "cluster (scheduler address, e.g. tcp://host:8786)."),
+    strict: bool = STRICT_OPTION,
 ) -> None:
     """Check motors (peak/RMS torque, speed, power), bearings (ISO 281 life, static safety,
     tilting moment), gear teeth (bending and contact stress) and column limits along every
@@ -273,6 +316,7 @@ def verify(
     from .batch.verify import count_jobs, run_verify  # noqa: PLC0415
 
     manifest = load_manifest(design)
+    _case_mechanism_warnings(manifest, strict)
     err = stderr_console()
     progress = Progress(TextColumn("verifying"), BarColumn(), TextColumn("{task.completed}/{task.total} trajectories"),
                         console=err, transient=True, disable=not err.is_terminal)
@@ -290,6 +334,14 @@ def verify(
                (f"; {counted(len(outcome.plots), 'plot')} in {plots}" if plots else ""))
     if failed:
         raise typer.Exit(EXIT_CHECK_FAILED)
+
+
+def _case_mechanism_warnings(manifest, strict: bool) -> None:
+    """:func:`report_mechanism_warnings` of every mechanism of a manifest, once each."""
+    from .batch.manifest import case_analysis  # noqa: PLC0415
+
+    for path in dict.fromkeys(c.mechanism for c in manifest.cases):
+        report_mechanism_warnings(case_analysis(path), strict)
 
 
 @app.command()

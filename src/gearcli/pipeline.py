@@ -28,6 +28,7 @@ from .io.trajectory import TrajectoryReader
 from .report.loss_summary import LossSummary, lossless_twin
 from .report.columns import Summary, column_names, column_units, first_non_finite, table
 from .report.table_files import CONVENTIONS, FORMATS, extension, format_of, open_table
+from .report.unit_warnings import RateWatch
 
 PREFETCH_CHUNKS = 8
 """Chunks the reading thread may be ahead of the solve: they are read and splined while the
@@ -55,6 +56,7 @@ class SolveReport:
     residual: float | None
     output: Path | None
     losses: LossSummary | None = None   # a mechanism with losses: energy lost, line efficiencies
+    warnings: list[Issue] = field(default_factory=list)   # implausible rates (report.unit_warnings.RateWatch)
 
 
 def check_solve_options(an: Analysis, method: str, backend: str) -> Analysis:
@@ -73,7 +75,8 @@ def check_solve_options(an: Analysis, method: str, backend: str) -> Analysis:
 
 def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, method: str = "block",
                verify: bool = False, chunk: int = 20_000, progress=None, analysis: Analysis | None = None,
-               precision: int | None = None, backend: str = "auto", jobs: int | None = None) -> SolveReport:
+               precision: int | None = None, backend: str = "auto", jobs: int | None = None,
+               strict: bool = False) -> SolveReport:
     """Solve a trajectory file and write the loads table (see :mod:`gearcli.report`).
 
     The format of ``out_path`` follows its extension (:mod:`gearcli.report.table_files`:
@@ -91,6 +94,11 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
     (:class:`~gearcli.errors.TrajectoryError` naming the first bad sample and column);
     with ``verify`` the worst residual of every chunk must be finite and at most
     :data:`VERIFY_TOLERANCE`.  ``backend`` and ``jobs`` as in :func:`~gearcli.dynamics.solve.solve`.
+
+    Implausible joint angles, joint rates and motor speeds (a trajectory in degrees read as
+    radians: :class:`~gearcli.report.unit_warnings.RateWatch`) are listed in the report's
+    ``warnings``; with ``strict`` the first one is a
+    :class:`~gearcli.report.unit_warnings.StrictError` (nothing written).
     """
     fmt = _output_format(out_path, (mech_path, traj_path), precision)   # refuse a bad -o before any work
     an = analysis or analyse(load_mechanism(mech_path))
@@ -98,14 +106,14 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
                               linear=prismatic_independent(an), loads=an.mech.loads)
     to_stdout = out_path is not None and str(out_path) == "-"
     rows = reader.check() if to_stdout or fmt == "npz" else reader.count()   # exact count first
+    watch = RateWatch(reader, an, strict)
     if progress is not None:
         progress(total=rows)
     summary = Summary.for_mechanism(an)
     losses = LossSummary.for_mechanism(an) if an.mech.has_losses else None
     twin = analyse(lossless_twin(an.mech)) if losses is not None else None
     names = column_names(an)
-    worst = 0.0
-    n = 0
+    worst, n = 0.0, 0
 
     def solve_chunks(table_file):
         # one warnings scope around the reading thread's lifetime: catch_warnings is process-wide,
@@ -123,6 +131,7 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
 
     def record(table_file, part, tab, res):
         nonlocal worst, n
+        watch.see(part)
         _check_loads(reader, part, tab, names)
         if verify:
             _check_residual(reader, part, res.residual)
@@ -141,14 +150,12 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
                                            rows=rows, jobs=jobs))
 
     out = None if out_path is None or to_stdout else Path(out_path)
-    if out_path is None:
-        _run(solve_chunks, None)
-    elif out is None:
-        _run(solve_chunks, opened(sys.stdout))
+    if out is None:   # no output, or stdout
+        _run(solve_chunks, None if out_path is None else opened(sys.stdout))
     else:
         with atomic_output(out, (mech_path, traj_path), binary=fmt != "csv") as f:
             _run(solve_chunks, opened(f))
-    return SolveReport(an, n, summary, worst if verify else None, out, losses)
+    return SolveReport(an, n, summary, worst if verify else None, out, losses, watch.issues)
 
 
 def lossless_motor(twin: Analysis, part, method: str, chunk: int, backend: str, jobs) -> np.ndarray:

@@ -132,7 +132,7 @@ def column_units(an) -> list[str]:
     """SI unit of every output column of ``an``, in the order of :func:`column_names`:
     :func:`column_unit`, with N (and m/s) where a motor drives a prismatic input
     directly, an independent joint slides or an ideal pair's driven joint slides."""
-    linear = {m.name for m in an.mech.motors if _motor_linear(an, m.name)}
+    linear = {m.name for m in an.mech.motors if motor_linear(an, m.name)}
     sliding = {n for n, ji in zip(an.independent_names, an.independent)
                if ji >= 0 and an.mech.joints[ji].type == "prismatic"}
     ideal = {an.mech.gears[c.gear].name: _ideal_unit(an, c) for c in an.circuits if c.geometry is None}
@@ -241,7 +241,7 @@ class Summary:
         self._last = np.r_[t[-1], X[-1]]
 
 
-def _motor_linear(an, name: str) -> bool:
+def motor_linear(an, name: str) -> bool:
     """True when motor ``name`` drives a prismatic input directly (speed in m/s)."""
     mi = [m.name for m in an.mech.motors].index(name)
     link = an.mech.motors[mi].link
