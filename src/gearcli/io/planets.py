@@ -10,6 +10,10 @@ the copy number appended: link ``planet`` -> ``planet1`` ... ``planetN``, joint 
 ``JP1`` ..., pair ``sun-planet`` -> ``sun-planet1`` ... (a pair without a name gets its
 default ``j-k`` from the new link names).  Every copy keeps the YAML path of its original,
 so problems are reported where the user wrote them.
+
+A pair naming the planet may set values of some copies only, ``per_planet: [{planet: k,
+stiffness: ...}, ...]`` (k = 1..N: the copy named ``<pair>k``); the other copies keep the
+pair's own values.
 """
 from __future__ import annotations
 
@@ -102,11 +106,32 @@ def _place_joint(c: dict, R, move) -> None:
     origin["rpy"] = matrix_rpy(R @ rpy_matrix(rpy)).tolist()
 
 
+def per_planet_problems(spec: dict, n: int, path: str, col: Collector) -> None:
+    """Report bad ``per_planet`` items of the gear pair ``spec`` copied ``n`` times (a copy
+    number outside 1..n or given twice, a stiffness that is not positive)."""
+    seen: dict = {}
+    for i, item in enumerate(spec.get("per_planet", ())):
+        where = f"{path}.per_planet[{i}]"
+        k = item["planet"]
+        if not 1 <= k <= n:
+            col.add(f"{where}.planet", f"planet {k} does not exist: the copies are numbered 1 to {n} (planets: {n})")
+        elif k in seen:
+            col.add(f"{where}.planet", f"planet {k} is given twice (first at {seen[k]})")
+        seen.setdefault(k, where)
+        if not item["stiffness"] > 0:
+            col.add(f"{where}.stiffness", f"mesh stiffness must be positive, got {item['stiffness']:g} N/m")
+
+
 def expand_planets(data: dict, geometry, col: Collector) -> dict:
     """``data`` with every ``planets: N`` joint expanded (see the module docstring); the
     original YAML path of every list item under :data:`PATHS`.  ``geometry(spec, col, path)``
     gives a joint's (R_pj, p_pj, R_jc, p_jc).  Issues go to ``col``."""
-    if not any("planets" in j for j in data["joints"]):
+    planets = {j["child"] for j in data["joints"] if "planets" in j}
+    for i, g in enumerate(data.get("gears", [])):
+        if "per_planet" in g and not planets & set(g["links"]):
+            col.add(f"gears[{i}].per_planet", "per_planet is for a gear pair of a planet (a link whose joint has "
+                    f"planets: N); this pair's links {', '.join(map(repr, g['links']))} are not copied")
+    if not planets:
         return data
     out = dict(data)
     lists = {key: [(f"{key}[{i}]", s) for i, s in enumerate(data.get(key, []))] for key in ("links", "joints", "gears")}
@@ -121,11 +146,15 @@ def expand_planets(data: dict, geometry, col: Collector) -> dict:
         if axis is None or _misuse(data, planet, carrier, path, col) or not _assembly_fits(data, planet, n, path, col):
             continue
         a0, u = axis
+        for gpath, g in lists["gears"]:
+            if planet in g["links"]:
+                per_planet_problems(g, n, gpath, col)
         lists["links"] = _expand(lists["links"], lambda s: s["name"] == planet,
                                  lambda s: _copies(s, n, a0, u, {"name": planet}, lambda c, R, m: None))
         lists["joints"] = _expand(lists["joints"], lambda s: s is spec,
                                   lambda s: _copies(s, n, a0, u, {"name": s["name"], "child": planet}, _place_joint))
-        lists["gears"] = _expand(lists["gears"], lambda s: planet in s["links"], lambda s: _gear_copies(s, n, a0, u, planet))
+        lists["gears"] = _expand(lists["gears"], lambda s: planet in s["links"],
+                                 lambda s: _gear_copies(s, n, a0, u, planet))
     for key, items in lists.items():
         if key in data:
             out[key] = [s for _, s in items]
@@ -136,6 +165,11 @@ def expand_planets(data: dict, geometry, col: Collector) -> dict:
 def _gear_copies(spec: dict, n: int, a0, u, planet: str) -> list[dict]:
     named = {"name": spec["name"]} if "name" in spec else {}
     copies = _copies(spec, n, a0, u, named, lambda c, R, m: None)
+    for c in copies:
+        c.pop("per_planet", None)
+    for item in spec.get("per_planet", ()):
+        if 1 <= item["planet"] <= n and item["stiffness"] > 0:
+            copies[item["planet"] - 1]["stiffness"] = item["stiffness"]
     for k, c in enumerate(copies):
         R = _turn(u, 2 * np.pi * k / n)
         if "mesh_point" in c:
