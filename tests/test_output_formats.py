@@ -299,7 +299,7 @@ def test_plot_refuses_npz_loads_that_are_not_numbers(run_cli, tmp_path):
     bad = tmp_path / "bad.npz"
     np.savez(bad, columns=np.array(["t", "motor:m"]), units=np.array(["s", "N*m"]),
              loads=np.array([["0", "x"], ["1", "y"]]))
-    refused(run_cli("plot", bad, "motor:*", "-o", tmp_path / "fig.png"), "bad.npz: cannot read the npz file")
+    refused(run_cli("plot", bad, "motor:*", "-o", tmp_path / "fig.png"), "bad.npz: 'loads': holds strings, not numbers")
 
 
 @pytest.mark.parametrize("jobs", [1, 3])

@@ -353,11 +353,14 @@ def plot(
                                         help="Column names or shell patterns, e.g. 'motor:*' 'gear:5-1:t'."),
     output: str = typer.Option(..., "-o", "--output", metavar="FIG.png|svg|pdf", help="Figure to write."),
 ) -> None:
-    """Draw columns of a loads file over time (one axis per unit: N, N*m, rad/s, W)."""
+    """Draw columns of a loads file over time (one axis per unit: N, N*m, rad/s, W).  Columns
+    that cannot be drawn (not numbers, no finite value) are left out with a warning; at most
+    24 lines on 6 axes are drawn."""
     from .report.plots import plot_loads_csv  # noqa: PLC0415
 
-    n = plot_loads_csv(loads, columns, output)
-    typer.echo(f"Wrote {output} ({counted(n, 'column')})")
+    report = plot_loads_csv(loads, columns, output)
+    print_problems([f"warning: {note}" for note in report.notes])
+    typer.echo(f"Wrote {output} ({counted(report.drawn, 'column')})")
 
 
 if __name__ == "__main__":  # pragma: no cover

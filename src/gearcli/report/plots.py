@@ -7,16 +7,16 @@ Files are written through a temporary file and renamed; the format follows the e
 from __future__ import annotations
 
 import fnmatch
-import re
-import zipfile
+import warnings
+from collections import Counter
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import GearcliError, counted
+from ..errors import GearcliError, plural
 from ..io.output import atomic_output, output_target
-from .columns import column_unit
-from .table_files import format_of
+from .loads_files import LoadsFile, Undrawable, csv_unit, open_loads, shown  # noqa: F401 (csv_unit: API)
 
 FORMATS = (".png", ".svg", ".pdf")
 
@@ -49,146 +49,171 @@ def check_output_path(path: str | Path) -> Path:
     return path
 
 
-def select_columns(header: list[str], patterns: list[str], file: str) -> list[str]:
-    """Columns of ``header`` matching any of ``patterns`` (names or shell globs), in header
-    order; a pattern that matches nothing is an error."""
-    out = []
+def select_columns(header: list[str], patterns: list[str], file: str) -> list[int]:
+    """Indices of the columns of ``header`` matching any of ``patterns`` (names or shell
+    globs), in header order (a duplicated name: each of its columns); a pattern that matches
+    nothing is an error."""
+    chosen = np.zeros(len(header), dtype=bool)
     for p in patterns:
-        hits = [h for h in header if fnmatch.fnmatchcase(h, p)]
+        hits = [i for i, h in enumerate(header) if fnmatch.fnmatchcase(h, p)]
         if not hits:
-            raise GearcliError(f"{file}:1: no column matches '{p}'")
-        out += [h for h in hits if h not in out]
-    return [h for h in header if h in out]
+            raise GearcliError(f"{file}:1: no column matches '{shown(p)}'")
+        chosen[hits] = True
+    return [int(i) for i in np.flatnonzero(chosen)]
 
 
-def plot_columns(t: np.ndarray, series: dict, units: dict, out: str | Path, title: str = "") -> None:
-    """Columns over time: one axis per unit (sharing t), units on the axes.
+MAX_LINES = 24
+"""Columns drawn at most (lines in a figure); more would be an unreadable figure whose
+legends take seconds to lay out (5,000 columns took minutes)."""
 
-    ``series`` maps column name to (N,) values, ``units`` column name to its unit.
+MAX_AXES = 6
+"""Axes (units) drawn at most, one above the other."""
+
+
+def _math_free(text: str) -> str:
+    """``text`` shown literally by matplotlib: ``$`` would start mathtext."""
+    return text.replace("$", r"\$")
+
+
+def plot_columns(t: np.ndarray, series: dict, units: dict, out: str | Path, title: str = "",
+                 t_label: str = "t [s]") -> list[str]:
+    """Columns over time: one axis per unit (sharing t), units on the axes; returns notes on
+    what the figure leaves out or shows oddly, in gearcli's words (matplotlib's own warnings
+    are never printed).
+
+    ``series`` maps a label to (N,) values (NaN: a gap), ``units`` a label to its unit.  Labels,
+    units and the title are shown as :func:`~gearcli.report.loads_files.shown` gives them.
     """
     plt = _pyplot()
     groups: dict[str, list[str]] = {}
     for name in series:
         groups.setdefault(units[name], []).append(name)
-    fig, axes = plt.subplots(len(groups), 1, sharex=True, figsize=(8, 2.6 * len(groups) + 0.6), squeeze=False)
-    for ax, (unit, names) in zip(axes[:, 0], groups.items()):
-        for n in names:
-            ax.plot(t, series[n], label=n, lw=1.2)
-        ax.set_ylabel(f"[{unit}]" if unit else "value")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize="small", loc="best")
-    axes[-1, 0].set_xlabel("t [s]")
-    if title:
-        axes[0, 0].set_title(title)
-    fig.tight_layout()
-    _save(fig, check_output_path(out))
+    marker = "." if len(t) == 1 else None
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fig, axes = plt.subplots(len(groups), 1, sharex=True, figsize=(8, 2.6 * len(groups) + 0.6), squeeze=False)
+        try:
+            for ax, (unit, names) in zip(axes[:, 0], groups.items()):
+                lines = [ax.plot(t, series[n], lw=1.2, marker=marker)[0] for n in names]
+                ax.set_ylabel(_math_free(f"[{shown(unit, 20)}]") if unit else "value")
+                ax.grid(alpha=0.3)
+                ax.legend(lines, [_math_free(shown(n)) for n in names], fontsize="small", loc="best")
+            axes[-1, 0].set_xlabel(_math_free(t_label))
+            if title:
+                axes[0, 0].set_title(_math_free(shown(title)))
+            fig.tight_layout()
+        except BaseException:
+            plt.close(fig)
+            raise
+        _save(fig, check_output_path(out))
+    if any("missing from font" in str(w.message) for w in caught):
+        return ["some characters of the names are not in the figure's font and show as boxes"]
+    return []
 
 
 def plot_check(t: np.ndarray, y: np.ndarray, limit: float, out: str | Path, title: str, ylabel: str,
                limit_label: str) -> None:
     """A check's quantity ``y`` over ``t`` (its worst trajectory) and the level ``limit``."""
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(7, 3.2))
-    ax.plot(t, y, lw=1.2, label="value")
-    if np.isfinite(limit):
-        ax.axhline(limit, color="red", ls="--", lw=1.2, label=limit_label)
-    ax.set_xlabel("t [s]")
-    ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize="medium")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize="small", loc="best")
-    fig.tight_layout()
-    _save(fig, check_output_path(out))
-
-
-def read_loads_csv(path: str | Path) -> tuple[list[str], np.ndarray]:
-    """Header and (N, ncol) data of a loads CSV; bad files raise GearcliError naming the row."""
-    path = Path(path)
-    try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise GearcliError(f"{path}: cannot read file: {getattr(exc, 'strerror', None) or exc}") from None
-    if not lines:
-        raise GearcliError(f"{path}: empty file")
-    header = lines[0].split(",")
-    if header[0] != "t":
-        raise GearcliError(f"{path}:1: the first column must be 't' (a CSV written by gearcli solve)")
-    rows = []
-    for i, line in enumerate(lines[1:], start=2):
-        cells = line.split(",")
-        if len(cells) != len(header):
-            raise GearcliError(f"{path}:{i}: {counted(len(cells), 'cell')}, the header has {len(header)}")
-        try:
-            rows.append([float(c) for c in cells])
-        except ValueError:
-            bad = next(j for j, c in enumerate(cells) if not _is_float(c))
-            raise GearcliError(f"{path}:{i}: column {bad + 1} '{header[bad]}': not a number") from None
-    if not rows:
-        raise GearcliError(f"{path}: no data rows")
-    return header, np.array(rows)
-
-
-def _is_float(text: str) -> bool:
-    try:
-        float(text)
-        return True
-    except ValueError:
-        return False
-
-
-OUTPUT_COLUMN = re.compile(r"t|tau:[^:]+|motor:[^:]+(:speed|:power)?|gear:[^:]+:(t|sep|torque)"
-                           r"|gear:[^:]+:[^:]+:(radial|axial)|joint:[^:]+:(fx|fy|fz|mx|my|mz|radial|axial|bending)")
-
-
-def csv_unit(name: str) -> str:
-    """Unit of a CSV column from its name (a CSV carries none): that of the output column
-    of that name (N*m for tau:/motor: columns, also of a prismatic joint: only the binary
-    formats know), none ('') for a name that is not an output column (e.g. q:J1)."""
-    return column_unit(name) if OUTPUT_COLUMN.fullmatch(name) else ""
+    with warnings.catch_warnings():     # matplotlib's (a glyph missing from the font) are not gearcli's
+        warnings.simplefilter("ignore")
+        fig, ax = plt.subplots(figsize=(7, 3.2))
+        ax.plot(t, y, lw=1.2, label="value")
+        if np.isfinite(limit):
+            ax.axhline(limit, color="red", ls="--", lw=1.2, label=limit_label)
+        ax.set_xlabel("t [s]")
+        ax.set_ylabel(ylabel)
+        ax.set_title(title, fontsize="medium")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize="small", loc="best")
+        fig.tight_layout()
+        _save(fig, check_output_path(out))
 
 
 def read_loads(path) -> tuple[list[str], np.ndarray, dict]:
     """Header, (N, ncol) data and units (column -> unit) of a loads file written by
     ``gearcli solve``: CSV (units from the column names), Parquet, Feather or NPZ (units
-    from the file's metadata)."""
-    fmt = format_of(str(path))
-    if fmt in (None, "csv"):
-        header, data = read_loads_csv(path)
-        return header, data, {n: csv_unit(n) for n in header}
+    from the file's metadata); GearcliError for a column that is not numbers."""
+    table = open_loads(path)
+    data = np.column_stack([table.time()] + [_values_or_error(table, i)[0] for i in range(1, len(table.names))])
+    return table.names, data, dict(zip(table.names, table.units))
+
+
+def _values_or_error(table: LoadsFile, i: int):
     try:
-        if fmt == "npz":
-            if not zipfile.is_zipfile(path):     # np.load: EOFError on an empty file, pickle talk on others
-                raise ValueError("not an npz file (no zip archive)")
-            with np.load(path, allow_pickle=False) as z:
-                header, units = [str(c) for c in z["columns"]], [str(u) for u in z["units"]]
-                data = np.asarray(z["loads"], dtype=float)
-        else:
-            header, data, units = _read_arrow(path, fmt)
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
-        raise GearcliError(f"{path}: cannot read the {fmt} file: {getattr(exc, 'strerror', None) or exc}") from None
-    if not header or header[0] != "t" or data.ndim != 2 or data.shape[1] != len(header):
-        raise GearcliError(f"{path}: not a loads table written by gearcli solve (first column 't')")
-    return header, data, dict(zip(header, (u.replace("*", "·") for u in units)))
+        return table.values(i)
+    except Undrawable as exc:
+        raise GearcliError(f"{table.where(i)}: {exc}") from None
 
 
-def _read_arrow(path, fmt: str):
-    import pyarrow.feather as feather  # noqa: PLC0415
-    import pyarrow.parquet as pq  # noqa: PLC0415
+@dataclass
+class PlotReport:
+    """What ``gearcli plot`` drew: ``drawn`` columns of ``matched``; ``notes`` (gearcli's
+    warnings: columns left out and why, gaps, the cap on lines)."""
 
-    t = pq.read_table(path) if fmt == "parquet" else feather.read_table(path)
-    units = [(f.metadata or {}).get(b"unit", b"").decode() for f in t.schema]
-    data = np.column_stack([t.column(i).to_numpy() for i in range(t.num_columns)]) if t.num_columns else np.zeros((0, 0))
-    return t.column_names, data.astype(float), units
+    drawn: int
+    matched: int
+    notes: list[str]
 
 
-def plot_loads_csv(path, patterns: list[str], out) -> int:
-    """Plot the columns of a loads file (CSV, Parquet, Feather, NPZ) matching
-    ``patterns`` into ``out``; returns their count."""
+def plot_loads_csv(path, patterns: list[str], out) -> PlotReport:
+    """Plot the columns of a loads file (CSV, Parquet, Feather, NPZ) matching ``patterns``
+    into ``out``.
+
+    Columns that cannot be drawn (not numbers, no finite value, beyond ±1e300) are left out
+    and named in the notes; only the first :data:`MAX_LINES` drawable columns of the first
+    :data:`MAX_AXES` units are drawn (the notes say how many of how many).  Nothing
+    drawable, or a ``t`` that is not finite seconds, is a GearcliError; nothing is written
+    then.
+    """
     name, out = out, check_output_path(out)
     output_target(name, [path])   # the name as given: Path('fig.png/') would drop the '/'
+    table = open_loads(path)
+    where = table.path
+    wanted = select_columns(table.names, patterns, where)
+    t = table.time()
+    series, units, left_out, gaps = {}, {}, [], []
+    skipped = 0
+    repeated = {n for n, k in Counter(table.names).items() if k > 1}
+    for i in wanted:
+        if len(series) == MAX_LINES:
+            skipped += 1
+            continue
+        unit = table.units[i]
+        if unit not in set(units.values()) and len(set(units.values())) == MAX_AXES:
+            skipped += 1
+            continue
+        try:
+            v, missing = (t, 0) if i == 0 else table.values(i)
+        except Undrawable as exc:
+            left_out.append(f"'{shown(table.names[i], 40)}' ({exc})")
+            continue
+        label = table.names[i]
+        if label in repeated:
+            label = f"{label} [column {i + 1}]"
+        series[label], units[label] = v, unit
+        if missing:
+            gaps.append(f"'{shown(table.names[i], 40)}' ({missing} of {len(v)})")
+    if not series:
+        raise GearcliError(f"{where}: nothing to draw: {_listed(left_out)}" if len(left_out) == 1 else
+                           f"{where}: none of the {len(left_out):,} matching columns can be drawn: {_listed(left_out)}")
+    notes = []
+    if left_out:
+        notes.append(f"{where}: left out {_count(len(left_out), 'column')} that cannot be drawn: {_listed(left_out)}")
+    if skipped:
+        notes.append(f"{where}: drew {len(series)} of {_count(len(wanted), 'matching column')} (at most {MAX_LINES} "
+                     f"lines on {MAX_AXES} axes); name fewer columns or a narrower pattern to see the others")
+    if gaps:
+        notes.append(f"{where}: missing values drawn as gaps: {_listed(gaps)}")
+    t_label = f"t [s] since {table.t_origin}" if table.t_origin else "t [s]"
+    notes += plot_columns(t, series, units, out, title=Path(path).name, t_label=t_label)
+    return PlotReport(len(series), len(wanted), notes)
 
-    header, data, units = read_loads(path)
-    names = select_columns(header, patterns, str(path))
-    series = {n: data[:, header.index(n)] for n in names}
-    plot_columns(data[:, 0], series, {n: units[n] for n in names}, out, title=Path(path).name)
-    return len(names)
+
+def _count(n: int, noun: str) -> str:
+    return f"{n:,} {plural(n, noun)}"
+
+
+def _listed(items: list[str], shown_at_most: int = 3) -> str:
+    more = len(items) - shown_at_most
+    return ", ".join(items[:shown_at_most]) + (f" and {more:,} more" if more > 0 else "")
