@@ -27,12 +27,31 @@ MECH = Path(__file__).resolve().parents[1] / "mechanisms"
 BUNDLED = sorted(p.name for p in MECH.glob("*.yaml")) + ["geared_arm.urdf"]
 
 
-def with_losses(mech, c=0.03, coulomb=0.05, viscous=0.002):
-    """``mech`` with a loss factor on every pair with tooth geometry and friction on every joint."""
+def with_losses(mech, c=0.03, coulomb=0.05, viscous=0.002, mu=0.004, bore=0.02):
+    """``mech`` with a loss factor on every pair with tooth geometry, friction on every joint
+    and a friction coefficient on every bearing it lists."""
     gears = tuple(dataclasses.replace(g, loss_factor=c) if g.mesh_point is not None and g.joints is None else g
                   for g in mech.gears)
-    joints = tuple(dataclasses.replace(j, friction=JointFriction(coulomb, viscous)) for j in mech.joints)
+    joints = tuple(dataclasses.replace(j, friction=JointFriction(coulomb, viscous), bearings=None if not j.bearings
+                                       else tuple(dataclasses.replace(b, friction_coefficient=mu, bore=bore)
+                                                  for b in j.bearings))
+                   for j in mech.joints)
     return dataclasses.replace(mech, gears=gears, joints=joints)
+
+
+def own_bearing_loads(jt, w):
+    """|load| (N,) of each bearing of joint ``jt`` from its reaction w (N, 6) (parent on child,
+    joint frame, about its origin): one bearing takes |f|; two at z1, z2 carry the force and
+    the tilting moment by the lever rule (the locating one takes fz too)."""
+    if len(jt.bearings) == 1:
+        return [np.linalg.norm(w[:, :3], axis=1)]
+    z1, z2 = jt.bearings[0].position, jt.bearings[1].position
+    # moments about bearing 1's point: (z2 - z1) e_z x R2 = M_xy - z1 e_z x F_xy (x, y parts)
+    R2x = (w[:, 4] - z1 * w[:, 0]) / (z2 - z1)
+    R2y = (-w[:, 3] - z1 * w[:, 1]) / (z2 - z1)
+    R = [(w[:, 0] - R2x, w[:, 1] - R2y), (R2x, R2y)]
+    return [np.sqrt(rx ** 2 + ry ** 2 + (w[:, 2] ** 2 if b.locating else 0.0))
+            for (rx, ry), b in zip(R, jt.bearings)]
 
 
 def random_motion(dof, n=60, seed=3):
@@ -86,6 +105,8 @@ def own_losses(an, q, qd, res):
         parts.append(gp.loss_factor * np.abs(res.gear_t[:, ci]) * np.abs(rate) * c.geometry.r_j)
     for ji, jt in enumerate(mech.joints):
         parts.append(jt.friction.coulomb * np.abs(qda[:, ji]) + jt.friction.viscous * qda[:, ji] ** 2)
+        for b, P in zip(jt.bearings or (), own_bearing_loads(jt, res.joint[:, ji]) if jt.bearings else ()):
+            parts.append(0.5 * b.friction_coefficient * b.bore * P * np.abs(qda[:, ji]))
     return np.sum(parts, axis=0), parts
 
 
@@ -110,7 +131,9 @@ def test_power_balance_with_losses(name, method):
     assert np.max(np.abs(P_motor - (dT - Pg - Pe + total)) / scale) < 1e-9
     assert all(np.all(p >= 0) for p in parts)
     reported = res.gear_loss.sum(axis=1) + res.joint_loss.sum(axis=1)
-    assert np.max(np.abs(reported - total) / scale) < 1e-12
+    assert np.max(np.abs(reported - total) / scale) < 1e-11
+    if any(j.bearings for j in an.mech.joints):
+        assert 2 <= np.median(res.bearing_iterations) and np.max(res.bearing_iterations) <= 10
     assert np.min(total) > 0 and np.max(np.abs(P_motor - (dT - Pg - Pe)) / scale) > 1e-4
 
 
@@ -375,3 +398,94 @@ def test_urdf_bad_loss_input(run_cli, tmp_path):
         assert res.exit_code == 2, new
         lines = res.stderr.strip().splitlines()
         assert len(lines) == 1 and lines[0].startswith(f"{bad}:") and message in lines[0], lines
+
+
+SHAFT = """
+name: shaft_hand
+gravity: [0, 0, 0]
+base: base
+end_effector: gear
+links:
+  - {{name: base}}
+  - {{name: pinion, mass: 0.1, inertia: [1.0e-5, 1.0e-5, 1.0e-5]}}
+  - {{name: gear, mass: 1.0, inertia: [1.0e-3, 1.0e-3, 1.0e-3]}}
+joints:
+  - {{name: JP, parent: base, child: pinion, origin: {{xyz: [0, 0, 0]}}, axis: [0, 0, 1]}}
+  - name: JG
+    parent: base
+    child: gear
+    origin: {{xyz: [0.075, 0, 0]}}
+    axis: [0, 0, 1]
+    bearings:
+      - {{name: near, position: {z1}, friction_coefficient: {mu}, bore: {d}, locating: true}}
+      - {{name: far, position: {z2}, friction_coefficient: {mu}, bore: {d}}}
+gears:
+  - {{name: stage, links: [pinion, gear], teeth: [15, 60], mesh_point: [0.015, 0, 0]}}
+motors:
+  - {{name: m, link: pinion}}
+loads:
+  - {{name: out, link: gear, frame: base, moment: [0, 0, {ML}]}}
+"""
+
+
+def test_overhung_shaft_bearing_friction_by_hand():
+    """A gear overhung on a shaft with two bearings at z1, z2 beyond the mesh plane (z = 0),
+    driven at constant speed against a load moment M_L, no gravity.  The tooth force
+    |g| = |t| / cos(phi) splits by the lever rule into R1 = |g| z2 / (z2 - z1) and
+    R2 = -|g| z1 / (z2 - z1), so the friction moment 1/2 mu d (|R1| + |R2|) =
+    1/2 mu d |t| k / cos(phi), k = (z2 + z1) / (z2 - z1), grows with t itself:
+    |t| r_k = M_L + 1/2 mu d k |t| / cos(phi), i.e. |t| = M_L / (r_k - mu d k / (2 cos phi))."""
+    z1, z2, mu, d, ML, rj, rk = 0.02, 0.06, 0.05, 0.03, -4.0, 0.015, 0.06
+    an = analyse(parse_mechanism(SHAFT.format(z1=z1, z2=z2, mu=mu, d=d, ML=ML)))
+    k = (z2 + z1) / (z2 - z1)
+    t = abs(ML) / (rk - mu * d * k / (2 * np.cos(np.deg2rad(20))))
+    res = solve(an, [[0.0]], [[2.0]], [[0.0]])         # the gear turns +z against -z: lifting
+    assert abs(res.gear_t[0, 0]) == pytest.approx(t, rel=1e-11)
+    assert abs(res.motor[0, 0]) == pytest.approx(t * rj, rel=1e-11)
+    jg = 1
+    Mb = 0.5 * mu * d * k * t / np.cos(np.deg2rad(20))
+    assert res.joint_friction[0, jg] == pytest.approx(-Mb, rel=1e-11)
+    assert res.joint_loss[0, jg] == pytest.approx(Mb * 2.0, rel=1e-11)
+    assert res.joint[0, jg, 5] == 0.0
+    assert 3 <= res.bearing_iterations[0] <= 12     # contraction ~ mu d k / (2 cos phi r_k) = 0.027
+    rest = solve(an, [[0.0]], [[0.0]], [[0.0]])          # at rest: no friction moment
+    assert abs(rest.gear_t[0, 0]) == pytest.approx(abs(ML) / rk, rel=1e-12)
+    assert rest.bearing_iterations[0] == 1
+
+
+@pytest.mark.parametrize("old,new,place,message", [
+    ("friction_coefficient: 0.05, bore: 0.03, locating: true", "friction_coefficient: 0.05, locating: true",
+     "joints[1].bearings[0].friction_coefficient", "bearing friction needs both friction_coefficient and bore"),
+    ("friction_coefficient: 0.05, bore: 0.03, locating: true", "bore: 0.03, locating: true",
+     "joints[1].bearings[0].bore", "bearing friction needs both friction_coefficient and bore"),
+    ("friction_coefficient: 0.05, bore: 0.03, locating: true", "friction_coefficient: -0.1, bore: 0.03, locating: true",
+     "joints[1].bearings[0].friction_coefficient", "bearing friction coefficient must be in [0, 1), got -0.1"),
+    ("friction_coefficient: 0.05, bore: 0.03, locating: true", "friction_coefficient: 0.05, bore: 0, locating: true",
+     "joints[1].bearings[0].bore", "bore must be positive, got 0"),
+    ("friction_coefficient: 0.05, bore: 0.03, locating: true", "locating: true",
+     "joints[1].bearings[0]", "a bearing needs a rating (C, C0, type) or friction"),
+    ("friction_coefficient: 0.05, bore: 0.03, locating: true", "friction_coefficient: 0.05, bore: 0.03, C: 1000, locating: true",
+     "joints[1].bearings[0].C", "a rated bearing needs C, C0 and type: C0, type missing"),
+])
+def test_bad_bearing_friction_input(run_cli, tmp_path, old, new, place, message):
+    text = SHAFT.format(z1=0.02, z2=0.06, mu=0.05, d=0.03, ML=-4.0).replace(old, new)
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    res = run_cli("check", path)
+    assert res.exit_code == 2
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and f": {place}: " in lines[0] and message in lines[0], lines
+    assert lines[0].startswith(f"{path}:{_line_of(text, new)}:")
+
+
+def _line_of(text: str, fragment: str) -> int:
+    return next(i for i, ln in enumerate(text.splitlines(), 1) if fragment in ln)
+
+
+def test_bearing_friction_on_prismatic_joint_refused(run_cli, tmp_path):
+    text = RACK.format(Fc=1.0, Fv=2.0, eta=0.9, F=-50.0).replace(
+        "friction: {coulomb: 1.0, viscous: 2.0}}", "bearings: [{name: b, position: 0, friction_coefficient: 0.1, bore: 0.01}]}")
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    res = run_cli("check", path)
+    assert res.exit_code == 2 and "joints[1].bearings: " in res.stderr and "prismatic" in res.stderr

@@ -25,6 +25,8 @@ import math
 
 import numpy as np
 
+from ..model.shaft import split_two_bearings  # noqa: F401  (with the model: the solve uses it too)
+
 from ..report.rms import trapezoid_weights
 
 
@@ -76,35 +78,3 @@ def static_safety(allowable: float, peak: float) -> float:
     """Safety factor s = allowable / peak (ISO 76 s0 = C0 / max P0; the same ratio for tooth
     stresses); inf when unloaded."""
     return math.inf if peak <= 0 else allowable / peak
-
-
-def split_two_bearings(F, M, z1: float, z2: float) -> tuple[np.ndarray, np.ndarray]:
-    """Radial force vectors on two bearings at z1 and z2 along the joint axis.
-
-    The shaft is held by two supports on its axis (z of the joint frame).  The radial
-    forces R1 (at z1 e_z) and R2 (at z2 e_z) must carry the joint reaction's force and
-    tilting moment about the joint origin:
-
-        R1 + R2 = F_xy,   z1 e_z x R1 + z2 e_z x R2 = M_xy,
-
-    and e_z x R = (-R_y, R_x), so z1 R1 + z2 R2 = (M_y, -M_x) =: m.  Hence
-    R2 = (m - z1 F_xy) / (z2 - z1) and R1 = F_xy - R2.
-
-    Parameters
-    ----------
-    F, M : array_like, shape (N, 3)
-        Reaction force (N) and moment about the joint origin (N*m), joint frame.
-    z1, z2 : float
-        Bearing positions along the joint axis from the joint origin, m (z1 != z2).
-
-    Returns
-    -------
-    R1, R2 : ndarray, shape (N, 2)
-        x, y components of the radial force on each bearing, N.
-    """
-    F, M = np.asarray(F, float), np.asarray(M, float)
-    if z1 == z2:
-        raise ValueError("two bearings need different positions")
-    m = np.stack([M[:, 1], -M[:, 0]], axis=1)
-    R2 = (m - z1 * F[:, :2]) / (z2 - z1)
-    return F[:, :2] - R2, R2

@@ -90,6 +90,8 @@ def _bearing_checks(an, req: Requirements, col: Collector) -> list[Check]:
             col.add(jt.bearings[0].path, f"bearings are rated on revolute joints; '{jt.name}' is {jt.type}")
             continue
         for bi, b in enumerate(jt.bearings):
+            if not b.rated:          # friction only: no rating to check
+                continue
             c = f"bearing {jt.name}/{b.name}"
             if req.bearing_life_h is not None:
                 life = "L10 life" if b.a_ISO is None and b.kappa is None else "Lnm life (a_ISO)"

@@ -107,15 +107,18 @@ def joint_loss(jt, qd: np.ndarray) -> np.ndarray:
     return -joint_friction_force(jt, qd) * qd
 
 
-LOSS_FIELDS = ("gear_loss", "joint_friction", "joint_loss")   # Result fields of a lossy mechanism
+LOSS_FIELDS = ("gear_loss", "joint_friction", "joint_loss", "bearing_iterations")   # of a lossy mechanism
 
 
-def fill_losses(an, kin, qd_all: np.ndarray, res) -> None:
+def fill_losses(an, kin, qd_all: np.ndarray, res, bearing: np.ndarray | None = None,
+                iterations: np.ndarray | None = None) -> None:
     """Set the loss fields of the :class:`~.solve.Result` ``res`` from its tooth forces and
     the joint rates ``qd_all`` (N, J): ``gear_loss`` (N, G) mesh power loss, W (0 for an
     ideal pair); ``joint_friction`` (N, J) the friction on each joint's child about (along)
-    its axis, N*m (N); ``joint_loss`` (N, J) its power loss, W.  Nothing for a lossless
-    mechanism (the fields stay None)."""
+    its axis, N*m (N), with the bearing friction moments ``bearing`` (N, J) >= 0
+    (:mod:`.bearing_friction`) against the rate; ``joint_loss`` (N, J) its power loss, W;
+    ``bearing_iterations`` (N,) the fixed-point iterations of the bearing friction (None
+    without it).  Nothing for a lossless mechanism (the fields stay None)."""
     if not an.mech.has_losses:
         return
     N = qd_all.shape[0]
@@ -124,3 +127,7 @@ def fill_losses(an, kin, qd_all: np.ndarray, res) -> None:
     joints = an.mech.joints
     res.joint_friction = np.column_stack([joint_friction_force(jt, qd_all[:, ji]) for ji, jt in enumerate(joints)])
     res.joint_loss = np.column_stack([joint_loss(jt, qd_all[:, ji]) for ji, jt in enumerate(joints)])
+    if bearing is not None:
+        res.joint_friction -= np.sign(qd_all) * bearing
+        res.joint_loss += bearing * np.abs(qd_all)
+        res.bearing_iterations = iterations

@@ -36,6 +36,7 @@ from .inertia import inertia_load
 from .inputs import motion_arrays
 from .kernel_program import build_program
 from .kinematics import forward
+from .bearing_friction import solve_with_bearing_friction
 from .losses import LOSS_FIELDS, fill_losses, subtract_joint_friction
 from .result_arrays import check_out, copy_into, result_arrays, work_arrays
 from .signs import SignError, sign_violation
@@ -75,10 +76,11 @@ class Result:
     gear_axial: np.ndarray
     residual: float | None = None
     motor_speed: np.ndarray | None = None   # (N, M) motor speeds A^T qd, rad/s (m/s linear)
-    # Losses, None for a lossless mechanism (:func:`.losses.fill_losses`; W, N*m or N, W).
+    # Losses, None for a lossless mechanism (:func:`.losses.fill_losses`; W, N*m or N, W, count).
     gear_loss: np.ndarray | None = None
     joint_friction: np.ndarray | None = None
     joint_loss: np.ndarray | None = None
+    bearing_iterations: np.ndarray | None = None
 
 
 @lru_cache(maxsize=1)
@@ -204,7 +206,7 @@ class Solver:
             worst = 0.0
             for s in range(0, q.shape[0], chunk):
                 sl = slice(s, s + chunk)
-                _, kin, b = self._loads(q[sl], qd[sl], qdd[sl], {k: v[sl] for k, v in values.items()})
+                _, _, kin, b = self._loads(q[sl], qd[sl], qdd[sl], {k: v[sl] for k, v in values.items()})
                 worst = _worst(worst, residual(self.an, self.groups, Columns(self.an, kin), b,
                                                {k: v[sl] for k, v in x_all.items()}, {k: v[sl] for k, v in sig.items()}))
             res.residual = worst
@@ -225,30 +227,29 @@ class Solver:
             res = Result(*(np.concatenate([getattr(p, f) for p in parts]) for f in
                            ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial")))
             res.residual = _worst(*(p.residual for p in parts)) if verify else None
-            for f in LOSS_FIELDS if parts[0].gear_loss is not None else ():
+            for f in (f for f in LOSS_FIELDS if getattr(parts[0], f) is not None):
                 setattr(res, f, np.concatenate([getattr(p, f) for p in parts]))
         return res
 
     def _loads(self, q_ind, qd_ind, qdd_ind, values):
-        """Kinematics and right-hand sides (inertia and external loads) of some samples."""
+        """Every joint's q, qd, the kinematics and right-hand sides (inertia, loads, friction)."""
         an = self.an
         q, qd, qdd = joint_space(an, q_ind, qd_ind, qdd_ind)
         kin = forward(an.mech, an.tree, q, qd, qdd)
         b = inertia_load(an, kin)
         subtract_external(b, external_wrenches(an, kin, values))
         subtract_joint_friction(an, kin, b, qd)
-        return q, kin, b
+        return q, qd, kin, b
 
     def _chunk(self, q_ind, qd_ind, qdd_ind, method, verify, values) -> Result:
         an = self.an
-        q, kin, b = self._loads(q_ind, qd_ind, qdd_ind, values)
+        q, qd, kin, b = self._loads(q_ind, qd_ind, qdd_ind, values)
         cols = Columns(an, kin) if (method == "full" or verify) else None
-        if method == "block":
-            x, sig = solve_blocks(an, self.plans, kin, b, q)
-        else:
-            x, sig = solve_full(an, cols, b)
+        x, sig, b, bearing, res_it = solve_with_bearing_friction(an, kin, b, qd, (
+            lambda rhs: solve_blocks(an, self.plans, kin, rhs, q)) if method == "block" else (
+            lambda rhs: solve_full(an, cols, rhs)))
         res = _result(an, self.groups, x)
-        fill_losses(an, kin, np.asarray(qd_ind, float) @ an.S.T, res)
+        fill_losses(an, kin, qd, res, bearing, res_it)
         if verify:
             res.residual = residual(an, self.groups, cols, b, x, sig)
         return res

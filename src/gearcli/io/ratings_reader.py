@@ -21,7 +21,8 @@ from .planets import item_path
 NS = "https://gearcli.dev/urdf/1"
 MOTOR_KEYS = ("peak_torque", "rms_torque", "max_speed", "max_power")
 BEARING_KEYS = ("name", "position", "C", "C0", "type", "X", "Y", "e", "X0", "Y0", "locating", "M", "f0", "a_ISO",
-                "kappa", "e_C", "Cu")
+                "kappa", "e_C", "Cu", "friction_coefficient", "bore")
+RATING_KEYS = ("C", "C0", "type")     # a rated bearing has all three (the design checks need them)
 LIFE_FACTOR_KEYS = ("kappa", "e_C", "Cu")
 GEAR_KEYS = ("module", "face_width", "bending_stress_limit", "contact_stress_limit",
              "elastic_coefficient", "application_factor", "load_sharing_factor")
@@ -49,19 +50,28 @@ def bearing_ratings(specs: list[dict], path: str, add) -> tuple[BearingRating, .
     out = []
     for i, spec in enumerate(specs):
         p = f"{path}[{i}]"
-        _positive(spec, ("C", "C0", "X", "Y", "e", "M", "f0", "a_ISO", "kappa", "e_C", "Cu"), p, add)
+        _positive(spec, ("C", "C0", "X", "Y", "e", "M", "f0", "a_ISO", "kappa", "e_C", "Cu", "bore"), p, add)
+        if not _rated_or_friction(spec, p, add):
+            continue
+        if "type" not in spec:      # friction only: no rating, no factors
+            out.append(BearingRating(spec["name"], float(spec["position"]), None, None, None, None, None, None,
+                                     None, None, bool(spec.get("locating", len(specs) == 1)), path=p,
+                                     friction_coefficient=float(spec["friction_coefficient"]),
+                                     bore=float(spec["bore"])))
+            continue
         f = {**BEARING_FACTOR_DEFAULTS[spec["type"]], **{k: spec[k] for k in ("X", "Y", "e", "X0", "Y0") if k in spec}}
         if spec.get("M") is not None and len(specs) == 2:
             add(f"{p}.M", "a moment rating M is for a single bearing (two bearings carry the moment as radial loads)")
         if len(specs) == 1 and spec.get("locating") is False:
             add(f"{p}.locating", "a joint's only bearing takes the axial load: it cannot be non-locating")
         _life_factor_keys(spec, p, add)
-        opt = {k: None if spec.get(k) is None else float(spec[k]) for k in ("M", "f0", "a_ISO") + LIFE_FACTOR_KEYS}
+        opt = {k: None if spec.get(k) is None else float(spec[k])
+               for k in ("M", "f0", "a_ISO", "friction_coefficient", "bore") + LIFE_FACTOR_KEYS}
         out.append(BearingRating(spec["name"], float(spec["position"]), float(spec["C"]), float(spec["C0"]),
                                  spec["type"], *(None if f[k] is None else float(f[k]) for k in ("X", "Y", "e")),
                                  float(f["X0"]), float(f["Y0"]), bool(spec.get("locating", len(specs) == 1)),
                                  path=p, **opt))
-    if len(out) == 2:
+    if len(out) == 2 and len(specs) == 2:
         if out[0].name == out[1].name:
             add(f"{path}[1].name", f"duplicate bearing name '{out[1].name}'")
         if out[0].position == out[1].position:
@@ -69,6 +79,29 @@ def bearing_ratings(specs: list[dict], path: str, add) -> tuple[BearingRating, .
         if sum(b.locating for b in out) != 1:
             add(path, "with two bearings, exactly one needs 'locating: true' (the one that takes the axial load)")
     return tuple(out)
+
+
+def _rated_or_friction(spec: dict, p: str, add) -> bool:
+    """A bearing entry is rated (C, C0 and type), or carries friction (friction_coefficient
+    and bore, which go together), or both; True when it can be built."""
+    rating = [k for k in RATING_KEYS if k in spec]
+    ok = True
+    if rating and len(rating) < len(RATING_KEYS):
+        missing = [k for k in RATING_KEYS if k not in spec]
+        add(f"{p}.{rating[0]}", f"a rated bearing needs C, C0 and type: {', '.join(missing)} missing")
+        ok = False
+    if ("friction_coefficient" in spec) != ("bore" in spec):
+        given, other = ("bore", "friction_coefficient") if "bore" in spec else ("friction_coefficient", "bore")
+        add(f"{p}.{given}", f"bearing friction needs both friction_coefficient and bore: {other} missing")
+        ok = False
+    mu = spec.get("friction_coefficient")
+    if isinstance(mu, (int, float)) and not isinstance(mu, bool) and not 0 <= mu < 1:
+        add(f"{p}.friction_coefficient", f"bearing friction coefficient must be in [0, 1), got {mu:g}")
+        ok = False
+    if not rating and "friction_coefficient" not in spec and "bore" not in spec:
+        add(p, "a bearing needs a rating (C, C0, type) or friction (friction_coefficient, bore)")
+        ok = False
+    return ok
 
 
 def _life_factor_keys(spec: dict, p: str, add) -> None:
@@ -199,7 +232,7 @@ def attach_urdf_ratings(mech: Mechanism, root, file: str) -> Mechanism:
         specs = []
         for i, b in enumerate(_ext(el, "bearing")):
             lines[f"{path}.gearcli:bearing[{i}]"] = b.sourceline
-            specs.append(_urdf_spec(b, BEARING_KEYS, ("name", "position", "C", "C0", "type"),
+            specs.append(_urdf_spec(b, BEARING_KEYS, ("name", "position"),
                                     f"{path}.gearcli:bearing[{i}]", adder(b)))
         if name not in joints:
             if specs:

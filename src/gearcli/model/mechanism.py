@@ -146,9 +146,11 @@ class Mechanism:
 
     @property
     def has_losses(self) -> bool:
-        """True when any gear pair has a loss factor or any joint has friction."""
+        """True when any gear pair has a loss factor, or any joint has friction of its own or
+        in its bearings."""
         return any(g.loss_factor for g in self.gears) or any(
-            j.friction is not None and j.friction.active for j in self.joints)
+            (j.friction is not None and j.friction.active) or any(b.friction_arm for b in j.bearings or ())
+            for j in self.joints)
 
     def link(self, name: str) -> Link:
         """The link called ``name``."""

@@ -53,13 +53,15 @@ class BearingRating:
     ``f0``: the ball bearing's factor f0 for the table (None: the catalogue Fa/C0 column);
     ``a_ISO``: a given life modification factor, or ``kappa``, ``e_C`` and ``Cu`` (N) to
     compute it (:func:`gearcli.design.iso281.a_iso`); all None: basic rating life.
+    A bearing with friction only (``friction_coefficient`` and ``bore``) has C, C0, type and
+    the factors None: it enters the solve, not the design checks.
     """
 
     name: str
     position: float
-    C: float
-    C0: float
-    type: str
+    C: float | None
+    C0: float | None
+    type: str | None
     X: float | None
     Y: float | None
     e: float | None
@@ -73,6 +75,20 @@ class BearingRating:
     kappa: float | None = None
     e_C: float | None = None
     Cu: float | None = None
+    # Bearing friction (issue 19): M_b = friction_coefficient * bore / 2 * P_b about the axis,
+    # P_b the magnitude of the bearing's load (dynamics.bearing_friction); bore in m.
+    friction_coefficient: float | None = None
+    bore: float | None = None
+
+    @property
+    def rated(self) -> bool:
+        """True when the bearing has load ratings (C, C0, type) for the design checks."""
+        return self.C is not None
+
+    @property
+    def friction_arm(self) -> float:
+        """mu_b d_b / 2 (m): the friction moment per N of bearing load; 0 without friction."""
+        return 0.5 * self.friction_coefficient * self.bore if self.friction_coefficient else 0.0
 
 
 @dataclass(frozen=True)

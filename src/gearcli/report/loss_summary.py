@@ -1,5 +1,6 @@
 """What a lossy drive spends along a trajectory: energy lost by element and the measured
-efficiency of each motor's transmission line (the ``gearcli solve`` summary).
+efficiency of each motor's transmission line (the ``gearcli solve`` summary), and the
+fixed-point iterations of bearing friction (median and worst over the samples).
 
 * **Energy lost** (J): the time integral of each element's power loss (``gear:<p>:loss``,
   ``joint:<J>:loss``), trapezoid rule over the samples' t, accumulated across chunks.
@@ -45,6 +46,7 @@ class LossSummary:
     energy: np.ndarray = None           # (elements,) J
     p_in: np.ndarray = None             # (motors,) J of forward input (lossy motor power > 0)
     p_out: np.ndarray = None            # (motors,) J delivered (lossless power) over the same samples
+    iterations: np.ndarray = None       # histogram of the bearing friction iterations per sample
     _last: tuple = field(default=(None, None, None))
 
     @classmethod
@@ -73,6 +75,12 @@ class LossSummary:
         M = len(self.motors)
         self.p_in += e[:M]
         self.p_out += e[M:]
+        if res.bearing_iterations is not None:
+            h = np.bincount(res.bearing_iterations)
+            old = self.iterations if self.iterations is not None else np.zeros(0, dtype=np.int64)
+            self.iterations = np.zeros(max(h.size, old.size), dtype=np.int64)
+            self.iterations[:h.size] += h
+            self.iterations[:old.size] += old
         self._last = (t[-1], loss[-1], both[-1])
 
     @property
@@ -88,6 +96,11 @@ class LossSummary:
         for i in np.argsort(-self.energy, kind="stable"):
             if self.energy[i] > 0:
                 out.append(f"  {self.elements[i]}: {self.energy[i]:.6g} J ({100 * self.energy[i] / total:.3g} %)")
+        if self.iterations is not None:
+            cum = np.cumsum(self.iterations)
+            median = int(np.searchsorted(cum, (cum[-1] + 1) // 2))
+            out.append(f"bearing friction: converged in {median} iterations per sample (median), "
+                       f"{self.iterations.size - 1} at worst")
         for m, eta in zip(self.motors, self.efficiency):
             out.append(f"line efficiency of motor {m}: " + ("- (its power never flows forward)" if np.isnan(eta)
                                                              else f"{eta:.4f} (lossless power / motor power where "

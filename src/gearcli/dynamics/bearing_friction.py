@@ -1,0 +1,115 @@
+"""Bearing friction: a load-dependent moment, converged per sample by fixed-point iteration.
+
+The simplified model of the bearing catalogues: bearing b of joint J resists the joint's
+relative rotation with
+
+    M_b = 1/2 mu_b d_b P_b,        on the child  -sign(q'_J) sum_b M_b  about the axis,
+
+reversed on the parent, P_b the magnitude of the bearing's load vector (radial and axial
+together), from gearcli's per-bearing split of the joint reaction: one bearing takes the
+whole reaction force, P = |f|; two share the force and the tilting moment as a shaft on two
+supports (:func:`gearcli.design.bearings.split_two_bearings`, positions along the axis from
+the joint origin), the locating one taking the axial force.  Revolute joints only.
+
+The moments depend on the reactions they change, so the balance equations become
+nonlinear.  :func:`solve_with_bearing_friction` iterates: solve with the moments of the
+previous reactions (zero at first), recompute the moments from the new reactions, until
+every sample's moments change by at most ``TOL`` relative (a contraction: one iteration
+multiplies the error by about mu d / (2 lever), ~1e-3).  A sample that does not converge in
+``MAX_ITERATIONS`` is an error naming it, never a silent approximation.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..model.shaft import split_two_bearings
+from ..errors import GearcliError
+from .losses import joint_axis_wrench
+
+TOL = 1e-12
+MAX_ITERATIONS = 50
+
+
+class BearingFrictionError(GearcliError):
+    """The bearing friction moments of a sample did not converge."""
+
+    def __init__(self, sample: int, joint: str, iterations: int):
+        super().__init__()
+        self.sample, self.joint, self.iterations = sample, joint, iterations
+
+    def lines(self) -> list[str]:
+        return [f"sample {self.sample}: the bearing friction moments of joint '{self.joint}' did not converge "
+                f"in {self.iterations} iterations (relative tolerance {TOL:g}); the friction is too large "
+                "for the loads it changes"]
+
+
+def friction_joints(mech) -> list[int]:
+    """Indices of the joints with bearing friction."""
+    return [ji for ji, jt in enumerate(mech.joints) if any(b.friction_arm for b in jt.bearings or ())]
+
+
+def bearing_loads(jt, x: np.ndarray) -> list[np.ndarray]:
+    """P_b (N,) of each bearing of revolute joint ``jt`` from its reaction ``x`` (N, 5):
+    [fx, fy, fz, mx, my] the parent exerts on the child, joint frame, about its origin."""
+    bearings = jt.bearings
+    if len(bearings) == 1:
+        return [np.linalg.norm(x[:, :3], axis=1)]
+    M = np.column_stack([x[:, 3], x[:, 4], np.zeros(x.shape[0])])
+    radial = split_two_bearings(x[:, :3], M, bearings[0].position, bearings[1].position)
+    return [np.hypot(np.hypot(R[:, 0], R[:, 1]), x[:, 2] if b.locating else 0.0)
+            for R, b in zip(radial, bearings)]
+
+
+def friction_moments(mech, joints: list[int], x_all: dict) -> np.ndarray:
+    """sum_b M_b (N, len(joints)) of each joint with bearing friction, N*m (>= 0)."""
+    out = []
+    for ji in joints:
+        jt = mech.joints[ji]
+        P = bearing_loads(jt, x_all[("joint", ji)])
+        out.append(sum(b.friction_arm * p for b, p in zip(jt.bearings, P)))
+    return np.column_stack(out)
+
+
+def solve_with_bearing_friction(an, kin, b: dict, qd_all: np.ndarray, solve_rhs):
+    """Solve ``solve_rhs(rhs) -> (x_all, signs)`` with the bearing friction of the converged
+    reactions on the right-hand side.
+
+    Returns (x_all, signs, rhs used, moments (N, J): sum_b M_b of every joint, iterations
+    (N,) int: the iteration at which each sample's moments met the tolerance; None for a
+    mechanism without bearing friction, which is solved once)."""
+    joints = friction_joints(an.mech)
+    if not joints:
+        x_all, sig = solve_rhs(b)
+        return x_all, sig, b, None, None
+    N, J = qd_all.shape
+    s = -np.sign(qd_all[:, joints])                 # the moment's sign on the child
+    axis = {ji: {L: joint_axis_wrench(an, kin, ji, L) for L in _links(an, ji)} for ji in joints}
+    Mb = np.zeros((N, len(joints)))
+    iterations = np.zeros(N, dtype=np.int64)
+    for it in range(1, MAX_ITERATIONS + 1):
+        rhs = {L: v.copy() for L, v in b.items()}
+        for k, ji in enumerate(joints):
+            Q = s[:, k] * Mb[:, k]
+            for L, w in axis[ji].items():
+                rhs[L] -= Q[:, None] * w
+        x_all, sig = solve_rhs(rhs)
+        new = np.where(s != 0.0, friction_moments(an.mech, joints, x_all), 0.0)
+        change = np.abs(new - Mb)
+        done = np.all(change <= TOL * np.abs(new) + 1e-300, axis=1)
+        iterations[(iterations == 0) & done] = it
+        if done.all():
+            break                   # Mb: the moments of this solve's right-hand side
+        Mb = new
+    else:
+        bad = int(np.flatnonzero(iterations == 0)[0])
+        worst = joints[int(np.argmax(np.abs(change[bad]) / (np.abs(Mb[bad]) + 1e-300)))]
+        raise BearingFrictionError(bad, an.mech.joints[worst].name, MAX_ITERATIONS)
+    moments = np.zeros((N, J))
+    moments[:, joints] = Mb
+    return x_all, sig, rhs, moments, iterations
+
+
+def _links(an, ji: int) -> list[int]:
+    jt = an.mech.joints[ji]
+    moving = set(an.tree.moving)
+    return [L for L in (an.tree.index[jt.child], an.tree.index[jt.parent]) if L in moving]
