@@ -18,7 +18,8 @@ field: ``planets: 65``, ``kind: rack``, ``hand: x`` ...) under check/graph/expor
 kernel and numpy backends agreeing on every mutated mechanism; their trajectories solved to
 ``-o`` .csv/.parquet/.feather/.npz/unknown extensions with ``--precision``, ``--jobs``,
 ``--backend`` and ``--method`` (bad values: exit 2, nothing written; binary tables read
-back and checked finite); files of >= 2000 rows (parsed by pyarrow) with mutated cells,
+back and checked finite); a planetary with every kind of loss (mesh efficiency, joint and
+bearing friction) mutated byte-wise and key by key; files of >= 2000 rows (parsed by pyarrow) with mutated cells,
 which must give the same status, message (line, column) and bytes as the line-by-line
 reader; the URDF exports of the three new mechanisms, mutated.
 
@@ -500,6 +501,60 @@ def test_fuzz_new_mechanisms(name, muts, command):
         if len(tables) == 2 and (col := first_differing_column(*tables)) is not None:
             found.append(f"backends differ in column {col}")
         verdict("new-yaml", found, files, codes[-1] if codes else None)
+
+
+def lossy_planetary() -> bytes:
+    """planetary_3p with every kind of loss: mesh efficiency and loss factor, joint friction,
+    bearing friction on a friction-only and on a rated bearing."""
+    text = (MECH_DIR / "planetary_3p.yaml").read_bytes()
+    text = text.replace(b"    stiffness: 3.0e8", b"    stiffness: 3.0e8\n    efficiency: 0.985")
+    text = text.replace(b"    stiffness: 3.5e8", b"    stiffness: 3.5e8\n    loss_factor: 0.012")
+    text = text.replace(b"axis: [0, 0, 1]}\n  - {name: JC", b"axis: [0, 0, 1], friction: {coulomb: 0.01, viscous: 1.0e-4},\n"
+                        b"     bearings: [{name: b, position: 0.01, friction_coefficient: 0.0015, bore: 0.01}]}\n  - {name: JC")
+    text = text.replace(b"    planets: 3", b"    planets: 3\n    friction: {viscous: 2.0e-5}\n    bearings:\n"
+                        b"      - {name: pin, position: 0, C: 900, C0: 400, type: ball, friction_coefficient: 0.002, bore: 0.004}")
+    assert text.count(b"friction") == 4
+    return text
+
+
+LOSS_FIELDS = ["efficiency", "loss_factor", "coulomb", "viscous", "friction_coefficient", "bore", "position",
+               "C", "type", "locating"]
+
+
+@few(20)
+@given(muts=st.lists(st.one_of(mutation(), st.tuples(st.sampled_from(LOSS_FIELDS), st.integers(0, 1 << 30),
+                                                     st.one_of(st.sampled_from(FIELD_VALUES),
+                                                               st.sampled_from(NASTY_NUMBERS)))),
+                     min_size=1, max_size=3),
+       command=st.sampled_from(["check", "graph", "solve", "solve", "export"]))
+def test_fuzz_lossy_mechanism(muts, command):
+    """planetary_3p with every kind of loss (mesh, joint, bearing friction), mutated byte-wise
+    and key by key (efficiency, friction coefficients, bores, bearing ratings), under
+    check/graph/solve/export: exit 0 or 2 with located lines, nothing non-finite written."""
+    data = lossy_planetary()
+    for m in muts:
+        data = apply_field_key(data, m) if isinstance(m[0], str) and m[0] in LOSS_FIELDS else apply(data, m)
+    files = {"mech.yaml": data, "traj.csv": short_csv("planetary_3p_traj.csv", 30)}
+    with tempfile.TemporaryDirectory(prefix="gearcli-fuzz-") as d:
+        work = Path(d)
+        for k, v in files.items():
+            (work / k).write_bytes(v)
+        args = {"check": ["check", work / "mech.yaml"], "graph": ["graph", work / "mech.yaml"],
+                "export": ["export", work / "mech.yaml", "-o", work / "out.urdf"],
+                "solve": ["solve", work / "mech.yaml", work / "traj.csv", "-o", work / "out.csv"]}[command]
+        result, hung = run_cli(args)
+        found = problems(result, hung, work, files, ("out.urdf", "out.csv"))
+        verdict("lossy-yaml", found, files, None if hung else result.exit_code)
+
+
+def apply_field_key(data: bytes, mut) -> bytes:
+    """:func:`apply_field` for a key of LOSS_FIELDS (flow or block style)."""
+    key, a, blob = mut
+    hits = list(re.finditer(rb"(?<![A-Za-z_0-9])" + key.encode() + rb":\s*(\[[^\]\n]*\]|[^,}\n#]+)", data))
+    if not hits:
+        return data
+    m = hits[a % len(hits)]
+    return data[:m.start(1)] + blob + data[m.end(1):]
 
 
 def first_differing_column(a: dict, b: dict) -> str | None:
