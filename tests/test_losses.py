@@ -489,3 +489,47 @@ def test_bearing_friction_on_prismatic_joint_refused(run_cli, tmp_path):
     path.write_text(text)
     res = run_cli("check", path)
     assert res.exit_code == 2 and "joints[1].bearings: " in res.stderr and "prismatic" in res.stderr
+
+
+def _verify_case(tmp_path, mech_text: str, limit: float) -> tuple[int, dict]:
+    """verify --json of one case: the rack axis pushed back and forth, its motor's peak torque
+    held to ``limit``; (exit status, the motor check's JSON record)."""
+    import json
+    (tmp_path / "m.yaml").write_text(mech_text)
+    t = np.linspace(0.0, 2.0, 201)
+    x = 0.05 * np.sin(np.pi * t)
+    (tmp_path / "traj.csv").write_text("t,q:JX\n" + "".join(f"{a:.17g},{b:.17g}\n" for a, b in zip(t, x)))
+    (tmp_path / "design.yaml").write_text(textwrap.dedent(f"""
+        name: lossy_rack
+        cases:
+          - name: push
+            mechanism: m.yaml
+            trajectories: [traj.csv]
+            limits:
+              - {{column: "motor:m", max_abs: {limit}}}
+        """))
+    from gearcli.cli import app
+    from typer.testing import CliRunner
+    res = CliRunner().invoke(app, ["verify", str(tmp_path / "design.yaml"), "--json", str(tmp_path / "r.json")])
+    report = json.loads((tmp_path / "r.json").read_text())
+    return res.exit_code, next(c for c in report["checks"] if "motor:m" in c["component"] + c["quantity"])
+
+
+def test_verify_uses_the_lossy_motor_torques(tmp_path):
+    """verify's motor figure is the lossy solve's peak |torque|, and a limit between the
+    lossless and the lossy peak passes without the losses and fails with them."""
+    lossy = RACK.format(Fc=12.0, Fv=30.0, eta=0.9, F=-50.0)
+    lossless = RACK.format(Fc=0.0, Fv=0.0, eta=1.0, F=-50.0)
+    an_lossy, an_free = analyse(parse_mechanism(lossy)), analyse(parse_mechanism(lossless))
+    t = np.linspace(0.0, 2.0, 201)
+    code_free, free = _verify_case(tmp_path, lossless, 1.2)
+    code_lossy, lossy_check = _verify_case(tmp_path, lossy, 1.2)
+    assert code_free == 0 and code_lossy == 1
+    assert free["value"] < 1.2 < lossy_check["value"]
+    assert free["passed"] and not lossy_check["passed"]
+    # the figure verify prints is the lossy solve's peak motor torque over the same motion
+    x = 0.05 * np.sin(np.pi * t)
+    v, a = 0.05 * np.pi * np.cos(np.pi * t), -0.05 * np.pi ** 2 * np.sin(np.pi * t)
+    peak = np.max(np.abs(solve(an_lossy, x[:, None], v[:, None], a[:, None]).motor))
+    assert lossy_check["value"] == pytest.approx(peak, rel=1e-3)      # spline vs exact rates
+    assert an_lossy.mech.has_losses and not an_free.mech.has_losses
