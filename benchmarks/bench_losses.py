@@ -1,0 +1,72 @@
+"""What losses cost in the solve (issue 19); prints figures, not a test.
+
+    python benchmarks/bench_losses.py [--samples 20000] [--rounds 5]
+
+The rated Bendix wrist (5 meshes, 5 joints, 7 bearings), random states, one thread.  Rows,
+interleaved round by round so that load drift hits all alike, medians of --rounds:
+
+* lossless, numpy and the compiled llvm kernel (the reference points);
+* mesh + joint friction (every mesh at 3 % loss, every joint with Coulomb + viscous friction),
+  numpy: the couples ride in the tooth-force columns (one extra set of block maps per pattern
+  of relative-speed signs met);
+* the same with bearing friction on every bearing (mu 0.0015, bore 20 mm), numpy: a
+  fixed-point iteration per sample, whose iterations are printed (median and worst).
+
+The compiled kernels do not model losses yet: a lossy mechanism runs on numpy (``auto``).
+"""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import sys
+from pathlib import Path
+
+import numpy as np
+from timing import load_line, median_time  # noqa: E402 (benchmarks/timing.py)
+
+from gearcli import analyse, load_mechanism, solve
+from gearcli.model.friction import JointFriction
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def lossy(mech, bearings: bool):
+    gears = tuple(dataclasses.replace(g, loss_factor=0.03) for g in mech.gears)
+    joints = tuple(dataclasses.replace(
+        j, friction=JointFriction(0.02, 1e-4),
+        bearings=tuple(dataclasses.replace(b, friction_coefficient=0.0015, bore=0.02) for b in j.bearings)
+        if bearings and j.bearings else j.bearings) for j in mech.joints)
+    return dataclasses.replace(mech, gears=gears, joints=joints)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--samples", type=int, default=20_000)
+    ap.add_argument("--rounds", type=int, default=5)
+    args = ap.parse_args(argv)
+    mech = load_mechanism(ROOT / "mechanisms" / "bendix_wrist_rated.yaml")
+    cases = {"lossless, llvm": (analyse(mech), "llvm"), "lossless, numpy": (analyse(mech), "numpy"),
+             "mesh + joint friction, numpy": (analyse(lossy(mech, False)), "numpy"),
+             "+ bearing friction, numpy": (analyse(lossy(mech, True)), "numpy")}
+    rng = np.random.default_rng(0)
+    dof = cases["lossless, numpy"][0].dof
+    q, qd, qdd = (rng.uniform(-3, 3, (args.samples, dof)) for _ in range(3))
+    for an, backend in cases.values():                 # warm up: compile, plans, caches
+        solve(an, q[:100], qd[:100], qdd[:100], backend=backend, jobs=1)
+    times = {k: [] for k in cases}
+    for _ in range(args.rounds):
+        for name, (an, backend) in cases.items():
+            times[name].append(median_time(lambda: solve(an, q, qd, qdd, backend=backend, jobs=1), 1))
+    print(f"Bendix wrist (rated), {args.samples:,} random samples, 1 thread, medians of {args.rounds}; {load_line()}")
+    base = float(np.median(times["lossless, numpy"]))
+    for name, ts in times.items():
+        t = float(np.median(ts))
+        print(f"  {name:32s} {t * 1e3:9.1f} ms  {args.samples / t:12,.0f} samples/s  {t / base:5.2f}x numpy lossless")
+    res = solve(cases["+ bearing friction, numpy"][0], q, qd, qdd, backend="numpy")
+    it = res.bearing_iterations
+    print(f"  bearing friction iterations per sample: median {int(np.median(it))}, worst {int(it.max())}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
