@@ -84,7 +84,7 @@ def test_missing_file(run_cli, tmp_path):
 def test_directory_instead_of_file(run_cli, tmp_path):
     res = run_cli("check", tmp_path)
     assert res.exit_code == 2
-    assert len(res.stderr.splitlines()) == 1 and res.stderr.startswith(f"{tmp_path}: cannot read file")
+    assert res.stderr.splitlines() == [f"{tmp_path}: not a regular file (a directory)"]
 
 
 def test_not_utf8(run_cli, tmp_path):

@@ -356,8 +356,12 @@ def plot(
     """Draw columns of a loads file over time (one axis per unit: N, N*m, rad/s, W).  Columns
     that cannot be drawn (not numbers, no finite value) are left out with a warning; at most
     24 lines on 6 axes are drawn."""
+    from .io.limits import input_problem  # noqa: PLC0415
     from .report.plots import plot_loads_csv  # noqa: PLC0415
 
+    why = input_problem(loads)     # a FIFO or a device is refused, not waited on or read without end
+    if why:
+        raise GearcliError(f"{loads}: {why}")
     report = plot_loads_csv(loads, columns, output)
     print_problems([f"warning: {note}" for note in report.notes])
     typer.echo(f"Wrote {output} ({counted(report.drawn, 'column')})")

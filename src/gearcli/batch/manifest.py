@@ -16,10 +16,13 @@ from pathlib import Path
 import jsonschema
 
 from ..design.checks import Check, Requirements, build_checks
-from ..errors import Collector, GearcliError, Issue, MechanismError
+from ..errors import Collector, GearcliError
 from ..io import load_mechanism
+from ..io.limits import input_problem
 from ..io.trajectory import TrajectoryReader
-from ..io.yaml_reader import yaml_lines
+from ..io.yaml_reader import json_path, number_issues, schema_messages
+from ..io.yaml_safe import read_text, yaml_lines
+from ..model.validate import MAX_ABS
 from ..pipeline import analyse, prismatic_independent
 from ..io.schemas import packaged_schema
 
@@ -37,7 +40,7 @@ def case_analysis(mech_path: str | Path):
     the manifest's preparation and the jobs run in this process share it."""
     try:
         mtime = os.path.getmtime(mech_path)
-    except OSError:       # load_mechanism says what is wrong with it
+    except (OSError, ValueError):       # load_mechanism says what is wrong with it
         mtime = None
     return _analysis(str(mech_path), mtime)
 
@@ -77,30 +80,65 @@ class Manifest:
     cases: tuple[Case, ...]
 
 
-def _schema_issues(data, col: Collector) -> None:
+MIN_POSITIVE = 1e-12
+"""Smallest positive number a manifest accepts (requirements, limits): below it products
+with the loads leave float64's normal range (``cycles_per_hour: 1e-320``)."""
+
+
+def _range_message(x) -> str:
+    """What is wrong with a manifest number outside [MIN_POSITIVE, MAX_ABS] (finite)."""
+    if x <= 0:
+        return f"must be positive, got {x:g}"
+    top = f"{MAX_ABS:.0e}".replace("e+", "e")
+    return f"{x:g} is out of range ({MIN_POSITIVE:g} <= x <= {top} in SI units)"
+
+
+def _schema_issues(data, col: Collector, skip: set) -> None:
+    """Schema violations (except at the paths in ``skip``, already reported), in the words
+    of mechanism files (:func:`gearcli.io.yaml_reader.schema_messages`)."""
     validator = jsonschema.Draft202012Validator(design_schema())
     for err in sorted(validator.iter_errors(data), key=lambda e: list(map(str, e.absolute_path))):
-        path = ""
-        for p in err.absolute_path:
-            path += f"[{p}]" if isinstance(p, int) else (f".{p}" if path else str(p))
-        msg = err.message
-        if err.validator == "additionalProperties":
-            allowed = ", ".join(err.schema.get("properties", {}))
-            msg = f"{msg} (allowed: {allowed})"
-        elif err.validator == "anyOf":
-            msg = "give max_abs or max_rms (or both)"
-        col.add(path, msg)
+        if json_path(err.absolute_path) in skip:    # a non-finite or huge number, reported already
+            continue
+        if err.validator == "anyOf":
+            found = [(list(err.absolute_path), "give max_abs or max_rms (or both)")]
+        elif err.validator in ("minimum", "maximum") and isinstance(err.instance, (int, float)):
+            found = [(list(err.absolute_path), _range_message(err.instance))]
+        elif err.validator == "pattern" and err.absolute_path and err.absolute_path[-1] == "name":
+            found = [(list(err.absolute_path), f"{err.instance!r}: a name without control characters"
+                      + (" or spaces (one word)" if len(err.absolute_path) > 1 else ""))]
+        else:
+            found = schema_messages(err)
+        for parts, message in found:
+            if json_path(parts) not in skip:
+                col.add(json_path(parts), message)
+
+
+def _with_enclosing(paths) -> set:
+    """Every path of ``paths`` and every path enclosing one (``a.b[2].c``: ``a.b[2]``,
+    ``a.b``, ``a``), so that :func:`_under` is one set lookup."""
+    out = set()
+    for p in paths:
+        while p and p not in out:
+            out.add(p)
+            cut = max(p.rfind("."), p.rfind("["))
+            p = p[:cut] if cut > 0 else ""
+    return out
+
+
+def _under(bad: set, path: str) -> bool:
+    """Whether a problem was reported at ``path`` or inside it (``bad``: from
+    :func:`_with_enclosing`)."""
+    return path in bad
 
 
 def load_manifest(path: str | Path) -> Manifest:
     """Read and validate a manifest and everything it names; raises
-    :class:`~gearcli.errors.MechanismError` listing every problem."""
+    :class:`~gearcli.errors.MechanismError` (an unreadable or non-YAML manifest) or
+    :class:`ManifestError` listing every problem: numbers (finite, in range), the schema,
+    and what the valid parts name (files, columns, requirements), in one round."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise MechanismError([Issue(str(path), "", None, f"cannot read file: {getattr(exc, 'strerror', exc)}")]) from None
-    data, lines = yaml_lines(text, str(path))
+    data, lines = yaml_lines(read_text(path, "design manifest"), str(path))
     col = Collector(str(path), lines)
     if not isinstance(data, dict):
         col.add("", "a design manifest must be a YAML mapping with a list of cases")
@@ -108,12 +146,16 @@ def load_manifest(path: str | Path) -> Manifest:
         col.add("", "this is a mechanism file, not a design manifest: a manifest lists cases, each naming "
                     "a mechanism and its trajectories (README, Design checks in CI)")
     col.raise_if_any()
-    _schema_issues(data, col)
-    col.raise_if_any()
+    number_issues(data, col)
+    _schema_issues(data, col, {i.path for i in col.issues})
+    bad = _with_enclosing(i.path for i in col.issues)
     issues: list[str] = []
     cases, names = [], {}
-    for i, spec in enumerate(data["cases"]):
-        case = _prepare_case(spec, f"cases[{i}]", path.parent, col, issues)
+    specs = data.get("cases") if isinstance(data.get("cases"), list) else []
+    for i, spec in enumerate(specs):
+        if not isinstance(spec, dict):
+            continue
+        case = _prepare_case(spec, f"cases[{i}]", path.parent, col, issues, bad)
         if case is None:
             continue
         if case.name in names:
@@ -121,31 +163,88 @@ def load_manifest(path: str | Path) -> Manifest:
         names[case.name] = f"cases[{i}]"
         cases.append(case)
     if col.issues or issues:
-        raise ManifestError([str(i) for i in col.issues] + issues)
-    return Manifest(path, data.get("name", path.stem), tuple(cases))
+        located = sorted(col.issues, key=lambda i: i.line or 0)
+        raise ManifestError([str(i) for i in located] + issues)
+    name = data["name"] if "name" in data else path.stem
+    return Manifest(path, name, tuple(cases))
 
 
-def _trajectory_paths(spec, where: str, base: Path, col: Collector) -> list[Path]:
-    patterns = spec["trajectories"]
-    patterns = [patterns] if isinstance(patterns, str) else patterns
+def _shown(name: str) -> str:
+    """A path from the manifest as it can be printed (a NUL byte as ``\\0``)."""
+    return name.replace("\0", "\\0")
+
+
+def _file_problem(name: str, base: Path) -> str | None:
+    """Why the file ``name`` of the manifest (relative to its folder ``base``) cannot be
+    read, found without opening it; None when it can."""
+    if "\0" in name:
+        return f"'{_shown(name)}': the path contains a NUL byte"
+    why = input_problem(base / name)
+    return None if why is None else f"'{name}' (relative to {base}): {why}"
+
+
+def _trajectory_paths(spec, where: str, base: Path, col: Collector, bad: set) -> list[Path]:
+    """The trajectory files of a case: every valid pattern expanded (a bad item is left out,
+    its problem is reported already)."""
+    value = spec["trajectories"]
+    if not isinstance(value, (str, list)) or isinstance(value, str) and _under(bad, f"{where}.trajectories"):
+        return []
+    single = isinstance(value, str)
+    patterns = [value] if single else value
     out = []
     for j, pat in enumerate(patterns):
+        sub = f"{where}.trajectories" + ("" if single else f"[{j}]")
+        if _under(bad, sub) or not isinstance(pat, str):
+            continue
+        if "\0" in pat:
+            col.add(sub, f"'{_shown(pat)}': the path contains a NUL byte")
+            continue
         full = str(base / pat)
-        found = sorted(glob.glob(full)) if glob.has_magic(pat) else ([full] if Path(full).is_file() else [])
+        found = sorted(glob.glob(full)) if glob.has_magic(pat) else ([full] if os.path.lexists(full) else [])
         if not found:
-            sub = f"{where}.trajectories" + (f"[{j}]" if not isinstance(spec["trajectories"], str) else "")
             col.add(sub, f"no trajectory file matches '{pat}' (relative to {base})")
-        out += [Path(f) for f in found]
+        for f in found:
+            why = input_problem(f)
+            if why:
+                col.add(sub, f"'{f}': {why}")
+            else:
+                out.append(Path(f))
     return out
 
 
-def _prepare_case(spec: dict, where: str, base: Path, col: Collector, issues: list) -> Case | None:
-    mech_path = base / spec["mechanism"]
-    req = Requirements(**{k: spec[k] for k in REQUIREMENT_KEYS if k in spec},
-                       limits=tuple(spec.get("limits", ())), limits_path=f"{where}.limits")
-    if req.bearing_life_h is not None and req.cycles_per_hour is None:
+def _limits(spec: dict, where: str, bad: set) -> tuple:
+    """The case's limits with every bad value left out (a bad item as ``{}``, so that the
+    others keep their index in messages)."""
+    out = []
+    items = spec.get("limits") if isinstance(spec.get("limits"), list) else []
+    for i, lim in enumerate(items):
+        p = f"{where}.limits[{i}]"
+        if not isinstance(lim, dict) or "column" not in lim or _under(bad, f"{p}.column"):
+            out.append({})
+            continue
+        out.append({"column": lim["column"], **{k: float(lim[k]) for k in ("max_abs", "max_rms")
+                                                 if k in lim and not _under(bad, f"{p}.{k}")}})
+    return tuple(out)
+
+
+def _prepare_case(spec: dict, where: str, base: Path, col: Collector, issues: list, bad: set) -> Case | None:
+    """The case ``spec`` ready to run, or None; every problem of its valid parts goes to
+    ``col`` (the manifest's) or ``issues`` (lines of the files it names)."""
+    def ok(key: str) -> bool:
+        return key in spec and not _under(bad, f"{where}.{key}")
+
+    req = Requirements(**{k: float(spec[k]) for k in REQUIREMENT_KEYS if ok(k)},
+                       limits=_limits(spec, where, bad), limits_path=f"{where}.limits")
+    if ok("bearing_life_h") and "cycles_per_hour" not in spec:
         col.add(f"{where}.bearing_life_h", "a bearing life in hours needs the duty's cycles_per_hour")
-    trajs = _trajectory_paths(spec, where, base, col)
+    trajs = _trajectory_paths(spec, where, base, col, bad) if "trajectories" in spec else []
+    if not ok("mechanism"):
+        return None
+    mech_path = base / spec["mechanism"]
+    why = _file_problem(spec["mechanism"], base)
+    if why:
+        col.add(f"{where}.mechanism", why)
+        return None
     try:
         an = case_analysis(mech_path)
     except GearcliError as exc:
@@ -154,19 +253,21 @@ def _prepare_case(spec: dict, where: str, base: Path, col: Collector, issues: li
     ccol = Collector(str(col.file), col.lines)
     mcol = Collector(an.mech.source, an.mech.lines)
     checks = _split_build(an, req, ccol, mcol)
-    col.issues += ccol.issues
+    for issue in ccol.issues:
+        col.add(issue.path, issue.message)
     issues += [str(i) for i in mcol.issues]
-    if not checks:
+    if not checks and not _under(bad, f"{where}.limits"):
         col.add(f"{where}.mechanism", f"nothing to check: '{spec['mechanism']}' has no ratings and the case no limits")
-    _unused_requirements(spec, where, checks, col)
-    for tp in trajs:
+    _unused_requirements({k: v for k, v in spec.items() if ok(k)}, spec["mechanism"], where, checks, col)
+    degrees = None if _under(bad, f"{where}.degrees") else spec.get("degrees", False)
+    for tp in trajs if degrees is not None else ():   # a bad 'degrees': the rows' scale is unknown
         try:
-            TrajectoryReader(tp, an.independent_names, degrees=spec.get("degrees", False),
+            TrajectoryReader(tp, an.independent_names, degrees=degrees,
                              linear=prismatic_independent(an), loads=an.mech.loads).check()   # rows only, no spline
         except GearcliError as exc:
             issues += exc.lines()
-    name = spec.get("name", Path(spec["mechanism"]).stem)
-    return Case(name, mech_path, tuple(trajs), bool(spec.get("degrees", False)), req, tuple(checks))
+    name = spec["name"] if ok("name") else Path(spec["mechanism"]).stem
+    return Case(name, mech_path, tuple(trajs), bool(degrees), req, tuple(checks))
 
 
 REQUIREMENT_CHECKS = {"bearing_life_h": ("L10 life", "joints[].bearings with C"),
@@ -176,12 +277,13 @@ REQUIREMENT_CHECKS = {"bearing_life_h": ("L10 life", "joints[].bearings with C")
 """Requirement key -> (quantity of the checks it sets, the ratings those checks need)."""
 
 
-def _unused_requirements(spec: dict, where: str, checks, col: Collector) -> None:
-    """A requirement the case gives but no check uses is an error, not a silent no-op."""
+def _unused_requirements(spec: dict, mechanism: str, where: str, checks, col: Collector) -> None:
+    """A requirement the case gives (valid keys of ``spec``) but no check uses is an
+    error, not a silent no-op."""
     quantities = {c.quantity for c in checks} | ({"L10 life"} if any(c.kind == "life" for c in checks) else set())
     for key, (quantity, needs) in REQUIREMENT_CHECKS.items():
         if key in spec and quantity not in quantities:
-            col.add(f"{where}.{key}", f"checks nothing: '{spec['mechanism']}' has no {needs} "
+            col.add(f"{where}.{key}", f"checks nothing: '{mechanism}' has no {needs} "
                     f"(remove {key} or rate the parts)")
 
 

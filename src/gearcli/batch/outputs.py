@@ -97,15 +97,16 @@ def write_junit(rows: list[Row], path, suite: str) -> None:
 
 
 def _num(x: float):
-    return None if math.isinf(x) or math.isnan(x) else x
+    """``x`` for JSON: null when it is not finite (an unturned bearing's infinite life)."""
+    return x if math.isfinite(x) else None
 
 
 def write_json(rows: list[Row], path, manifest: str) -> None:
     doc = {"manifest": manifest, "passed": all(r.passed for r in rows),
            "checks": [{"case": r.case, "component": r.component, "quantity": r.quantity, "value": _num(r.value),
-                       "limit": r.limit, "unit": r.unit, "margin_pct": _num(r.margin), "passed": r.passed,
+                       "limit": _num(r.limit), "unit": r.unit, "margin_pct": _num(r.margin), "passed": r.passed,
                        "trajectory": r.trajectory, "time": _num(r.time)} for r in rows]}
-    write_text(path, json.dumps(doc, indent=2) + "\n")
+    write_text(path, json.dumps(doc, indent=2, allow_nan=False) + "\n")   # strict JSON: never NaN/Infinity
 
 
 def markdown(rows: list[Row], manifest: str) -> str:

@@ -51,7 +51,12 @@ def equivalent_load(total: float, revs: float, p: float) -> float:
 
 def rating_life_mrev(C: float, P_eq: float, p: float) -> float:
     """ISO 281 basic rating life L10 = (C / P_eq)^p in millions of revolutions (inf if P_eq = 0)."""
-    return math.inf if P_eq <= 0 else (C / P_eq) ** p
+    if P_eq <= 0:
+        return math.inf
+    try:
+        return (C / P_eq) ** p
+    except OverflowError:     # float ** raises where * and / give inf: beyond 1.8e308, inf
+        return math.inf
 
 
 def rating_life_hours(L10_mrev: float, revolutions_per_hour: float) -> float:
@@ -62,10 +67,12 @@ def rating_life_hours(L10_mrev: float, revolutions_per_hour: float) -> float:
 
 
 def required_equivalent_load(C: float, life_h: float, revolutions_per_hour: float, p: float) -> float:
-    """The P_eq (N) that gives exactly ``life_h`` hours: C / (life_h * rev/h / 1e6)^(1/p)."""
-    if revolutions_per_hour <= 0:
+    """The P_eq (N) that gives exactly ``life_h`` hours: C / (life_h * rev/h / 1e6)^(1/p);
+    inf when the bearing turns too little for the product to be a positive float."""
+    base = life_h * revolutions_per_hour / 1e6
+    if not base > 0:
         return math.inf
-    return C / (life_h * revolutions_per_hour / 1e6) ** (1.0 / p)
+    return C / base ** (1.0 / p)
 
 
 def static_equivalent_load(Fr, Fa, X0: float, Y0: float) -> np.ndarray:

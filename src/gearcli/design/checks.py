@@ -18,7 +18,6 @@ import math
 from dataclasses import dataclass, field
 
 from ..errors import Collector
-from ..report.columns import column_names, column_unit
 from .iso281 import life_exponent
 from .gears import lewis_form_factor, virtual_helical_teeth, virtual_spur
 
@@ -35,7 +34,7 @@ class Requirements:
     min_static_safety: float = 1.0
     min_bending_safety: float = 1.0
     min_contact_safety: float = 1.0
-    limits: tuple = ()   # ({"column": str, "max_abs": float, "max_rms": float}, ...)
+    limits: tuple = ()   # ({"column": str, "max_abs": float, "max_rms": float} or {} (skipped), ...)
     limits_path: str = "limits"
 
 
@@ -168,9 +167,15 @@ def _joint_limit_checks(an) -> list[Check]:
 
 
 def _column_checks(an, req: Requirements, col: Collector) -> list[Check]:
+    if not req.limits:
+        return []
+    from ..report.columns import column_names, column_unit  # noqa: PLC0415 (imports the solver: not for check)
+
     out = []
     names = column_names(an)
     for i, lim in enumerate(req.limits):
+        if "column" not in lim:     # left out by the manifest reader (a bad item, reported there)
+            continue
         name = lim["column"]
         if name not in names:
             close = difflib.get_close_matches(name, names, n=1)

@@ -10,6 +10,7 @@ from pathlib import Path
 
 from ..errors import Issue, MechanismError
 from ..model.mechanism import Mechanism
+from .limits import open_regular
 
 URDF_SUFFIXES = (".urdf", ".xml")
 """Extensions (any case) of the mechanism files read as URDF; every other name is YAML."""
@@ -37,9 +38,9 @@ def load_mechanism(path: str | Path) -> Mechanism:
 
 def _looks_like_xml(path) -> bool:
     try:
-        with open(path, "rb") as f:
+        with open_regular(path) as f:     # a FIFO is refused, not waited on
             head = f.read(256).lstrip(b"\xef\xbb\xbf \t\r\n")
-    except OSError:
+    except (OSError, MechanismError):
         return False
     return head[:1] == b"<" and (head[1:2].isalpha() or head[1:2] in (b"?", b"!"))
 

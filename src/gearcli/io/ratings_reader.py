@@ -14,6 +14,7 @@ from dataclasses import replace
 
 from ..errors import Collector, Issue, MechanismError
 from ..model.mechanism import Mechanism
+from ..model.validate import number_problem
 from ..model.ratings import (BEARING_FACTOR_DEFAULTS, STEEL_ELASTIC_COEFFICIENT, BearingRating, GearRating,
                              JointLimit, MotorRating)
 from .planets import item_path
@@ -186,6 +187,9 @@ def _urdf_spec(el, keys, required, path: str, add) -> dict | None:
             if not math.isfinite(spec[key]):
                 add(f"{path}.{key}", f"{key} must be a finite number, got '{text}'")
                 ok = False
+            elif why := number_problem(spec[key]):    # as in YAML files: |x| <= 1e12
+                add(f"{path}.{key}", why)
+                ok = False
     for key in required:
         if key not in spec:
             add(path, f"missing attribute '{key}'")
@@ -193,20 +197,27 @@ def _urdf_spec(el, keys, required, path: str, add) -> dict | None:
     return spec if ok else None
 
 
-def _urdf_limit(el, path: str, warn) -> JointLimit | None:
-    """A joint's ``<limit effort velocity>``; non-positive values are not limits (warning)."""
+def _urdf_limit(el, path: str, warn, add) -> JointLimit | None:
+    """A joint's ``<limit effort velocity>``; non-positive values are not limits (warning),
+    a non-finite or out-of-range one (``effort="inf"``) is an error, as in YAML files."""
     lim = el.find("limit")
     if lim is None:
         return None
     vals = {}
     for key in ("effort", "velocity"):
-        try:
-            v = float(lim.get(key, "nan"))
-        except ValueError:
-            v = math.nan
-        if lim.get(key) is not None and not v > 0:
-            warn(f"{path}.limit", f"limit {key}=\"{lim.get(key)}\" is not a positive limit: not checked", lim)
-        vals[key] = v if v > 0 else None
+        text, v = lim.get(key), None
+        if text is not None:
+            try:
+                v = float(text)
+            except ValueError:
+                v = None
+            why = None if v is None else number_problem(v)
+            if why:
+                add(f"{path}.limit", f"limit {key}=\"{text}\": {why}")
+                v = None
+            elif v is None or not v > 0:
+                warn(f"{path}.limit", f"limit {key}=\"{text}\" is not a positive limit: not checked", lim)
+        vals[key] = v if v is not None and v > 0 else None
     return None if vals == {"effort": None, "velocity": None} else JointLimit(vals["effort"], vals["velocity"], path)
 
 
@@ -244,7 +255,7 @@ def attach_urdf_ratings(mech: Mechanism, root, file: str) -> Mechanism:
             adder(el)(path, PRISMATIC_BEARINGS)
         elif specs and None not in specs:
             joints[name] = replace(joints[name], bearings=bearing_ratings(specs, f"{path}.gearcli:bearing", adder(el)))
-        limit = _urdf_limit(el, path, warn)
+        limit = _urdf_limit(el, path, warn, adder(el.find("limit") if el.find("limit") is not None else el))
         if limit is not None:
             joints[name] = replace(joints[name], limit=limit)
     motors = {m.name: m for m in mech.motors}

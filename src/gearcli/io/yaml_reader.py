@@ -58,14 +58,14 @@ def load_yaml(path: str | Path) -> Mechanism:
     return parse_mechanism(read_text(path), str(path))
 
 
-def _json_path(parts) -> str:
+def json_path(parts) -> str:
     out = ""
     for p in parts:
         out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))
     return out
 
 
-def _schema_messages(err) -> list[tuple[list, str]]:
+def schema_messages(err) -> list[tuple[list, str]]:
     """(path parts, message) pairs for one jsonschema error, made precise for the common
     cases: an unknown key is reported at its own path (with a close match), a missing key
     by name, and a oneOf by the branch whose type fits the value."""
@@ -88,7 +88,7 @@ def _schema_messages(err) -> list[tuple[list, str]]:
         fitting = [b for b in branches.values()
                    if not any(e.validator == "type" and list(e.absolute_path) == path for e in b)]
         if len(fitting) == 1:
-            return [m for e in fitting[0] for m in _schema_messages(e)]
+            return [m for e in fitting[0] for m in schema_messages(e)]
         types = [s.get("type") for s in err.validator_value if isinstance(s, dict) and "type" in s]
         if types:
             return [(path, f"{err.instance!r} is not valid: expected {' or '.join(map(str, types))}")]
@@ -109,20 +109,20 @@ def _schema_issues(data, col: Collector, skip: set) -> None:
     """Schema violations, except at the paths in ``skip`` (already reported)."""
     validator = _validator()
     for err in sorted(validator.iter_errors(data), key=lambda e: list(map(str, e.absolute_path))):
-        for parts, message in _schema_messages(err):
-            if _json_path(parts) not in skip:
-                col.add(_json_path(parts), message)
+        for parts, message in schema_messages(err):
+            if json_path(parts) not in skip:
+                col.add(json_path(parts), message)
 
 
-def _number_issues(data, col: Collector, path: str = "") -> None:
+def number_issues(data, col: Collector, path: str = "") -> None:
     """Report numbers the schema lets through but no mechanism has: NaN, infinities (YAML
     .nan, .inf) and magnitudes beyond :data:`~gearcli.model.validate.MAX_ABS`."""
     if isinstance(data, dict):
         for k, v in data.items():
-            _number_issues(v, col, f"{path}.{k}" if path else str(k))
+            number_issues(v, col, f"{path}.{k}" if path else str(k))
     elif isinstance(data, list):
         for i, v in enumerate(data):
-            _number_issues(v, col, f"{path}[{i}]")
+            number_issues(v, col, f"{path}[{i}]")
     else:
         why = number_problem(data)
         if why:
@@ -139,7 +139,7 @@ def parse_mechanism(text: str, file: str = "<string>") -> Mechanism:
     elif "cases" in data and "links" not in data:
         col.add("", "this is a design manifest (it lists cases), not a mechanism file: run gearcli verify on it")
     col.raise_if_any()
-    _number_issues(data, col)
+    number_issues(data, col)
     _schema_issues(data, col, {i.path for i in col.issues})
     col.raise_if_any()
     data = expand_planets(data, joint_geometry, col)
