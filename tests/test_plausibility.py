@@ -266,3 +266,17 @@ def test_module_in_mm_is_a_warning_where_no_teeth_are_given(run_cli, tmp_path):
         # 4,000 teeth are rated (a warning); 0.04 teeth are not (the Lewis factor's error, as in verify)
         assert r.exit_code == (0 if module == "1.0e-5" else 2)
         assert run_cli("check", mm, "--strict").exit_code == 2
+
+
+@pytest.mark.parametrize("mass,inertia", [(1e-300, [0.0008, 0.0006, 0.0005]), (1e12, [1e-300, 1e-300, 1e-300]),
+                                          (1e-300, [1e12, 1e12, 1e12]), (5.0, [1e-300, 1e-300, 2e-300])])
+def test_density_of_extreme_numbers_is_finite_or_inf_never_an_error(mass, inertia):
+    """A mistyped mass or inertia within the accepted range (|x| <= 1e12, e.g. 1e-300 kg) gives
+    a density (possibly 0 or inf), not an OverflowError (found by the long fuzz run)."""
+    import warnings
+    from gearcli.model.plausibility import ellipsoid_density, sphere_density
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for f in (ellipsoid_density, sphere_density):
+            d = f(mass, np.diag(inertia))
+            assert d >= 0 and not math.isnan(d)

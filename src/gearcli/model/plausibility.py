@@ -72,9 +72,12 @@ def ellipsoid_density(mass: float, inertia: np.ndarray) -> float:
     w = np.linalg.eigvalsh(inertia)
     if not mass > 0 or not w.sum() > 0:
         return math.nan
-    axes2 = 5.0 * (w.sum() - 2.0 * w) / (2.0 * mass)
-    volume = 4.0 / 3.0 * math.pi * math.sqrt(max(float(np.prod(np.clip(axes2, 0.0, None))), 0.0))
-    return mass / volume if volume > 0 else math.inf
+    # in logarithms: a mass of 1e-300 kg or moments of 1e12 must not overflow (a mistyped file)
+    with np.errstate(all="ignore"):
+        axes2 = 5.0 * (w.sum() - 2.0 * w) / (2.0 * mass)
+        if np.any(axes2 <= 0.0):
+            return math.inf
+        return float(np.exp(math.log(mass) - math.log(4.0 / 3.0 * math.pi) - 0.5 * float(np.sum(np.log(axes2)))))
 
 
 def sphere_density(mass: float, inertia: np.ndarray) -> float:
@@ -84,8 +87,10 @@ def sphere_density(mass: float, inertia: np.ndarray) -> float:
     tr = float(np.trace(inertia))
     if not mass > 0 or not tr > 0:
         return math.nan
-    radius = math.sqrt(5.0 * tr / (6.0 * mass))
-    return mass / (4.0 / 3.0 * math.pi * radius**3)
+    # m / (4/3 pi R^3) in logarithms (no overflow for a mistyped 1e-300 kg)
+    with np.errstate(all="ignore"):
+        return float(np.exp(math.log(mass) - math.log(4.0 / 3.0 * math.pi)
+                            - 1.5 * (math.log(5.0 * tr) - math.log(6.0 * mass))))
 
 
 def link_density(link) -> Finding | None:
