@@ -21,6 +21,7 @@ from gearcli.dynamics.solve import solve, solver_for  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 BENDIX = ROOT / "mechanisms" / "bendix_wrist.yaml"
+PAPER = ROOT / "mechanisms" / "paper_2dof.yaml"
 
 # A fresh process: solve 200 random samples (one with angles of 3e5 rad) with the llvm kernel (cache on or off), print
 # whether its code came from the cache, was stored, and every output array's bytes (hex).
@@ -48,10 +49,11 @@ print(json.dumps({"from_cache": k.jit.from_cache, "stored": k.jit.stored, "by_pr
 """
 
 
-def run_child(cache_dir, mode: str = "on") -> dict:
+def run_child(cache_dir, mode: str = "on", mech: Path = BENDIX) -> dict:
     env = {"PYTHONPATH": str(ROOT / "src"), "PATH": "/usr/bin:/bin", "GEARCLI_CACHE_DIR": str(cache_dir)}
-    out = subprocess.run([sys.executable, "-c", CHILD, str(BENDIX), mode], capture_output=True, text=True,
-                         env=env, check=True)
+    out = subprocess.run([sys.executable, "-c", CHILD, str(mech), mode], capture_output=True, text=True,
+                         env=env, timeout=300)
+    assert out.returncode == 0, (out.returncode, out.stderr[-2000:])    # a crash signal: negative
     assert out.stderr == ""                      # no warning, no traceback, whatever the cache
     return json.loads(out.stdout)
 
@@ -124,6 +126,77 @@ def test_a_damaged_entry_is_recompiled(tmp_path, damage):
     assert (again["from_cache"], again["stored"]) == (False, True)
     assert again["arrays"] == reference["arrays"]
     assert run_child(tmp_path)["from_cache"] is True       # the rewritten entry is whole
+
+
+def files_of(cache_dir, run) -> dict[str, Path]:
+    """The .obj and .prog files ``run()`` adds to the cache, by suffix."""
+    before = set((Path(cache_dir) / "llvm").glob("*")) if (Path(cache_dir) / "llvm").exists() else set()
+    run()
+    new = sorted(set((Path(cache_dir) / "llvm").glob("*")) - before)
+    assert sorted(p.suffix for p in new) == [".obj", ".prog"]
+    return {p.suffix: p for p in new}
+
+
+@pytest.mark.parametrize("swap", ["entries and notes", "entries only", "notes only", "a note naming the other entry",
+                                  "an entry copied over the other"])
+def test_foreign_entries_are_never_run(tmp_path, swap):
+    """Two mechanisms' kernel-cache entries swapped (issue 17: the checksum covered the
+    payload only, so the other kernel's code ran: SIGABRT, SIGSEGV or values 1e300x too
+    large): each process proves the entry is its own before the first call, else
+    recompiles and repairs the entry; the results equal a clean run bit for bit (in a
+    subprocess: a crash fails the test)."""
+    clean = {m: run_child(tmp_path / "clean", "off", m) for m in (BENDIX, PAPER)}
+    a = files_of(tmp_path, lambda: run_child(tmp_path, "on", BENDIX))
+    b = files_of(tmp_path, lambda: run_child(tmp_path, "on", PAPER))
+    data = {p: p.read_bytes() for f in (a, b) for p in f.values()}
+    if swap in ("entries and notes", "entries only"):
+        a[".obj"].write_bytes(data[b[".obj"]])
+        b[".obj"].write_bytes(data[a[".obj"]])
+    if swap in ("entries and notes", "notes only"):
+        a[".prog"].write_bytes(data[b[".prog"]])
+        b[".prog"].write_bytes(data[a[".prog"]])
+    if swap == "a note naming the other entry":        # self-consistent, but for the other program
+        a[".prog"].write_bytes(a[".prog"].stem.encode() + b" " + b[".obj"].stem.encode())
+    if swap == "an entry copied over the other":
+        a[".obj"].write_bytes(data[b[".obj"]])
+    for m in (BENDIX, PAPER):
+        got = run_child(tmp_path, "on", m)
+        assert got["arrays"] == clean[m]["arrays"], m.name
+        intact = m == PAPER and swap in ("a note naming the other entry", "an entry copied over the other")
+        assert got["by_program"] == intact         # loaded by program only where its note and entry are its own
+    for m in (BENDIX, PAPER):                                     # repaired: own entries, found by program
+        again = run_child(tmp_path, "on", m)
+        assert (again["from_cache"], again["by_program"], again["arrays"]) == (True, True, clean[m]["arrays"])
+    assert sorted(p.name for p in (tmp_path / "llvm").iterdir()) == sorted(p.name for f in (a, b) for p in f.values())
+
+
+def make_special(path: Path, kind: str) -> None:
+    """Put a FIFO, a symlink to /dev/zero or a folder at ``path`` (whatever was there goes)."""
+    path.unlink()
+    if kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "symlink to /dev/zero":
+        path.symlink_to("/dev/zero")
+    else:
+        path.mkdir()
+        (path / "x").write_text("x")          # not empty: cannot be removed or replaced
+
+
+@pytest.mark.parametrize("kind", ["fifo", "symlink to /dev/zero", "folder"])
+@pytest.mark.parametrize("suffix", [".obj", ".prog"])
+def test_a_special_file_as_entry_is_never_read(tmp_path, kind, suffix):
+    """A FIFO or /dev/zero in an entry's place blocked for ever (issue 17): only regular
+    files are opened; the special file is removed and the entry written again (a folder
+    that is not empty stays: then the kernel is compiled in memory), results unchanged."""
+    reference = run_child(tmp_path)
+    (path,) = (tmp_path / "llvm").glob(f"*{suffix}")
+    make_special(path, kind)
+    got = run_child(tmp_path)                 # (a timeout: the test fails)
+    assert got["arrays"] == reference["arrays"] and not got["by_program"]
+    if kind == "folder":
+        assert path.is_dir() and not path.is_symlink()
+    else:
+        assert path.is_file() and not path.is_symlink() and run_child(tmp_path)["by_program"]
 
 
 @pytest.mark.skipif(hasattr(os, "geteuid") and os.geteuid() == 0, reason="root writes anywhere")

@@ -4,22 +4,32 @@ An entry is the object code MCJIT made of one IR module for one host, in
 ``<cache dir>/llvm/<key>.obj``: the key hashes the IR text, the target triple, the host
 CPU's name and features, the llvmlite and LLVM versions and :data:`FORMAT`, so a second
 process compiling the same IR on the same machine loads the object code instead of
-optimising and generating it again.  The cache dir is ``$GEARCLI_CACHE_DIR`` if set, else
-``$XDG_CACHE_HOME/gearcli`` or ``~/.cache/gearcli``.
+optimising and generating it again.  The cache dir is :func:`gearcli.io.cache_root.cache_root`
+(``$GEARCLI_CACHE_DIR``, ``$XDG_CACHE_HOME/gearcli`` or ``~/.cache/gearcli``).
 
 * A location that cannot be created or written is no error: the kernel is compiled in
   memory as without a cache (every failure of this module is silent, by design).
-* Writes are atomic (:func:`gearcli.io.output.atomic_output`: an anonymous file in the
+* Writes are atomic (:func:`gearcli.io.cache_root.write_entry`: an anonymous file in the
   same folder, named when whole): concurrent processes or threads storing the same key
   each leave a whole entry.
-* An entry holds :data:`MAGIC`, its payload's length and SHA-256 before the payload; one
-  that does not match (truncated, corrupted) is deleted and the kernel recompiled.
+* An entry holds :data:`MAGIC`, the lengths of its header and payload and the SHA-256 of
+  both, then the header (the entry's own object key and the fingerprint of the kernel
+  program it was compiled for, :func:`program_fingerprint`) and the payload.  One that
+  does not match (truncated, corrupted) or that is not the entry of the key asked for (a
+  foreign entry: another kernel's file under this name, an entry copied from another
+  cache) is deleted, the kernel recompiled and the entry written again: machine code is
+  run only when its entry proves it is the code of this key (and, loaded by program, of
+  this program), checked before the first call.
+* Only regular files of at most :data:`MAX_ENTRY_BYTES` are read (:func:`gearcli.io.
+  cache_root.read_entry`): a FIFO, a device, a symlink or a folder in an entry's place is
+  removed, never opened for reading in a way that could block.
 * Bounded: after a write the oldest entries (by modification time, which a hit renews)
   go beyond :data:`MAX_ENTRIES` or :data:`MAX_BYTES`.
 
-``<program key>.prog`` files name the object key of a kernel program (its arrays and
-loads, hashed without building the IR, see :func:`program_key`): :func:`.backends.
-llvm_compile_estimate` asks :func:`has_program` whether a compile would be a load, and
+``<program key>.prog`` notes hold their own program key and the object key of that kernel
+program (its arrays and loads, hashed without building the IR, see :func:`program_key`); a
+note that does not name itself (moved from another program's name, damaged) is deleted.
+:func:`.backends.llvm_compile_estimate` asks :func:`has_program` whether a compile would be a load, and
 :class:`.llvm_driver.Jit` loads the object code through :func:`load_program` without
 generating the IR at all (~0.05 s for the Bendix wrist) when the program key also hashes
 the source of the IR generator (:func:`.llvm_driver.generator_digest`).
@@ -33,14 +43,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.cache_root import cache_root
-from ..io.output import OutputError, atomic_output
+from ..io.cache_root import BadEntry, cache_root, read_entry, remove_entry, write_entry
 
-FORMAT = 1                          # ours: change when the entry layout or the key changes
+FORMAT = 2                          # ours: change when the entry layout or the key changes
 MAGIC = b"gearcli-llvm-obj\x00"
-_HEAD = len(MAGIC) + 8 + 32         # magic, payload length (little endian), SHA-256
+_HEAD = len(MAGIC) + 8 + 8 + 32     # magic, header and payload lengths (little endian), SHA-256
 MAX_ENTRIES = 500
 MAX_BYTES = 200 * 2**20
+MAX_ENTRY_BYTES = 64 * 2**20        # one kernel's object code is 15-300 kB
 _STALE_TEMP_SECONDS = 3600.0
 
 
@@ -62,11 +72,10 @@ def object_key(ir: str, host: str) -> str:
     return _sha(["object", FORMAT, host, ir])
 
 
-def program_key(prog, loads: list, host: str, version: str) -> str:
-    """A key of what the IR is generated from: the kernel program's arrays and fields, the
-    external loads (:func:`.llvm_driver.mech_loads`), the host and gearcli's version."""
-    parts = ["program", FORMAT, host, version, prog.ncols, sorted(prog.offsets.items()), prog.signed,
-             prog.names, prog.covered]
+def program_fingerprint(prog, loads: list) -> str:
+    """SHA-256 of what a kernel's IR is generated from: the kernel program's arrays and
+    fields and the external loads (:func:`.llvm_driver.mech_loads`); kept in each entry."""
+    parts = ["fingerprint", FORMAT, prog.ncols, sorted(prog.offsets.items()), prog.signed, prog.names, prog.covered]
     for a in (*prog.ints, *prog.flts):
         a = np.ascontiguousarray(a)
         parts += [a.dtype.str, a.shape, a.tobytes()]
@@ -75,75 +84,118 @@ def program_key(prog, loads: list, host: str, version: str) -> str:
     return _sha(parts)
 
 
-def load(key: str) -> bytes | None:
-    """The object code stored under ``key``, or None (absent, unreadable or not whole: then deleted)."""
-    path = cache_dir() / f"{key}.obj"
+def program_key(prog, loads: list, host: str, version: str) -> str:
+    """A key of what the IR is generated from (:func:`program_fingerprint`), the host and
+    gearcli's version."""
+    return fingerprint_key(program_fingerprint(prog, loads), host, version)
+
+
+def fingerprint_key(fingerprint: str, host: str, version: str) -> str:
+    """:func:`program_key` of the kernel program of ``fingerprint``."""
+    return _sha(["program", FORMAT, host, version, fingerprint])
+
+
+def _read(path: Path, max_bytes: int = MAX_ENTRY_BYTES) -> bytes | None:
+    """The bytes of entry ``path``, or None (absent or unreadable; a special file, symlink
+    or oversized entry is removed)."""
     try:
-        data = path.read_bytes()
+        return read_entry(path, max_bytes)
+    except BadEntry:
+        remove_entry(path)
     except OSError:
+        pass
+    return None
+
+
+def load(key: str, fingerprint: str | None = None) -> bytes | None:
+    """The object code stored under ``key``, or None (absent, unreadable, not whole or not
+    this key's entry: then deleted).  With ``fingerprint``, only the entry of that kernel
+    program (:func:`program_fingerprint`) is taken; another's is left in place."""
+    path = cache_dir() / f"{key}.obj"
+    data = _read(path)
+    if data is None:
         return None
-    payload = data[_HEAD:]
-    n = int.from_bytes(data[len(MAGIC):len(MAGIC) + 8], "little") if len(data) >= _HEAD else -1
-    if (data[:len(MAGIC)] != MAGIC or n != len(payload) or not payload
-            or data[len(MAGIC) + 8:_HEAD] != hashlib.sha256(payload).digest()):
-        _remove(path)
+    entry = _parse(data)
+    if entry is None or entry[0] != key:
+        remove_entry(path)
+        return None
+    if fingerprint is not None and entry[1] != fingerprint:
         return None
     try:
         os.utime(path)              # the newest again: pruned last
     except OSError:
         pass
-    return payload
+    return entry[2]
 
 
-def _write(path: Path, data: bytes) -> bool:
-    """``data`` into ``path`` atomically (False where that fails)."""
+def _parse(data: bytes) -> tuple[str, str, bytes] | None:
+    """(object key, program fingerprint or "", payload) of an entry's bytes (None: not whole)."""
+    if len(data) < _HEAD or data[:len(MAGIC)] != MAGIC:
+        return None
+    nh = int.from_bytes(data[len(MAGIC):len(MAGIC) + 8], "little")
+    npl = int.from_bytes(data[len(MAGIC) + 8:len(MAGIC) + 16], "little")
+    body = data[_HEAD:]
+    if nh + npl != len(body) or npl == 0 or data[_HEAD - 32:_HEAD] != hashlib.sha256(body).digest():
+        return None
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with atomic_output(path, binary=True) as f:
-            f.write(data)
-        return True
-    except (OSError, OutputError):
-        return False
+        key, fingerprint = body[:nh].decode("ascii").split("\n")
+    except (UnicodeDecodeError, ValueError):
+        return None
+    return key, fingerprint, body[nh:]
 
 
-def store(key: str, payload: bytes) -> bool:
-    """Keep ``payload`` (object code) under ``key``; False where the cache is not writable."""
-    head = MAGIC + len(payload).to_bytes(8, "little") + hashlib.sha256(payload).digest()
-    ok = _write(cache_dir() / f"{key}.obj", head + bytes(payload))
+def entry_bytes(key: str, payload: bytes, fingerprint: str = "") -> bytes:
+    """The entry of object code ``payload`` under ``key`` for program ``fingerprint``."""
+    header = f"{key}\n{fingerprint}".encode("ascii")
+    body = header + bytes(payload)
+    return MAGIC + len(header).to_bytes(8, "little") + len(payload).to_bytes(8, "little") + \
+        hashlib.sha256(body).digest() + body
+
+
+def store(key: str, payload: bytes, fingerprint: str = "") -> bool:
+    """Keep ``payload`` (object code of program ``fingerprint``) under ``key``; False where
+    the cache is not writable."""
+    ok = write_entry(cache_dir() / f"{key}.obj", entry_bytes(key, payload, fingerprint))
     if ok:
         prune(cache_dir())
     return ok
 
 
+def _note(pkey: str) -> str | None:
+    """The object key program key ``pkey``'s note names (None: no note; one that is not
+    ``pkey``'s own, or damaged, is deleted)."""
+    path = cache_dir() / f"{pkey}.prog"
+    data = _read(path, 256)
+    if data is None:
+        return None
+    parts = data.split(b" ")
+    if len(parts) != 2 or parts[0] != pkey.encode() or len(parts[1]) != 64 or not parts[1].isalnum():
+        remove_entry(path)
+        return None
+    return parts[1].decode()
+
+
 def note_program(pkey: str, key: str) -> None:
     """Remember that program key ``pkey`` compiles to object key ``key`` (for the estimate)."""
-    path = cache_dir() / f"{pkey}.prog"
-    try:
-        if path.read_text() == key:
-            return
-    except (OSError, ValueError):
-        pass
-    _write(path, key.encode())
+    if _note(pkey) != key:
+        write_entry(cache_dir() / f"{pkey}.prog", f"{pkey} {key}".encode())
 
 
-def load_program(pkey: str) -> tuple[str, bytes] | None:
-    """(object key, object code) noted for program key ``pkey``, or None (no note, or its
-    entry absent or not whole)."""
-    try:
-        key = (cache_dir() / f"{pkey}.prog").read_text()
-    except (OSError, ValueError):
-        return None
-    payload = load(key) if len(key) == 64 else None
+def load_program(pkey: str, fingerprint: str | None = None) -> tuple[str, bytes] | None:
+    """(object key, object code) noted for program key ``pkey`` (and kernel program
+    ``fingerprint``), or None (no note, or its entry absent, not whole or another program's)."""
+    key = _note(pkey)
+    payload = None if key is None else load(key, fingerprint)
     return None if payload is None else (key, payload)
 
 
 def has_program(pkey: str) -> bool:
-    """True when program key ``pkey``'s object code is in the cache (a compile would be a load)."""
-    d = cache_dir()
+    """True when program key ``pkey``'s object code is in the cache (a compile would be a
+    load; a guess: the entry is not read)."""
+    key = _note(pkey)
     try:
-        key = (d / f"{pkey}.prog").read_text()
-        return len(key) == 64 and (d / f"{key}.obj").is_file()
-    except (OSError, ValueError):
+        return key is not None and (cache_dir() / f"{key}.obj").is_file()
+    except OSError:
         return False
 
 
@@ -151,7 +203,11 @@ def prune(d: Path, max_entries: int = MAX_ENTRIES, max_bytes: int = MAX_BYTES) -
     """Delete the oldest entries of ``d`` beyond ``max_entries`` / ``max_bytes`` (objects and
     program notes counted apart) and temporary files left by a killed writer."""
     try:
-        files = [(e.stat().st_mtime, e.stat().st_size, Path(e.path)) for e in os.scandir(d) if e.is_file()]
+        files = []
+        for e in os.scandir(d):
+            if e.is_file(follow_symlinks=False):
+                st = e.stat(follow_symlinks=False)
+                files.append((st.st_mtime, st.st_size, Path(e.path)))
     except OSError:
         return
     now = time.time()
@@ -160,14 +216,7 @@ def prune(d: Path, max_entries: int = MAX_ENTRIES, max_bytes: int = MAX_BYTES) -
         for mtime, nbytes, path in sorted((f for f in files if f[2].suffix == suffix), reverse=True):
             kept, size = kept + 1, size + nbytes
             if kept > max_entries or size > max_bytes:
-                _remove(path)
+                remove_entry(path)
     for mtime, _, path in files:
         if path.name.startswith(".gearcli.") and now - mtime > _STALE_TEMP_SECONDS:
-            _remove(path)
-
-
-def _remove(path: Path) -> None:
-    try:
-        path.unlink()
-    except OSError:
-        pass
+            remove_entry(path)
