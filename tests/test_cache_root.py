@@ -6,11 +6,11 @@ from __future__ import annotations
 
 import errno
 import os
-import threading
 from pathlib import Path
 
 import pytest
 
+from cache_faults import in_thread
 from gearcli.io import cache_root as cr
 
 
@@ -35,25 +35,6 @@ def test_cache_root_of_a_relative_xdg_is_not_in_the_working_directory(monkeypatc
     monkeypatch.delenv("GEARCLI_CACHE_DIR")
     monkeypatch.setenv("XDG_CACHE_HOME", "cache")
     assert cr.cache_root().is_absolute() and cr.cache_root() == tmp_path / "home" / ".cache" / "gearcli"
-
-
-def in_thread(fn, seconds: float = 10.0):
-    """fn() on a daemon thread: its result or exception; a call still blocked after
-    ``seconds`` fails the test (instead of hanging it)."""
-    box = {}
-
-    def run():
-        try:
-            box["value"] = fn()
-        except BaseException as exc:  # noqa: BLE001
-            box["error"] = exc
-    t = threading.Thread(target=run, daemon=True)
-    t.start()
-    t.join(seconds)
-    assert not t.is_alive(), "blocked"
-    if "error" in box:
-        raise box["error"]
-    return box["value"]
 
 
 def test_read_entry_reads_a_regular_file(tmp_path):

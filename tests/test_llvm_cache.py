@@ -15,6 +15,7 @@ import pytest
 pytest.importorskip("llvmlite")
 
 from big_mechanisms import serial_chain  # noqa: E402
+from cache_faults import SPECIAL, make_special  # noqa: E402
 from gearcli import analyse, load_mechanism, parse_mechanism  # noqa: E402
 from gearcli.dynamics import backends, llvm_cache  # noqa: E402
 from gearcli.dynamics.solve import solve, solver_for  # noqa: E402
@@ -170,19 +171,7 @@ def test_foreign_entries_are_never_run(tmp_path, swap):
     assert sorted(p.name for p in (tmp_path / "llvm").iterdir()) == sorted(p.name for f in (a, b) for p in f.values())
 
 
-def make_special(path: Path, kind: str) -> None:
-    """Put a FIFO, a symlink to /dev/zero or a folder at ``path`` (whatever was there goes)."""
-    path.unlink()
-    if kind == "fifo":
-        os.mkfifo(path)
-    elif kind == "symlink to /dev/zero":
-        path.symlink_to("/dev/zero")
-    else:
-        path.mkdir()
-        (path / "x").write_text("x")          # not empty: cannot be removed or replaced
-
-
-@pytest.mark.parametrize("kind", ["fifo", "symlink to /dev/zero", "folder"])
+@pytest.mark.parametrize("kind", SPECIAL)
 @pytest.mark.parametrize("suffix", [".obj", ".prog"])
 def test_a_special_file_as_entry_is_never_read(tmp_path, kind, suffix):
     """A FIFO or /dev/zero in an entry's place blocked for ever (issue 17): only regular
@@ -190,7 +179,7 @@ def test_a_special_file_as_entry_is_never_read(tmp_path, kind, suffix):
     that is not empty stays: then the kernel is compiled in memory), results unchanged."""
     reference = run_child(tmp_path)
     (path,) = (tmp_path / "llvm").glob(f"*{suffix}")
-    make_special(path, kind)
+    make_special(path, kind, full=True)
     got = run_child(tmp_path)                 # (a timeout: the test fails)
     assert got["arrays"] == reference["arrays"] and not got["by_program"]
     if kind == "folder":

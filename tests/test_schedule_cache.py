@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 from big_mechanisms import geared_chain, serial_chain
+from cache_faults import SPECIAL, in_thread, make_special
 from gearcli import analyse, load_mechanism, parse_mechanism
 from gearcli.analysis import schedule_cache
 from gearcli.analysis.schedule import UnknownGroup
@@ -63,7 +64,7 @@ def test_a_damaged_entry_is_recomputed(tmp_path, monkeypatch, damage):
         path.write_text(json.dumps(entry))
     elif damage == "not a partition":    # consistent checksum, but a link is missing
         entry["blocks"] = entry["blocks"][1:]
-        entry["sha"] = schedule_cache._blocks_sha(entry["blocks"])
+        entry["sha"] = schedule_cache._entry_sha(entry["blocks"], entry["flow"])
         path.write_text(json.dumps(entry))
     else:
         entry["key"] = "0" * 64
@@ -103,3 +104,77 @@ def test_prune_keeps_the_newest(tmp_path):
         os.utime(tmp_path / f"{i}.json", (1000 + i, 1000 + i))
     schedule_cache.prune(tmp_path, max_entries=3)
     assert sorted(p.stem for p in tmp_path.glob("*.json")) == ["2", "3", "4"]
+
+
+def forge(entry: dict, blocks=None, flow=None) -> str:
+    """``entry`` with other blocks or flow and its checksum recomputed (a checksum is no proof)."""
+    entry = dict(entry, blocks=entry["blocks"] if blocks is None else blocks,
+                 flow=entry["flow"] if flow is None else flow)
+    entry["sha"] = schedule_cache._entry_sha(entry["blocks"], entry["flow"])
+    return json.dumps(entry)
+
+
+def other_flow(flow):
+    """A scalar of the first link's first matched group moved to another link of the group
+    (the link sums no longer 6: not a maximum flow of this incidence)."""
+    flow = [list(t) for t in flow]
+    flow[0][2] -= 1
+    return flow if flow[0][2] > 0 else flow[1:]
+
+
+@pytest.mark.parametrize("forgery", ["blocks reversed", "blocks merged", "flow changed", "another mechanism's entry",
+                                     "booleans for ids", "no flow", "flow of strings"])
+def test_a_forged_entry_with_its_checksum_is_recomputed(tmp_path, monkeypatch, forgery):
+    """A cached schedule is used only when its flow proves it (issue 17: blocks reversed with
+    the checksum recomputed gave a false 'statically indeterminate' error)."""
+    monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path))
+    mech = load_mechanism(MECH / "bendix_wrist.yaml")
+    good = analyse(mech).schedule
+    (path,) = entries(tmp_path)
+    entry = json.loads(path.read_text())
+    if forgery == "blocks reversed":
+        text = forge(entry, blocks=entry["blocks"][::-1])
+    elif forgery == "blocks merged":
+        text = forge(entry, blocks=[entry["blocks"][0] + entry["blocks"][1]] + entry["blocks"][2:])
+    elif forgery == "flow changed":
+        text = forge(entry, flow=other_flow(entry["flow"]))
+    elif forgery == "another mechanism's entry":
+        analyse(load_mechanism(MECH / "paper_2dof.yaml"))
+        (other,) = set(entries(tmp_path)) - {path}
+        text = forge(dict(json.loads(other.read_text()), key=entry["key"]))
+    elif forgery == "booleans for ids":
+        text = forge(entry, flow=[[x, g, True if a == 1 else a] for x, g, a in entry["flow"]])
+    elif forgery == "no flow":
+        text = forge(entry, flow=[])
+    else:
+        text = forge(entry, flow=[[str(v) for v in t] for t in entry["flow"]])
+    path.write_text(text)
+    assert analyse(mech).schedule == good
+    assert json.loads(path.read_text()) == entry                         # rewritten whole
+
+
+@pytest.mark.parametrize("damage", ["100,000 deep", "larger than the bound", *SPECIAL])
+def test_a_hostile_entry_is_recomputed(tmp_path, monkeypatch, damage):
+    """Deep JSON raised RecursionError, a FIFO or /dev/zero blocked for ever (issue 17)."""
+    monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path))
+    mech = load_mechanism(MECH / "bendix_wrist.yaml")
+    good = analyse(mech).schedule
+    (path,) = entries(tmp_path)
+    if damage == "100,000 deep":
+        path.write_text("[" * 100_000 + "]" * 100_000)
+    elif damage == "larger than the bound":
+        monkeypatch.setattr(schedule_cache, "MAX_ENTRY_BYTES", 100)
+        path.write_text(" " * 101 + "{}")
+    else:
+        make_special(path, damage)
+    assert in_thread(lambda: analyse(mech).schedule) == good
+    assert path.is_file() and not path.is_symlink()
+    if damage != "larger than the bound":
+        assert schedule_cache.load(path.stem, *_inputs(mech)) == good     # rewritten whole
+
+
+def _inputs(mech):
+    from gearcli.analysis.schedule import unknown_groups  # noqa: PLC0415
+
+    an = analyse(mech)
+    return an.tree.moving, unknown_groups(an), an.level, an.primary

@@ -15,13 +15,13 @@ incidence reads it and does not import scipy.sparse.csgraph (most of a ``gearcli
 """
 from __future__ import annotations
 
-import heapq
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import Collector, counted
 from . import schedule_cache
+from .schedule_proof import ordered_blocks
 
 
 @dataclass(frozen=True)
@@ -90,7 +90,7 @@ def solution_schedule(an, col: Collector | None = None) -> tuple[tuple[int, ...]
                     "the loads are not statically determinate")
         return ()
     key = schedule_cache.schedule_key(moving, groups, an.redundant, an.level, an.primary)
-    cached = schedule_cache.load(key, moving)
+    cached = schedule_cache.load(key, moving, groups, an.level, an.primary)
     if cached is not None:
         return cached
     net = _Network(moving, groups)
@@ -102,7 +102,7 @@ def solution_schedule(an, col: Collector | None = None) -> tuple[tuple[int, ...]
         return ()
     comp, after = net.blocks()
     order = _ordered_blocks(an, moving, comp, after)
-    schedule_cache.store(key, order)
+    schedule_cache.store(key, order, matched_flow(net, moving))
     return order
 
 
@@ -196,29 +196,16 @@ class _Network:
 
 
 def _ordered_blocks(an, moving: list[int], comp: np.ndarray, after: dict[int, set[int]]):
-    """The blocks in the paper's order among those the dependencies allow: highest level
-    first, a primary link before the secondary links of its level, then by link id."""
+    """The blocks in the paper's order among those the dependencies allow
+    (:func:`.schedule_proof.ordered_blocks`)."""
     blocks: dict[int, list[int]] = {}
     for i, x in enumerate(moving):
         blocks.setdefault(int(comp[i]), []).append(x)
-    prim = set(an.primary)
+    return ordered_blocks(blocks, after, an.level, an.primary)
 
-    def key(k):
-        xs = blocks[k]
-        return (-max(an.level[x] for x in xs), 0 if prim & set(xs) else 1, min(xs))
-    indeg = {k: len(v) for k, v in after.items()}
-    users: dict[int, list[int]] = {k: [] for k in blocks}
-    for a, bs in after.items():
-        for b in bs:
-            users[b].append(a)
-    heap = [(key(k), k) for k, d in indeg.items() if d == 0]
-    heapq.heapify(heap)
-    order = []
-    while heap:
-        _, k = heapq.heappop(heap)
-        order.append(tuple(sorted(blocks[k])))
-        for a in users[k]:
-            indeg[a] -= 1
-            if indeg[a] == 0:
-                heapq.heappush(heap, (key(a), a))
-    return tuple(order)
+
+def matched_flow(net: _Network, moving: list[int]) -> list[list[int]]:
+    """[link, group index, scalars] of each pair the maximum flow of ``net`` matches (kept
+    with a cached schedule: :func:`.schedule_proof.proven_blocks`)."""
+    f = net.flow[1:net.L + 1, net.L + 1:net.L + 1 + net.G].tocoo()
+    return sorted([int(moving[r]), int(c), int(a)] for r, c, a in zip(f.row, f.col, f.data) if a > 0)

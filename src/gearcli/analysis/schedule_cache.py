@@ -12,11 +12,16 @@ mechanism some earlier process scheduled reads the blocks from
   scheduler never reads an older one's entries).
 * Only schedules are stored: a mechanism whose loads are not determined is found out by the
   flow in every process (its messages need it).
-* An entry holds its key, the blocks and their SHA-256; one that does not match, or whose
-  blocks are not a partition of the moving links, is deleted and the schedule recomputed.
+* An entry holds its key, the blocks, the maximum flow they were found from and a SHA-256
+  of both.  A checksum is no proof (anyone can recompute one): the blocks are used only
+  when the flow is a maximum flow of *this* incidence and the schedule derived from it in
+  plain Python (:func:`.schedule_proof.proven_blocks`) is the stored one.  An entry that
+  fails any of this (truncated, foreign, forged, not JSON, nested 100,000 deep, larger than
+  :data:`MAX_ENTRY_BYTES`, a FIFO or symlink, :func:`gearcli.io.cache_root.read_entry`) is
+  deleted and the schedule recomputed: :func:`load` never raises.
 * Like the kernel cache: a location that cannot be created or written is no error (nothing
-  is cached), writes are atomic, and after a write the oldest entries beyond
-  :data:`MAX_ENTRIES` go.
+  is cached), writes are atomic (:func:`gearcli.io.cache_root.write_entry`), and after a
+  write the oldest entries beyond :data:`MAX_ENTRIES` go.
 """
 from __future__ import annotations
 
@@ -26,11 +31,12 @@ import os
 from functools import lru_cache
 from pathlib import Path
 
-from ..io.cache_root import cache_root
-from ..io.output import OutputError, atomic_output
+from ..io.cache_root import BadEntry, cache_root, read_entry, remove_entry, write_entry
+from .schedule_proof import proven_blocks
 
-FORMAT = 1
+FORMAT = 2
 MAX_ENTRIES = 2000
+MAX_ENTRY_BYTES = 64 * 2**20        # 10,000 links: ~1 MB
 
 
 def cache_dir() -> Path:
@@ -40,11 +46,15 @@ def cache_dir() -> Path:
 
 @lru_cache(maxsize=1)
 def scheduler_digest() -> str | None:
-    """SHA-256 of :mod:`.schedule`'s source (None: it cannot be read; then nothing is cached)."""
+    """SHA-256 of the source of :mod:`.schedule` and :mod:`.schedule_proof` (None: one cannot
+    be read; then nothing is cached)."""
+    h = hashlib.sha256()
     try:
-        return hashlib.sha256((Path(__file__).parent / "schedule.py").read_bytes()).hexdigest()
+        for name in ("schedule.py", "schedule_proof.py"):
+            h.update(hashlib.sha256((Path(__file__).parent / name).read_bytes()).digest())
     except OSError:
         return None
+    return h.hexdigest()
 
 
 def schedule_key(moving, groups, redundant: bool, level, primary) -> str | None:
@@ -60,50 +70,63 @@ def schedule_key(moving, groups, redundant: bool, level, primary) -> str | None:
     return hashlib.sha256(json.dumps(parts, separators=(",", ":")).encode()).hexdigest()
 
 
-def _blocks_sha(blocks) -> str:
-    return hashlib.sha256(json.dumps(blocks, separators=(",", ":")).encode()).hexdigest()
+def _entry_sha(blocks, flow) -> str:
+    return hashlib.sha256(json.dumps([blocks, flow], separators=(",", ":")).encode()).hexdigest()
 
 
-def load(key: str | None, moving) -> tuple[tuple[int, ...], ...] | None:
-    """The schedule stored under ``key`` (blocks of link ids), or None (absent, or not whole
-    or not a partition of ``moving``: then deleted)."""
+def load(key: str | None, moving, groups=None, level=None, primary=()) -> tuple[tuple[int, ...], ...] | None:
+    """The schedule stored under ``key`` (blocks of link ids), or None (absent; or not whole,
+    not this key's, or not the schedule its maximum flow proves for ``moving`` links,
+    unknown ``groups``, ``level`` and ``primary`` links (:func:`.schedule_proof.proven_blocks`):
+    then deleted).  Never raises: a special file, a huge or deeply nested entry is damage too."""
     if key is None:
         return None
     path = cache_dir() / f"{key}.json"
     try:
-        entry = json.loads(path.read_text())
+        entry = json.loads(read_entry(path, MAX_ENTRY_BYTES))
     except FileNotFoundError:
         return None
-    except (OSError, ValueError):
-        return _remove(path)
-    try:
-        blocks = entry["blocks"]
-        ok = (entry["key"] == key and entry["sha"] == _blocks_sha(blocks)
-              and all(isinstance(x, int) for b in blocks for x in b) and all(blocks)
-              and sorted(x for b in blocks for x in b) == sorted(int(x) for x in moving))
-    except (KeyError, TypeError):
-        ok = False
-    if not ok:
-        return _remove(path)
+    except BadEntry:
+        return remove_entry(path)
+    except OSError:                 # unreadable: leave it
+        return None
+    except (ValueError, RecursionError, MemoryError):
+        return remove_entry(path)
+    blocks = _proven(entry, key, moving, groups, level, primary)
+    if blocks is None:
+        return remove_entry(path)
     try:
         os.utime(path)              # the newest again: pruned last
     except OSError:
         pass
-    return tuple(tuple(b) for b in blocks)
+    return blocks
 
 
-def store(key: str | None, blocks) -> bool:
-    """Keep ``blocks`` under ``key``; False where the cache is not writable (or no key)."""
+def _proven(entry, key, moving, groups, level, primary):
+    """The blocks of ``entry`` when it is whole, ``key``'s, and its flow proves them."""
+    if not (isinstance(entry, dict) and entry.get("key") == key and isinstance(entry.get("blocks"), list)):
+        return None
+    blocks, flow = entry["blocks"], entry.get("flow")
+    try:
+        if entry.get("sha") != _entry_sha(blocks, flow) or groups is None:
+            return None
+    except (ValueError, TypeError, RecursionError):
+        return None
+    proven = proven_blocks(flow, moving, groups, level, primary)
+    return proven if proven is not None and [list(b) for b in proven] == blocks else None
+
+
+def store(key: str | None, blocks, flow) -> bool:
+    """Keep ``blocks`` and the maximum ``flow`` they come from ([link, group index, scalars]
+    triples, :func:`.schedule.matched_flow`) under ``key``; False where the cache is not
+    writable (or no key)."""
     if key is None:
         return False
     blocks = [[int(x) for x in b] for b in blocks]
-    text = json.dumps({"key": key, "blocks": blocks, "sha": _blocks_sha(blocks)})
+    flow = [[int(v) for v in t] for t in flow]
+    text = json.dumps({"key": key, "blocks": blocks, "flow": flow, "sha": _entry_sha(blocks, flow)})
     d = cache_dir()
-    try:
-        d.mkdir(parents=True, exist_ok=True)
-        with atomic_output(d / f"{key}.json") as f:
-            f.write(text)
-    except (OSError, OutputError):
+    if not write_entry(d / f"{key}.json", text.encode()):
         return False
     prune(d)
     return True
@@ -112,15 +135,9 @@ def store(key: str | None, blocks) -> bool:
 def prune(d: Path, max_entries: int = MAX_ENTRIES) -> None:
     """Delete the oldest entries of ``d`` beyond ``max_entries``."""
     try:
-        files = sorted((e.stat().st_mtime, e.path) for e in os.scandir(d) if e.name.endswith(".json"))
+        files = sorted((e.stat(follow_symlinks=False).st_mtime, e.path) for e in os.scandir(d)
+                       if e.name.endswith(".json"))
     except OSError:
         return
     for _, path in files[:max(0, len(files) - max_entries)]:
-        _remove(Path(path))
-
-
-def _remove(path: Path) -> None:
-    try:
-        path.unlink()
-    except OSError:
-        pass
+        remove_entry(Path(path))

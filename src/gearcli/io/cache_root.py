@@ -10,7 +10,7 @@ among the user's files.
 Entries are read by :func:`read_entry`, which opens only regular files (``O_NOFOLLOW``, then
 ``fstat``, with ``O_NONBLOCK`` so that a FIFO put in an entry's place cannot block the open)
 of bounded size, and written by :func:`write_entry`: an anonymous file in the folder named
-only when whole (:mod:`.output`'s ``O_TMPFILE``/``linkat`` writer), replacing whatever has
+only when whole (:func:`.output.replace_file`, gearcli's one atomic writer), replacing whatever has
 the name (a symlink is replaced, never followed).  Neither raises for an unusable cache:
 every failure of a cache is silent by design (the caller computes what it wanted instead).
 """
@@ -21,7 +21,7 @@ import os
 import stat
 from pathlib import Path
 
-from .output import _link_anonymous, _open_anonymous
+from .output import replace_file
 
 
 def cache_root() -> Path:
@@ -77,28 +77,10 @@ def write_entry(path: Path, data: bytes) -> bool:
     fails: no folder can be made, not writable, full disk; nothing is left behind then)."""
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = _open_anonymous(str(path.parent))
-    except OSError:
-        return False
-    try:
-        view = memoryview(data)
-        while view:
-            view = view[os.write(fd, view):]
-        if tmp is None:
-            _link_anonymous(fd, str(path))
-        else:
-            os.replace(tmp, path)
-            tmp = None
+        replace_file(path, data)
         return True
     except OSError:
         return False
-    finally:
-        try:
-            os.close(fd)
-        except OSError:
-            pass
-        if tmp is not None:
-            remove_entry(Path(tmp))
 
 
 def remove_entry(path: Path) -> None:

@@ -205,3 +205,25 @@ def write_text(path: str | os.PathLike, text: str, inputs: Iterable[str | os.Pat
     """Write ``text`` to ``path`` atomically (see :func:`atomic_output`)."""
     with atomic_output(path, inputs) as f:
         f.write(text)
+
+
+def replace_file(path: str | os.PathLike, data: bytes) -> None:
+    """``data`` as file ``path``, atomically, replacing whatever has that name: a symlink is
+    replaced, not followed (for gearcli's own files, the disk caches' entries: none of
+    :func:`output_target`'s checks of an ``-o`` argument).  Raises OSError; nothing is left
+    behind on failure (no temporary file, the old file unchanged)."""
+    target = os.fspath(path)
+    fd, tmp = _open_anonymous(os.path.dirname(target) or ".")
+    try:
+        view = memoryview(data)
+        while view:
+            view = view[os.write(fd, view):]
+        if tmp is None:
+            _link_anonymous(fd, target)
+        else:
+            os.replace(tmp, target)
+            tmp = None
+    finally:
+        _close_quietly(None, fd)
+        if tmp is not None:
+            Path(tmp).unlink(missing_ok=True)
