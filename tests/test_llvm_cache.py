@@ -210,17 +210,23 @@ def test_an_unusable_location_compiles_in_memory(tmp_path, where):
     assert run_child(tmp_path / "ok")["arrays"] == got["arrays"]
 
 
-def test_concurrent_first_processes_both_store(tmp_path):
-    """Two processes compiling the same kernel into an empty cache at once: both store
-    (atomically), the entry left is whole, the results agree."""
-    env = {"PYTHONPATH": str(ROOT / "src"), "PATH": "/usr/bin:/bin", "GEARCLI_CACHE_DIR": str(tmp_path)}
-    procs = [subprocess.Popen([sys.executable, "-c", CHILD, str(BENDIX), "on"], stdout=subprocess.PIPE, env=env,
-                              text=True) for _ in range(2)]
-    outs = [json.loads(p.communicate()[0]) for p in procs]
-    assert [p.returncode for p in procs] == [0, 0]
-    assert outs[0]["arrays"] == outs[1]["arrays"]
-    assert len(objects(tmp_path)) == 1 and not list((tmp_path / "llvm").glob(".gearcli.*"))
-    assert run_child(tmp_path)["from_cache"] is True
+def test_concurrent_cold_compiles(tmp_path):
+    """Four processes compiling two kernels (two each) into an empty cache at once: all
+    store atomically, the entries left are whole (the next process of each loads by
+    program), no temporary file is left, and every result equals a clean run bit for bit."""
+    clean = {m: run_child(tmp_path / "clean", "off", m) for m in (BENDIX, PAPER)}
+    env = {"PYTHONPATH": str(ROOT / "src"), "PATH": "/usr/bin:/bin", "GEARCLI_CACHE_DIR": str(tmp_path / "c")}
+    mechs = [BENDIX, PAPER, BENDIX, PAPER]
+    procs = [subprocess.Popen([sys.executable, "-c", CHILD, str(m), "on"], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, env=env, text=True) for m in mechs]
+    outs = [p.communicate(timeout=600) for p in procs]
+    assert [p.returncode for p in procs] == [0] * 4, [e[-2000:] for _, e in outs]
+    for m, (out, err) in zip(mechs, outs):
+        assert err == "" and json.loads(out)["arrays"] == clean[m]["arrays"]
+    assert len(objects(tmp_path / "c")) == 2 and not list((tmp_path / "c").rglob(".gearcli.*"))
+    for m in (BENDIX, PAPER):
+        again = run_child(tmp_path / "c", "on", m)
+        assert (again["by_program"], again["arrays"]) == (True, clean[m]["arrays"])
 
 
 def test_host_identity_names_cpu_and_features():
