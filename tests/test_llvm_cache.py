@@ -281,6 +281,30 @@ def test_auto_counts_a_cached_kernel_as_cheap(tmp_path, monkeypatch):
     assert "run:" in second.llvm_kernel().jit.assembly()    # optimised again on demand
 
 
+def test_programs_sharing_one_ir_share_the_entry(tmp_path, monkeypatch):
+    """Two kernel programs that differ only in a load's point (a run-time array) generate the
+    same IR: the second finds
+    the first's entry by its IR key, adds its own fingerprint to it (no second entry) and is
+    found by program from then on, and so is the first; a program not in the entry is not."""
+    monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path))
+
+    def kernel(text):
+        s = solver_for(analyse(parse_mechanism(text)))
+        q = np.zeros((2, s.an.dof))
+        solve(s.an, q, q, q, backend="llvm", jobs=1)
+        return s.llvm_kernel().jit
+    load = "loads:\n  - {name: tip, link: L3, point: [P, 0, 0], frame: base, force: [0, 10, 0], moment: [0, 0, 0]}\n"
+    a, b = serial_chain(3) + load.replace("P", "0.5"), serial_chain(3) + load.replace("P", "0.25")
+    first = kernel(a)
+    assert (first.from_cache, first.stored) == (False, True)
+    second = kernel(b)
+    assert (second.from_cache, second.by_program, second.key) == (True, False, first.key)
+    assert len(objects(tmp_path)) == 1
+    assert kernel(b).by_program and kernel(a).by_program
+    (obj,) = objects(tmp_path)
+    assert llvm_cache.load(obj.stem, "0" * 64) is None and llvm_cache.load(obj.stem) is not None
+
+
 def test_prune_keeps_the_newest(tmp_path):
     for i in range(6):
         (tmp_path / f"{i:064x}.obj").write_bytes(b"x" * 100)

@@ -13,8 +13,9 @@ optimising and generating it again.  The cache dir is :func:`gearcli.io.cache_ro
   same folder, named when whole): concurrent processes or threads storing the same key
   each leave a whole entry.
 * An entry holds :data:`MAGIC`, the lengths of its header and payload and the SHA-256 of
-  both, then the header (the entry's own object key and the fingerprint of the kernel
-  program it was compiled for, :func:`program_fingerprint`) and the payload.  One that
+  both, then the header (the entry's own object key and the fingerprints of the kernel
+  programs it is the code of, :func:`program_fingerprint`: the one it was compiled for,
+  and those whose IR was found to hash to its key) and the payload.  One that
   does not match (truncated, corrupted) or that is not the entry of the key asked for (a
   foreign entry: another kernel's file under this name, an entry copied from another
   cache) is deleted, the kernel recompiled and the entry written again: machine code is
@@ -51,6 +52,7 @@ _HEAD = len(MAGIC) + 8 + 8 + 32     # magic, header and payload lengths (little 
 MAX_ENTRIES = 500
 MAX_BYTES = 200 * 2**20
 MAX_ENTRY_BYTES = 64 * 2**20        # one kernel's object code is 15-300 kB
+MAX_PROGRAMS = 16                   # kernel programs noted in one entry (same IR: loads differ, names differ)
 _STALE_TEMP_SECONDS = 3600.0
 
 
@@ -107,10 +109,13 @@ def _read(path: Path, max_bytes: int = MAX_ENTRY_BYTES) -> bytes | None:
     return None
 
 
-def load(key: str, fingerprint: str | None = None) -> bytes | None:
+def load(key: str, fingerprint: str | None = None, adopt: str = "") -> bytes | None:
     """The object code stored under ``key``, or None (absent, unreadable, not whole or not
-    this key's entry: then deleted).  With ``fingerprint``, only the entry of that kernel
-    program (:func:`program_fingerprint`) is taken; another's is left in place."""
+    this key's entry: then deleted).  With ``fingerprint``, only an entry compiled for that
+    kernel program (:func:`program_fingerprint`) is taken; another's is left in place.
+    ``adopt``: a program whose IR is ``key``'s (the caller generated and hashed it), added
+    to the entry's programs (at most :data:`MAX_PROGRAMS`, the newest kept) so that it is
+    found by program next time."""
     path = cache_dir() / f"{key}.obj"
     data = _read(path)
     if data is None:
@@ -119,8 +124,10 @@ def load(key: str, fingerprint: str | None = None) -> bytes | None:
     if entry is None or entry[0] != key:
         remove_entry(path)
         return None
-    if fingerprint is not None and entry[1] != fingerprint:
+    if fingerprint is not None and fingerprint not in entry[1]:
         return None
+    if adopt and adopt not in entry[1]:
+        write_entry(path, entry_bytes(key, entry[2], (*entry[1], adopt)[-MAX_PROGRAMS:]))
     try:
         os.utime(path)              # the newest again: pruned last
     except OSError:
@@ -128,8 +135,8 @@ def load(key: str, fingerprint: str | None = None) -> bytes | None:
     return entry[2]
 
 
-def _parse(data: bytes) -> tuple[str, str, bytes] | None:
-    """(object key, program fingerprint or "", payload) of an entry's bytes (None: not whole)."""
+def _parse(data: bytes) -> tuple[str, tuple[str, ...], bytes] | None:
+    """(object key, program fingerprints, payload) of an entry's bytes (None: not whole)."""
     if len(data) < _HEAD or data[:len(MAGIC)] != MAGIC:
         return None
     nh = int.from_bytes(data[len(MAGIC):len(MAGIC) + 8], "little")
@@ -138,15 +145,15 @@ def _parse(data: bytes) -> tuple[str, str, bytes] | None:
     if nh + npl != len(body) or npl == 0 or data[_HEAD - 32:_HEAD] != hashlib.sha256(body).digest():
         return None
     try:
-        key, fingerprint = body[:nh].decode("ascii").split("\n")
-    except (UnicodeDecodeError, ValueError):
+        key, *fingerprints = body[:nh].decode("ascii").split("\n")
+    except UnicodeDecodeError:
         return None
-    return key, fingerprint, body[nh:]
+    return key, tuple(fingerprints), body[nh:]
 
 
-def entry_bytes(key: str, payload: bytes, fingerprint: str = "") -> bytes:
-    """The entry of object code ``payload`` under ``key`` for program ``fingerprint``."""
-    header = f"{key}\n{fingerprint}".encode("ascii")
+def entry_bytes(key: str, payload: bytes, fingerprints: tuple[str, ...] = ()) -> bytes:
+    """The entry of object code ``payload`` under ``key`` for the kernel programs ``fingerprints``."""
+    header = "\n".join((key, *fingerprints)).encode("ascii")
     body = header + bytes(payload)
     return MAGIC + len(header).to_bytes(8, "little") + len(payload).to_bytes(8, "little") + \
         hashlib.sha256(body).digest() + body
@@ -155,7 +162,7 @@ def entry_bytes(key: str, payload: bytes, fingerprint: str = "") -> bytes:
 def store(key: str, payload: bytes, fingerprint: str = "") -> bool:
     """Keep ``payload`` (object code of program ``fingerprint``) under ``key``; False where
     the cache is not writable."""
-    ok = write_entry(cache_dir() / f"{key}.obj", entry_bytes(key, payload, fingerprint))
+    ok = write_entry(cache_dir() / f"{key}.obj", entry_bytes(key, payload, (fingerprint,) if fingerprint else ()))
     if ok:
         prune(cache_dir())
     return ok

@@ -133,7 +133,7 @@ class Jit:
         else:
             self._ir = self._text(module)
             self.key = llvm_cache.object_key(self._ir, host_identity())
-            cached = llvm_cache.load(self.key) if cache else None
+            cached = llvm_cache.load(self.key, adopt=fingerprint) if cache else None
         self.from_cache = cached is not None
         self._module = None if cached else self._optimised(llvm, tm)
         mod = self._module
