@@ -484,6 +484,30 @@ def test_broken_pipe_exits_quietly(mech_dir):
     assert p.returncode == 141 and err == b"", err
 
 
+
+@pytest.mark.parametrize("args", [
+    ("check", "mechanisms/bendix_wrist.yaml"),
+    ("graph", "mechanisms/bendix_wrist.yaml"),
+    ("graph", "--json", "mechanisms/bendix_wrist.yaml"),
+    ("graph", "--dot", "mechanisms/bendix_wrist.yaml"),
+    ("export", "mechanisms/bendix_wrist.yaml", "-o", "-"),
+    ("solve", "mechanisms/paper_2dof.yaml", "mechanisms/paper_2dof_traj.csv", "-o", "-", "--backend", "numpy"),
+    ("verify", "designs/ci_example.yaml", "-j", "1"),
+    ("--version",),
+    ("solve", "--help"),
+], ids=lambda a: " ".join(a[:2]) if a[0] == "graph" else a[0])
+def test_every_command_ends_quietly_on_a_closed_pipe(args):
+    """stdout is a pipe whose reader is gone before gearcli writes (``| head -c 0``, without
+    the race): status 141, nothing on stderr, whatever prints the text (rich or echo)."""
+    r, w = os.pipe()
+    os.close(r)
+    try:
+        p = subprocess.run(gearcli_cmd(*args), env=env(), cwd=ROOT, stdout=w, stderr=subprocess.PIPE, timeout=300)
+    finally:
+        os.close(w)
+    assert (p.returncode, p.stderr) == (141, b"")
+
+
 def test_stdout_output_checks_the_whole_trajectory_first(run_cli, work):
     t = np.arange(3000) * 1e-3
     text = rows(t, np.sin(t)) + "3.0,oops,0\n"

@@ -18,7 +18,7 @@ import typer
 
 from . import __version__
 from .errors import GearcliError, counted
-from .exits import EXIT_CHECK_FAILED, bad_input_exits, print_problems, reports_bad_input, stderr_may_fail
+from .exits import EXIT_BROKEN_PIPE, EXIT_CHECK_FAILED, bad_input_exits, print_problems, reports_bad_input, stderr_may_fail
 from .report.features import feature_notes
 from .report.sharing import sharing_notes
 from .report.tables import JSON_DIGITS, print_graph_tables, round_sig, stderr_console, stdout_console, summary_table
@@ -28,7 +28,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
 
 class _App(typer.Typer):
-    """A failure outside a command (``--help`` into a full stdout) is one line too, no traceback."""
+    """A failure outside a command (``--help`` into a full stdout) is one line too, no
+    traceback; a closed pipe there ends with status 141 too."""
     def __call__(self, *args, **kwargs):
         try:
             with bad_input_exits():
@@ -37,6 +38,12 @@ class _App(typer.Typer):
                 return super().__call__(*args, **kwargs)
         except typer.Exit as exc:
             sys.exit(exc.exit_code)
+        except SystemExit as exc:
+            if exc.code == 1 and type(sys.stdout).__name__ == "PacifyFlushWrapper":
+                # click's (or typer's copy of click's) answer to a closed pipe during
+                # --help/--version: stdout wrapped, exit 1; gearcli's is 141, as for commands
+                sys.exit(EXIT_BROKEN_PIPE)
+            raise
 
 
 app = _App(

@@ -6,7 +6,9 @@ rich is imported when a table or console is made (``gearcli --help`` and ``check
 """
 from __future__ import annotations
 
+import errno
 import math
+import os
 from typing import TYPE_CHECKING
 
 from ..errors import counted
@@ -53,9 +55,21 @@ def stdout_console() -> Console:
     lines (solve order, ...) are never wrapped, so they stay greppable."""
     from rich.console import Console  # noqa: PLC0415
 
-    console = Console(markup=False, highlight=False, soft_wrap=True)
+    console = _raises_on_closed_pipe(Console(markup=False, highlight=False, soft_wrap=True))
     if not console.is_terminal:   # piped or redirected: do not squeeze tables into 80 columns
         console.width = max(console.width, 132)
+    return console
+
+
+def _raises_on_closed_pipe(console: Console) -> Console:
+    """``console`` raising :class:`BrokenPipeError` on a closed pipe, as every other write
+    does, so that :func:`gearcli.exits.bad_input_exits` ends the run quietly with status 141
+    (rich's own handler exits with status 1: ``gearcli graph ... | head -c 10`` did)."""
+    def closed() -> None:
+        console.quiet = True   # nothing more to write
+        raise BrokenPipeError(errno.EPIPE, os.strerror(errno.EPIPE))
+
+    console.on_broken_pipe = closed
     return console
 
 
@@ -71,7 +85,7 @@ def stderr_console() -> Console:
     no highlighting; as wide as :func:`stdout_console`'s when not a terminal."""
     from rich.console import Console  # noqa: PLC0415
 
-    err = Console(stderr=True, markup=False, highlight=False)
+    err = _raises_on_closed_pipe(Console(stderr=True, markup=False, highlight=False))
     if not err.is_terminal:
         err.width = max(err.width, 132)
     return err
