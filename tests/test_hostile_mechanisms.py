@@ -469,3 +469,30 @@ def test_quiet_yourdfpy_silences_its_log_and_prints(capfd, caplog):
     assert out == "" and err == "" and not caplog.records
     logging.getLogger("yourdfpy.urdf").error("visible again")
     assert [r.getMessage() for r in caplog.records] == ["visible again"]
+
+
+# --------------------------------------------------------------------------------------
+# truncated files: the line cited is one of the file's
+# --------------------------------------------------------------------------------------
+def test_truncated_file_without_final_newline_cites_its_last_line(run_cli, tmp_path):
+    """libyaml puts the end of a stream without a final newline on the line after it."""
+    text = "name: x\nlinks:\n  - {name: a, mass: 1"
+    bad(run_cli, tmp_path, text, 3, "", "^YAML syntax error: did not find expected ',' or '}'$")
+    bad(run_cli, tmp_path, "name: x\nlinks: [", 2, "", "^YAML syntax error: ")
+    bad(run_cli, tmp_path, "name: x\nlinks: [\n", 3, "", "^YAML syntax error: ")   # the empty line after the newline
+
+
+def test_every_truncation_cites_a_line_of_the_file():
+    from gearcli.errors import MechanismError  # noqa: PLC0415
+    from gearcli.io.yaml_reader import parse_mechanism  # noqa: PLC0415
+
+    cuts = sorted({*range(1, len(PAPER), 23), *(i for i, c in enumerate(PAPER) if c in "[{:,")})
+    beyond = []
+    for cut in cuts:
+        text = PAPER[:cut].rstrip("\n")
+        last = text.count("\n") + 1
+        try:
+            parse_mechanism(text, "cut.yaml")
+        except MechanismError as exc:
+            beyond += [(cut, i.line, last, i.message) for i in exc.issues if i.line is not None and i.line > last]
+    assert beyond == []

@@ -21,6 +21,7 @@ import gc
 import re
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Iterator
 
 import yaml
 from yaml.events import (AliasEvent, MappingEndEvent, MappingStartEvent, ScalarEvent,
@@ -59,6 +60,21 @@ Loader.add_implicit_resolver(
 def _fail(file: str, mark, message: str):
     line = mark.line + 1 if mark is not None else None
     raise MechanismError([Issue(file, "", line, message)])
+
+
+@contextmanager
+def _lines_within(text: str) -> Iterator[None]:
+    """Errors raised in the block cite a line of ``text``: libyaml puts the end of a
+    stream that lacks its final newline on the line after it (a truncated file was
+    reported one line past its end); such a line becomes the last one."""
+    try:
+        yield
+    except MechanismError as exc:
+        last = text.count("\n") + 1     # the last line (empty after a final newline)
+        if all(i.line is None or i.line <= last for i in exc.issues):
+            raise
+        raise MechanismError([Issue(i.file, i.path, i.line if i.line is None else min(i.line, last), i.message)
+                              for i in exc.issues]) from None
 
 
 def read_text(path: str | Path, kind: str = "mechanism file") -> str:
@@ -266,16 +282,17 @@ def compose(text: str, file: str):
     limits of the module docstring; raises MechanismError."""
     flow_depth_guard(text, file)
     loader = Loader(text)
-    try:
-        with _gc_paused():
-            comp = _Composer(loader, file)
-            root, size = comp.document()
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        _fail(file, mark, f"YAML syntax error: {problem}")
-    finally:
-        loader.dispose()
+    with _lines_within(text):
+        try:
+            with _gc_paused():
+                comp = _Composer(loader, file)
+                root, size = comp.document()
+        except yaml.YAMLError as exc:
+            mark = getattr(exc, "problem_mark", None)
+            problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+            _fail(file, mark, f"YAML syntax error: {problem}")
+        finally:
+            loader.dispose()
     limit = ALIAS_FACTOR * comp.nodes + ALIAS_SLACK
     if size > limit:
         _fail(file, comp.worst_alias[1], f"YAML aliases expand the document to more than {limit:,} nodes "
