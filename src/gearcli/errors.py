@@ -48,6 +48,20 @@ def counted(n: int, noun: str, nouns: str | None = None) -> str:
     return f"{n} {plural(n, noun, nouns)}"
 
 
+MAX_SHOWN = 50
+"""Problems the command line prints of one error; the rest are counted on one more line
+(a file with 20,000 unknown keys gives 50 lines and ``… and 19,950 more problems``)."""
+
+
+def shown(lines: list[str], limit: int = MAX_SHOWN) -> list[str]:
+    """The first ``limit`` of ``lines`` and, when some are left out, a last line counting
+    them: ``… and 19,950 more problems``."""
+    if len(lines) <= limit:
+        return list(lines)
+    rest = len(lines) - limit
+    return lines[:limit] + [f"… and {rest:,} more {plural(rest, 'problem')}"]
+
+
 class GearcliError(Exception):
     """Base class of the errors gearcli reports as bad input (exit status 2)."""
 
@@ -92,6 +106,8 @@ class Collector:
         self.file = file
         self.lines = lines if lines is not None else {}
         self.issues: list[Issue] = []
+        self._seen: set[Issue] = set()   # the issues[:_counted] as a set: add() is O(1)
+        self._counted = 0
 
     def line_of(self, path: str) -> int | None:
         """Line of ``path`` or of its nearest enclosing node."""
@@ -107,8 +123,15 @@ class Collector:
         """Record a problem at YAML/element ``path`` (its line looked up), once (the copies
         of a ``planets: N`` item report at their original's path)."""
         issue = Issue(self.file, path, self.line_of(path), message)
-        if issue not in self.issues:
+        if len(self.issues) < self._counted:      # the list was replaced by a shorter one
+            self._seen, self._counted = set(), 0
+        if len(self.issues) > self._counted:      # issues appended directly (readers merge lists)
+            self._seen.update(self.issues[self._counted:])
+            self._counted = len(self.issues)
+        if issue not in self._seen:
             self.issues.append(issue)
+            self._seen.add(issue)
+            self._counted += 1
 
     def raise_if_any(self) -> None:
         """Raise a :class:`MechanismError` with every problem recorded so far, if any."""

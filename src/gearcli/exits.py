@@ -18,7 +18,7 @@ from typing import Iterator
 
 import typer
 
-from .errors import GearcliError
+from .errors import GearcliError, shown
 
 EXIT_CHECK_FAILED = 1     # verify: a check failed
 EXIT_BAD_INPUT = 2
@@ -90,8 +90,8 @@ def _silence(stream) -> None:
 def bad_input_exits() -> Iterator[None]:
     """Turn every failure that is not a bug into one line on stderr and an exit status.
 
-    :class:`~gearcli.errors.GearcliError` (bad input, an unwritable output): its lines,
-    status 2.  A failing stdout (a full device): ``stdout: cannot write: ...``, status 2.
+    :class:`~gearcli.errors.GearcliError` (bad input, an unwritable output): its lines
+    (at most :data:`~gearcli.errors.MAX_SHOWN`, then a count of the rest), status 2.  A failing stdout (a full device): ``stdout: cannot write: ...``, status 2.
     A closed pipe (``gearcli ... | head -1``): no message, status 141.  Ctrl-C: one line,
     status 130; SIGTERM: one line, status 143 (temporary files are removed first).
     """
@@ -103,7 +103,7 @@ def bad_input_exits() -> Iterator[None]:
             yield
             sys.stdout.flush()
     except GearcliError as exc:
-        print_problems(exc.lines())
+        print_problems(shown(exc.lines()))
         raise typer.Exit(EXIT_BAD_INPUT) from None
     except BrokenPipeError:
         _silence(sys.stdout)
