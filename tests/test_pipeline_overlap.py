@@ -20,7 +20,25 @@ def test_prefetch_yields_in_order_then_raises_the_producers_error():
         with Prefetch(items()) as parts:
             for x in parts:
                 got.append(x)
-    assert got == [0, 1, 2, 3, 4]
+    assert got == list(range(len(got)))     # in order; the last ones may be dropped for the error
+
+
+def test_prefetch_raises_the_producers_error_before_the_items_still_queued():
+    """A bad row near the end of a file is reported as soon as it is read, not after the
+    chunks queued before it are solved (issue 17: 8.2 s for a bad row at 59,002 of 60,000)."""
+    def items():
+        yield from range(5)
+        raise ValueError("row 59002 is bad")
+
+    got = []
+    pf = Prefetch(items(), depth=8)
+    with pytest.raises(ValueError, match="row 59002 is bad"):
+        with pf as parts:
+            for x in parts:
+                got.append(x)
+                pf.thread.join(timeout=60)      # the producer has read everything and failed
+                assert not pf.thread.is_alive()
+    assert got in ([], [0])      # whether the error came before the first item or after
 
 
 def test_prefetch_runs_ahead_in_another_thread():

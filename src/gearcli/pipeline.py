@@ -180,12 +180,15 @@ def _run(solve_chunks, table_file) -> None:
 class Prefetch:
     """Context manager iterating ``items`` one item ahead in a background thread (reading and
     spline differentiation of chunk k + 1 overlap the solve of chunk k; parsing, LAPACK and
-    the kernel release the GIL).  Items, and an exception raised by ``items``, arrive in
-    order; leaving the context stops the thread (after the item it is producing)."""
+    the kernel release the GIL).  Items arrive in order; an exception raised by ``items``
+    is raised as soon as it is known, in place of the items still queued (the run fails
+    anyway: a bad row near the end of a file is reported without solving the chunks read
+    before it); leaving the context stops the thread (after the item it is producing)."""
 
     def __init__(self, items, depth: int = 1):
         self.items, self.queue, self.stop = items, queue.Queue(maxsize=depth), threading.Event()
         self.thread = threading.Thread(target=self._run, name="gearcli-read", daemon=True)
+        self.error: BaseException | None = None
 
     def __enter__(self):
         self.thread.start()
@@ -201,6 +204,7 @@ class Prefetch:
                 if not self._put((True, x)):
                     return
         except BaseException as exc:   # noqa: BLE001 (re-raised in the consuming thread)
+            self.error = exc
             self._put((False, exc))
             return
         self._put((False, None))
@@ -217,6 +221,8 @@ class Prefetch:
     def _iter(self):
         while True:
             ok, x = self.queue.get()
+            if self.error is not None:
+                raise self.error
             if ok:
                 yield x
             elif x is None:

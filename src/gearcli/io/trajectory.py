@@ -25,10 +25,8 @@ derived by the highest-degree interpolating spline the samples allow (k = min(5,
 """
 from __future__ import annotations
 
-import csv
 import math
 import os
-import re
 import stat
 import warnings
 from dataclasses import dataclass
@@ -36,19 +34,18 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import Issue, TrajectoryError, counted
-from .csv_numbers import parse_bytes, parse_floats
+from ..errors import TrajectoryError
+from .csv_numbers import parse_bytes
+from .csv_rows import MAX_ABS, check_utf8, check_values, column_place, fail, parse_rows, show, split_row
 from .load_columns import load_columns, load_samples
 from .spline import derivatives
 from .text_lines import line_chunks, plain_chunks
 
 PAD = 64
-MAX_ABS = 1e12        # largest |value| accepted, SI units (s, rad, m and their rates)
 MIN_STEP = 1e-9       # s, smallest time step
 MAX_LINE = 1 << 20    # characters per line
-SEPARATORS = ",;\t"
 FAST_PARSE_ROWS = 2000   # from this many rows a chunk is parsed by pyarrow (its import: ~0.2 s)
-_NUMBER = re.compile(r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)?|nan)", re.I)
+SEPARATORS = ",;\t"
 
 
 @dataclass
@@ -65,44 +62,6 @@ class Trajectory:
     loads: dict | None = None
 
 
-def show(text: str, limit: int = 40) -> str:
-    """``text`` for a one-line message: control characters escaped, at most ``limit``."""
-    text = text.encode("unicode_escape", "backslashreplace").decode("ascii") \
-        if not text.isprintable() else text
-    return text if len(text) <= limit else text[:limit - 1] + "…"
-
-
-def _fail(file: str, line: int | None, place: str, message: str) -> TrajectoryError:
-    return TrajectoryError(Issue(file, place, line, message))
-
-
-def _place(header: list[str], c: int) -> str:
-    return f"column {c + 1} '{show(header[c])}'" if c < len(header) else f"column {c + 1}"
-
-
-def _check_utf8(file: str, lines: list[str], linenos: list[int]) -> None:
-    """Refuse text read with ``surrogateescape`` that held bytes other than UTF-8."""
-    try:
-        "".join(lines).encode("utf-8")
-        return
-    except UnicodeEncodeError:
-        pass
-    for text, ln in zip(lines, linenos):
-        try:
-            text.encode("utf-8")
-        except UnicodeEncodeError as exc:
-            byte = ord(text[exc.start]) - 0xDC00
-            raise _fail(file, ln, f"character {exc.start + 1}", f"byte 0x{byte:02x} is not UTF-8 "
-                        "(save the file as UTF-8 or ASCII text)") from None
-
-
-def _split(line: str, sep: str) -> list[str]:
-    try:
-        return [c.strip() for c in next(csv.reader([line.rstrip("\r\n")], delimiter=sep, quotechar='"'), [""])]
-    except csv.Error:
-        return line.rstrip("\r\n").split(sep)
-
-
 def _expected(names: list[str]) -> str:
     qs = [f"q:{n}" for n in names[:6]] + (["…"] if len(names) > 6 else [])
     return "expected t, " + ", ".join(qs) + " and optional qd:/qdd: columns, separated by ',', ';' or tab"
@@ -114,7 +73,7 @@ def _columns(header: list[str], names: list[str], file: str, loads=()) -> dict:
     pos: dict[str, int] = {}
     for i, h in enumerate(header):
         if h in pos:
-            raise _fail(file, 1, _place(header, i), "duplicate column")
+            raise fail(file, 1, column_place(header, i), "duplicate column")
         pos[h] = i
     lcols = load_columns(pos, loads, file)
     known = {"t"} | {f"{p}:{n}" for p in ("q", "qd", "qdd") for n in names}
@@ -123,70 +82,21 @@ def _columns(header: list[str], names: list[str], file: str, loads=()) -> dict:
         if h not in known:
             joint = h.partition(":")[2] if h.partition(":")[0] in ("q", "qd", "qdd") else ""   # e.g. a gear shaft
             what = ("unknown column" + (f": '{show(joint)}' is not an independent joint" if joint else "")) if h else "empty column name"
-            raise _fail(file, 1, _place(header, i), f"{what} ({_expected(names)})")
+            raise fail(file, 1, column_place(header, i), f"{what} ({_expected(names)})")
     if "t" not in pos:
-        raise _fail(file, 1, "", "missing column 't' (time, s)")
+        raise fail(file, 1, "", "missing column 't' (time, s)")
     for n in names:
         if f"q:{n}" not in pos:
-            raise _fail(file, 1, "", f"missing column 'q:{show(n)}' (independent joint '{show(n)}')")
+            raise fail(file, 1, "", f"missing column 'q:{show(n)}' (independent joint '{show(n)}')")
     out = {"t": pos["t"], "load": lcols}
     for p in ("q", "qd", "qdd"):
         cols = [pos.get(f"{p}:{n}") for n in names]
         if p != "q" and any(c is None for c in cols) and any(c is not None for c in cols):
             missing = [f"{p}:{n}" for n, c in zip(names, cols) if c is None]
-            raise _fail(file, 1, "", f"give {p}: columns for every joint or for none (missing "
+            raise fail(file, 1, "", f"give {p}: columns for every joint or for none (missing "
                         f"{show(', '.join(missing), 80)})")
         out[p] = None if cols[0] is None else cols
     return out
-
-
-def _bad_cell(lines: list[str], linenos: list[int], header: list[str], sep: str, file: str) -> TrajectoryError:
-    """The error for the first unreadable cell (called when fast parsing failed)."""
-    for text, ln in zip(lines, linenos):
-        cells = _split(text, sep)
-        if len(cells) != len(header):
-            return _fail(file, ln, "", f"row has {counted(len(cells), 'column')}, the header has {len(header)} "
-                         f"(separator '{show(sep)}')")
-        for c, cell in enumerate(cells):
-            if not _NUMBER.fullmatch(cell):
-                hint = " (decimal comma? use '.')" if re.fullmatch(r"[+-]?\d*,\d+", cell) else ""
-                what = "empty cell" if not cell else f"not a number: '{show(cell)}'{hint}"
-                return _fail(file, ln, _place(header, c), what)
-        try:
-            np.loadtxt([text], delimiter=sep, quotechar='"', comments=None, ndmin=2)
-        except ValueError:
-            return _fail(file, ln, "", "cannot read the row as numbers")
-    return _fail(file, linenos[0], "", "cannot read the rows as numbers")
-
-
-def _parse_rows(lines: list[str], linenos: list[int], header: list[str], sep: str, file: str) -> np.ndarray:
-    """Rows of floats (n, ncol); on failure, find and report the first bad cell."""
-    _check_utf8(file, lines, linenos)
-    data = parse_floats(lines, len(header), sep) if len(lines) >= FAST_PARSE_ROWS else None
-    if data is not None:
-        return data
-    try:
-        data = np.loadtxt(lines, delimiter=sep, quotechar='"', comments=None, ndmin=2, dtype=float)
-        ok = data.shape == (len(lines), len(header))
-    except ValueError:
-        ok = False
-    if not ok:
-        raise _bad_cell(lines, linenos, header, sep, file)
-    return data
-
-
-def _check_values(data: np.ndarray, si: np.ndarray, lines: list[str], linenos: list[int],
-                  header: list[str], sep: str, file: str) -> None:
-    """Refuse non-finite values and values beyond ``MAX_ABS`` in SI units."""
-    bad = ~np.isfinite(data) | (np.abs(si) > MAX_ABS)
-    if not bad.any():
-        return
-    r, c = (int(x) for x in np.argwhere(bad)[0])
-    cell = show(_split(lines[r], sep)[c]) if c < len(_split(lines[r], sep)) else str(data[r, c])
-    if not math.isfinite(data[r, c]):
-        raise _fail(file, linenos[r], _place(header, c), f"value '{cell}' is not a finite number (NaN or infinite)")
-    raise _fail(file, linenos[r], _place(header, c), f"value {cell} is out of range (|x| <= {MAX_ABS:g} "
-                "in SI units: s, rad, m and their rates)")
 
 
 def _check_time(t: np.ndarray, last_t: float | None, linenos: list[int], place: str, file: str) -> None:
@@ -200,9 +110,9 @@ def _check_time(t: np.ndarray, last_t: float | None, linenos: list[int], place: 
     r = int(bad[0])
     ln = linenos[r + 1 - off]
     if dt[r] <= 0:
-        raise _fail(file, ln, place, f"time {tt[r + 1]:.9g} s is not after the previous {tt[r]:.9g} s "
-                    "(time must increase strictly)")
-    raise _fail(file, ln, place, f"time step {dt[r]:.3g} s after t = {tt[r]:.9g} s is below the minimum "
+        raise fail(file, ln, place, f"time {tt[r + 1]:.9g} s is not after the previous {tt[r]:.9g} s "
+                   "(time must increase strictly)")
+    raise fail(file, ln, place, f"time step {dt[r]:.3g} s after t = {tt[r]:.9g} s is below the minimum "
                 f"{MIN_STEP:g} s")
 
 
@@ -228,10 +138,10 @@ class TrajectoryReader:
             head = self._readline(f, 1)
         head = head.removeprefix("\ufeff")
         if not head.strip():
-            raise _fail(self.file, 1, "", "empty file (expected a header row: t,q:<joint>,...)")
-        _check_utf8(self.file, [head], [1])
+            raise fail(self.file, 1, "", "empty file (expected a header row: t,q:<joint>,...)")
+        check_utf8(self.file, [head], [1])
         self.sep = next((s for s in SEPARATORS if s in head), ",")
-        self.header = _split(head, self.sep)
+        self.header = split_row(head, self.sep)
         self.cols = _columns(self.header, self.names, self.file, self.loads)
         self.scale = self._column_scale()
 
@@ -239,15 +149,15 @@ class TrajectoryReader:
         """The file as text (undecodable bytes kept as surrogates, refused per chunk)."""
         try:
             if not stat.S_ISREG(os.stat(self.path).st_mode):
-                raise _fail(self.file, None, "", "not a regular file")
+                raise fail(self.file, None, "", "not a regular file")
             return open(self.path, encoding="utf-8", errors="surrogateescape")
         except OSError as exc:
-            raise _fail(self.file, None, "", f"cannot read file: {exc.strerror}") from None
+            raise fail(self.file, None, "", f"cannot read file: {exc.strerror}") from None
 
     def _readline(self, f, lineno: int) -> str:
         line = f.readline(MAX_LINE)
         if len(line) == MAX_LINE and not line.endswith("\n"):
-            raise _fail(self.file, lineno, "", f"line longer than {MAX_LINE} characters")
+            raise fail(self.file, lineno, "", f"line longer than {MAX_LINE} characters")
         return line
 
     def _column_scale(self) -> np.ndarray:
@@ -304,12 +214,12 @@ class TrajectoryReader:
         c_t = self.cols["t"]
         with self._open() as f:
             f.seek(offset)
-            too_long = lambda n: _fail(self.file, n, "", f"line longer than {MAX_LINE} characters")  # noqa: E731
+            too_long = lambda n: fail(self.file, n, "", f"line longer than {MAX_LINE} characters")  # noqa: E731
             for lines, linenos in line_chunks(f, lineno, self.chunk, MAX_LINE, too_long):
-                data = _parse_rows(lines, linenos, self.header, self.sep, self.file)
+                data = parse_rows(lines, linenos, self.header, self.sep, self.file, FAST_PARSE_ROWS)
                 si = data * self.scale
-                _check_values(data, si, lines, linenos, self.header, self.sep, self.file)
-                _check_time(si[:, c_t], last_t, linenos, _place(self.header, c_t), self.file)
+                check_values(data, si, lines, linenos, self.header, self.sep, self.file)
+                _check_time(si[:, c_t], last_t, linenos, column_place(self.header, c_t), self.file)
                 last_t = si[-1, c_t]
                 yield si, np.asarray(linenos)
 
@@ -319,7 +229,7 @@ class TrajectoryReader:
         samples."""
         n = sum(len(data) for data, _ in self._raw())
         if n == 0:
-            raise _fail(self.file, None, "", "no samples after the header")
+            raise fail(self.file, None, "", "no samples after the header")
         need = 1 + (self.cols["qd"] is None) + (self.cols["qdd"] is None)
         if n < need:
             raise self._too_few(n, need, "q" if self.cols["qd"] is None else "qd")
@@ -334,7 +244,7 @@ class TrajectoryReader:
                 prev = pending
             pending = (data, lines)
         if pending is None:
-            raise _fail(self.file, None, "", "no samples after the header")
+            raise fail(self.file, None, "", "no samples after the header")
         yield self._finish(prev, pending, None)
 
     def _finish(self, prev, cur, nxt) -> Trajectory:
@@ -358,8 +268,8 @@ class TrajectoryReader:
 
     def _too_few(self, n: int, need: int, kind: str) -> TrajectoryError:
         given = "positions only" if kind == "q" else "no qdd: columns"
-        return _fail(self.file, None, "", f"{n} sample{'s' if n != 1 else ''} with {given}: rates and "
-                     f"accelerations are derived by spline, which needs at least {need} samples (or "
+        return fail(self.file, None, "", f"{n} sample{'s' if n != 1 else ''} with {given}: rates and "
+                    f"accelerations are derived by spline, which needs at least {need} samples (or "
                      "give the qd: and qdd: columns)")
 
     def _derive(self, t, y, order: int, lines, kind: str) -> list[np.ndarray]:
@@ -371,14 +281,14 @@ class TrajectoryReader:
                 warnings.simplefilter("ignore")
                 out = derivatives(t, y, order)
         except (ValueError, np.linalg.LinAlgError) as exc:
-            raise _fail(self.file, None, "", f"cannot fit the interpolating spline: {show(str(exc), 80)}") from None
+            raise fail(self.file, None, "", f"cannot fit the interpolating spline: {show(str(exc), 80)}") from None
         for i, d in enumerate(out):
             bad = ~np.isfinite(d)
             if bad.any():
                 r, j = (int(x) for x in np.argwhere(bad)[0])
                 what = ("qd" if i == 0 else "qdd") if kind == "q" else "qdd"
-                raise _fail(self.file, int(lines[r]), f"{what}:{show(self.names[j])}",
-                            "derived by spline is not finite (time steps too small for the values?)")
+                raise fail(self.file, int(lines[r]), f"{what}:{show(self.names[j])}",
+                           "derived by spline is not finite (time steps too small for the values?)")
         return out
 
 
