@@ -73,7 +73,14 @@ SMOOTH = rows(SMOOTH_T, np.sin(5 * SMOOTH_T), 0.3 * np.cos(3 * SMOOTH_T))
     (HEADER + "0,0,0\n\n0.1,0,0\n0.2,abc,0\n", (":5: column 2 'q:J1':", "not a number: 'abc'")),
     (HEADER + "0,0,0\n0.1,0,0\n0.2,1_0,0\n", (":4: column 2 'q:J1':", "not a number: '1_0'")),
     (HEADER + "0,0,0\n0.1,,0\n0.2,1,0\n", (":3: column 2 'q:J1':", "empty cell")),
-    ("t;q:J1;q:J2\n0;0;0\n0.1;1,5;0\n", (":3: column 2 'q:J1':", "decimal comma")),
+    ("t;q:J1;q:J2\n0;0;0\n0.1;1,5;0\n", (":3: column 2 'q:J1': not a number: '1,5' looks like a decimal comma: "
+                                         "write 1.5",)),
+    ("t\tq:J1\tq:J2\n0\t0\t0\n0,1\t-1,5e-3\t0\n", (":3: column 1 't': not a number: '0,1' looks like a decimal "
+                                                 "comma: write 0.1",)),
+    (HEADER + "0,0,0\n0,1,0,5,0,25\n", (":3: row has 6 columns, the header has 3 (separator ','): '0,1' looks like "
+                                        "a decimal comma: write 0.1",)),
+    (HEADER + "0,0,0\n1,0,5,0\n", (":3: row has 4 columns, the header has 3 (separator ','): '1,0' looks like "
+                                   "a decimal comma: write 1.0",)),
     ("t q:J1 q:J2\n0 0 0\n", (":1: column 1 't q:J1 q:J2':", "unknown column", "separated by")),
     (HEADER + "0,0,0\n0.1,0,0\n0.2,0,0,\n", (":4:", "4 columns, the header has 3")),
     (HEADER + "0,0,0\n5e-324,0,0\n1,0,0\n", (":3: column 1 't':", "time step 4.94e-324 s", "minimum 1e-09 s")),
@@ -94,6 +101,14 @@ SMOOTH = rows(SMOOTH_T, np.sin(5 * SMOOTH_T), 0.3 * np.cos(3 * SMOOTH_T))
 def test_bad_trajectory_is_one_line_and_writes_nothing(run_cli, work, text, parts):
     line = solve_refused(run_cli, work, text, *parts)
     assert "missing column 't'" not in line
+
+
+@pytest.mark.parametrize("row", ["0.2,0,0,", "0.2,0,0,0", "1,x,5,0", "1,2,3,4,5,6,7", "0,5,0,5e"])
+def test_extra_cells_that_are_no_decimal_comma_are_not_called_one(run_cli, work, row):
+    """A row with a '.' (its writer uses decimal points) or a cell that is not digits, or
+    too few pairs of an integer and digits for its extra cells: no decimal-comma hint."""
+    line = solve_refused(run_cli, work, HEADER + "0,0,0\n" + row + "\n", ":3:")
+    assert "decimal comma" not in line
 
 
 def test_degrees_with_huge_values_is_refused(run_cli, work):

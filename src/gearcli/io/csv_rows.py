@@ -21,6 +21,9 @@ from ..errors import Issue, TrajectoryError, counted
 from .csv_numbers import parse_floats
 
 MAX_ABS = 1e12        # largest |value| accepted, SI units (s, rad, m and their rates)
+_DECIMAL_COMMA = re.compile(r"[+-]?\d*,\d+(?:[eE][+-]?\d+)?")   # one cell: 0,5 or -1,5e-3
+_INTEGER = re.compile(r"[+-]?\d+")                # 0,5 split by a ',' separator: '0' and '5'
+_FRACTION = re.compile(r"\d+(?:[eE][+-]?\d+)?")
 _NUMBER = re.compile(r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)?|nan)", re.I)
 
 
@@ -93,6 +96,28 @@ def _first_unreadable(lines: list[str], ncol: int, sep: str, fast_rows: int) -> 
     return lo
 
 
+def _split_decimal_comma(cells: list[str], ncol: int, sep: str) -> str:
+    """``: '0,5' looks like a decimal comma: write 0.5`` when a ``,``-separated row has more
+    cells than the header and reads as the header's count with decimal commas: every cell
+    an integer or digits (no '.': the row's writer does not use decimal points) and, for
+    every extra cell, an integer cell followed by a cell of digits (``0`` ``5`` from
+    ``0,5``); else ``""``."""
+    extra = len(cells) - ncol
+    if sep != "," or extra <= 0 or not all(_INTEGER.fullmatch(c) or _FRACTION.fullmatch(c) for c in cells):
+        return ""
+    pairs, i = [], 0
+    while i + 1 < len(cells):
+        if _INTEGER.fullmatch(cells[i]) and _FRACTION.fullmatch(cells[i + 1]):
+            pairs.append(i)
+            i += 2
+        else:
+            i += 1
+    if len(pairs) < extra:
+        return ""
+    a, b = cells[pairs[0]], cells[pairs[0] + 1]
+    return f": '{show(a)},{show(b)}' looks like a decimal comma: write {show(a)}.{show(b)}"
+
+
 def _bad_cell(lines: list[str], linenos: list[int], header: list[str], sep: str, file: str,
               fast_rows: int) -> TrajectoryError:
     """The error for the first unreadable cell (called when fast parsing failed): the
@@ -102,10 +127,11 @@ def _bad_cell(lines: list[str], linenos: list[int], header: list[str], sep: str,
         cells = split_row(text, sep)
         if len(cells) != len(header):
             return fail(file, ln, "", f"row has {counted(len(cells), 'column')}, the header has {len(header)} "
-                        f"(separator '{show(sep)}')")
+                        f"(separator '{show(sep)}')" + _split_decimal_comma(cells, len(header), sep))
         for c, cell in enumerate(cells):
             if not _NUMBER.fullmatch(cell):
-                hint = " (decimal comma? use '.')" if re.fullmatch(r"[+-]?\d*,\d+", cell) else ""
+                comma = _DECIMAL_COMMA.fullmatch(cell)
+                hint = f" looks like a decimal comma: write {cell.replace(',', '.')}" if comma else ""
                 what = "empty cell" if not cell else f"not a number: '{show(cell)}'{hint}"
                 return fail(file, ln, column_place(header, c), what)
         try:
