@@ -216,33 +216,18 @@ def solve(
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn  # noqa: PLC0415
 
     from .pipeline import check_solve_options, solve_file  # noqa: PLC0415
+    from .report.progress import LateProgress  # noqa: PLC0415
 
     an = check_solve_options(load_analysis(mech, strict), method, backend)
     out = output if output is not None else str(traj.with_suffix(".loads.csv"))
     err = stderr_console()
     to_stdout = out == "-"
-    progress = Progress(TextColumn("solving"), BarColumn(), TextColumn("{task.completed:,}/{task.total:,} samples"),
-                        TimeRemainingColumn(), console=err, transient=True, disable=not err.is_terminal)
-    task = None
-    started = False
-
-    def tick(total=None, advance=None):
-        nonlocal task, started
-        if total is not None:
-            if total > 4 * chunk:
-                progress.start()
-                started = True
-            task = progress.add_task("solve", total=total)
-        if advance is not None:
-            progress.update(task, advance=advance)
-
-    try:
+    bar = Progress(TextColumn("solving"), BarColumn(), TextColumn("{task.completed:,}/{task.total:,} samples"),
+                   TimeRemainingColumn(), console=err, transient=True, disable=not err.is_terminal)
+    with LateProgress(bar, "solve") as progress:   # shown once the run has taken a second
         report = solve_file(mech, traj, out, degrees=degrees, method=method, verify=verify,
-                            chunk=chunk, progress=tick, analysis=an, precision=precision,
+                            chunk=chunk, progress=progress.update, analysis=an, precision=precision,
                             backend=backend, jobs=jobs, strict=strict)
-    finally:
-        if started:
-            progress.stop()
     from .report.unit_warnings import warning_lines  # noqa: PLC0415
 
     print_problems(warning_lines(report.warnings))
@@ -321,17 +306,18 @@ def verify(
     from .batch.manifest import load_manifest  # noqa: PLC0415
     from .batch.outputs import rich_table, with_unit  # noqa: PLC0415
     from .batch.verify import count_jobs, run_verify  # noqa: PLC0415
+    from .report.progress import LateProgress  # noqa: PLC0415
 
     manifest = load_manifest(design)
     _case_mechanism_warnings(manifest, strict)
     err = stderr_console()
-    progress = Progress(TextColumn("verifying"), BarColumn(), TextColumn("{task.completed}/{task.total} trajectories"),
-                        console=err, transient=True, disable=not err.is_terminal)
-    task = progress.add_task("verify", total=count_jobs(manifest))
-    with progress:
+    bar = Progress(TextColumn("verifying"), BarColumn(), TextColumn("{task.completed}/{task.total} trajectories"),
+                   console=err, transient=True, disable=not err.is_terminal)
+    with LateProgress(bar, "verify") as progress:   # shown once the run has taken a second
+        progress.update(total=count_jobs(manifest))
         outcome = run_verify(design, jobs=jobs, dask_address=dask, junit=junit, json_path=json_out,
                              markdown_path=markdown, plots_dir=plots, manifest=manifest,
-                             progress=lambda: progress.update(task, advance=1))
+                             progress=lambda: progress.update(advance=1))
     console = stdout_console()
     console.print(rich_table(outcome.rows))
     failed = [r for r in outcome.rows if not r.passed]
