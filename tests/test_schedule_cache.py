@@ -98,12 +98,17 @@ def test_an_unusable_location_only_computes(tmp_path, monkeypatch, where):
 
 def test_prune_keeps_the_newest(tmp_path):
     import os  # noqa: PLC0415
+    import time  # noqa: PLC0415
 
     for i in range(5):
         (tmp_path / f"{i}.json").write_text("{}")
         os.utime(tmp_path / f"{i}.json", (1000 + i, 1000 + i))
+    for name, age in ((".gearcli.old.tmp", 7200), (".gearcli.new.tmp", 10)):   # a killed writer's, a live one's
+        (tmp_path / name).write_text("")
+        os.utime(tmp_path / name, (time.time() - age, time.time() - age))
     schedule_cache.prune(tmp_path, max_entries=3)
     assert sorted(p.stem for p in tmp_path.glob("*.json")) == ["2", "3", "4"]
+    assert [p.name for p in tmp_path.glob(".gearcli.*")] == [".gearcli.new.tmp"]
 
 
 def forge(entry: dict, blocks=None, flow=None) -> str:

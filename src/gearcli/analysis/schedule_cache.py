@@ -28,6 +28,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import time
 from functools import lru_cache
 from pathlib import Path
 
@@ -37,6 +38,7 @@ from .schedule_proof import proven_blocks
 FORMAT = 2
 MAX_ENTRIES = 2000
 MAX_ENTRY_BYTES = 64 * 2**20        # 10,000 links: ~1 MB
+_STALE_TEMP_SECONDS = 3600.0
 
 
 def cache_dir() -> Path:
@@ -133,11 +135,17 @@ def store(key: str | None, blocks, flow) -> bool:
 
 
 def prune(d: Path, max_entries: int = MAX_ENTRIES) -> None:
-    """Delete the oldest entries of ``d`` beyond ``max_entries``."""
+    """Delete the oldest entries of ``d`` beyond ``max_entries`` and temporary files left
+    by a killed writer (on a system without ``O_TMPFILE``) an hour ago or earlier."""
     try:
         files = sorted((e.stat(follow_symlinks=False).st_mtime, e.path) for e in os.scandir(d)
-                       if e.name.endswith(".json"))
+                       if e.name.endswith(".json") or e.name.startswith(".gearcli."))
     except OSError:
         return
-    for _, path in files[:max(0, len(files) - max_entries)]:
+    entries = [f for f in files if f[1].endswith(".json")]
+    for _, path in entries[:max(0, len(entries) - max_entries)]:
         remove_entry(Path(path))
+    now = time.time()
+    for mtime, path in files:
+        if os.path.basename(path).startswith(".gearcli.") and now - mtime > _STALE_TEMP_SECONDS:
+            remove_entry(Path(path))
