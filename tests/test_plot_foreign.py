@@ -163,8 +163,10 @@ def test_missing_values_are_gaps_and_said(run_cli, tmp_path, legends):
     assert lines == [f"warning: {path}: missing values drawn as gaps: 'motor:a' (1 of 11)"]
 
 
-def test_duplicate_names_are_drawn_apart(run_cli, tmp_path, legends):
-    path = arrow(tmp_path / "dup.feather", {"t": T, "a": T, "b": 2 * T, "c": 3 * T}, names=["t", "m", "x", "m"])
+@pytest.mark.parametrize("ext", [".feather", ".parquet"])
+def test_duplicate_names_are_drawn_apart(run_cli, tmp_path, legends, ext):
+    """A Parquet file with a duplicated name could not be read ('Multiple matches for FieldRef')."""
+    path = arrow(tmp_path / f"dup{ext}", {"t": T, "a": T, "b": 2 * T, "c": 3 * T}, names=["t", "m", "x", "m"])
     drawn(run_cli("plot", path, "m", "-o", tmp_path / "fig.png"), tmp_path / "fig.png")
     assert legends["legend"] == ["m [column 2]", "m [column 4]"]
 
@@ -268,3 +270,30 @@ def test_single_row_is_drawn_as_a_point(run_cli, tmp_path, monkeypatch):
     path.write_text("t,motor:a\n0,1\n")
     drawn(run_cli("plot", path, "motor:a", "-o", tmp_path / "fig.png"), tmp_path / "fig.png")
     assert markers == ["."]
+
+
+@pytest.mark.parametrize("kind", ["fifo", "dir", "dev", "missing"])
+def test_loads_that_is_not_a_regular_file_is_refused(run_cli, tmp_path, kind):
+    """A FIFO as LOADS blocked for ever, /dev/zero would never end."""
+    import os
+
+    path = {"fifo": tmp_path / "l.csv", "dir": tmp_path / "d.parquet", "dev": "/dev/zero",
+            "missing": tmp_path / "no.npz"}[kind]
+    if kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "dir":
+        path.mkdir()
+    r = run_cli("plot", path, "*", "-o", tmp_path / "fig.png")
+    refused(r, f"{path}: ", "not a regular file" if kind != "missing" else "cannot read file")
+    assert not (tmp_path / "fig.png").exists()
+
+
+def test_long_patterns_are_names_or_refused(run_cli, tmp_path):
+    """A 130,000-character pattern '*x*x...' took 8 s in fnmatch; a long name without * ? [
+    is compared as it is."""
+    name = "x" * 100_000
+    path = arrow(tmp_path / "l.feather", {"t": T, name: T})
+    drawn(run_cli("plot", path, name, "-o", tmp_path / "fig.png"), tmp_path / "fig.png")
+    refused(run_cli("plot", path, "*x" * 65_000, "-o", tmp_path / "g.png"),
+            "a pattern with * ? [ of 130,000 characters is too long (at most 1,000")
+    assert not (tmp_path / "g.png").exists()

@@ -17,7 +17,9 @@ dictionary-encoded numbers are drawn as float64; a null (missing) value is a gap
 """
 from __future__ import annotations
 
+import os
 import re
+import stat
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -198,6 +200,12 @@ def open_loads(path) -> LoadsFile:
     """The loads file ``path`` (CSV, Parquet, Feather or NPZ by its extension; CSV for any
     other) with its names and units; GearcliError when it is not a loads table."""
     fmt = format_of(str(path)) or "csv"
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError) as exc:      # ValueError: a NUL byte in the name
+        raise GearcliError(f"{path}: cannot read file: {getattr(exc, 'strerror', None) or shown(exc, 200)}") from None
+    if not stat.S_ISREG(mode):     # a FIFO would block for ever, /dev/zero never end
+        raise GearcliError(f"{path}: not a regular file (a directory, FIFO or device)")
     if fmt == "csv":
         table = _open_csv(path)
     else:
@@ -280,7 +288,14 @@ def _open_arrow(path, fmt: str) -> LoadsFile:
     import pyarrow.feather as feather  # noqa: PLC0415
     import pyarrow.parquet as pq  # noqa: PLC0415
 
-    t = pq.read_table(path) if fmt == "parquet" else feather.read_table(path)
+    if fmt == "parquet":      # not pq.read_table: its dataset reader refuses duplicate column names
+        f = pq.ParquetFile(path)
+        try:
+            t = f.read()
+        finally:
+            f.close()
+    else:
+        t = feather.read_table(path)
     units = [(f.metadata or {}).get(b"unit", b"").decode("utf-8", "replace").replace("*", "·") for f in t.schema]
     return LoadsFile(str(path), [str(n) for n in t.column_names], units, t.num_rows, t.column, fmt)
 

@@ -49,13 +49,23 @@ def check_output_path(path: str | Path) -> Path:
     return path
 
 
+MAX_GLOB = 1000
+"""Characters of a shell pattern at most: a 130,000-character '*x*x...' took 8 s to compile."""
+
+
 def select_columns(header: list[str], patterns: list[str], file: str) -> list[int]:
     """Indices of the columns of ``header`` matching any of ``patterns`` (names or shell
     globs), in header order (a duplicated name: each of its columns); a pattern that matches
     nothing is an error."""
     chosen = np.zeros(len(header), dtype=bool)
     for p in patterns:
-        hits = [i for i, h in enumerate(header) if fnmatch.fnmatchcase(h, p)]
+        if not any(c in p for c in "*?["):         # a name: compared, whatever its length
+            hits = [i for i, h in enumerate(header) if h == p]
+        elif len(p) > MAX_GLOB:
+            raise GearcliError(f"COLUMN_OR_GLOB '{shown(p)}': a pattern with * ? [ of {len(p):,} characters is too long "
+                               f"(at most {MAX_GLOB:,}; a name without them may be of any length)")
+        else:
+            hits = [i for i, h in enumerate(header) if fnmatch.fnmatchcase(h, p)]
         if not hits:
             raise GearcliError(f"{file}:1: no column matches '{shown(p)}'")
         chosen[hits] = True
