@@ -224,3 +224,18 @@ def test_a_iso_formulas_by_hand_continuity_and_limits():
     assert I.a_iso(np.array([2000.0]), "ball", 9.0, 0.5, 400.0) == I.a_iso(np.array([2000.0]), "ball", 4.0, 0.5, 400.0)
     with pytest.raises(ValueError):
         I.a_iso(np.array([2000.0]), "ball", 0.05, 0.5, 400.0)
+
+
+def test_running_and_cumulative_rms_by_hand():
+    # x = 2 from t = 0 on (idle before): over a window W = 1 s the running RMS is
+    # 2 sqrt(t / W) until the window fills, then 2.  A burst of 4 between t = 2 and 2.5
+    # (steps of 0.25 s, straight ramps between samples): at t = 3 the window [2, 3] holds,
+    # by trapezoids, 0.25 (4+16)/2 + 0.25 16 + 0.25 (16+4)/2 + 0.25 4 = 10.
+    t = np.r_[0.0, 0.25, 0.5, 1.0, 1.5, 2.0, 2.25, 2.5, 2.75, 3.0]
+    x = np.r_[2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 4.0, 4.0, 2.0, 2.0]
+    run = Rms.running_rms(x, t, 1.0)
+    assert run[[1, 2, 3, 4]] == pytest.approx([2 * math.sqrt(0.25), 2 * math.sqrt(0.5), 2.0, 2.0])
+    assert run[-1] == pytest.approx(math.sqrt(10.0))
+    whole = Rms.cumulative_rms(x, t)
+    assert whole[-1] == pytest.approx(Rms.rms(x, t)) and whole[0] == 2.0
+    assert Rms.rms(x, t) == pytest.approx(math.sqrt((4 * 2.0 + 10.0) / 3.0))    # [0, 2]: 4 for 2 s; [2, 3]: 10

@@ -416,3 +416,25 @@ def test_bad_life_factor_keys_are_one_line_each(run_cli, tmp_path, extra, messag
     (tmp_path / "rotor.yaml").write_text(rotor_yaml(f"[{{name: x, position: 0, C: 3000, C0: 3000, type: ball, {extra}}}]"))
     r = run_cli("check", tmp_path / "rotor.yaml")
     assert r.exit_code == 2 and len(r.stderr.strip().splitlines()) == 1 and message in r.stderr, r.stderr
+
+
+def test_running_rms_over_the_thermal_window_is_checked(run_cli, tmp_path):
+    # The rotor accelerated at qdd = 5 rad/s^2 for the first 0.2 s, then coasting: tau = J qdd.
+    # Over the 2 s cycle the RMS is J 5 sqrt(0.2/2) (trapezoid: the ramp at 0.2 s adds a half
+    # step); over a 0.5 s window the worst running RMS is J 5 sqrt(0.2/0.5), 2.2x more.
+    t = np.linspace(0, 2.0, 2001)
+    qdd = np.where(t <= 0.2 + 1e-12, 5.0, 0.0)
+    qd = np.cumsum(np.r_[0.0, np.diff(t)] * qdd)
+    q = np.cumsum(np.r_[0.0, np.diff(t)] * qd)
+    text = rotor_yaml("[{name: x, position: 0, C: 3000, C0: 3000, type: ball}]").replace(
+        "max_speed: 20}", "max_speed: 20, thermal_window: 0.5}")
+    (tmp_path / "rotor.yaml").write_text(text)
+    np.savetxt(tmp_path / "rotor.csv", np.column_stack([t, q, qd, qdd]), delimiter=",", header="t,q:J,qd:J,qdd:J",
+               comments="")
+    r, doc = run_json(run_cli, tmp_path, "cases:\n  - {name: rotor, mechanism: rotor.yaml, trajectories: [rotor.csv]}\n")
+    checks = by_name(doc)
+    J = 0.02 + M * R**2
+    run = checks[("rotor", "motor m", "running RMS torque (0.5 s)")]
+    assert run["value"] == pytest.approx(J * 5 * math.sqrt((0.2 + 0.0005) / 0.5), rel=1e-6)
+    assert checks[("rotor", "motor m", "RMS torque")]["value"] == pytest.approx(J * 5 * math.sqrt(0.2005 / 2), rel=1e-6)
+    assert run["limit"] == 0.5

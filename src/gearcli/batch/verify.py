@@ -8,11 +8,12 @@ from pathlib import Path
 from ..errors import GearcliError
 from ..io.output import output_target
 from ..report.plots import plot_check
+from ..report.rms import cumulative_rms
 from .manifest import load_manifest
 from .outputs import WARN_MARGIN, rows_of, write_json, write_junit, write_markdown
 from .runner import jobs_of, run_manifest, worst_samples
 
-SIGNAL_LABELS = {"abs": "|{}|", "col": "{}", "rate": "|joint rate|", "bearing_P": "dynamic equivalent load P",
+SIGNAL_LABELS = {"abs": "|{}|", "col": "RMS of {} from the start", "rate": "|joint rate|", "running_rms": "running RMS of {}", "bearing_P": "dynamic equivalent load P",
                  "bearing_P0": "static equivalent load P0", "bending": "Lewis root bending stress",
                  "contact": "Hertz contact stress"}
 LIMIT_LABELS = {"peak": "limit", "rms": "RMS limit", "safety": "allowable / required safety",
@@ -89,7 +90,9 @@ def write_plots(results, directory: Path) -> list[Path]:
                 continue
             ch = v.check
             t, y = worst_samples(r, v)
-            label = SIGNAL_LABELS[ch.signal[0]].format(ch.signal[1] if ch.signal[0] in ("abs", "col") else "")
+            if ch.kind == "rms":            # the RMS so far (its last value is the trajectory's RMS)
+                y = cumulative_rms(y, t)
+            label = SIGNAL_LABELS[ch.signal[0]].format(ch.signal[1] if ch.signal[0] in ("abs", "col", "running_rms") else "")
             path = directory / f"{_slug(r.case.name)}__{_slug(ch.component)}__{_slug(ch.quantity)}.png"
             status = "FAIL" if not v.passed else "tight"
             title = (f"{r.case.name}: {ch.name} ({status}, margin {v.margin:.3g} %)\n"

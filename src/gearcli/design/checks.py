@@ -75,6 +75,9 @@ def _motor_checks(an) -> list[Check]:
         out += [Check(c, "peak torque", "N·m", r.peak_torque, "peak", ("abs", f"motor:{m.name}"), "N·m"),
                 Check(c, "RMS torque", "N·m", r.rms_torque, "rms", ("col", f"motor:{m.name}"), "N·m"),
                 Check(c, "speed", "rad/s", r.max_speed, "peak", ("abs", f"motor:{m.name}:speed"), "rad/s")]
+        if r.thermal_window is not None:
+            out.append(Check(c, f"running RMS torque ({r.thermal_window:g} s)", "N·m", r.rms_torque, "peak",
+                             ("running_rms", f"motor:{m.name}", r.thermal_window), "N·m"))
         if r.max_power is not None:
             out.append(Check(c, "power", "W", r.max_power, "peak", ("abs", f"motor:{m.name}:power"), "W"))
     return out

@@ -20,7 +20,7 @@ from ..model.ratings import (BEARING_FACTOR_DEFAULTS, STEEL_ELASTIC_COEFFICIENT,
 from .planets import item_path
 
 NS = "https://gearcli.dev/urdf/1"
-MOTOR_KEYS = ("peak_torque", "rms_torque", "max_speed", "max_power")
+MOTOR_KEYS = ("peak_torque", "rms_torque", "max_speed", "max_power", "thermal_window")
 BEARING_KEYS = ("name", "position", "C", "C0", "type", "X", "Y", "e", "X0", "Y0", "locating", "M", "f0", "a_ISO",
                 "kappa", "e_C", "Cu", "friction_coefficient", "bore")
 RATING_KEYS = ("C", "C0", "type")     # a rated bearing has all three (the design checks need them)
@@ -41,9 +41,10 @@ def motor_rating(spec: dict, path: str, add) -> MotorRating:
     _positive(spec, MOTOR_KEYS, path, add)
     if spec["rms_torque"] > spec["peak_torque"]:
         add(f"{path}.rms_torque", f"rms_torque {spec['rms_torque']:g} exceeds peak_torque {spec['peak_torque']:g}")
-    power = spec.get("max_power")
+    power, window = spec.get("max_power"), spec.get("thermal_window")
     return MotorRating(float(spec["peak_torque"]), float(spec["rms_torque"]), float(spec["max_speed"]),
-                       None if power is None else float(power), path)
+                       None if power is None else float(power), path,
+                       thermal_window=None if window is None else float(window))
 
 
 def bearing_ratings(specs: list[dict], path: str, add) -> tuple[BearingRating, ...]:

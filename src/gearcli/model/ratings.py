@@ -32,13 +32,15 @@ ISO 76 X0 = 0.5, Y0 = 0.22 cot a."""
 @dataclass(frozen=True)
 class MotorRating:
     """``peak_torque`` and ``rms_torque`` (continuous) in N*m (N for a linear input),
-    ``max_speed`` in rad/s (m/s), optional ``max_power`` in W."""
+    ``max_speed`` in rad/s (m/s), optional ``max_power`` in W, optional ``thermal_window``
+    in s (the running RMS over that window is checked against ``rms_torque`` too)."""
 
     peak_torque: float
     rms_torque: float
     max_speed: float
     max_power: float | None = None
     path: str = field(default="", compare=False)   # where it was read (for messages)
+    thermal_window: float | None = None
 
 
 @dataclass(frozen=True)

@@ -71,3 +71,17 @@ def running_rms(x, t, window: float) -> np.ndarray:
     cum = np.concatenate(([0.0], np.cumsum(np.diff(t) * (x2[:-1] + x2[1:]) * 0.5)))
     start = np.interp(t - window, t, cum, left=0.0)
     return np.sqrt(np.maximum(cum - start, 0.0) / window)
+
+
+def cumulative_rms(x, t) -> np.ndarray:
+    """RMS from the start to every sample, (N,): sqrt(integral of x^2 over [t_0, t] / (t - t_0))
+    (|x_0| at the first sample); its last value is :func:`rms`."""
+    x, t = np.asarray(x, float), np.asarray(t, float)
+    if t.size < 2:
+        return np.abs(x)
+    x2 = x * x
+    cum = np.concatenate(([0.0], np.cumsum(np.diff(t) * (x2[:-1] + x2[1:]) * 0.5)))
+    span = t - t[0]
+    out = np.abs(x).copy()
+    out[1:] = np.sqrt(cum[1:] / np.where(span[1:] > 0, span[1:], 1.0))
+    return out
