@@ -26,7 +26,7 @@ from ..model.validate import MAX_ABS
 from ..pipeline import analyse, prismatic_independent
 from ..io.schemas import packaged_schema
 
-REQUIREMENT_KEYS = ("cycles_per_hour", "bearing_life_h", "min_static_safety", "min_bending_safety",
+REQUIREMENT_KEYS = ("cycles_per_hour", "bearing_life_h", "gear_life_h", "min_static_safety", "min_bending_safety",
                     "min_contact_safety")
 
 
@@ -235,8 +235,9 @@ def _prepare_case(spec: dict, where: str, base: Path, col: Collector, issues: li
 
     req = Requirements(**{k: float(spec[k]) for k in REQUIREMENT_KEYS if ok(k)},
                        limits=_limits(spec, where, bad), limits_path=f"{where}.limits")
-    if ok("bearing_life_h") and "cycles_per_hour" not in spec:
-        col.add(f"{where}.bearing_life_h", "a bearing life in hours needs the duty's cycles_per_hour")
+    for key, what in (("bearing_life_h", "a bearing life"), ("gear_life_h", "a gear fatigue life")):
+        if ok(key) and "cycles_per_hour" not in spec:
+            col.add(f"{where}.{key}", f"{what} in hours needs the duty's cycles_per_hour")
     trajs = _trajectory_paths(spec, where, base, col, bad) if "trajectories" in spec else []
     if not ok("mechanism"):
         return None
@@ -271,6 +272,7 @@ def _prepare_case(spec: dict, where: str, base: Path, col: Collector, issues: li
 
 
 REQUIREMENT_CHECKS = {"bearing_life_h": ("L10 life", "joints[].bearings with C"),
+                      "gear_life_h": ("bending fatigue life", "gears[].rating"),
                       "min_static_safety": ("static safety s0", "joints[].bearings"),
                       "min_bending_safety": ("bending safety", "gears[].rating"),
                       "min_contact_safety": ("contact safety", "gears[].rating")}

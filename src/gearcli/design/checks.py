@@ -9,7 +9,9 @@ and how the samples of a duty cycle are reduced to the value compared with the l
 * ``peak``: max over the samples <= limit;
 * ``rms``: time-weighted RMS over the whole duty cycle <= limit;
 * ``safety``: ``rating`` / max over the samples >= limit (static safety, tooth stresses);
-* ``life``: ISO 281 rating life in hours >= limit (``rating`` = C, ``exponent`` = p).
+* ``life``: ISO 281 rating life in hours >= limit (``rating`` = C, ``exponent`` = p);
+* ``fatigue``: gear tooth life in hours (rainflow + Miner, :mod:`gearcli.design.fatigue`)
+  >= limit (``rating`` = the allowable stress).
 """
 from __future__ import annotations
 
@@ -19,6 +21,7 @@ from dataclasses import dataclass, field
 
 from ..errors import Collector
 from .iso281 import life_exponent
+from .fatigue import dynamic_factor
 from .gears import lewis_form_factor, virtual_helical_teeth, virtual_spur
 
 MODULE_RTOL = 0.01
@@ -31,6 +34,7 @@ class Requirements:
 
     cycles_per_hour: float | None = None
     bearing_life_h: float | None = None
+    gear_life_h: float | None = None
     min_static_safety: float = 1.0
     min_bending_safety: float = 1.0
     min_contact_safety: float = 1.0
@@ -132,7 +136,24 @@ def _gear_checks(an, req: Requirements, col: Collector) -> list[Check]:
                       "Pa", rating=r.bending_stress_limit, extra=stress),
                 Check(comp, "contact safety", "", req.min_contact_safety, "safety", ("contact", gp.name),
                       "Pa", rating=r.contact_stress_limit, extra=stress)]
+        if req.gear_life_h is not None:
+            passes = _tooth_passes(an, c, gp, teeth)
+            out += [Check(comp, f"{kind} fatigue life", "h", req.gear_life_h, "fatigue", (kind, gp.name), "Pa",
+                          rating=limit, extra={**stress, "passes": passes})
+                    for kind, limit in (("bending", r.bending_stress_limit), ("contact", r.contact_stress_limit))]
     return out
+
+
+def _tooth_passes(an, c, gp, teeth) -> tuple | None:
+    """(joint index, factor): the pinion's revolutions relative to the carrier are
+    factor x the turns of that joint (a gear of the pair jointed straight to the carrier;
+    factor = its teeth / the pinion's teeth).  None when neither gear is: no tooth passes."""
+    carrier = an.names[c.carrier]
+    for link, z in zip((gp.j, gp.k), teeth):
+        for ji, jt in enumerate(an.mech.joints):
+            if jt.child == link and jt.parent == carrier and jt.type == "revolute":
+                return ji, z / min(teeth)
+    return None
 
 
 def _stress_factors(gp, g, teeth, r) -> dict:
@@ -146,6 +167,8 @@ def _stress_factors(gp, g, teeth, r) -> dict:
     zk, dk = virtual_spur(teeth[1], 2 * g.r_k, g.cone_k)
     beta = gp.helix_angle
     K = r.application_factor * r.load_sharing_factor
+    if r.quality_number is not None:      # AGMA K_v at the highest pitch-line velocity (rating)
+        K *= float(dynamic_factor(r.pitch_line_velocity, r.quality_number))
     Y = min(lewis_form_factor(virtual_helical_teeth(z, beta)) for z in (zj, zk))
     d1, u = min(dj, dk), max(dj, dk) / min(dj, dk)
     return {"K": K, "Y": Y, "d1": d1, "u": u, "alpha": gp.pressure_angle, "internal": g.ring is not None,

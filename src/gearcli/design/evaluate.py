@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import bearings as B
+from . import fatigue as F
 from . import iso281
 from .checks import Check
 from ..report.rms import running_rms, rms_of, square_integral
@@ -102,6 +103,16 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
             total = B.life_sum(x, n, ch.exponent, iso281.life_factor(bearing_of(ch, mech), x))
             wsum = revs = float(np.sum(n))
             score = B.equivalent_load(total, wsum, ch.exponent)
+        elif ch.kind == "fatigue":
+            peaks = F.rainflow_peaks(x)
+            total = F.miner_damage(peaks, ch.rating, ch.signal[0])
+            revs = float(len(peaks))
+            if ch.extra.get("passes") is not None:       # each pinion tooth: one cycle per revolution
+                ji, factor = ch.extra["passes"]
+                n = B.revolutions(s.rates[:, ji], s.t) * factor
+                total += F.pass_damage(x, n, ch.rating, ch.signal[0])
+                revs += float(np.sum(n))
+            score = total
         out.append((peak, tp, total, wsum, revs, score))
     return out
 
@@ -133,6 +144,12 @@ def combine(check: Check, parts: list[tuple], cycles_per_hour: float | None) -> 
     elif check.kind == "safety":
         value = B.static_safety(check.rating, peak)
         sig_lim = check.rating / check.limit
+    elif check.kind == "fatigue":
+        per_hour = sum(p[2] for p in parts) * (cycles_per_hour or 0.0)
+        value = F.life_hours(per_hour)
+        cycles = check.limit * sum(p[4] for p in parts) * (cycles_per_hour or 0.0)
+        factor = F.bending_cycle_factor if check.signal[0] == "bending" else F.pitting_cycle_factor
+        sig_lim = check.rating * float(factor(max(cycles, 1.0)))
     else:
         P_eq = B.equivalent_load(sum(p[2] for p in parts), sum(p[3] for p in parts), check.exponent)
         rev_h = sum(p[4] for p in parts) * (cycles_per_hour or 0.0)

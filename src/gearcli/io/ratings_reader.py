@@ -26,7 +26,8 @@ BEARING_KEYS = ("name", "position", "C", "C0", "type", "X", "Y", "e", "X0", "Y0"
 RATING_KEYS = ("C", "C0", "type")     # a rated bearing has all three (the design checks need them)
 LIFE_FACTOR_KEYS = ("kappa", "e_C", "Cu")
 GEAR_KEYS = ("module", "face_width", "bending_stress_limit", "contact_stress_limit",
-             "elastic_coefficient", "application_factor", "load_sharing_factor")
+             "elastic_coefficient", "application_factor", "load_sharing_factor", "quality_number",
+             "pitch_line_velocity")
 
 
 def _positive(spec: dict, keys, path: str, add) -> None:
@@ -125,9 +126,14 @@ def _life_factor_keys(spec: dict, p: str, add) -> None:
 def gear_rating(spec: dict, path: str, add) -> GearRating:
     """A :class:`GearRating` from a mapping with the keys of :data:`GEAR_KEYS`."""
     _positive(spec, GEAR_KEYS, path, add)
+    kv = [k for k in ("quality_number", "pitch_line_velocity") if k in spec]
+    if len(kv) == 1:
+        other = "pitch_line_velocity" if kv[0] == "quality_number" else "quality_number"
+        add(f"{path}.{kv[0]}", f"the dynamic factor K_v needs both quality_number and pitch_line_velocity: {other} missing")
     return GearRating(float(spec["module"]), float(spec["face_width"]), float(spec["bending_stress_limit"]),
                       float(spec["contact_stress_limit"]), float(spec.get("elastic_coefficient", STEEL_ELASTIC_COEFFICIENT)),
-                      float(spec.get("application_factor", 1.0)), float(spec.get("load_sharing_factor", 1.0)), path)
+                      float(spec.get("application_factor", 1.0)), float(spec.get("load_sharing_factor", 1.0)), path,
+                      *(None if spec.get(k) is None else float(spec[k]) for k in ("quality_number", "pitch_line_velocity")))
 
 
 PRISMATIC_BEARINGS = ("rolling-bearing ratings (ISO 281 life in revolutions) are for revolute joints; "
@@ -264,7 +270,8 @@ def attach_urdf_ratings(mech: Mechanism, root, file: str) -> Mechanism:
     for kind, table, keys, builder in (("motor", motors, MOTOR_KEYS, motor_rating),
                                        ("gear", gears, GEAR_KEYS, gear_rating)):
         required = [k for k in keys if k not in ("max_power", "elastic_coefficient", "application_factor",
-                                                 "load_sharing_factor")]
+                                                 "load_sharing_factor", "thermal_window", "quality_number",
+                                                 "pitch_line_velocity")]
         for el in _ext(root, f"{kind}_rating"):
             path = f"gearcli:{kind}_rating '{el.get(kind)}'"
             lines[path] = el.sourceline

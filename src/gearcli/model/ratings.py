@@ -109,7 +109,9 @@ class GearRating:
     ``module`` and ``face_width`` in m; ``bending_stress_limit`` and
     ``contact_stress_limit`` (allowable stresses) in Pa; ``elastic_coefficient`` Z_E in
     sqrt(Pa); ``application_factor`` K_A and ``load_sharing_factor`` multiply the
-    tangential force.
+    tangential force; ``quality_number`` Q_v and ``pitch_line_velocity`` (m/s) give the
+    AGMA dynamic factor K_v (:func:`gearcli.design.fatigue.dynamic_factor`), which
+    multiplies it too.
     """
 
     module: float
@@ -120,3 +122,5 @@ class GearRating:
     application_factor: float = 1.0
     load_sharing_factor: float = 1.0
     path: str = field(default="", compare=False)   # where it was read (for messages)
+    quality_number: float | None = None       # AGMA Q_v: with pitch_line_velocity, the dynamic factor K_v
+    pitch_line_velocity: float | None = None  # m/s, the highest of the duty (K_v is taken there)

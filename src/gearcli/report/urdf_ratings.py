@@ -38,4 +38,4 @@ def add_rating_elements(mech, root, joint_elements: dict) -> None:
         if g.rating is not None:
             etree.SubElement(root, _q("gear_rating"), {"gear": g.name, **_attrs(g.rating, (
                 "module", "face_width", "bending_stress_limit", "contact_stress_limit", "elastic_coefficient",
-                "application_factor", "load_sharing_factor"))})
+                "application_factor", "load_sharing_factor", "quality_number", "pitch_line_velocity"))})

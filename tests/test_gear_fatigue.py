@@ -1,0 +1,102 @@
+"""Gear tooth fatigue: AGMA stress-cycle factors and K_v against Shigley's worked example,
+rainflow counts against the library, Miner sums by hand, and the check through verify."""
+import math
+
+import numpy as np
+import pytest
+
+from gearcli.design import fatigue as F
+
+
+def test_stress_cycle_factors_shigley_example_14_4():
+    # Budynas & Nisbett, Shigley's Mechanical Engineering Design, 9th ed., Example 14-4 (a
+    # 17-tooth pinion driving a 52-tooth gear, pinion life 10^8 cycles, gear 10^8 / (52/17)
+    # = 3.27(10^7)), printed: (Y_N)_P = 1.3558(10^8)^-0.0178 = 0.977, (Y_N)_G = 0.996,
+    # (Z_N)_P = 1.4488(10^8)^-0.023 = 0.948, (Z_N)_G = 0.973.
+    NP, NG = 1e8, 3.27e7
+    assert round(float(F.bending_cycle_factor(NP)), 3) == 0.977
+    assert round(float(F.bending_cycle_factor(NG)), 3) == 0.996
+    assert round(float(F.pitting_cycle_factor(NP)), 3) == 0.948
+    assert round(float(F.pitting_cycle_factor(NG)), 3) == 0.973
+
+
+def test_dynamic_factor_shigley_example_14_4():
+    # Same example: Q_v = 6, V = 801.1 ft/min; B = 0.25 (12 - 6)^(2/3) = 0.8255,
+    # A = 50 + 56 (1 - 0.8255) = 59.77, K_v = ((59.77 + sqrt(801.1)) / 59.77)^0.8255 = 1.377.
+    # The SI form takes V in m/s with sqrt(200 V): V = 801.1 / 200 m/s gives the same number.
+    assert round(float(F.dynamic_factor(801.1 / 200, 6)), 3) == 1.377
+    assert float(F.dynamic_factor(0.0, 6)) == 1.0
+
+
+def test_cycles_to_failure_inverts_the_curves_on_both_branches():
+    S = 2.0e8
+    for sigma, kind, factor in ((0.9 * S, "bending", F.bending_cycle_factor), (1.3 * S, "bending", F.bending_cycle_factor),
+                                (0.95 * S, "contact", F.pitting_cycle_factor), (1.2 * S, "contact", F.pitting_cycle_factor)):
+        N = float(F.cycles_to_failure(sigma, S, kind))
+        assert S * float(factor(N)) == pytest.approx(sigma, rel=1e-9)
+    # 1.3 S in bending is on the low-cycle branch: (2.3194 / 1.3)^(1/0.0538) cycles, by hand
+    assert float(F.cycles_to_failure(1.3 * S, S, "bending")) == pytest.approx((2.3194 / 1.3) ** (1 / 0.0538), rel=1e-9)
+    assert float(F.cycles_to_failure(0.0, S, "bending")) == math.inf
+
+
+def test_rainflow_counts_equal_fatpacks_on_a_random_signal():
+    import fatpack
+
+    rng = np.random.default_rng(7)
+    y = np.cumsum(rng.normal(size=5000))
+    peaks = F.rainflow_peaks(y)
+    ranges, means = fatpack.find_rainflow_ranges(y, k=F.RAINFLOW_CLASSES, return_means=True)
+    assert len(peaks) == len(ranges) > 100
+    # each cycle's largest |stress| from the library's range and mean
+    ref = np.maximum(np.abs(means + ranges / 2), np.abs(means - ranges / 2))
+    assert np.sort(peaks) == pytest.approx(np.sort(ref), rel=1e-12)
+
+
+def test_rainflow_of_a_known_history_and_miner_by_hand():
+    # 0 -> 5 -> 1 -> 4 -> 0: the inner cycle 1-4 (largest 4) and, closing the residue of a
+    # repeating history, 0-5 (largest 5).  Classes of 5/1024 resolve them to 5/2048.
+    y = np.interp(np.linspace(0, 4, 401), [0, 1, 2, 3, 4], [0.0, 5.0, 1.0, 4.0, 0.0]) * 1e8
+    peaks = np.sort(F.rainflow_peaks(y))
+    assert peaks == pytest.approx([4e8, 5e8], abs=5e8 / 1024)
+    S = 4.5e8
+    hand = 0.0
+    for p in peaks:              # N_f of the AGMA bending curve, written out
+        n = (1.3558 * S / p) ** (1 / 0.0178)
+        if n < 3e6:
+            n = (2.3194 * S / p) ** (1 / 0.0538)
+        hand += 1 / n
+    assert F.miner_damage(peaks, S, "bending") == pytest.approx(hand, rel=1e-12)
+    assert F.life_hours(2 * hand) == pytest.approx(1 / (2 * hand))
+    assert len(F.rainflow_peaks(np.full(10, 3.0))) == 0
+
+
+def test_rated_arm_gear_checks_carry_k_v_and_the_pinion_passes():
+    from gearcli import analyse, load_mechanism
+    from gearcli.design.checks import Requirements, build_checks
+    from gearcli.errors import Collector
+    from pathlib import Path
+
+    an = analyse(load_mechanism(Path(__file__).resolve().parents[1] / "mechanisms" / "paper_2dof_rated.yaml"))
+    checks = {c.name: c for c in build_checks(an, Requirements(cycles_per_hour=1200, gear_life_h=2e4), Collector("x"))}
+    ch = checks["gear 5-1: bending fatigue life"]
+    B = 0.25 * (12 - 8) ** (2 / 3)                     # Q_v = 8, V = 0.5 m/s, K_A = 1.25, by hand
+    A = 50 + 56 * (1 - B)
+    assert ch.extra["K"] == pytest.approx(1.25 * ((A + math.sqrt(200 * 0.5)) / A) ** B, rel=1e-12)
+    ji, factor = ch.extra["passes"]                    # the pinion 5 turns on J5 about the base
+    assert an.mech.joints[ji].name == "J5" and factor == 1.0
+    # the bevel pair 3-4 (carrier: link 1): gear 4 turns on J4 in link 1, 30/30 teeth
+    ji, factor = checks["gear 3-4: contact fatigue life"].extra["passes"]
+    assert an.mech.joints[ji].name == "J4" and factor == 1.0
+
+
+def test_bundled_realistic_design_passes_and_its_tight_twin_fails_on_the_expected_check(run_cli, tmp_path):
+    import xml.etree.ElementTree as ET
+    from pathlib import Path
+
+    designs = Path(__file__).resolve().parents[1] / "designs"
+    r = run_cli("verify", designs / "paper_arm_duty.yaml", "--junit", tmp_path / "ok.xml", "-j", "1")
+    assert r.exit_code == 0, r.stdout + r.stderr
+    r = run_cli("verify", designs / "paper_arm_duty_tight.yaml", "--junit", tmp_path / "tight.xml", "-j", "1")
+    assert r.exit_code == 1, r.stdout + r.stderr
+    failed = [tc.get("name") for tc in ET.parse(tmp_path / "tight.xml").iter("testcase") if tc.find("failure") is not None]
+    assert failed == ["bearing J5/upper: L10 life"]
