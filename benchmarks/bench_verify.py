@@ -1,13 +1,16 @@
 """Wall time of `gearcli verify` run serially, in processes and on Dask (prints figures; not a test).
 
-    python benchmarks/bench_verify.py [--trajectories 8] [--samples 20000] [--repeat 3]
+    python benchmarks/bench_verify.py [--trajectories 8] [--samples 20000] [--repeat 3] [--serial]
 
 Builds a manifest over the rated Bendix wrist with --trajectories trajectory files of
---samples samples each (a 1 Hz / 0.7 Hz / 1.3 Hz multi-sine), then reports the median
-wall time over --repeat runs of: -j 1 (this process), -j 2 (process pool) and a Dask
-LocalCluster with 2 worker processes (cluster start-up excluded), their ratios, and that
-the three JSON reports are identical.  The load average is printed with the figures: the
-machine is shared, so compare the ratios rather than single numbers.
+--samples samples each (a 1 Hz / 0.7 Hz / 1.3 Hz multi-sine) and every check switched on
+(bearing lives with the ISO 281 table, static safeties, tooth stresses, gear fatigue by
+rainflow + Miner), then reports the median wall time over --repeat runs of: the library's
+``solve`` alone on the same samples (the floor), -j 1 (this process, end to end: manifest,
+CSV reading, splines, solve, checks, JSON), -j 2 (process pool) and a Dask LocalCluster
+with 2 worker processes (cluster start-up excluded), their rates, and that the three JSON
+reports are identical (--serial: the library and -j 1 only).  The load average is printed
+with the figures: the machine is shared, so compare the ratios rather than single numbers.
 """
 from __future__ import annotations
 
@@ -36,8 +39,20 @@ def make_manifest(d: Path, n_traj: int, n: int) -> Path:
         write_trajectory(d / f"traj_{k:02d}.csv", ["J1", "J2", "J3"], t, q)
     man = d / "design.yaml"
     man.write_text(f"cases:\n  - name: wrist\n    mechanism: {ROOT / 'mechanisms' / 'bendix_wrist_rated.yaml'}\n"
-                   "    trajectories: traj_*.csv\n    cycles_per_hour: 60\n    bearing_life_h: 20000\n")
+                   "    trajectories: traj_*.csv\n    cycles_per_hour: 60\n    bearing_life_h: 20000\n"
+                   "    gear_life_h: 20000\n")
     return man
+
+
+def library_solve(d: Path, repeat: int) -> float:
+    """Median time of the library's solve over the trajectories' samples (arrays in memory)."""
+    from gearcli import analyse, load_mechanism, solve
+    from gearcli.io.trajectory import read_trajectory
+
+    an = analyse(load_mechanism(ROOT / "mechanisms" / "bendix_wrist_rated.yaml"))
+    trs = [read_trajectory(p, an.independent_names) for p in sorted(d.glob("traj_*.csv"))]
+    solve(an, trs[0].q[:10], trs[0].qd[:10], trs[0].qdd[:10], jobs=1)    # warm (kernel cache)
+    return timed(lambda: [solve(an, tr.q, tr.qd, tr.qdd, jobs=1) for tr in trs], repeat)[0]
 
 
 def timed(fn, repeat: int) -> tuple[float, object]:
@@ -54,6 +69,7 @@ def main() -> None:
     ap.add_argument("--trajectories", type=int, default=8)
     ap.add_argument("--samples", type=int, default=20_000)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--serial", action="store_true", help="the library solve and -j 1 only")
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         d = Path(tmp)
@@ -64,16 +80,22 @@ def main() -> None:
             run_verify(man, json_path=out, **kw)
             return json.loads(out.read_text())
 
+        lib_t = library_solve(d, args.repeat)
         serial_t, serial = timed(lambda: run("serial", jobs=1), args.repeat)
-        pool_t, pool = timed(lambda: run("pool", jobs=2), args.repeat)
-        from dask.distributed import LocalCluster
+        if not args.serial:
+            pool_t, pool = timed(lambda: run("pool", jobs=2), args.repeat)
+            from dask.distributed import LocalCluster
 
-        with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl:
-            dask_t, dask = timed(lambda: run("dask", dask_address=cl.scheduler_address), args.repeat)
+            with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl:
+                dask_t, dask = timed(lambda: run("dask", dask_address=cl.scheduler_address), args.repeat)
     total = args.trajectories * args.samples
     print(f"gearcli verify: {args.trajectories} trajectories x {args.samples:,} samples "
           f"({len(serial['checks'])} checks), medians of {args.repeat}; load average {os.getloadavg()[0]:.2f}")
-    print(f"  -j 1 (serial)       {serial_t:7.2f} s  {total / serial_t:10,.0f} samples/s")
+    print(f"  library solve       {lib_t:7.2f} s  {total / lib_t:10,.0f} samples/s  (solve() on the same samples)")
+    print(f"  -j 1 (serial)       {serial_t:7.2f} s  {total / serial_t:10,.0f} samples/s  "
+          f"(end to end; {100 * (1 - lib_t / serial_t):.0f} % outside the solver)")
+    if args.serial:
+        return
     print(f"  -j 2 (processes)    {pool_t:7.2f} s  {total / pool_t:10,.0f} samples/s  speed-up {serial_t / pool_t:.2f}x")
     print(f"  --dask (2 workers)  {dask_t:7.2f} s  {total / dask_t:10,.0f} samples/s  speed-up {serial_t / dask_t:.2f}x")
     print(f"  identical reports: {serial == pool == dask}")

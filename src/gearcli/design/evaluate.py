@@ -47,8 +47,18 @@ def bearing_loads(s: Samples, joint: str, bearings, bi: int) -> tuple[np.ndarray
     return np.hypot(R[:, 0], R[:, 1]), axial
 
 
-def signal(check: Check, s: Samples, mech) -> np.ndarray:
-    """The check's quantity at every sample, (N,), in ``check.signal_unit``."""
+def signal(check: Check, s: Samples, mech, cache: dict | None = None) -> np.ndarray:
+    """The check's quantity at every sample, (N,), in ``check.signal_unit``; ``cache`` (one
+    per trajectory) keeps signals and bearing loads that several checks share."""
+    if cache is None:
+        cache = {}
+    key = (check.signal, check.extra.get("K"))
+    if key not in cache:
+        cache[key] = _signal(check, s, mech, cache)
+    return cache[key]
+
+
+def _signal(check: Check, s: Samples, mech, cache: dict) -> np.ndarray:
     kind = check.signal[0]
     if kind == "abs":
         return np.abs(s.cols[check.signal[1]])
@@ -61,7 +71,9 @@ def signal(check: Check, s: Samples, mech) -> np.ndarray:
     if kind in ("bearing_P", "bearing_P0"):
         jt = mech.joints[check.signal[1]]
         b = jt.bearings[check.signal[2]]
-        Fr, Fa = bearing_loads(s, jt.name, jt.bearings, check.signal[2])
+        if ("loads", jt.name) not in cache:
+            cache[("loads", jt.name)] = [bearing_loads(s, jt.name, jt.bearings, bi) for bi in range(len(jt.bearings))]
+        Fr, Fa = cache[("loads", jt.name)][check.signal[2]]
         if kind == "bearing_P":
             return iso281.bearing_equivalent_load(b, Fr, Fa)
         return B.static_equivalent_load(Fr, Fa, b.X0, b.Y0)
@@ -89,8 +101,9 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
     """
     out = []
     span = float(s.t[-1] - s.t[0]) if s.t.size else 0.0
+    cache: dict = {}
     for ch in checks:
-        x = signal(ch, s, mech)
+        x = signal(ch, s, mech, cache)
         k = int(np.argmax(np.abs(x))) if x.size else 0
         peak, tp = (float(np.abs(x[k])), float(s.t[k])) if x.size else (0.0, math.nan)
         total = wsum = revs = 0.0
@@ -99,7 +112,7 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
             total, wsum = float(square_integral(x, s.t)), span
             score = rms_of(total, wsum, peak)
         elif ch.kind == "life":
-            n = B.revolutions(s.rates[:, ch.signal[1]], s.t)
+            n = _revolutions(cache, s, ch.signal[1])
             total = B.life_sum(x, n, ch.exponent, iso281.life_factor(bearing_of(ch, mech), x))
             wsum = revs = float(np.sum(n))
             score = B.equivalent_load(total, wsum, ch.exponent)
@@ -109,12 +122,20 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
             revs = float(len(peaks))
             if ch.extra.get("passes") is not None:       # each pinion tooth: one cycle per revolution
                 ji, factor = ch.extra["passes"]
-                n = B.revolutions(s.rates[:, ji], s.t) * factor
+                n = _revolutions(cache, s, ji) * factor
                 total += F.pass_damage(x, n, ch.rating, ch.signal[0])
                 revs += float(np.sum(n))
             score = total
         out.append((peak, tp, total, wsum, revs, score))
     return out
+
+
+def _revolutions(cache: dict, s: Samples, ji: int) -> np.ndarray:
+    """Revolutions of joint ``ji`` at each sample (:func:`gearcli.design.bearings.revolutions`),
+    once per trajectory."""
+    if ("revs", ji) not in cache:
+        cache[("revs", ji)] = B.revolutions(s.rates[:, ji], s.t)
+    return cache[("revs", ji)]
 
 
 @dataclass(frozen=True)
