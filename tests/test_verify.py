@@ -438,3 +438,31 @@ def test_running_rms_over_the_thermal_window_is_checked(run_cli, tmp_path):
     assert run["value"] == pytest.approx(J * 5 * math.sqrt((0.2 + 0.0005) / 0.5), rel=1e-6)
     assert checks[("rotor", "motor m", "RMS torque")]["value"] == pytest.approx(J * 5 * math.sqrt(0.2005 / 2), rel=1e-6)
     assert run["limit"] == 0.5
+
+
+def test_mission_profile_shares_weight_every_life(run_cli, tmp_path):
+    # Two motions (the same rotor file twice): a fraction 0.5 of the time, i.e. 0.5 * 3600 / 2 s
+    # = 900 repetitions an hour, and 1000 h of a 4000 h service life, i.e. 450 an hour.  The
+    # bearing turns W T / 2 pi per repetition under a constant load: its life is the
+    # closed form at 1350 repetitions an hour, i.e. 1800/1350 of continuous rotation's.
+    write_rotor_case(tmp_path, "[{name: x, position: 0, C: 3000, C0: 3000, type: tapered_roller}]")
+    (tmp_path / "rotor2.csv").write_bytes((tmp_path / "rotor.csv").read_bytes())
+    case = ("cases:\n  - {name: rotor, mechanism: rotor.yaml, service_life_h: 4000, bearing_life_h: 1000,\n"
+            "     trajectories: [{file: rotor.csv, fraction: 0.5}, {file: rotor2.csv, hours: 1000}]}\n")
+    r, doc = run_json(run_cli, tmp_path, case)
+    assert r.exit_code in (0, 1), r.stderr
+    Fr, Fa = M * W**2 * R, M * G
+    P = 0.4 * Fr + 1.49 * Fa                           # tapered roller defaults, Fa/Fr > e
+    closed = (3000 / P) ** (10 / 3) * 1e6 / (3600 * W / (2 * math.pi))
+    assert by_name(doc)[("rotor", "bearing J/x", "L10 life")]["value"] == pytest.approx(closed * 1800 / 1350, rel=1e-6)
+    r, doc = run_json(run_cli, tmp_path, case.replace("hours: 1000}", "cycles_per_hour: 450}"))
+    assert by_name(doc)[("rotor", "bearing J/x", "L10 life")]["value"] == pytest.approx(closed * 1800 / 1350, rel=1e-6)
+
+
+def test_mission_profile_hours_need_the_service_life(run_cli, tmp_path):
+    write_rotor_case(tmp_path, "[{name: x, position: 0, C: 3000, C0: 3000, type: ball}]")
+    man = tmp_path / "design.yaml"
+    man.write_text("cases:\n  - {mechanism: rotor.yaml, bearing_life_h: 10, trajectories: [{file: rotor.csv, hours: 5}]}\n")
+    r = run_cli("verify", man, "-j", "1")
+    assert r.exit_code == 2 and "cases[0].trajectories[0].hours: hours of the profile need the case's service_life_h" \
+        in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr

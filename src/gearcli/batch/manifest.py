@@ -26,8 +26,8 @@ from ..model.validate import MAX_ABS
 from ..pipeline import analyse, prismatic_independent
 from ..io.schemas import packaged_schema
 
-REQUIREMENT_KEYS = ("cycles_per_hour", "bearing_life_h", "gear_life_h", "min_static_safety", "min_bending_safety",
-                    "min_contact_safety")
+REQUIREMENT_KEYS = ("cycles_per_hour", "service_life_h", "bearing_life_h", "gear_life_h", "min_static_safety",
+                    "min_bending_safety", "min_contact_safety")
 
 
 @lru_cache(maxsize=8)
@@ -71,6 +71,7 @@ class Case:
     degrees: bool
     req: Requirements
     checks: tuple[Check, ...]
+    shares: tuple = ()     # per trajectory: (hours|fraction|cycles_per_hour, value) or None
 
 
 @dataclass(frozen=True)
@@ -183,17 +184,32 @@ def _file_problem(name: str, base: Path) -> str | None:
     return None if why is None else f"'{name}' (relative to {base}): {why}"
 
 
-def _trajectory_paths(spec, where: str, base: Path, col: Collector, bad: set) -> list[Path]:
-    """The trajectory files of a case: every valid pattern expanded (a bad item is left out,
-    its problem is reported already)."""
+SHARE_KEYS = ("hours", "fraction", "cycles_per_hour")
+
+
+def _trajectory_paths(spec, where: str, base: Path, col: Collector, bad: set) -> tuple[list[Path], list]:
+    """The trajectory files of a case and their mission-profile shares ((key, value), or
+    None): every valid pattern expanded (a bad item is left out, its problem is reported
+    already)."""
     value = spec["trajectories"]
     if not isinstance(value, (str, list)) or isinstance(value, str) and _under(bad, f"{where}.trajectories"):
-        return []
+        return [], []
     single = isinstance(value, str)
     patterns = [value] if single else value
-    out = []
+    out, shares = [], []
     for j, pat in enumerate(patterns):
         sub = f"{where}.trajectories" + ("" if single else f"[{j}]")
+        share = None
+        if isinstance(pat, dict) and not _under(bad, sub):
+            key = next((k for k in SHARE_KEYS if k in pat), None)
+            if key is None or not isinstance(pat.get("file"), str):
+                continue                                  # the schema said what is wrong
+            share, pat, sub = (key, float(pat[key])), pat["file"], f"{sub}.file"
+            if glob.has_magic(pat):
+                col.add(sub, f"a trajectory with a share names one file, not a pattern: '{_shown(pat)}'")
+                continue
+            if key == "hours" and "service_life_h" not in spec:
+                col.add(f"{where}.trajectories[{j}].hours", "hours of the profile need the case's service_life_h")
         if _under(bad, sub) or not isinstance(pat, str):
             continue
         if "\0" in pat:
@@ -209,7 +225,8 @@ def _trajectory_paths(spec, where: str, base: Path, col: Collector, bad: set) ->
                 col.add(sub, f"'{f}': {why}")
             else:
                 out.append(Path(f))
-    return out
+                shares.append(share)
+    return out, shares
 
 
 def _limits(spec: dict, where: str, bad: set) -> tuple:
@@ -235,10 +252,12 @@ def _prepare_case(spec: dict, where: str, base: Path, col: Collector, issues: li
 
     req = Requirements(**{k: float(spec[k]) for k in REQUIREMENT_KEYS if ok(k)},
                        limits=_limits(spec, where, bad), limits_path=f"{where}.limits")
+    trajs, shares = _trajectory_paths(spec, where, base, col, bad) if "trajectories" in spec else ([], [])
+    items = spec.get("trajectories")             # plain files repeat at the case's cycles_per_hour
+    plain = isinstance(items, str) or isinstance(items, list) and any(isinstance(i, str) for i in items)
     for key, what in (("bearing_life_h", "a bearing life"), ("gear_life_h", "a gear fatigue life")):
-        if ok(key) and "cycles_per_hour" not in spec:
+        if ok(key) and "cycles_per_hour" not in spec and plain:
             col.add(f"{where}.{key}", f"{what} in hours needs the duty's cycles_per_hour")
-    trajs = _trajectory_paths(spec, where, base, col, bad) if "trajectories" in spec else []
     if not ok("mechanism"):
         return None
     mech_path = base / spec["mechanism"]
@@ -268,7 +287,7 @@ def _prepare_case(spec: dict, where: str, base: Path, col: Collector, issues: li
         except GearcliError as exc:
             issues += exc.lines()
     name = spec["name"] if ok("name") else Path(spec["mechanism"]).stem
-    return Case(name, mech_path, tuple(trajs), bool(degrees), req, tuple(checks))
+    return Case(name, mech_path, tuple(trajs), bool(degrees), req, tuple(checks), tuple(shares))
 
 
 REQUIREMENT_CHECKS = {"bearing_life_h": ("L10 life", "joints[].bearings with C"),

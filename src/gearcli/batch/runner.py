@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..design.checks import build_checks
-from ..design.evaluate import Samples, Verdict, combine, partials, signal
+from ..design.evaluate import Samples, Verdict, combine, partials, profile_rates, signal
 from ..dynamics.solve import solve
 from ..errors import Collector, GearcliError
 from ..io.trajectory import read_trajectory
@@ -80,7 +80,10 @@ def run_manifest(manifest: Manifest, jobs: int | None = None, dask_address: str 
     out = []
     for ci, case in enumerate(manifest.cases):
         parts = [results[(ci, ti)] for ti in range(len(case.trajectories))]
-        verdicts = [combine(ch, [p[k] for p in parts], case.req.cycles_per_hour) for k, ch in enumerate(case.checks)]
+        spans = [p[0][6] if p else 0.0 for p in parts]
+        rates = profile_rates(case.shares or (None,) * len(parts), spans, case.req.cycles_per_hour,
+                              case.req.service_life_h)
+        verdicts = [combine(ch, [p[k] for p in parts], rates) for k, ch in enumerate(case.checks)]
         out.append(CaseResult(case, tuple(verdicts)))
     return out
 

@@ -33,6 +33,7 @@ class Requirements:
     """A case's requirements (manifest keys of the same names); None: not checked."""
 
     cycles_per_hour: float | None = None
+    service_life_h: float | None = None
     bearing_life_h: float | None = None
     gear_life_h: float | None = None
     min_static_safety: float = 1.0

@@ -92,7 +92,7 @@ def bearing_of(check: Check, mech):
 
 
 def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
-    """Per check, the trajectory's (peak, t at peak, sum, weight sum, revolutions, score).
+    """Per check, the trajectory's (peak, t at peak, sum, weight sum, revolutions, score, span).
 
     ``sum``/``weight`` are the trapezoid integral of x^2 and the time span (rms,
     :mod:`gearcli.design.rms`), or the Palmgren-Miner sum n_k P_k^p / a_ISO and the
@@ -126,7 +126,7 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
                 total += F.pass_damage(x, n, ch.rating, ch.signal[0])
                 revs += float(np.sum(n))
             score = total
-        out.append((peak, tp, total, wsum, revs, score))
+        out.append((peak, tp, total, wsum, revs, score, span))
     return out
 
 
@@ -151,8 +151,34 @@ class Verdict:
     signal_limit: float    # the signal level that just meets the limit (for plots)
 
 
-def combine(check: Check, parts: list[tuple], cycles_per_hour: float | None) -> Verdict:
-    """Merge the partials of a case's trajectories (in order) into a :class:`Verdict`."""
+def profile_rates(shares, spans, cycles_per_hour: float | None, service_life_h: float | None) -> list:
+    """Repetitions per hour of service of each trajectory of a mission profile.
+
+    A trajectory's share is ("cycles_per_hour", r): r; ("fraction", f) of the time: f 3600 / T;
+    ("hours", h) of the service life L: (h / L) 3600 / T (T its duration, s); None: the
+    case's ``cycles_per_hour`` (the trajectories together make one duty cycle repeated at
+    that rate), or None when that is not given either (no life can be computed).
+    """
+    out = []
+    for share, T in zip(shares, spans):
+        if share is None:
+            out.append(cycles_per_hour)
+        elif share[0] == "cycles_per_hour":
+            out.append(share[1])
+        else:
+            f = share[1] if share[0] == "fraction" else share[1] / service_life_h
+            out.append(f * 3600.0 / T if T > 0 else 0.0)
+    return out
+
+
+def combine(check: Check, parts: list[tuple], rates) -> Verdict:
+    """Merge the partials of a case's trajectories (in order) into a :class:`Verdict`;
+    ``rates``: each trajectory's repetitions per hour (:func:`profile_rates`), or one number
+    for all.  RMS, equivalent loads, revolutions and damage are weighted by them."""
+    if not isinstance(rates, (list, tuple)):
+        rates = [rates] * len(parts)
+    w = [1.0 if r is None else r for r in rates]         # RMS: equal repetitions when unknown
+    per_hour = [r or 0.0 for r in rates]
     scores = [p[5] for p in parts]
     worst = int(np.argmax(scores))
     t_worst = parts[worst][1]
@@ -160,20 +186,20 @@ def combine(check: Check, parts: list[tuple], cycles_per_hour: float | None) -> 
     if check.kind == "peak":
         value, sig_lim = peak, check.limit
     elif check.kind == "rms":
-        value = rms_of(sum(p[2] for p in parts), sum(p[3] for p in parts), peak)
+        value = rms_of(sum(r * p[2] for r, p in zip(w, parts)), sum(r * p[3] for r, p in zip(w, parts)), peak)
         sig_lim = check.limit
     elif check.kind == "safety":
         value = B.static_safety(check.rating, peak)
         sig_lim = check.rating / check.limit
     elif check.kind == "fatigue":
-        per_hour = sum(p[2] for p in parts) * (cycles_per_hour or 0.0)
-        value = F.life_hours(per_hour)
-        cycles = check.limit * sum(p[4] for p in parts) * (cycles_per_hour or 0.0)
+        value = F.life_hours(sum(r * p[2] for r, p in zip(per_hour, parts)))
+        cycles = check.limit * sum(r * p[4] for r, p in zip(per_hour, parts))
         factor = F.bending_cycle_factor if check.signal[0] == "bending" else F.pitting_cycle_factor
         sig_lim = check.rating * float(factor(max(cycles, 1.0)))
     else:
-        P_eq = B.equivalent_load(sum(p[2] for p in parts), sum(p[3] for p in parts), check.exponent)
-        rev_h = sum(p[4] for p in parts) * (cycles_per_hour or 0.0)
+        P_eq = B.equivalent_load(sum(r * p[2] for r, p in zip(w, parts)), sum(r * p[3] for r, p in zip(w, parts)),
+                                 check.exponent)
+        rev_h = sum(r * p[4] for r, p in zip(per_hour, parts))
         value = B.rating_life_hours(B.rating_life_mrev(check.rating, P_eq, check.exponent), rev_h)
         sig_lim = B.required_equivalent_load(check.rating, check.limit, rev_h, check.exponent)
     if check.kind in ("peak", "rms"):
