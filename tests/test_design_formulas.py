@@ -239,3 +239,15 @@ def test_running_and_cumulative_rms_by_hand():
     whole = Rms.cumulative_rms(x, t)
     assert whole[-1] == pytest.approx(Rms.rms(x, t)) and whole[0] == 2.0
     assert Rms.rms(x, t) == pytest.approx(math.sqrt((4 * 2.0 + 10.0) / 3.0))    # [0, 2]: 4 for 2 s; [2, 3]: 10
+
+
+def test_load_spectrum_by_hand():
+    from gearcli.design.spectra import bin_edges, load_spectrum
+
+    # samples 1 s apart: trapezoid weights 0.5, 1, 1, 0.5; |x| = 1, 3, 3, 9 in bins of 3 N
+    # from 0 to 9: [0,3) 0.5 s, [3,6) 2 s, [6,9] 0.5 s; at 2 pi rad/s one revolution per second
+    t = np.arange(4.0)
+    edges = bin_edges(9.0, 3)
+    sec, rev = load_spectrum([1.0, -3.0, 3.0, 9.0], t, np.full(4, 2 * math.pi), edges)
+    assert sec == pytest.approx([0.5, 2.0, 0.5]) and rev == pytest.approx([0.5, 2.0, 0.5])
+    assert load_spectrum([1.0, -3.0, 3.0, 9.0], t, None, edges)[1] == pytest.approx([0, 0, 0])

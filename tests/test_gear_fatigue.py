@@ -100,3 +100,18 @@ def test_bundled_realistic_design_passes_and_its_tight_twin_fails_on_the_expecte
     assert r.exit_code == 1, r.stdout + r.stderr
     failed = [tc.get("name") for tc in ET.parse(tmp_path / "tight.xml").iter("testcase") if tc.find("failure") is not None]
     assert failed == ["bearing J5/upper: L10 life"]
+
+
+def test_life_and_fatigue_plots_are_drawn_over_the_whole_profile(run_cli, tmp_path):
+    from pathlib import Path
+
+    designs = Path(__file__).resolve().parents[1] / "designs"
+    text = (designs / "paper_arm_duty.yaml").read_text().replace("../mechanisms/", str(designs.parent / "mechanisms") + "/")
+    text = text.replace("gear_life_h: 20000 ", "gear_life_h: 1.0e+12").replace("bearing_life_h: 20000 ", "bearing_life_h: 1.0e+5")
+    (tmp_path / "d.yaml").write_text(text)
+    r = run_cli("verify", tmp_path / "d.yaml", "-j", "1", "--plots", tmp_path / "pl")
+    assert r.exit_code == 1, r.stdout + r.stderr
+    names = sorted(p.name for p in (tmp_path / "pl").iterdir())
+    assert "pick_and_place__bearing_J5_upper__L10_life.png" in names
+    assert "pick_and_place__gear_5-1__contact_fatigue_life.png" in names
+    assert all((tmp_path / "pl" / n).read_bytes()[:4] == b"\x89PNG" for n in names)

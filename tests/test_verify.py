@@ -466,3 +466,24 @@ def test_mission_profile_hours_need_the_service_life(run_cli, tmp_path):
     r = run_cli("verify", man, "-j", "1")
     assert r.exit_code == 2 and "cases[0].trajectories[0].hours: hours of the profile need the case's service_life_h" \
         in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
+
+
+def test_load_spectra_sum_to_the_duty_and_its_revolutions(run_cli, tmp_path):
+    # The rotor at constant rate W for 2 s, 1800 times an hour: every spectrum holds 3600 s
+    # per hour, and the bearing's turns W T / 2 pi x 1800 per hour, all in the one bin of its
+    # constant equivalent load.
+    case = write_rotor_case(tmp_path, "[{name: x, position: 0, C: 3000, C0: 3000, type: tapered_roller}]")
+    man = tmp_path / "design.yaml"
+    man.write_text("cases:\n" + case)
+    r = run_cli("verify", man, "-j", "1", "--spectra", tmp_path / "sp")
+    assert r.exit_code in (0, 1) and "load spectra of 1 case in" in r.stdout, r.stdout + r.stderr
+    doc = json.loads((tmp_path / "sp" / "rotor__spectra.json").read_text())
+    by = {(s["component"], s["quantity"]): s for s in doc["spectra"]}
+    bearing = by[("bearing J/x", "equivalent load P")]
+    assert sum(bearing["seconds_per_hour"]) == pytest.approx(3600.0)
+    assert sum(bearing["revolutions_per_hour"]) == pytest.approx(W * T / (2 * math.pi) * 1800, rel=1e-9)
+    assert bearing["seconds_per_hour"][-1] == pytest.approx(3600.0)          # constant load: the top bin
+    assert sum(by[("motor m", "torque")]["fraction_of_time"]) == pytest.approx(1.0)
+    rows = (tmp_path / "sp" / "rotor__spectra.csv").read_text().splitlines()
+    assert rows[0] == "component,quantity,unit,load_from,load_to,seconds_per_hour,fraction_of_time,revolutions_per_hour"
+    assert len(rows) == 1 + 2 * 20

@@ -293,6 +293,9 @@ def verify(
     markdown: str = typer.Option(None, "--markdown", metavar="FILE", help="Write a Markdown table (CI job summary)."),
     plots: Path = typer.Option(None, "--plots", metavar="DIR", help="Write a PNG of each failing or tight "
                                "(< 10 % margin) check along its worst trajectory."),
+    spectra: Path = typer.Option(None, "--spectra", metavar="DIR", help="Write each case's load spectra (time "
+                                 "and revolutions per hour at each load level of every motor, gear mesh and "
+                                 "rated bearing) as CSV and JSON."),
     jobs: int = typer.Option(None, "-j", "--jobs", min=1, metavar="N", help="Worker processes (default: the number of cores)."),
     dask: str = typer.Option(None, "--dask", metavar="ADDRESS", help="Run on an existing dask.distributed "
                              "cluster (scheduler address, e.g. tcp://host:8786)."),
@@ -316,7 +319,7 @@ def verify(
     with LateProgress(bar, "verify") as progress:   # shown once the run has taken a second
         progress.update(total=count_jobs(manifest))
         outcome = run_verify(design, jobs=jobs, dask_address=dask, junit=junit, json_path=json_out,
-                             markdown_path=markdown, plots_dir=plots, manifest=manifest,
+                             markdown_path=markdown, plots_dir=plots, manifest=manifest, spectra_dir=spectra,
                              progress=lambda: progress.update(advance=1))
     console = stdout_console()
     console.print(rich_table(outcome.rows))
@@ -324,7 +327,8 @@ def verify(
     for r in failed:
         typer.echo(f"FAILED {r.case}: {r.name}: worst {with_unit(r.value, r.unit)} against limit {with_unit(r.limit, r.unit)}")
     typer.echo(f"{len(outcome.rows) - len(failed)} of {counted(len(outcome.rows), 'check')} passed" +
-               (f"; {counted(len(outcome.plots), 'plot')} in {plots}" if plots else ""))
+               (f"; {counted(len(outcome.plots), 'plot')} in {plots}" if plots else "") +
+               (f"; load spectra of {counted(len(outcome.spectra) // 2, 'case')} in {spectra}" if spectra else ""))
     if failed:
         raise typer.Exit(EXIT_CHECK_FAILED)
 

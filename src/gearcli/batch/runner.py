@@ -11,6 +11,7 @@ from __future__ import annotations
 import os
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -137,6 +138,45 @@ def _run_dask(todo: list[Job], address: str, progress) -> dict:
             if progress:
                 progress()
     return results
+
+
+def profile_plot(result: CaseResult, verdict: Verdict, path, title: str):
+    """The plot of a life or fatigue check over every trajectory of its case (the check's
+    partials recomputed per trajectory): bearing loads with their equivalent loads, or the
+    S-N curve with the counted cycles (:mod:`gearcli.report.check_plots`); returns ``path``."""
+    from ..design import bearings as B  # noqa: PLC0415
+    from ..design import fatigue as F  # noqa: PLC0415
+    from ..report.check_plots import plot_life, plot_sn  # noqa: PLC0415
+
+    ch, case = verdict.check, result.case
+    an = case_analysis(case.mechanism)
+    samples = [solve_samples(an, tp, case.degrees) for tp in case.trajectories]
+    parts = [partials([ch], s, an.mech)[0] for s in samples]
+    if ch.kind == "life":
+        traces = [(Path(tp).stem, s.t, signal(ch, s, an.mech), p[5]) for tp, s, p in zip(case.trajectories, samples, parts)]
+        P_eq = B.equivalent_load(sum(p[2] for p in parts), sum(p[3] for p in parts), ch.exponent)
+        plot_life(traces, P_eq, verdict.signal_limit, path, title)
+        return path
+    rates = profile_rates(case.shares or (None,) * len(samples), [p[6] for p in parts], case.req.cycles_per_hour,
+                          case.req.service_life_h)
+    hours = [ch.limit * (r or 0.0) for r in rates]          # repetitions of each trajectory in the required life
+    sig = [signal(ch, s, an.mech) for s in samples]
+    counted = [F.rainflow_peaks(x) for x in sig]
+    peaks = np.concatenate(counted)
+    passes = None
+    if ch.extra.get("passes") is not None:
+        ji, factor_z = ch.extra["passes"]
+        n = np.concatenate([h * B.revolutions(s.rates[:, ji], s.t) * factor_z for h, s in zip(hours, samples)])
+        x = np.concatenate(sig)
+        order = np.argsort(x)[::-1]
+        passes = (np.cumsum(n[order]), x[order])
+    total = sum(h * len(c) for h, c in zip(hours, counted))
+    top = max([total] + ([float(passes[0][-1])] if passes is not None and passes[0].size else []))
+    N = np.logspace(2, max(12.0, np.log10(max(top, 1.0)) + 1), 200)
+    factor = F.bending_cycle_factor if ch.signal[0] == "bending" else F.pitting_cycle_factor
+    plot_sn(N, ch.rating * factor(N), peaks, max(total, 1.0), path, title,
+            f"{'root bending' if ch.signal[0] == 'bending' else 'contact'} stress [Pa]", passes)
+    return path
 
 
 def worst_samples(result: CaseResult, verdict: Verdict) -> tuple[np.ndarray, np.ndarray]:

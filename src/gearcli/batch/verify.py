@@ -11,7 +11,8 @@ from ..report.plots import plot_check
 from ..report.rms import cumulative_rms
 from .manifest import load_manifest
 from .outputs import WARN_MARGIN, rows_of, write_json, write_junit, write_markdown
-from .runner import jobs_of, run_manifest, worst_samples
+from .runner import jobs_of, profile_plot, run_manifest, worst_samples
+from .spectra import write_spectra
 
 SIGNAL_LABELS = {"abs": "|{}|", "col": "RMS of {} from the start", "rate": "|joint rate|", "running_rms": "running RMS of {}", "bearing_P": "dynamic equivalent load P",
                  "bearing_P0": "static equivalent load P0", "bending": "Lewis root bending stress",
@@ -25,6 +26,7 @@ class VerifyOutcome:
     rows: list
     results: list
     plots: list
+    spectra: list = ()
 
     @property
     def passed(self) -> bool:
@@ -36,16 +38,19 @@ def count_jobs(manifest) -> int:
 
 
 def run_verify(manifest_path, *, jobs: int | None = None, dask_address: str | None = None, junit=None,
-               json_path=None, markdown_path=None, plots_dir=None, progress=None, manifest=None) -> VerifyOutcome:
+               json_path=None, markdown_path=None, plots_dir=None, progress=None, manifest=None,
+               spectra_dir=None) -> VerifyOutcome:
     """Run a manifest (already loaded with :func:`load_manifest` when ``manifest`` is given)
-    and write the requested reports; ``progress(total=..)`` once, then ``progress()`` per job.
+    and write the requested reports (``spectra_dir``: the load spectra, :mod:`.spectra`);
+    ``progress(total=..)`` once, then ``progress()`` per job.
     ``jobs`` and ``dask_address`` exclude each other (the cluster has its own workers)."""
     if jobs is not None and dask_address is not None:
         raise GearcliError("verify: give -j/--jobs or --dask, not both (a Dask cluster has its own workers)")
     manifest = manifest or load_manifest(manifest_path)
     check_outputs(manifest, {"--junit": junit, "--json": json_path, "--markdown": markdown_path})
-    if plots_dir:
-        make_plot_dir(Path(plots_dir))
+    for d, option in ((plots_dir, "--plots"), (spectra_dir, "--spectra")):
+        if d:
+            make_plot_dir(Path(d), option)
     results = run_manifest(manifest, jobs=jobs, dask_address=dask_address, progress=progress)
     rows = rows_of(results)
     suite = manifest.name
@@ -56,7 +61,8 @@ def run_verify(manifest_path, *, jobs: int | None = None, dask_address: str | No
     if markdown_path:
         write_markdown(rows, markdown_path, str(manifest_path))
     plots = write_plots(results, Path(plots_dir)) if plots_dir else []
-    return VerifyOutcome(rows, results, plots)
+    spectra = write_spectra(results, Path(spectra_dir)) if spectra_dir else []
+    return VerifyOutcome(rows, results, plots, spectra)
 
 
 def check_outputs(manifest, paths: dict) -> None:
@@ -68,12 +74,12 @@ def check_outputs(manifest, paths: dict) -> None:
             output_target(p, inputs, option)
 
 
-def make_plot_dir(directory: Path) -> None:
-    """Create the ``--plots`` directory (before any work); problems are bad input."""
+def make_plot_dir(directory: Path, option: str = "--plots") -> None:
+    """Create the ``--plots`` (``--spectra``) directory before any work; problems are bad input."""
     try:
         directory.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise GearcliError(f"{directory}: --plots: cannot create the directory: {exc.strerror}") from None
+        raise GearcliError(f"{directory}: {option}: cannot create the directory: {exc.strerror}") from None
 
 
 def _slug(text: str) -> str:
@@ -89,12 +95,15 @@ def write_plots(results, directory: Path) -> list[Path]:
             if v.passed and v.margin >= WARN_MARGIN:
                 continue
             ch = v.check
+            path = directory / f"{_slug(r.case.name)}__{_slug(ch.component)}__{_slug(ch.quantity)}.png"
+            status = "FAIL" if not v.passed else "tight"
+            if ch.kind in ("life", "fatigue"):
+                out.append(profile_plot(r, v, path, f"{r.case.name}: {ch.name} ({status}, margin {v.margin:.3g} %)"))
+                continue
             t, y = worst_samples(r, v)
             if ch.kind == "rms":            # the RMS so far (its last value is the trajectory's RMS)
                 y = cumulative_rms(y, t)
             label = SIGNAL_LABELS[ch.signal[0]].format(ch.signal[1] if ch.signal[0] in ("abs", "col", "running_rms") else "")
-            path = directory / f"{_slug(r.case.name)}__{_slug(ch.component)}__{_slug(ch.quantity)}.png"
-            status = "FAIL" if not v.passed else "tight"
             title = (f"{r.case.name}: {ch.name} ({status}, margin {v.margin:.3g} %)\n"
                      f"worst trajectory {Path(r.case.trajectories[v.trajectory]).name}")
             plot_check(t, y, v.signal_limit, path, title, f"{label} [{ch.signal_unit}]", LIMIT_LABELS[ch.kind])
