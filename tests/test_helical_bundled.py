@@ -180,7 +180,7 @@ def test_bearing_radial_and_axial_loads_by_hand(an):
         pos = [b.position for b in jt.bearings]
         own = own_bearing_loads(f, m, *pos)
         for bi, b in enumerate(jt.bearings):
-            Fr, Fa = bearing_loads(s, jt.name, jt.bearings, bi)
+            Fr, Fa = bearing_loads(s, jt.name, jt.bearings)[bi]
             np.testing.assert_allclose(Fr, own[bi], rtol=1e-12)
             np.testing.assert_allclose(Fa, abs(f[2]) if b.locating else 0.0, rtol=1e-12, atol=1e-12)
     # the intermediate shaft's gear and pinion have the same hand: their thrusts oppose

@@ -30,21 +30,22 @@ class Samples:
     rates: np.ndarray
 
 
-def bearing_loads(s: Samples, joint: str, bearings, bi: int) -> tuple[np.ndarray, np.ndarray]:
-    """Radial and axial load (N) on bearing ``bi`` of a joint, per sample.
+def bearing_loads(s: Samples, joint: str, bearings) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Radial and axial load (N) on each bearing of a joint, per sample.
 
     One bearing takes the whole reaction force; two share its force and tilting moment as
     a shaft on two supports (:func:`gearcli.design.bearings.split_two_bearings`), the
     locating one taking the axial force.
     """
     c = s.cols
-    axial = np.abs(c[f"joint:{joint}:fz"]) if bearings[bi].locating else np.zeros_like(s.t)
+    axial = np.abs(c[f"joint:{joint}:fz"])
+    none = np.zeros_like(s.t)
     if len(bearings) == 1:
-        return c[f"joint:{joint}:radial"], axial
-    F = np.column_stack([c[f"joint:{joint}:f{a}"] for a in "xyz"])
-    M = np.column_stack([c[f"joint:{joint}:m{a}"] for a in "xyz"])
-    R = B.split_two_bearings(F, M, bearings[0].position, bearings[1].position)[bi]
-    return np.hypot(R[:, 0], R[:, 1]), axial
+        return [(c[f"joint:{joint}:radial"], axial)]
+    F = np.column_stack([c[f"joint:{joint}:f{a}"] for a in "xy"])      # the split needs x, y only
+    M = np.column_stack([c[f"joint:{joint}:m{a}"] for a in "xy"])
+    R = B.split_two_bearings(F, M, bearings[0].position, bearings[1].position)
+    return [(np.hypot(r[:, 0], r[:, 1]), axial if b.locating else none) for r, b in zip(R, bearings)]
 
 
 def signal(check: Check, s: Samples, mech, cache: dict | None = None) -> np.ndarray:
@@ -72,7 +73,7 @@ def _signal(check: Check, s: Samples, mech, cache: dict) -> np.ndarray:
         jt = mech.joints[check.signal[1]]
         b = jt.bearings[check.signal[2]]
         if ("loads", jt.name) not in cache:
-            cache[("loads", jt.name)] = [bearing_loads(s, jt.name, jt.bearings, bi) for bi in range(len(jt.bearings))]
+            cache[("loads", jt.name)] = bearing_loads(s, jt.name, jt.bearings)
         Fr, Fa = cache[("loads", jt.name)][check.signal[2]]
         if kind == "bearing_P":
             return iso281.bearing_equivalent_load(b, Fr, Fa)
