@@ -8,6 +8,7 @@ values (a bearing that never turns has an infinite life) are written as ``inf`` 
 from __future__ import annotations
 
 import json
+import re
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
@@ -18,6 +19,12 @@ from rich.text import Text
 
 from ..errors import counted
 from ..io.output import write_text
+
+
+def file_slug(text: str) -> str:
+    """``text`` as a file-name part: runs of other characters than [A-Za-z0-9_.-] become _."""
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_")
+
 
 WARN_MARGIN = 10.0
 """%: a passing check with less margin is flagged (and plotted with ``--plots``)."""

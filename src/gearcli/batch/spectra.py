@@ -18,6 +18,7 @@ from ..design.evaluate import profile_rates, signal
 from ..design.spectra import bin_edges, load_spectrum
 from ..io.output import write_text
 from .manifest import case_analysis
+from .outputs import file_slug
 from .runner import solve_samples
 
 
@@ -71,12 +72,10 @@ def case_spectra(case) -> list[dict]:
 
 def write_spectra(results, directory: Path) -> list[Path]:
     """``<case>__spectra.json`` and ``.csv`` in ``directory`` for every case; the paths."""
-    from .verify import _slug  # noqa: PLC0415
-
     paths = []
     for r in results:
         spectra = case_spectra(r.case)
-        base = directory / f"{_slug(r.case.name)}__spectra"
+        base = directory / f"{file_slug(r.case.name)}__spectra"
         write_text(base.with_suffix(".json"), json.dumps({"case": r.case.name, "spectra": spectra}, indent=1) + "\n")
         buf = io.StringIO()
         w = csv.writer(buf, lineterminator="\n")

@@ -1,7 +1,6 @@
 """``gearcli verify``: manifest in, verdicts and reports out (the CLI is a thin layer on it)."""
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -10,7 +9,7 @@ from ..io.output import output_target
 from ..report.plots import plot_check
 from ..report.rms import cumulative_rms
 from .manifest import load_manifest
-from .outputs import WARN_MARGIN, rows_of, write_json, write_junit, write_markdown
+from .outputs import WARN_MARGIN, file_slug as _slug, rows_of, write_json, write_junit, write_markdown
 from .runner import jobs_of, profile_plot, run_manifest, worst_samples
 from .spectra import write_spectra
 
@@ -80,10 +79,6 @@ def make_plot_dir(directory: Path, option: str = "--plots") -> None:
         directory.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise GearcliError(f"{directory}: {option}: cannot create the directory: {exc.strerror}") from None
-
-
-def _slug(text: str) -> str:
-    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text).strip("_")
 
 
 def write_plots(results, directory: Path) -> list[Path]:
