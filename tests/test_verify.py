@@ -487,3 +487,13 @@ def test_load_spectra_sum_to_the_duty_and_its_revolutions(run_cli, tmp_path):
     rows = (tmp_path / "sp" / "rotor__spectra.csv").read_text().splitlines()
     assert rows[0] == "component,quantity,unit,load_from,load_to,seconds_per_hour,fraction_of_time,revolutions_per_hour"
     assert len(rows) == 1 + 2 * 20
+
+
+def test_mission_profile_shares_cannot_exceed_the_service_time(run_cli, tmp_path):
+    write_rotor_case(tmp_path, "[{name: x, position: 0, C: 3000, C0: 3000, type: ball}]")
+    man = tmp_path / "design.yaml"
+    man.write_text("cases:\n  - {mechanism: rotor.yaml, bearing_life_h: 10, service_life_h: 100, trajectories:"
+                   " [{file: rotor.csv, hours: 60}, {file: rotor.csv, fraction: 0.5}]}\n")
+    r = run_cli("verify", man, "-j", "1")
+    assert r.exit_code == 2 and "cases[0].trajectories: the profile's shares add up to 1.1 of the service time" \
+        in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr

@@ -226,6 +226,11 @@ def _trajectory_paths(spec, where: str, base: Path, col: Collector, bad: set) ->
             else:
                 out.append(Path(f))
                 shares.append(share)
+    life = spec.get("service_life_h") if isinstance(spec.get("service_life_h"), (int, float)) else None
+    time = sum(s[1] if s[0] == "fraction" else s[1] / life for s in shares if s and s[0] != "cycles_per_hour" and
+               (s[0] == "fraction" or life))
+    if time > 1 + 1e-12:
+        col.add(f"{where}.trajectories", f"the profile's shares add up to {time:.4g} of the service time (more than all of it)")
     return out, shares
 
 
