@@ -26,13 +26,12 @@ import math
 import numpy as np
 
 from ..model.shaft import split_two_bearings  # noqa: F401  (with the model: the solve uses it too)
-
 from ..report.rms import trapezoid_weights
 
 
 def revolutions(rate, t) -> np.ndarray:
     """Revolutions turned at each sample, |rate_k| w_k / 2 pi (w the trapezoid weights of
-    :func:`gearcli.design.rms.trapezoid_weights`), shape (N,); rate in rad/s, t in s."""
+    :func:`gearcli.report.rms.trapezoid_weights`), shape (N,); rate in rad/s, t in s."""
     return np.abs(np.asarray(rate, float)) * trapezoid_weights(t) / (2 * math.pi)
 
 
