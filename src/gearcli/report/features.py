@@ -1,9 +1,11 @@
-"""One-line notes on a mechanism's external loads, helical pairs and racks (``check``,
-``graph``, the ``solve`` summary) and their plain-data form (``graph --json``)."""
+"""One-line notes on a mechanism's external loads, helical pairs, racks and losses
+(``check``, ``graph``, the ``solve`` summary) and their plain-data form (``graph --json``)."""
 from __future__ import annotations
 
 import math
 from typing import TYPE_CHECKING
+
+from .loss_notes import loss_notes
 
 if TYPE_CHECKING:   # no numpy or analysis import for `gearcli --help`
     from ..analysis.graph import Analysis
@@ -40,7 +42,8 @@ def pair_dicts(an: Analysis) -> list[dict]:
 
 def feature_notes(an: Analysis) -> list[str]:
     """Human-readable lines: ``load 'tip' on link '2' (frame base): force [..] N, moment [..]
-    N*m at [..] m``, ``helical pair ...``, ``rack pair ...``."""
+    N*m at [..] m``, ``helical pair ...``, ``rack pair ...``, then the losses
+    (:func:`gearcli.report.loss_notes.loss_notes`)."""
     lines = [f"load '{d['name']}' on link '{d['link']}' (frame {d['frame']}): force {_vec(d['force'])} N, "
              f"moment {_vec(d['moment'])} N*m at {_vec(d['point'])} m (link frame)" for d in load_dicts(an)]
     for d in pair_dicts(an):
@@ -50,4 +53,4 @@ def feature_notes(an: Analysis) -> list[str]:
         else:
             lines.append(f"rack pair '{d['pair']}': pinion '{d['pinion']}' (pitch radius {d['pitch_radius']:.6g} m) "
                          f"drives rack '{d['rack']}': x = {d['x_per_rad']:.6g} m/rad * theta")
-    return lines
+    return lines + loss_notes(an)

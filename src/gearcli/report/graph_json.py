@@ -4,6 +4,7 @@ from __future__ import annotations
 from ..analysis.graph import Analysis, Circuit
 from ..model.mechanism import Mechanism
 from .features import load_dicts, pair_dicts
+from .loss_notes import loss_dicts
 from .sharing import sharing_sets
 
 
@@ -45,6 +46,7 @@ def analysis_dict(an: Analysis) -> dict:
         "load_sharing": sharing_sets(an),
         "loads": load_dicts(an),
         "helical_and_rack_pairs": pair_dicts(an),
+        "losses": loss_dicts(an),
     } | ({"open_loop": "tree"} if an.open_loop == "tree" else {})
 
 

@@ -1,0 +1,121 @@
+"""Losses as a designer meets them on the command line: ``check``/``graph`` name every lossy
+pair and joint (one line each, the friction arm from the README's closed forms, computed
+here by hand), ``graph --json`` has them as ``losses``, and the ``solve`` summary's energy
+and line efficiency are the hand values of a 15/60 mm spur pair (README, "Losses")."""
+from __future__ import annotations
+
+import json
+
+import pytest
+
+SPUR = """\
+name: spur_lossy
+gravity: [0, 0, -9.81]
+base: frame
+end_effector: wheel
+links:
+  - name: frame
+  - {name: pinion, mass: 0.1, inertia: [1.0e-5, 1.0e-5, 1.0e-5]}
+  - {name: wheel, mass: 1.0, inertia: [1.0e-3, 1.0e-3, 1.0e-3]}
+joints:
+  - name: Jp
+    parent: frame
+    child: pinion
+    axis: [0, 0, 1]
+    friction: {coulomb: 0.002, viscous: 1.0e-5}
+    bearings:
+      - {name: a, position: 0.0, locating: true, friction_coefficient: 0.0015, bore: 0.008}
+      - {name: b, position: 0.02, friction_coefficient: 0.0015, bore: 0.008}
+  - {name: Jw, parent: frame, child: wheel, origin: {xyz: [0.075, 0, 0]}, axis: [0, 0, 1]}
+gears:
+  - {name: mesh, links: [pinion, wheel], teeth: [15, 60], mesh_point: [0.015, 0, 0], efficiency: 0.97}
+motors:
+  - {name: motor, link: pinion}
+loads:
+  - {name: brake, link: wheel, frame: base, moment: [0, 0, 2.0]}
+"""
+
+# the wheel turns at -1 rad/s (the pinion at +4 rad/s) for 1 s against the brake's 2 N*m
+TRAJ = "t,q:Jw,qd:Jw,qdd:Jw\n0,0,-1,0\n0.5,-0.5,-1,0\n1,-1,-1,0\n"
+
+
+def _spur_only(text: str) -> str:
+    """The spur pair with its mesh loss only (no joint or bearing friction)."""
+    start, end = text.index("    friction: {coulomb"), text.index("  - {name: Jw")
+    return text[:start] + text[end:]
+
+
+def test_check_and_graph_print_one_line_per_lossy_pair_and_joint(run_cli, tmp_path):
+    path = tmp_path / "spur.yaml"
+    path.write_text(SPUR)
+    rho = 0.015 * 0.060 / (0.015 + 0.060)          # external spur: r_j r_k / (r_j + r_k) = 0.012 m
+    pair = (f"mesh friction on pair 'mesh': efficiency 0.97 (loss factor 0.03), friction arm {rho:.6g} m: "
+            f"couple 0.03 * {rho:.6g} m * |t|")
+    joint = ("friction of joint 'Jp': Coulomb 0.002 N*m, viscous 1e-05 N*m*s/rad, "
+             "bearing 'a' (mu 0.0015, bore 0.008 m), bearing 'b' (mu 0.0015, bore 0.008 m)")
+    r = run_cli("check", path)
+    assert r.exit_code == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert lines[0] == f"{path}: OK (1 dof, 3 links, 1 gear pair, 1 motor)"
+    assert lines[2:] == [pair, joint]                      # Jw has no friction: no line
+    g = run_cli("graph", path)
+    assert pair in g.stdout.splitlines() and joint in g.stdout.splitlines()
+    doc = json.loads(run_cli("graph", "--json", path).stdout)
+    assert doc["losses"]["gears"] == [{"pair": "mesh", "efficiency": 0.97, "loss_factor": pytest.approx(0.03, rel=1e-12),
+                                       "friction_arm": pytest.approx(rho, rel=1e-12)}]
+    assert doc["losses"]["joints"] == [{"joint": "Jp", "type": "revolute", "coulomb": 0.002, "viscous": 1e-5,
+                                        "bearings": [{"name": "a", "friction_coefficient": 0.0015, "bore": 0.008},
+                                                     {"name": "b", "friction_coefficient": 0.0015, "bore": 0.008}]}]
+
+
+def test_check_lists_internal_and_rack_arms_and_prismatic_units(run_cli, mech_dir, tmp_path):
+    """Internal pair: rho = r_j r_k / |r_k - r_j| (planet 9 mm, ring 30 mm); rack: rho = r
+    (24 mm); a prismatic joint's friction in N and N*s/m."""
+    plan = (mech_dir / "planetary_3p.yaml").read_text().replace(
+        "    stiffness: 3.5e8\n", "    stiffness: 3.5e8\n    loss_factor: 0.015\n")
+    assert "loss_factor" in plan
+    (tmp_path / "p.yaml").write_text(plan)
+    r = run_cli("check", tmp_path / "p.yaml")
+    assert r.exit_code == 0, r.stderr
+    rho = 0.009 * 0.030 / (0.030 - 0.009)
+    notes = [ln for ln in r.stdout.splitlines() if ln.startswith("mesh friction")]
+    assert notes == [f"mesh friction on pair 'planet-ring{k}': efficiency 0.985 (loss factor 0.015), friction arm "
+                     f"{rho:.6g} m: couple 0.015 * {rho:.6g} m * |t|" for k in (1, 2, 3)]
+    rack = (mech_dir / "rack_axis.yaml").read_text()
+    rack = rack.replace("    pressure_angle_deg: 20\n", "    pressure_angle_deg: 20\n    efficiency: 0.9\n")
+    rack = rack.replace("    axis: [1, 0, 0]\n", "    axis: [1, 0, 0]\n    friction: {coulomb: 5.0, viscous: 20.0}\n")
+    (tmp_path / "r.yaml").write_text(rack)
+    r = run_cli("check", tmp_path / "r.yaml")
+    assert r.exit_code == 0, r.stderr
+    assert r.stdout.splitlines()[-2:] == [
+        "mesh friction on pair 'rack': efficiency 0.9 (loss factor 0.1), friction arm 0.024 m: couple 0.1 * 0.024 m * |t|",
+        "friction of joint 'Jx': Coulomb 5 N, viscous 20 N*s/m"]
+
+
+@pytest.mark.parametrize("name", ["rack_axis.yaml", "planetary_3p.yaml", "bendix_wrist_rated.yaml"])
+def test_lossless_check_has_no_loss_lines(run_cli, mech_dir, name):
+    r = run_cli("check", mech_dir / name)
+    assert r.exit_code == 0
+    assert not any(ln.startswith(("mesh friction", "friction of joint")) for ln in r.stdout.splitlines())
+    assert json.loads(run_cli("graph", "--json", mech_dir / name).stdout)["losses"] == {"gears": [], "joints": []}
+
+
+def test_solve_summary_spur_pair_by_hand(run_cli, tmp_path):
+    """15/60 mm at eta = 0.97, pinion driving at 4 rad/s against 2 N*m on the wheel: the
+    tooth force t = M / (r_k - c rho), the mesh loss c |t| r_j w = 0.0603622 W for 1 s, and
+    the line efficiency (r_k - c rho) r_j / (r_k (r_j + c rho)) = 0.9707 (README)."""
+    mech, traj = tmp_path / "spur.yaml", tmp_path / "traj.csv"
+    mech.write_text(_spur_only(SPUR))
+    traj.write_text(TRAJ)
+    r = run_cli("solve", mech, traj, "-o", tmp_path / "out.csv")
+    assert r.exit_code == 0, r.stderr
+    rj, rk, c, M, w = 0.015, 0.060, 0.03, 2.0, 4.0
+    rho = rj * rk / (rj + rk)
+    t = M / (rk - c * rho)
+    energy = c * t * rj * w * 1.0
+    eta = (rk - c * rho) * rj / (rk * (rj + c * rho))
+    assert f"{eta:.4f}" == "0.9707"
+    lines = r.stdout.splitlines()
+    assert f"energy lost: {energy:.6g} J in all" in lines
+    assert f"  gear mesh: {energy:.6g} J (100 %)" in lines
+    assert f"line efficiency of motor motor: {eta:.4f} (lossless power / motor power where the motor drives)" in lines
