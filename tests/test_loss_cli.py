@@ -119,3 +119,31 @@ def test_solve_summary_spur_pair_by_hand(run_cli, tmp_path):
     assert f"energy lost: {energy:.6g} J in all" in lines
     assert f"  gear mesh: {energy:.6g} J (100 %)" in lines
     assert f"line efficiency of motor motor: {eta:.4f} (lossless power / motor power where the motor drives)" in lines
+
+
+def test_summary_lists_equal_losses_in_file_order(run_cli, mech_dir, tmp_path):
+    """The three copies of a planet lose the same energy (to rounding): the summary lists
+    them 1, 2, 3 (was: by their rounding noise, 2, 1, 3)."""
+    plan = (mech_dir / "planetary_3p.yaml").read_text()
+    plan = plan.replace("    stiffness: 3.0e8                   # N/m\n", "    stiffness: 3.0e8\n    efficiency: 0.98\n")
+    plan = plan.replace("    stiffness: 3.5e8\n", "    stiffness: 3.5e8\n    loss_factor: 0.015\n")
+    assert plan.count("efficiency: 0.98") == 1 and plan.count("loss_factor") == 1
+    (tmp_path / "p.yaml").write_text(plan)
+    traj = (mech_dir / "planetary_3p_traj.csv").read_text().splitlines()[:200]
+    (tmp_path / "t.csv").write_text("\n".join(traj) + "\n")
+    r = run_cli("solve", tmp_path / "p.yaml", tmp_path / "t.csv", "-o", tmp_path / "out.csv")
+    assert r.exit_code == 0, r.stderr
+    listed = [ln.split(":")[0].strip() for ln in r.stdout.splitlines() if ln.startswith("  gear ")]
+    assert listed == [f"gear sun-planet{k}" for k in (1, 2, 3)] + [f"gear planet-ring{k}" for k in (1, 2, 3)]
+
+
+def test_summary_iterations_agree_with_their_noun():
+    import numpy as np
+
+    from gearcli.report.loss_summary import LossSummary
+    s = LossSummary(["joint J"], ["m"], energy=np.array([1.0]), p_in=np.array([2.0]), p_out=np.array([1.5]),
+                    iterations=np.array([0, 7]))
+    assert "bearing friction: converged in 1 iteration per sample (median), 1 at worst" in s.lines()
+    s.iterations = np.array([0, 0, 0, 5, 1])
+    assert "bearing friction: converged in 3 iterations per sample (median), 4 at worst" in s.lines()
+

@@ -18,6 +18,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..errors import counted
+
 
 def lossless_twin(mech):
     """The same mechanism with every loss removed (efficiency 1, no joint friction)."""
@@ -90,16 +92,18 @@ class LossSummary:
             return np.where(self.p_in > 0, self.p_out / np.where(self.p_in > 0, self.p_in, 1.0), np.nan)
 
     def lines(self) -> list[str]:
-        """The summary's lines: energy lost by element (largest first) and line efficiencies."""
+        """The summary's lines: energy lost by element (largest first; elements equal to the
+        printed digits, the copies of a planet, in file order) and line efficiencies."""
         total = float(self.energy.sum())
         out = [f"energy lost: {total:.6g} J in all"]
-        for i in np.argsort(-self.energy, kind="stable"):
+        shown = np.array([float(f"{e:.6g}") for e in self.energy])   # equal as printed: file order
+        for i in np.argsort(-shown, kind="stable"):
             if self.energy[i] > 0:
                 out.append(f"  {self.elements[i]}: {self.energy[i]:.6g} J ({100 * self.energy[i] / total:.3g} %)")
         if self.iterations is not None:
             cum = np.cumsum(self.iterations)
             median = int(np.searchsorted(cum, (cum[-1] + 1) // 2))
-            out.append(f"bearing friction: converged in {median} iterations per sample (median), "
+            out.append(f"bearing friction: converged in {counted(median, 'iteration')} per sample (median), "
                        f"{self.iterations.size - 1} at worst")
         for m, eta in zip(self.motors, self.efficiency):
             out.append(f"line efficiency of motor {m}: " + ("- (its power never flows forward)" if np.isnan(eta)
