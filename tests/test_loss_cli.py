@@ -147,3 +147,27 @@ def test_summary_iterations_agree_with_their_noun():
     s.iterations = np.array([0, 0, 0, 5, 1])
     assert "bearing friction: converged in 3 iterations per sample (median), 4 at worst" in s.lines()
 
+
+def test_help_names_the_losses_and_their_units(run_cli):
+    solve = " ".join(run_cli("solve", "--help").stdout.split())
+    for text in ("gears[].efficiency", "joints[].friction", "gear:<pair>:loss (W)", "joint:<joint>:friction (N*m; N if",
+                 "joint:<joint>:loss (W)", "energy lost (J)", "line efficiency"):
+        assert text in solve, text
+    check = " ".join(run_cli("check", "--help").stdout.split())
+    assert "losses (mesh efficiency in (0, 1], friction >= 0)" in check
+    assert "lossy gear pair (efficiency, friction arm in m)" in check
+
+
+def test_bearing_friction_on_a_slide_points_to_joint_friction(run_cli, mech_dir, tmp_path):
+    rack = (mech_dir / "rack_axis.yaml").read_text().replace(
+        "    axis: [1, 0, 0]\n",
+        "    axis: [1, 0, 0]\n    bearings: [{name: g, position: 0, friction_coefficient: 0.002, bore: 0.01}]\n")
+    path = tmp_path / "r.yaml"
+    path.write_text(rack)
+    r = run_cli("check", path)
+    assert r.exit_code == 2 and r.stdout == ""
+    line = next(i for i, ln in enumerate(rack.splitlines(), 1) if "bearings: [{name: g" in ln)
+    assert r.stderr == (f"{path}:{line}: joints[1].bearings: rolling-bearing ratings and friction (ISO 281 life in "
+                        "revolutions, a moment about the axis) are for revolute joints; a prismatic joint's linear "
+                        "guide is not rated, and its friction is joints[].friction (coulomb N, viscous N*s/m)\n")
+

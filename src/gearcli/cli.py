@@ -120,8 +120,10 @@ def check(mech: Path = typer.Argument(..., metavar="MECH", help=MECH_HELP, show_
           strict: bool = STRICT_OPTION) -> None:
     """Validate a mechanism file: schema, names, masses and inertias, joint tree, gear
     geometry (pitch radii in m, cone angles), motors against the degrees of freedom, and
-    static determinacy of the loads, ratings against the geometry, and the plausibility of
-    the values (warnings).  Prints a one-line summary; exit 2 on bad input."""
+    static determinacy of the loads, ratings against the geometry, losses (mesh efficiency
+    in (0, 1], friction >= 0), and the plausibility of the values (warnings).  Prints a
+    one-line summary, then one line per external load, helical or rack pair, lossy gear
+    pair (efficiency, friction arm in m) and joint with friction; exit 2 on bad input."""
     an = load_analysis(mech, strict)
     _check_ratings(an)
     m = an.mech
@@ -212,7 +214,10 @@ def solve(
     """Motor torques (N*m), bearing reaction wrenches (N, N*m, parent on child, joint frame)
     and gear tooth forces (N) at every sample of a trajectory.  Writes a table (CSV, Parquet,
     Feather or NPZ; columns in the README) and prints, for every motor, gear mesh and bearing, the peak, RMS and time of
-    the peak."""
+    the peak.  A mechanism with losses (gears[].efficiency or loss_factor, joints[].friction,
+    bearings' friction_coefficient and bore) has them in the motor torques, adds the columns
+    gear:<pair>:loss (W), joint:<joint>:friction (N*m; N if prismatic) and joint:<joint>:loss
+    (W), and prints the energy lost (J) by element and each motor's line efficiency."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn  # noqa: PLC0415
 
     from .pipeline import check_solve_options, solve_file  # noqa: PLC0415

@@ -136,8 +136,9 @@ def gear_rating(spec: dict, path: str, add) -> GearRating:
                       *(None if spec.get(k) is None else float(spec[k]) for k in ("quality_number", "pitch_line_velocity")))
 
 
-PRISMATIC_BEARINGS = ("rolling-bearing ratings (ISO 281 life in revolutions) are for revolute joints; "
-                      "a prismatic joint's linear guide is not rated")
+PRISMATIC_BEARINGS = ("rolling-bearing ratings and friction (ISO 281 life in revolutions, a moment about the axis) "
+                      "are for revolute joints; a prismatic joint's linear guide is not rated, and its friction is "
+                      "joints[].friction (coulomb N, viscous N*s/m)")
 
 
 def attach_yaml_ratings(mech: Mechanism, data: dict, col: Collector) -> Mechanism:
