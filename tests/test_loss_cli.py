@@ -171,3 +171,33 @@ def test_bearing_friction_on_a_slide_points_to_joint_friction(run_cli, mech_dir,
                         "revolutions, a moment about the axis) are for revolute joints; a prismatic joint's linear "
                         "guide is not rated, and its friction is joints[].friction (coulomb N, viscous N*s/m)\n")
 
+
+@pytest.mark.parametrize("old, new, key, message", [
+    ("efficiency: 0.97", "efficiency: 0.03", "gears[0].efficiency",
+     "gear pair 'mesh': mesh efficiency 0.03 (loss factor 0.97) is below 0.5; a gear mesh loses 0.5 to 3 % at the "
+     "pitch point: efficiency and loss_factor swapped? (loss_factor = 1 - efficiency)"),
+    ("efficiency: 0.97", "loss_factor: 0.97", "gears[0].loss_factor",
+     "gear pair 'mesh': mesh efficiency 0.03 (loss factor 0.97) is below 0.5; a gear mesh loses 0.5 to 3 % at the "
+     "pitch point: efficiency and loss_factor swapped? (loss_factor = 1 - efficiency)"),
+    ("bore: 0.008}\n      - {name: b", "bore: 8}\n      - {name: b", "joints[0].bearings[0].bore",
+     "joint 'Jp': bearing 'a': bore 8 m is above 2 m: in mm? (gearcli reads m)"),
+])
+def test_implausible_losses_are_warned_and_strict_refuses(run_cli, tmp_path, old, new, key, message):
+    text = SPUR.replace(old, new)
+    assert text != SPUR
+    path = tmp_path / "m.yaml"
+    path.write_text(text)
+    line = next(i for i, ln in enumerate(text.splitlines(), 1) if new.split("\n")[0] in ln)
+    r = run_cli("check", path)
+    assert r.exit_code == 0 and r.stdout.startswith(f"{path}: OK")
+    assert r.stderr == f"{path}:{line}: {key}: warning: {message}\n"
+    r = run_cli("check", "--strict", path)
+    assert r.exit_code == 2 and r.stdout == ""
+    assert r.stderr == f"{path}:{line}: {key}: {message} (--strict)\n"
+
+
+def test_plausible_losses_give_no_warning(run_cli, tmp_path):
+    path = tmp_path / "m.yaml"
+    path.write_text(SPUR.replace("efficiency: 0.97", "efficiency: 0.5").replace("bore: 0.008}", "bore: 2.0}"))
+    r = run_cli("check", "--strict", path)
+    assert r.exit_code == 0 and r.stderr == ""

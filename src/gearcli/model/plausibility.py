@@ -38,6 +38,15 @@ TEETH_RANGE = (5.0, 2000.0)
 """Tooth counts 2 r / m (pitch radius r from the mesh geometry, transverse module m from the
 rating) outside this range mean the module and the lengths are in different units."""
 
+MIN_EFFICIENCY = 0.5
+"""A mesh efficiency below it (a loss factor above 1 - it): a spur, helical, bevel or rack
+mesh loses 0.5-3 % at the pitch point (no worm pairs in gearcli); 0.03 is a loss factor
+given as ``efficiency``, or 0.97 an efficiency given as ``loss_factor``."""
+
+MAX_BORE = 2.0
+"""m: a bearing bore above it (a robot's largest slewing bearings are about 1 m); in mm,
+a 2 mm bore reads as 2 m."""
+
 MAX_JOINT_RATE = 100.0
 """rad/s at a revolute independent joint (955 rpm at the output of a gear train)."""
 
@@ -168,12 +177,43 @@ def module_teeth(an) -> list[Finding]:
     return found
 
 
+def _key_path(mech, path: str, keys: tuple[str, ...]) -> str:
+    """``path.key`` of the first key the file gave (located in ``mech.lines``), else ``path``."""
+    return next((f"{path}.{k}" for k in keys if f"{path}.{k}" in mech.lines), path)
+
+
+def mesh_losses(mech) -> list[Finding]:
+    """Gear pairs whose mesh efficiency is below :data:`MIN_EFFICIENCY`."""
+    found = []
+    for g in mech.gears:
+        eta = 1.0 - g.loss_factor
+        if eta < MIN_EFFICIENCY:
+            found.append(Finding(_key_path(mech, g.path, ("efficiency", "loss_factor")),
+                                 f"gear pair '{g.name}': mesh efficiency {_g(eta)} (loss factor {_g(g.loss_factor)}) "
+                                 f"is below {_g(MIN_EFFICIENCY)}; a gear mesh loses 0.5 to 3 % at the pitch point: "
+                                 "efficiency and loss_factor swapped? (loss_factor = 1 - efficiency)"))
+    return found
+
+
+def large_bores(mech) -> list[Finding]:
+    """Bearings (with friction) whose bore is above :data:`MAX_BORE`."""
+    found = []
+    for j in mech.joints:
+        for b in j.bearings or ():
+            if b.bore is not None and b.bore > MAX_BORE:
+                found.append(Finding(_key_path(mech, b.path, ("bore",)), f"joint '{j.name}': bearing '{b.name}': "
+                                     f"bore {_g(b.bore)} m is above {_g(MAX_BORE)} m: in mm? (gearcli reads m)"))
+    return found
+
+
 def mechanism_findings(an) -> dict[str, list[Finding]]:
     """The findings of the analysed mechanism ``an`` by kind (what they are, plural: lengths,
     densities, gear modules), each once."""
     return {f"lengths above {MAX_LENGTH:g} m": list(dict.fromkeys(long_lengths(an.mech))),
             f"link densities outside {MIN_DENSITY:g} to {MAX_DENSITY:,.0f} kg/m^3": list(dict.fromkeys(densities(an.mech))),
-            "gear modules that contradict the pitch radii": list(dict.fromkeys(module_teeth(an)))}
+            "gear modules that contradict the pitch radii": list(dict.fromkeys(module_teeth(an))),
+            f"mesh efficiencies below {MIN_EFFICIENCY:g}": mesh_losses(an.mech),
+            f"bearing bores above {MAX_BORE:g} m": large_bores(an.mech)}
 
 
 # -- trajectories -------------------------------------------------------------------------
