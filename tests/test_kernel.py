@@ -33,7 +33,9 @@ from test_urdf import ERD, erd, talos_left_arm  # noqa: E402
 MECH = Path(__file__).resolve().parents[1] / "mechanisms"
 FIELDS = ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial", "motor_speed")
 TOL = 1e-12
-BUNDLED = sorted(p.name for p in MECH.glob("*.yaml")) + ["geared_arm.urdf"]
+# the compiled kernels do not model losses yet (issue 19): a lossy bundled file is solved by
+# numpy only (tests/test_losses.py::test_compiled_kernels_refuse_losses_and_auto_takes_numpy)
+BUNDLED = sorted(p.name for p in MECH.glob("*.yaml") if not load_mechanism(p).has_losses) + ["geared_arm.urdf"]
 BACKENDS = ["kernel", "llvm"]
 
 

@@ -141,10 +141,14 @@ def test_power_balance_with_losses(name, method):
 def test_lossless_mechanism_outputs_unchanged_and_without_loss_columns(name):
     """Efficiency 1 and zero friction written out: every output equals the file without them,
     bit for bit, and no loss column appears."""
-    mech = _load(name)
-    zero = dataclasses.replace(mech, gears=tuple(dataclasses.replace(g, loss_factor=0.0) for g in mech.gears),
-                               joints=tuple(dataclasses.replace(j, friction=JointFriction(0.0, 0.0))
-                                            for j in mech.joints))
+    def stripped(m, mu):
+        """m without losses: none at all (mu None), or every one written as zero (mu 0)."""
+        fr = None if mu is None else JointFriction(0.0, 0.0)
+        return dataclasses.replace(m, gears=tuple(dataclasses.replace(g, loss_factor=0.0) for g in m.gears),
+                                   joints=tuple(dataclasses.replace(j, friction=fr, bearings=None if not j.bearings else
+                                                tuple(dataclasses.replace(b, friction_coefficient=mu) for b in j.bearings))
+                                                for j in m.joints))
+    mech, zero = stripped(_load(name), None), stripped(_load(name), 0.0)
     a0, a1 = analyse(mech), analyse(zero)
     q, qd, qdd = random_motion(a0.dof, n=20)
     c0 = named_columns(a0, solve(a0, q, qd, qdd, backend="numpy"))
@@ -533,3 +537,42 @@ def test_verify_uses_the_lossy_motor_torques(tmp_path):
     peak = np.max(np.abs(solve(an_lossy, x[:, None], v[:, None], a[:, None]).motor))
     assert lossy_check["value"] == pytest.approx(peak, rel=1e-3)      # spline vs exact rates
     assert an_lossy.mech.has_losses and not an_free.mech.has_losses
+
+
+def test_bundled_design_verdict_changes_with_losses(run_cli, tmp_path):
+    """designs/servo_joint_losses.yaml: the rated servo joint with its losses fails its motor's
+    peak torque rating (named in the JUnit XML); the same case with every loss key removed
+    from the mechanism passes."""
+    import re
+    root = Path(__file__).resolve().parents[1]
+    res = run_cli("verify", root / "designs" / "servo_joint_losses.yaml", "--junit", tmp_path / "lossy.xml")
+    assert res.exit_code == 1
+    junit = (tmp_path / "lossy.xml").read_text()
+    assert re.search(r'<testcase[^>]*name="motor motor: peak torque"[^>]*>\s*<failure', junit)
+    assert junit.count("<failure") == 1
+    text = (root / "mechanisms" / "servo_joint_rated.yaml").read_text()
+    text = re.sub(r"\n\s*efficiency: [0-9.]+", "", text)
+    text = re.sub(r"\n\s*friction: \{[^}]*\}[^\n]*", "", text)
+    text = re.sub(r",\s*friction_coefficient: [0-9.]+, bore: [0-9.]+", "", text)
+    text = text.replace("- {name: needle, position: 0.0}", "- {name: needle, position: 0.0, C: 2000, C0: 2000, type: roller}")
+    body = text.split("name: servo_joint_rated", 1)[1]
+    assert not re.search(r"friction\w*:|efficiency:", body)
+    (tmp_path / "mechanisms").mkdir()
+    (tmp_path / "designs").mkdir()
+    (tmp_path / "mechanisms" / "servo_joint_rated.yaml").write_text(text)
+    (tmp_path / "mechanisms" / "servo_joint_duty.csv").write_bytes((root / "mechanisms" / "servo_joint_duty.csv").read_bytes())
+    (tmp_path / "designs" / "d.yaml").write_text((root / "designs" / "servo_joint_losses.yaml").read_text())
+    res = run_cli("verify", tmp_path / "designs" / "d.yaml")
+    assert res.exit_code == 0, res.stdout[-2000:]
+
+
+def test_compiled_kernels_refuse_losses_and_auto_takes_numpy():
+    """Until the compiled kernels model losses, they refuse a lossy mechanism with a reason
+    and ``auto`` solves it with numpy (the same figures as backend "numpy")."""
+    an = analyse(load_mechanism(MECH / "servo_joint_rated.yaml"))
+    q, qd, qdd = random_motion(an.dof, n=5)
+    for backend in ("llvm", "kernel"):
+        with pytest.raises(ValueError, match="losses, which only the numpy reference solves"):
+            solve(an, q, qd, qdd, backend=backend)
+    auto, ref = solve(an, q, qd, qdd), solve(an, q, qd, qdd, backend="numpy")
+    assert np.array_equal(auto.motor, ref.motor) and np.array_equal(auto.joint_loss, ref.joint_loss)
