@@ -533,7 +533,7 @@ def test_fuzz_lossy_mechanism(muts, command):
     check/graph/solve/export: exit 0 or 2 with located lines, nothing non-finite written."""
     data = lossy_planetary()
     for m in muts:
-        data = apply_field_key(data, m) if isinstance(m[0], str) and m[0] in LOSS_FIELDS else apply(data, m)
+        data = apply_field(data, m) if isinstance(m[0], str) and m[0] in LOSS_FIELDS else apply(data, m)
     files = {"mech.yaml": data, "traj.csv": short_csv("planetary_3p_traj.csv", 30)}
     with tempfile.TemporaryDirectory(prefix="gearcli-fuzz-") as d:
         work = Path(d)
@@ -545,16 +545,6 @@ def test_fuzz_lossy_mechanism(muts, command):
         result, hung = run_cli(args)
         found = problems(result, hung, work, files, ("out.urdf", "out.csv"))
         verdict("lossy-yaml", found, files, None if hung else result.exit_code)
-
-
-def apply_field_key(data: bytes, mut) -> bytes:
-    """:func:`apply_field` for a key of LOSS_FIELDS (flow or block style)."""
-    key, a, blob = mut
-    hits = list(re.finditer(rb"(?<![A-Za-z_0-9])" + key.encode() + rb":\s*(\[[^\]\n]*\]|[^,}\n#]+)", data))
-    if not hits:
-        return data
-    m = hits[a % len(hits)]
-    return data[:m.start(1)] + blob + data[m.end(1):]
 
 
 def first_differing_column(a: dict, b: dict) -> str | None:
