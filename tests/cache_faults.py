@@ -9,15 +9,27 @@ from pathlib import Path
 SPECIAL = ["fifo", "symlink to /dev/zero", "folder"]
 
 
-def make_special(path: Path, kind: str, full: bool = False) -> None:
-    """Put a FIFO, a symlink to /dev/zero or a folder (``full``: not empty, so it can be
-    neither removed nor replaced) at ``path`` (whatever was there goes)."""
+def clear(path: Path) -> None:
+    """Remove whatever is at ``path`` (a file, symlink, FIFO or a folder of files)."""
     if path.is_dir() and not path.is_symlink():
         for p in path.iterdir():
             p.unlink()
         path.rmdir()
     elif os.path.lexists(path):
         path.unlink()
+
+
+def put(path: Path, data: bytes) -> None:
+    """``data`` as the regular file ``path`` (writing into a FIFO left by an earlier fault
+    would block)."""
+    clear(path)
+    path.write_bytes(data)
+
+
+def make_special(path: Path, kind: str, full: bool = False) -> None:
+    """Put a FIFO, a symlink to /dev/zero or a folder (``full``: not empty, so it can be
+    neither removed nor replaced) at ``path`` (whatever was there goes)."""
+    clear(path)
     if kind == "fifo":
         os.mkfifo(path)
     elif kind == "symlink to /dev/zero":

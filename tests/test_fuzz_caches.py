@@ -43,10 +43,10 @@ import pytest
 
 pytest.importorskip("llvmlite")
 pytest.importorskip("hypothesis")
-from hypothesis import given, settings  # noqa: E402
+from hypothesis import example, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
-from cache_faults import finish_cli, make_special, stale_files, start_cli  # noqa: E402
+from cache_faults import finish_cli, make_special, put, stale_files, start_cli  # noqa: E402
 from test_fuzz import HANG_SECONDS, MECH_DIR, PROFILE, short_csv, verdict  # noqa: E402
 
 MECHS = ["paper_2dof.yaml", "bendix_wrist.yaml", "rack_axis.yaml"]
@@ -150,15 +150,15 @@ def apply_fault(cache: Path, own: dict, other: dict, fault: dict) -> dict:
     path, other_path = cache / name, cache / other[fault["suffix"]][0]
     kind = fault["kind"]
     if kind == "swap":
-        path.write_bytes(other[fault["suffix"]][1])
-        other_path.write_bytes(data)
+        put(path, other[fault["suffix"]][1])
+        put(other_path, data)
     elif kind == "copy":
-        path.write_bytes(other[fault["suffix"]][1])
+        put(path, other[fault["suffix"]][1])
     elif kind == "truncate":
-        path.write_bytes(data[:fault["a"] % max(1, len(data))])
+        put(path, data[:fault["a"] % max(1, len(data))])
     elif kind == "flip":
         i = fault["a"] % len(data)
-        path.write_bytes(data[:i] + bytes([data[i] ^ (fault["b"] or 1)]) + data[i + 1:])
+        put(path, data[:i] + bytes([data[i] ^ (fault["b"] or 1)]) + data[i + 1:])
     elif kind == "special":
         make_special(path, "folder" if fault["special"] == "full folder" else fault["special"],
                      full=fault["special"] == "full folder")
@@ -166,14 +166,14 @@ def apply_fault(cache: Path, own: dict, other: dict, fault: dict) -> dict:
         s = cache / own[".json"][0]
         how = fault["schedule"]
         if how == "deep":
-            s.write_text("[" * 100_000 + "]" * 100_000)
+            put(s, b"[" * 100_000 + b"]" * 100_000)
         elif how == "huge":
-            s.write_bytes(own[".json"][1] + b" " * 20_000)
+            put(s, own[".json"][1] + b" " * 20_000)
             return {"max_schedule_bytes": 10_000}
         elif how == "not json":
-            s.write_bytes(own[".json"][1][: fault["a"] % len(own[".json"][1])] + b"\xff{")
+            put(s, own[".json"][1][: fault["a"] % len(own[".json"][1])] + b"\xff{")
         else:
-            s.write_bytes(forged(own[".json"][1], how))
+            put(s, forged(own[".json"][1], how))
     return {}
 
 
@@ -186,6 +186,9 @@ def fill_cache(cache: Path, entries: dict) -> None:
 
 
 @count(6, 600)
+@example(target="bendix_wrist.yaml", other="paper_2dof.yaml", faults=[   # a FIFO, then written over (harness)
+    dict(kind="special", suffix=".obj", a=0, b=0, special="fifo", schedule="deep"),
+    dict(kind="truncate", suffix=".obj", a=100, b=0, special="fifo", schedule="deep")])
 @given(target=st.sampled_from(MECHS), other=st.sampled_from(MECHS), faults=st.lists(entry_fault(), min_size=1,
                                                                                       max_size=3))
 def test_fuzz_cache_entries(target, other, faults):
