@@ -23,6 +23,9 @@ _EXPORTS = {
     "analyse": "pipeline",
     "solve": "dynamics.solve",
     "Result": "dynamics.solve",
+    "mass_matrix": "dynamics.forward",
+    "forward_dynamics": "dynamics.forward",
+    "motor_inertia": "dynamics.forward",
     "solve_file": "pipeline",
     "named_columns": "report.columns",
     "read_trajectory": "io.trajectory",
@@ -36,6 +39,7 @@ __all__ = ["__version__", *_EXPORTS]
 
 if TYPE_CHECKING:  # pragma: no cover
     from .analysis.graph import Analysis
+    from .dynamics.forward import forward_dynamics, mass_matrix, motor_inertia
     from .dynamics.solve import Result, solve
     from .errors import GearcliError, MechanismError
     from .io import load_mechanism

@@ -1,0 +1,93 @@
+"""Speed of forward dynamics against inverse dynamics (prints figures; not a test).
+
+    python benchmarks/bench_forward.py [--repeat 5] [--samples 20000] [--jobs 1]
+
+For the Bendix wrist (bundled) and Panda (example-robot-data, if installed), in the same
+run: samples/s of ``gearcli.solve`` and of ``gearcli.forward_dynamics`` on the same random
+states (median of --repeat calls, after a warm-up call that compiles the llvm kernel), their
+ratio against the limit 1/(dof + 1) (what dof + 1 inverse-dynamics calls cost: the issue 20
+target is ratio >= limit), and ``mass_matrix`` alone.  Also the wall time of ``gearcli
+simulate`` of 2 s of the Bendix wrist with default tolerances (target < 5 s), when the
+command exists.
+"""
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from timing import load_line, median_time  # noqa: E402 (benchmarks/timing.py)
+
+import gearcli
+from gearcli.dynamics.forward import forward_dynamics, mass_matrix
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def panda_path() -> Path | None:
+    for p in map(Path, sys.path):
+        d = p / "cmeel.prefix" / "share" / "example-robot-data" / "robots" / "panda_description" / "urdf" / "panda.urdf"
+        if d.is_file():
+            return d
+    return None
+
+
+def bench(name: str, path: Path, n: int, repeat: int, jobs: int | None) -> None:
+    an = gearcli.analyse(gearcli.load_mechanism(path))
+    rng = np.random.default_rng(0)
+    q, qd = rng.uniform(-1, 1, (n, an.dof)), rng.uniform(-1, 1, (n, an.dof))
+    T = rng.uniform(-1, 1, (n, len(an.mech.motors)))
+    qdd = rng.uniform(-1, 1, (n, an.dof))
+    gearcli.solve(an, q[:10], qd[:10], qdd[:10], jobs=jobs)        # compile / load the kernel
+    t_inv = median_time(lambda: gearcli.solve(an, q, qd, qdd, jobs=jobs), repeat)
+    t_fwd = median_time(lambda: forward_dynamics(an, q, qd, T, jobs=jobs), repeat)
+    t_mm = median_time(lambda: mass_matrix(an, q, jobs=jobs), repeat)
+    ratio, limit = t_inv / t_fwd, 1.0 / (an.dof + 1)
+    print(f"{name} (dof {an.dof}), {n:,} samples, jobs {jobs or 'all'}:")
+    print(f"  solve            {n / t_inv:12,.0f} samples/s")
+    print(f"  forward_dynamics {n / t_fwd:12,.0f} samples/s   ratio {ratio:.3f}, limit 1/(dof+1) = {limit:.3f}: "
+          f"{ratio / limit:.0%} of the limit ({'meets' if ratio >= limit else 'misses'} the target)")
+    print(f"  mass_matrix      {n / t_mm:12,.0f} samples/s")
+
+
+def bench_simulate() -> None:
+    with tempfile.TemporaryDirectory() as d:
+        inp = Path(d) / "torques.csv"
+        t = np.linspace(0.0, 2.0, 201)
+        cols = "t,motor:motor4,motor:motor5,motor:motor7"
+        rows = np.column_stack([t, 0.02 * np.sin(3 * t), 0.01 * np.cos(2 * t), -0.015 * np.sin(t)])
+        np.savetxt(inp, rows, delimiter=",", header=cols, comments="")
+        cmd = [sys.executable, "-m", "gearcli.cli", "simulate", str(ROOT / "mechanisms" / "bendix_wrist.yaml"),
+               str(inp), "-o", str(Path(d) / "traj.csv")]
+        t0 = time.perf_counter()
+        proc = subprocess.run(cmd, capture_output=True, text=True)
+        wall = time.perf_counter() - t0
+        if proc.returncode != 0:
+            print(f"gearcli simulate: exit {proc.returncode}: {proc.stderr.strip()[-300:]}")
+            return
+        print(f"gearcli simulate, 2 s of the Bendix wrist, default tolerances: {wall:.2f} s wall (target < 5 s; "
+              f"new process, imports included)")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--samples", type=int, default=20_000)
+    ap.add_argument("--jobs", type=int, default=None)
+    args = ap.parse_args()
+    print(load_line())
+    bench("bendix_wrist", ROOT / "mechanisms" / "bendix_wrist.yaml", args.samples, args.repeat, args.jobs)
+    panda = panda_path()
+    if panda is None:
+        print("panda: example-robot-data not installed, skipped")
+    else:
+        bench("panda", panda, args.samples, args.repeat, args.jobs)
+    bench_simulate()
+
+
+if __name__ == "__main__":
+    main()
