@@ -20,7 +20,7 @@ def inertia_load(an, kin: Kinematics) -> dict[int, np.ndarray]:
     g = mech.gravity
     out = {}
     for L in tree.moving:
-        link = mech.links[L]
+        link = mech.bodies[L]          # payloads merged (model.loads.with_payloads)
         out[L] = inertia_wrench(link.mass, link.inertia, link.com, kin.R[L], kin.w[L], kin.dw[L], kin.a[L], g)
     return out
 

@@ -78,7 +78,7 @@ def _joints(an):
 def _links(an):
     out = np.zeros((len(an.tree.links), 13))
     for L in an.tree.moving:
-        link = an.mech.links[L]
+        link = an.mech.bodies[L]          # payloads merged
         out[L] = np.concatenate([[link.mass], np.ravel(link.inertia), link.com])
     return out
 

@@ -5,6 +5,7 @@ import numpy as np
 
 from ..errors import Collector
 from ..model.loads import LOAD_FRAMES, Load
+from ..model.validate import check_inertia, inertia_matrix
 
 
 def load_link_problem(link: str, links: set, base: str) -> str | None:
@@ -29,17 +30,36 @@ def yaml_loads(data: dict, col: Collector, links: set, base: str) -> tuple[Load,
         why = load_link_problem(spec["link"], links, base)
         if why:
             col.add(f"{path}.link", why)
+        mass, inertia = payload(spec.get("mass", 0.0), spec.get("inertia"), path, col.add)
         out.append(Load(name, spec["link"], spec["frame"],
                         *(np.asarray(spec.get(k, [0.0, 0.0, 0.0]), float) for k in ("point", "force", "moment")),
-                        path=path))
+                        path=path, mass=mass, inertia=inertia))
     return tuple(out)
 
 
-LOAD_ATTRS = ("name", "link", "frame", "point", "force", "moment")
+def payload(mass, inertia, path: str, add) -> tuple[float, np.ndarray]:
+    """A payload's mass (kg) and inertia (3, 3) about its point (kg*m^2), checked: mass not
+    negative, inertia a physical tensor (positive semi-definite, triangle inequality), and
+    no inertia without mass."""
+    mass = float(mass)
+    I = np.zeros((3, 3)) if inertia is None else (inertia if isinstance(inertia, np.ndarray) else inertia_matrix(inertia))
+    if not mass >= 0:
+        add(f"{path}.mass", f"payload mass must not be negative, got {mass:g} kg")
+    elif np.any(I) and not mass > 0:
+        add(f"{path}.inertia", "a payload inertia needs a positive mass")
+    elif np.any(I):
+        why = check_inertia(I, mass)
+        if why:
+            add(f"{path}.inertia", f"payload {why}")
+    return mass, I
+
+
+LOAD_ATTRS = ("name", "link", "frame", "point", "force", "moment", "mass", "inertia")
 
 
 class UrdfLoads:
-    """``<gearcli:load name= link= frame= point= force= moment=/>`` elements; a mixin of the
+    """``<gearcli:load name= link= frame= point= force= moment= [mass= inertia=]/>`` elements
+    (a payload's inertia "ixx iyy izz ixy ixz iyz" about the point, URDF link axes); a mixin of the
     URDF reader (needs ``add``, ``lines``, ``vector``, ``unknown_attrs``, ``body_of``, ``base``).
 
     The point (and, with ``frame="link"``, the force and moment) are given in the URDF
@@ -77,5 +97,9 @@ class UrdfLoads:
             R, p = T[:3, :3], T[:3, 3]
             point = R @ vals[0] + p
             force, moment = (R @ vals[1], R @ vals[2]) if frame == "link" else (vals[1], vals[2])
-            out.append(Load(name, body, frame, point, force, moment, path))
+            mass = self.vector(el, "mass", path, n=1, default=np.zeros(1))[0]
+            i6 = self.vector(el, "inertia", path, n=6, default=np.zeros(6))
+            I = np.array([[i6[0], i6[3], i6[4]], [i6[3], i6[1], i6[5]], [i6[4], i6[5], i6[2]]])
+            mass, I = payload(mass, R @ I @ R.T, path, lambda p, msg: self.add(p, msg, el))
+            out.append(Load(name, body, frame, point, force, moment, path, mass=mass, inertia=I))
         return tuple(out)

@@ -16,7 +16,7 @@ from ..errors import Collector, Issue, MechanismError
 from ..model.mechanism import Mechanism
 from ..model.validate import number_problem
 from ..model.ratings import (BEARING_FACTOR_DEFAULTS, STEEL_ELASTIC_COEFFICIENT, BearingRating, GearRating,
-                             JointLimit, MotorRating)
+                             JointLimit, MotorModel, MotorRating)
 from .planets import item_path
 
 NS = "https://gearcli.dev/urdf/1"
@@ -46,6 +46,14 @@ def motor_rating(spec: dict, path: str, add) -> MotorRating:
     return MotorRating(float(spec["peak_torque"]), float(spec["rms_torque"]), float(spec["max_speed"]),
                        None if power is None else float(power), path,
                        thermal_window=None if window is None else float(window))
+
+
+def motor_model(spec: dict, path: str, add) -> MotorModel:
+    """A :class:`MotorModel` from ``motors[].model`` (kt, resistance, inductance, supply_voltage)."""
+    _positive(spec, ("kt", "resistance", "inductance", "supply_voltage"), path, add)
+    ind = spec.get("inductance")
+    return MotorModel(float(spec["kt"]), float(spec["resistance"]), float(spec["supply_voltage"]),
+                      None if ind is None else float(ind), path)
 
 
 def bearing_ratings(specs: list[dict], path: str, add) -> tuple[BearingRating, ...]:
@@ -145,6 +153,8 @@ def attach_yaml_ratings(mech: Mechanism, data: dict, col: Collector) -> Mechanis
     """``mech`` with the ratings of the (schema-valid) YAML ``data`` attached; issues to ``col``."""
     motors = tuple(replace(m, rating=motor_rating(s["rating"], f"motors[{i}].rating", col.add))
                    if "rating" in s else m for i, (m, s) in enumerate(zip(mech.motors, data.get("motors", []))))
+    motors = tuple(replace(m, model=motor_model(s["model"], f"motors[{i}].model", col.add))
+                   if "model" in s else m for i, (m, s) in enumerate(zip(motors, data.get("motors", []))))
     joints = tuple(replace(j, bearings=bearing_ratings(s["bearings"], f"{item_path(data, 'joints', i)}.bearings",
                                                        col.add))
                    if "bearings" in s else j for i, (j, s) in enumerate(zip(mech.joints, data["joints"])))

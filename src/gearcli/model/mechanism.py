@@ -17,12 +17,13 @@ Rz(theta)*Tz(d) of the parent frame.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
 from .friction import JointFriction
-from .loads import Load
-from .ratings import BearingRating, GearRating, JointLimit, MotorRating
+from .loads import Load, with_payloads
+from .ratings import BearingRating, GearRating, JointLimit, MotorModel, MotorRating
 
 
 @dataclass(frozen=True, eq=False)
@@ -121,6 +122,7 @@ class Motor:
     # the joint's child and reversed on its parent.  Empty: the default above.
     joints: tuple[tuple[str, float], ...] = ()
     rating: MotorRating | None = None   # design checks
+    model: MotorModel | None = None     # DC motor model (gearcli simulate, voltage columns)
 
 
 @dataclass(frozen=True, eq=False)
@@ -158,6 +160,13 @@ class Mechanism:
             if link.name == name:
                 return link
         raise KeyError(name)
+
+    @cached_property
+    def bodies(self) -> tuple[Link, ...]:
+        """The rigid bodies the dynamics moves: ``links`` with every payload's mass and
+        inertia (``loads[].mass``, ``loads[].inertia``) merged into its link
+        (:func:`~gearcli.model.loads.with_payloads`); the same order and names."""
+        return with_payloads(self.links, self.loads)
 
     @property
     def link_names(self) -> list[str]:

@@ -44,6 +44,25 @@ class MotorRating:
 
 
 @dataclass(frozen=True)
+class MotorModel:
+    """A DC motor (``gearcli simulate`` with voltage columns): torque ``kt`` * i (N*m/A,
+    also the back-EMF constant in V*s/rad), winding ``resistance`` (ohm) and
+    ``inductance`` (H; None: the current follows the voltage at once,
+    i = (V - kt*omega) / R), ``supply_voltage`` the largest |V| the drive applies (V)."""
+
+    kt: float
+    resistance: float
+    supply_voltage: float
+    inductance: float | None = None
+    path: str = field(default="", compare=False)   # where it was read (for messages)
+
+    def peak_torque(self, omega):
+        """Largest torque at motor speed omega (rad/s) in the direction of motion:
+        kt (V_supply - kt omega) / R (the torque-speed line)."""
+        return self.kt * (self.supply_voltage - self.kt * omega) / self.resistance
+
+
+@dataclass(frozen=True)
 class BearingRating:
     """A rolling bearing of a joint.
 

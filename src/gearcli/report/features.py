@@ -20,7 +20,8 @@ def _vec(x) -> str:
 def load_dicts(an: Analysis) -> list[dict]:
     """Each external load: name, link, frame, point (m, link frame), force (N), moment (N*m)."""
     return [{"name": ld.name, "link": ld.link, "frame": ld.frame, "point": [float(v) for v in ld.point],
-             "force": [float(v) for v in ld.force], "moment": [float(v) for v in ld.moment]}
+             "force": [float(v) for v in ld.force], "moment": [float(v) for v in ld.moment],
+             **({"mass": float(ld.mass), "inertia": [[float(v) for v in row] for row in ld.inertia]} if ld.mass else {})}
             for ld in an.mech.loads]
 
 
@@ -45,7 +46,9 @@ def feature_notes(an: Analysis) -> list[str]:
     N*m at [..] m``, ``helical pair ...``, ``rack pair ...``, then the losses
     (:func:`gearcli.report.loss_notes.loss_notes`)."""
     lines = [f"load '{d['name']}' on link '{d['link']}' (frame {d['frame']}): force {_vec(d['force'])} N, "
-             f"moment {_vec(d['moment'])} N*m at {_vec(d['point'])} m (link frame)" for d in load_dicts(an)]
+             f"moment {_vec(d['moment'])} N*m at {_vec(d['point'])} m (link frame)"
+             + (f"; payload mass {d['mass']:.6g} kg (its weight and inertia move with the link)" if "mass" in d else "")
+             for d in load_dicts(an)]
     for d in pair_dicts(an):
         if d["kind"] == "helical":
             hands = ", ".join(f"'{k}' {v} hand" for k, v in d["hands"].items())

@@ -249,8 +249,12 @@ def _add_loads(mech: Mechanism, root, corr: dict) -> None:
     for ld in mech.loads:
         R, _ = corr[ld.link]
         f, m = (R.T @ ld.force, R.T @ ld.moment) if ld.frame == "link" else (ld.force, ld.moment)
-        etree.SubElement(root, q("load"), name=ld.name, link=ld.link, frame=ld.frame,
-                         point=_vec(_to_urdf(corr, ld.link, ld.point)), force=_vec(f), moment=_vec(m))
+        el = etree.SubElement(root, q("load"), name=ld.name, link=ld.link, frame=ld.frame,
+                              point=_vec(_to_urdf(corr, ld.link, ld.point)), force=_vec(f), moment=_vec(m))
+        if ld.mass:                      # a payload: mass, inertia about the point in URDF link axes
+            I = R.T @ ld.inertia @ R
+            el.set("mass", _num(ld.mass))
+            el.set("inertia", _vec([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]))
 
 
 def _gear_attrs(el, gp, mesh_point) -> None:

@@ -1,0 +1,142 @@
+"""Time integration of the exact geared dynamics (``gearcli simulate``).
+
+State: the independent joint angles q and rates qd (rad, rad/s; m, m/s for a prismatic
+joint; ``an.independent_names`` order) and, for every motor driven by voltage whose DC
+model has an inductance, its winding current i (A, starting at 0).  The motor torques are
+
+* a ``motor:<m>`` column: the given torque (N*m), linear between the input's rows;
+* a ``voltage:<m>`` column with a DC model ``(kt, R, L, V_supply)``: kt * i, with
+  L di/dt = V - R i - kt omega, or without L, i = (V - kt omega) / R; omega = (A^T qd)_m is
+  the motor's speed relative to its stator (rad/s).
+
+The accelerations are :func:`~.forward.forward_dynamics` (exact, every gear and rotor),
+integrated by :func:`scipy.integrate.solve_ivp`.  Joints with position limits (a URDF
+``<limit lower upper>``) stop the integration when they reach one (a terminal event); the
+stop is reported, with the samples up to it.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .forward import forward_dynamics
+
+METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
+
+
+@dataclass
+class Simulation:
+    """Samples of a simulated motion: ``t`` (n,) s; ``q``, ``qd``, ``qdd`` (n, dof) of the
+    independent joints; ``motor`` (n, M) the motor torques applied (N*m); ``current``
+    (n, M) the winding currents (A; NaN for a torque-driven motor); ``stop``: why the
+    integration ended early (a joint limit reached), else None; ``nfev``: right-hand side
+    evaluations."""
+
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    motor: np.ndarray
+    current: np.ndarray
+    stop: str | None
+    nfev: int
+
+
+class SimulationError(Exception):
+    """The integrator failed (the message says why and when)."""
+
+
+def joint_limits(an) -> list[tuple[int, str, float, float]]:
+    """(joint index, name, lower, upper) of every real joint with position limits (a URDF
+    ``<limit lower upper>`` on a revolute or prismatic joint; rad or m)."""
+    out = []
+    for ji, jt in enumerate(an.mech.joints):
+        lim = (jt.source or {}).get("limit")
+        if lim and jt.source.get("urdf_type") in ("revolute", "prismatic") and lim["lower"] < lim["upper"]:
+            out.append((ji, jt.name, float(lim["lower"]), float(lim["upper"])))
+    return out
+
+
+class Drive:
+    """The motor torques of a drive input (:class:`~gearcli.io.drive_input.DriveInput`) as a
+    function of time, rates and winding currents; see the module docstring."""
+
+    def __init__(self, an, drive):
+        self.an, self.drive = an, drive
+        models = [m.model for m in an.mech.motors]
+        volt = np.asarray(drive.voltage, bool)
+        self.volt = volt
+        self.kt = np.array([m.kt if m is not None else 0.0 for m in models])
+        self.R = np.array([m.resistance if m is not None else 1.0 for m in models])
+        self.inductive = np.array([bool(v and models[k].inductance is not None) for k, v in enumerate(volt)])
+        self.L = np.array([models[k].inductance for k in np.flatnonzero(self.inductive)])
+
+    def torques(self, t, qd, current):
+        """(..., M) motor torques at time(s) t with rates qd (..., dof) and the inductive
+        motors' currents (..., n_L); also the winding currents (NaN for torque columns)."""
+        u = self.drive.at(t)
+        w = qd @ self.an.A                                    # motor speeds A^T qd
+        i = np.where(self.volt, (u - self.kt * w) / self.R, np.nan)
+        i[..., self.inductive] = current
+        return np.where(self.volt, self.kt * i, u), i
+
+    def current_rate(self, t, qd, current):
+        """dI/dt (n_L,) of the inductive motors: (V - R i - kt omega) / L."""
+        k = self.inductive
+        u = self.drive.at(t)[..., k]
+        w = (qd @ self.an.A)[..., k]
+        return (u - self.R[k] * current - self.kt[k] * w) / self.L
+
+
+def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10, method: str = "DOP853",
+             progress=None, backend: str = "auto") -> Simulation:
+    """Integrate from (q0, qd0) at t_eval[0] to t_eval[-1]; samples at ``t_eval`` (s).
+
+    ``drive`` a :class:`~gearcli.io.drive_input.DriveInput`; ``rtol``, ``atol``, ``method``
+    those of :func:`scipy.integrate.solve_ivp` (atol in rad, rad/s, A); ``progress(t)`` is
+    called with the time reached.  Raises :class:`SimulationError` when the integrator
+    fails or the state stops being finite.
+    """
+    from scipy.integrate import solve_ivp  # noqa: PLC0415  (scipy is a dependency; import when used)
+
+    dof = an.dof
+    d = Drive(an, drive)
+    nL = int(d.inductive.sum())
+
+    def rhs(t, x):
+        q, qd, cur = x[:dof], x[dof:2 * dof], x[2 * dof:]
+        T, _ = d.torques(t, qd, cur)
+        try:
+            qdd = forward_dynamics(an, q, qd, T, backend=backend)[0]
+        except ValueError as exc:
+            raise SimulationError(f"the state is not finite at t = {t:.9g} s ({exc})") from None
+        if progress is not None:
+            progress(t)
+        return np.concatenate([qd, qdd, d.current_rate(t, qd, cur)])
+
+    events = []
+    for ji, name, lo, hi in joint_limits(an):
+        row = an.S[ji]
+        for side, bound in (("lower", lo), ("upper", hi)):
+            sign = 1.0 if side == "lower" else -1.0
+            ev = (lambda t, x, row=row, b=bound, s=sign: s * (row @ x[:dof] - b))
+            ev.terminal, ev.direction = True, -1.0
+            ev.joint = (name, side, bound)
+            events.append(ev)
+    x0 = np.concatenate([q0, qd0, np.zeros(nL)])
+    sol = solve_ivp(rhs, (t_eval[0], t_eval[-1]), x0, method=method, t_eval=t_eval, rtol=rtol, atol=atol,
+                    events=events or None)
+    if sol.status == -1:
+        raise SimulationError(f"the integrator failed at t = {sol.t[-1] if len(sol.t) else t_eval[0]:.9g} s: {sol.message}")
+    t, x, stop = sol.t, sol.y.T, None
+    if sol.status == 1:
+        k = next(i for i, te in enumerate(sol.t_events) if len(te))
+        name, side, bound = events[k].joint
+        te = float(sol.t_events[k][0])
+        stop = f"joint '{name}' reached its {side} limit {bound:g} at t = {te:.6g} s"
+        t, x = np.append(t[t < te], te), np.vstack([x[t < te], sol.y_events[k][:1]])
+    q, qd, cur = x[:, :dof], x[:, dof:2 * dof], x[:, 2 * dof:]
+    T, current = d.torques(t, qd, cur)
+    qdd = forward_dynamics(an, q, qd, T, backend=backend)
+    return Simulation(t, q, qd, qdd, T, current, stop, int(sol.nfev))

@@ -1,0 +1,107 @@
+"""The input of ``gearcli simulate``: motor torques or DC-motor voltages over time (CSV).
+
+Format: a header row, then one row per sample; ``t`` (s, strictly increasing) and, for
+every motor ``m`` of the mechanism, either ``motor:<m>`` (its torque, N*m; N for a linear
+input: the torque the motor applies to its input link about its positive joint axis, as the
+``motor:`` columns ``gearcli solve`` writes) or ``voltage:<m>`` (V, for a motor with a DC
+model ``motors[].model``; |V| at most its ``supply_voltage``).  Values are linear between
+rows.  Cells, values and times are checked as in a trajectory file (one line naming the
+file, line and column): :class:`~.trajectory.TrajectoryReader` reads the rows.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import counted
+from .trajectory import SEPARATORS, TrajectoryReader, _check_utf8, _fail, _place, _split, show
+
+
+@dataclass
+class DriveInput:
+    """``t`` (n,) s; ``values`` (n, M) per motor in ``mech.motors`` order: N*m for a torque
+    column, V for a voltage column; ``voltage`` (M,) bool: which motors are driven by
+    voltage; ``line`` (n,) the file line of every row."""
+
+    t: np.ndarray
+    values: np.ndarray
+    voltage: np.ndarray
+    line: np.ndarray
+    file: str
+
+    def at(self, t) -> np.ndarray:
+        """The values at time(s) t: (M,) for a scalar t, (n, M) for an array; linear between
+        rows, the first or last row's values outside them."""
+        tt = np.asarray(t, float)
+        out = np.stack([np.interp(tt, self.t, self.values[:, k]) for k in range(self.values.shape[1])], axis=-1)
+        return out
+
+
+class _DriveReader(TrajectoryReader):
+    """The row reading of :class:`TrajectoryReader` with the columns of a drive input."""
+
+    def __init__(self, path, motors):   # noqa: super().__init__ is for q columns
+        self.path, self.names, self.degrees, self.loads, self.linear = Path(path), [], False, (), set()
+        self.chunk, self.file = 1 << 62, str(path)
+        with self._open() as f:
+            head = self._readline(f, 1).removeprefix("\ufeff")
+        if not head.strip():
+            raise _fail(self.file, 1, "", "empty file (expected a header row: t,motor:<motor>,...)")
+        _check_utf8(self.file, [head], [1])
+        self.sep = next((s for s in SEPARATORS if s in head), ",")
+        self.header = _split(head, self.sep)
+        self.cols = {"t": self._drive_columns(motors)}
+        self.scale = np.ones(len(self.header))
+
+    def _drive_columns(self, motors) -> int:
+        pos: dict[str, int] = {}
+        for i, h in enumerate(self.header):
+            if h in pos:
+                raise _fail(self.file, 1, _place(self.header, i), "duplicate column")
+            pos[h] = i
+        names = {m.name: m for m in motors}
+        expected = "expected t and, for every motor, motor:<motor> (N*m) or voltage:<motor> (V)"
+        for h, i in pos.items():
+            kind, _, name = h.partition(":")
+            if h != "t" and (kind not in ("motor", "voltage") or name not in names):
+                what = f"'{show(name)}' is not a motor of the mechanism" if kind in ("motor", "voltage") else "unknown column"
+                raise _fail(self.file, 1, _place(self.header, i), f"{what} ({expected}: {', '.join(names)})")
+            if kind == "voltage" and names[name].model is None:
+                raise _fail(self.file, 1, _place(self.header, i), f"motor '{name}' has no DC model "
+                            "(motors[].model: kt, resistance, supply_voltage) to turn a voltage into a torque")
+        if "t" not in pos:
+            raise _fail(self.file, 1, "", "missing column 't' (time, s)")
+        for m in motors:
+            both = [f"{k}:{m.name}" for k in ("motor", "voltage") if f"{k}:{m.name}" in pos]
+            if len(both) != 1:
+                what = "both motor: and voltage: columns" if both else "no column"
+                raise _fail(self.file, 1, "", f"motor '{m.name}' has {what} (give one of 'motor:{m.name}' "
+                            f"(torque, N*m) and 'voltage:{m.name}' (V))")
+        self.motor_cols = [pos.get(f"motor:{m.name}", pos.get(f"voltage:{m.name}")) for m in motors]
+        self.voltage = np.array([f"voltage:{m.name}" in pos for m in motors])
+        return pos["t"]
+
+
+def read_drive_input(path, motors) -> DriveInput:
+    """Read and check a drive input CSV for ``motors`` (``mech.motors``); raises
+    :class:`~gearcli.errors.TrajectoryError` naming the file, line and column."""
+    r = _DriveReader(path, motors)
+    parts = list(r._raw())
+    data = np.concatenate([d for d, _ in parts]) if parts else np.zeros((0, len(r.header)))
+    lines = np.concatenate([ln for _, ln in parts]) if parts else np.zeros(0, int)
+    if len(data) == 0:
+        raise _fail(r.file, None, "", "no samples after the header")
+    values = data[:, r.motor_cols]
+    for k, m in enumerate(motors):
+        if r.voltage[k]:
+            over = np.flatnonzero(np.abs(values[:, k]) > m.model.supply_voltage)
+            if over.size:
+                i = int(over[0])
+                raise _fail(r.file, int(lines[i]), _place(r.header, r.motor_cols[k]),
+                            f"voltage {values[i, k]:g} V exceeds motor '{m.name}''s supply_voltage "
+                            f"{m.model.supply_voltage:g} V")
+    if len(data) < 2:
+        raise _fail(r.file, None, "", f"{counted(len(data), 'row')}: give at least 2 (values are linear between rows)")
+    return DriveInput(data[:, r.cols["t"]], values, r.voltage, lines, r.file)

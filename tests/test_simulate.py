@@ -1,0 +1,201 @@
+"""``gearcli simulate`` (issue 20): integrate the exact geared dynamics over time.
+
+* Simulate then solve: ``gearcli solve`` on the written trajectory returns the input motor
+  torques (Bendix wrist, coupled motors).
+* By hand: a motor, one spur stage and a flywheel under a constant torque T: the motor
+  accelerates at T / J_eff, J_eff = J_rotor + J_load / n^2, the disc at -T / (n J_eff);
+  a DC motor without inductance reaches omega = V/kt with time constant R J_eff / kt^2.
+* Energy: UR5 (Pinocchio's kinetic and potential energy of the written states, nothing of
+  gearcli's) with zero torques and gravity keeps its energy to 1e-8 over 2 s (DOP853,
+  tight tolerances).
+* A joint limit stops the integration: message, exit status 1, the trajectory up to it.
+* ``--loads`` writes what ``gearcli solve`` writes; bad input: one line, exit 2.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from test_forward import J_LOAD, J_ROTOR, TEETH, spur_stage_yaml
+
+N_RATIO = TEETH[1] / TEETH[0]
+J_EFF = J_ROTOR + J_LOAD / N_RATIO ** 2
+
+
+def read_csv(path):
+    names = path.read_text().splitlines()[0].split(",")
+    data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    return {n: data[:, i] for i, n in enumerate(names)}
+
+
+def write(path, text):
+    path.write_text(text)
+    return path
+
+
+def test_simulate_then_solve_returns_the_input_torques(run_cli, mech_dir, tmp_path):
+    t = np.linspace(0.0, 0.5, 11)
+    T = np.column_stack([0.05 * np.sin(6 * t), 0.03 * np.cos(4 * t), -0.04 * t])
+    inp = tmp_path / "in.csv"
+    np.savetxt(inp, np.column_stack([t, T]), delimiter=",", comments="",
+               header="t,motor:motor4,motor:motor5,motor:motor7")
+    r = run_cli("simulate", mech_dir / "bendix_wrist.yaml", inp, "-o", tmp_path / "traj.csv")
+    assert r.exit_code == 0, r.stderr
+    assert "Wrote 501 rows to" in r.stdout
+    r = run_cli("solve", mech_dir / "bendix_wrist.yaml", tmp_path / "traj.csv", "-o", tmp_path / "loads.csv",
+                "--precision", "17")
+    assert r.exit_code == 0, r.stderr
+    loads = read_csv(tmp_path / "loads.csv")
+    for k, m in enumerate(("motor4", "motor5", "motor7")):
+        expected = np.interp(loads["t"], t, T[:, k])
+        assert np.max(np.abs(loads[f"motor:{m}"] - expected)) < 1e-9 * np.abs(T).max()
+
+
+def test_flywheel_accelerates_at_torque_over_effective_inertia(run_cli, tmp_path):
+    mech = write(tmp_path / "stage.yaml", spur_stage_yaml())
+    T = 0.02
+    inp = write(tmp_path / "in.csv", f"t,motor:servo\n0,{T}\n1,{T}\n")
+    r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv", "--rtol", "1e-10", "--atol", "1e-12")
+    assert r.exit_code == 0, r.stderr
+    tr = read_csv(tmp_path / "traj.csv")
+    a_motor = T / J_EFF                           # the motor's acceleration, by hand
+    a_disc = -a_motor / N_RATIO                   # external stage: the disc turns the other way
+    assert np.max(np.abs(tr["qdd:Jd"] - a_disc)) < 1e-12 * abs(a_disc)
+    assert np.max(np.abs(tr["qd:Jd"] - a_disc * tr["t"])) < 1e-9 * abs(a_disc)
+    assert np.max(np.abs(tr["q:Jd"] - 0.5 * a_disc * tr["t"] ** 2)) < 1e-9 * abs(a_disc)
+
+
+def test_armature_inertia_would_be_caught():
+    """Forgetting the reflected rotor (J_load only) or reflecting it without the square of the
+    ratio changes the disc's acceleration far beyond the test's tolerance."""
+    exact = 0.02 / J_EFF / N_RATIO
+    for wrong in (0.02 / N_RATIO / (J_LOAD / N_RATIO ** 2), 0.02 / N_RATIO / (J_ROTOR + J_LOAD / N_RATIO)):
+        assert abs(wrong - exact) > 1e-3 * exact
+
+
+DC = "\n    model: {kt: 0.05, resistance: 2.0, supply_voltage: 24.0}"
+
+
+def dc_stage(inductance: float | None = None) -> str:
+    model = DC if inductance is None else DC.replace("}", f", inductance: {inductance}}}")
+    return spur_stage_yaml().replace("  - {name: servo, link: rotor}", "  - name: servo\n    link: rotor" + model)
+
+
+def test_dc_motor_reaches_its_no_load_speed_exponentially(run_cli, tmp_path):
+    mech = write(tmp_path / "stage.yaml", dc_stage())
+    V, kt, R = 12.0, 0.05, 2.0
+    inp = write(tmp_path / "in.csv", f"t,voltage:servo\n0,{V}\n3,{V}\n")
+    r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv", "--rtol", "1e-10", "--atol", "1e-12",
+                "--dt", "0.01")
+    assert r.exit_code == 0, r.stderr
+    tr = read_csv(tmp_path / "traj.csv")
+    tau = R * J_EFF / kt ** 2
+    omega_motor = -N_RATIO * tr["qd:Jd"]
+    assert np.max(np.abs(omega_motor - V / kt * (1 - np.exp(-tr["t"] / tau)))) < 1e-7 * V / kt
+
+
+def test_dc_motor_with_inductance_follows_the_linear_model(run_cli, tmp_path):
+    """J_eff w' = kt i, L i' = V - R i - kt w from rest: x(t) = x_ss + expm(A t)(x0 - x_ss)."""
+    from scipy.linalg import expm
+    V, kt, R, L = 12.0, 0.05, 2.0, 1e-3
+    mech = write(tmp_path / "stage.yaml", dc_stage(inductance=L))
+    inp = write(tmp_path / "in.csv", f"t,voltage:servo\n0,{V}\n0.3,{V}\n")
+    r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv", "--method", "Radau", "--dt", "0.01",
+                "--rtol", "1e-10", "--atol", "1e-12")
+    assert r.exit_code == 0, r.stderr
+    tr = read_csv(tmp_path / "traj.csv")
+    A = np.array([[0.0, kt / J_EFF], [-kt / L, -R / L]])
+    x_ss = np.array([V / kt, 0.0])
+    omega = np.array([(x_ss + expm(A * t) @ (0 - x_ss))[0] for t in tr["t"]])
+    assert np.max(np.abs(-N_RATIO * tr["qd:Jd"] - omega)) < 1e-6 * omega.max()
+    # the current starts at 0: no torque at t = 0, unlike the model without inductance
+    assert tr["qdd:Jd"][0] == 0.0
+
+
+PENDULUM = """<?xml version="1.0"?>
+<robot name="pendulum">
+  <link name="base"/>
+  <link name="arm"><inertial><origin xyz="0.5 0 0"/><mass value="2"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+  <joint name="swing" type="revolute">
+    <parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
+    <limit lower="-0.5" upper="1.0" effort="100" velocity="10"/>
+  </joint>
+</robot>
+"""
+
+
+def test_a_joint_limit_stops_the_simulation(run_cli, tmp_path):
+    mech = write(tmp_path / "pendulum.urdf", PENDULUM)
+    inp = write(tmp_path / "in.csv", "t,motor:swing\n0,0\n2,0\n")     # falls from horizontal
+    r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv")
+    assert r.exit_code == 1
+    assert "in.csv: stopped: joint 'swing' reached its upper limit 1 at t = " in r.stderr
+    tr = read_csv(tmp_path / "traj.csv")
+    assert tr["q:swing"][-1] == pytest.approx(1.0, abs=1e-9)
+    assert np.all(tr["q:swing"][:-1] < 1.0) and tr["t"][-1] < 2.0
+
+
+def test_loads_option_writes_what_solve_writes(run_cli, mech_dir, tmp_path):
+    inp = write(tmp_path / "in.csv", "t,motor:motor3,motor:motor5\n0,0.5,-1\n0.2,-0.5,1\n")
+    r = run_cli("simulate", mech_dir / "paper_2dof.yaml", inp, "-o", tmp_path / "traj.csv",
+                "--loads", tmp_path / "a.csv", "--q0", "0.1,-0.2", "--qd0", "1,0")
+    assert r.exit_code == 0, r.stderr
+    assert "Wrote 201 rows of loads to" in r.stdout
+    r = run_cli("solve", mech_dir / "paper_2dof.yaml", tmp_path / "traj.csv", "-o", tmp_path / "b.csv")
+    assert (tmp_path / "a.csv").read_text() == (tmp_path / "b.csv").read_text()
+    tr = read_csv(tmp_path / "traj.csv")
+    assert (tr["q:J1"][0], tr["q:J2"][0], tr["qd:J1"][0]) == (0.1, -0.2, 1.0)
+
+
+@pytest.mark.parametrize("text,args,message", [
+    ("t,motor:motor3\n0,1\n1,1\n", (), "in.csv:1: motor 'motor5' has no column (give one of 'motor:motor5'"),
+    ("t,motor:motor3,motor:nope\n0,1,1\n1,1,1\n", (), "in.csv:1: column 3 'motor:nope': 'nope' is not a motor"),
+    ("t,motor:motor3,voltage:motor5\n0,1,1\n1,1,1\n", (), "in.csv:1: column 3 'voltage:motor5': motor 'motor5' has no DC model"),
+    ("t,motor:motor3,motor:motor5\n0,1,1\n1,x,1\n", (), "in.csv:3: column 2 'motor:motor3': not a number: 'x'"),
+    ("t,motor:motor3,motor:motor5\n0,1,1\n", (), "in.csv: 1 row: give at least 2"),
+    ("t,motor:motor3,motor:motor5\n0,1,1\n1,1,1\n", ("--q0", "1,2,3"), "--q0: expected 2 finite comma-separated numbers"),
+    ("t,motor:motor3,motor:motor5\n0,1,1\n1,1,1\n", ("--rtol", "0"), "--rtol: expected a positive number"),
+    ("t,motor:motor3,motor:motor5\n0,1,1\n1,1,1\n", ("--method", "Euler"), "--method: expected one of DOP853"),
+    ("t,motor:motor3,motor:motor5\n0,1,1\n1,1,1\n", ("--t-end", "-1"), "--t-end: expected a time after"),
+])
+def test_bad_input_is_one_line_and_exit_2(run_cli, mech_dir, tmp_path, text, args, message):
+    inp = write(tmp_path / "in.csv", text)
+    r = run_cli("simulate", mech_dir / "paper_2dof.yaml", inp, "-o", tmp_path / "traj.csv", *args)
+    assert r.exit_code == 2
+    assert message in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "traj.csv").exists()
+
+
+def test_voltage_above_the_supply_is_refused(run_cli, tmp_path):
+    mech = write(tmp_path / "stage.yaml", dc_stage())
+    inp = write(tmp_path / "in.csv", "t,voltage:servo\n0,12\n1,30\n")
+    r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv")
+    assert r.exit_code == 2
+    assert "in.csv:3: column 2 'voltage:servo': voltage 30 V exceeds motor 'servo''s supply_voltage 24 V" in r.stderr
+
+
+def test_lossless_simulation_conserves_energy(run_cli, tmp_path):
+    pin = pytest.importorskip("pinocchio")
+    from test_urdf import ERD, erd
+    if ERD is None:
+        pytest.skip("example-robot-data not installed")
+    path = erd("ur_description/urdf/ur5_robot.urdf")
+    names = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint",
+             "wrist_3_joint"]
+    inp = write(tmp_path / "in.csv", "t," + ",".join(f"motor:{n.replace('_joint', '_motor')}" for n in names) + "\n0" + ",0" * 6 + "\n2" + ",0" * 6 + "\n")
+    r = run_cli("simulate", path, inp, "-o", tmp_path / "traj.csv", "--q0", "0.3,-1.0,0.5,0.2,0.4,0.1",
+                "--method", "DOP853", "--rtol", "1e-11", "--atol", "1e-11", "--dt", "0.01")
+    assert r.exit_code == 0, r.stderr
+    tr = read_csv(tmp_path / "traj.csv")
+    model = pin.buildModelFromUrdf(str(path))
+    data = model.createData()
+    assert [model.names[i] for i in range(1, model.njoints)] == names and model.nq == 6
+    q = np.column_stack([tr[f"q:{n}"] for n in names])
+    qd = np.column_stack([tr[f"qd:{n}"] for n in names])
+    kin = np.array([pin.computeKineticEnergy(model, data, a, b) for a, b in zip(q, qd)])
+    pot = np.array([pin.computePotentialEnergy(model, data, a) for a in q])
+    E = kin + pot
+    assert kin.max() > 10.0                      # the arm does fall: gravity does work
+    assert np.max(np.abs(E - E[0])) < 1e-8 * kin.max()
