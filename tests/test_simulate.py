@@ -199,3 +199,15 @@ def test_lossless_simulation_conserves_energy(run_cli, tmp_path):
     E = kin + pot
     assert kin.max() > 10.0                      # the arm does fall: gravity does work
     assert np.max(np.abs(E - E[0])) < 1e-8 * kin.max()
+
+
+@pytest.mark.parametrize("out,message", [
+    ("-", "-: -o: simulate writes its trajectory to a file, not to stdout"),
+    ("sub/", "-o: names a directory"),
+])
+def test_bad_output_is_refused_before_any_work(run_cli, mech_dir, tmp_path, out, message):
+    inp = write(tmp_path / "in.csv", "t,motor:motor3,motor:motor5\n0,1,1\n1,1,1\n")
+    (tmp_path / "sub").mkdir()
+    r = run_cli("simulate", mech_dir / "paper_2dof.yaml", inp, "-o", out if out == "-" else f"{tmp_path}/{out}")
+    assert r.exit_code == 2
+    assert message in r.stderr and len(r.stderr.strip().splitlines()) == 1

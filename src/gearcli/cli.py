@@ -268,7 +268,7 @@ def simulate(
     drive: Path = typer.Argument(..., metavar="INPUT.csv", show_default=False,
                                  help="Motor inputs over time: t (s) and, per motor, motor:<m> (torque, N*m) or "
                                       "voltage:<m> (V, needs motors[].model); linear between rows."),
-    output: Path = typer.Option(..., "-o", "--output", metavar="TRAJ.csv",
+    output: str = typer.Option(..., "-o", "--output", metavar="TRAJ.csv",
                                 help="Trajectory to write: t, q:, qd:, qdd: columns (what 'gearcli solve' reads)."),
     t_end: float = typer.Option(None, "--t-end", metavar="T", help="End time, s (default: the input's last t; "
                                 "the last row's values hold after it)."),
@@ -281,7 +281,7 @@ def simulate(
     method: str = typer.Option("RK45", "--method", metavar="RK45|DOP853|Radau|...",
                                help="scipy solve_ivp method: RK45, DOP853, RK23, Radau, BDF, LSODA (stiff: "
                                     "Radau, e.g. with a small motor inductance)."),
-    loads: Path = typer.Option(None, "--loads", metavar="LOADS.csv|parquet|...",
+    loads: str = typer.Option(None, "--loads", metavar="LOADS.csv|parquet|...",
                                help="Also write the loads along the motion (the columns of 'gearcli solve')."),
 ) -> None:
     """Forward dynamics over time: integrate the exact geared model (every gear and rotor)

@@ -353,6 +353,8 @@ def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None
     from .io.drive_input import read_drive_input  # noqa: PLC0415
 
     inputs = (mech_path, input_path)
+    if str(out_path) == "-":
+        raise OutputError("-", "simulate writes its trajectory to a file, not to stdout (give -o TRAJ.csv)")
     output_target(out_path, inputs)
     if loads_path is not None:
         _output_format(loads_path, inputs + (out_path,), None)
@@ -384,7 +386,7 @@ def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None
         raise GearcliError(f"{input_path}: simulation failed: {exc} (nothing written)") from None
     names = an.independent_names
     header = ",".join(["t"] + [f"{p}:{n}" for p in ("q", "qd", "qdd") for n in names])
-    with atomic_output(Path(out_path), inputs) as f:
+    with atomic_output(out_path, inputs) as f:
         f.write(header + "\n")
         np.savetxt(f, np.column_stack([sim.t, sim.q, sim.qd, sim.qdd]), delimiter=",", fmt="%.17g")
     report = SimulateReport(an, sim, Path(out_path))
