@@ -366,7 +366,8 @@ def verify(
                              "cluster (scheduler address, e.g. tcp://host:8786)."),
     strict: bool = STRICT_OPTION,
 ) -> None:
-    """Check motors (peak/RMS torque, speed, power), bearings (ISO 281 life, static safety,
+    """Check motors (peak/RMS torque, speed, power; servo sizing: inertia ratio, torque-speed
+    envelope, regenerative energy per cycle), bearings (ISO 281 life, static safety,
     tilting moment), gear teeth (bending and contact stress) and column limits along every
     trajectory of each case.  Exit 0 when every check passes, 1 when any fails, 2 on bad input."""
     from rich.progress import BarColumn, Progress, TextColumn  # noqa: PLC0415

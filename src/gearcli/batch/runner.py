@@ -17,6 +17,7 @@ import numpy as np
 
 from ..design.checks import build_checks
 from ..design.evaluate import Samples, Verdict, combine, partials, profile_rates, signal
+from ..design.sizing import inertia_columns
 from ..dynamics.solve import solve
 from ..errors import Collector, GearcliError
 from ..io.trajectory import read_trajectory
@@ -43,7 +44,9 @@ def solve_samples(an, traj_path, degrees: bool, threads: int | None = None) -> S
     tr = read_trajectory(traj_path, an.independent_names, degrees=degrees, linear=prismatic_independent(an),
                          loads=an.mech.loads)
     res = solve(an, tr.q, tr.qd, tr.qdd, loads=tr.loads, jobs=threads, check_finite=False)   # read checked them
-    return Samples(tr.t, named_columns(an, res, tr.t), tr.qd @ an.S.T)
+    cols = named_columns(an, res, tr.t)
+    cols.update(inertia_columns(an, tr.q))     # servo sizing: inertia at the rated motors
+    return Samples(tr.t, cols, tr.qd @ an.S.T)
 
 
 def run_job(job: Job, threads: int | None = None) -> list[tuple]:

@@ -15,9 +15,10 @@ from .spectra import write_spectra
 
 SIGNAL_LABELS = {"abs": "|{}|", "col": "RMS of {} from the start", "rate": "|joint rate|", "running_rms": "running RMS of {}", "bearing_P": "dynamic equivalent load P",
                  "bearing_P0": "static equivalent load P0", "bending": "Lewis root bending stress",
-                 "contact": "Hertz contact stress"}
+                 "contact": "Hertz contact stress", "inertia_ratio": "load-to-rotor inertia ratio",
+                 "envelope": "|T| / T_max(speed)", "regen_power": "regenerative power"}
 LIMIT_LABELS = {"peak": "limit", "rms": "RMS limit", "safety": "allowable / required safety",
-                "life": "P_eq giving the required life"}
+                "life": "P_eq giving the required life", "energy": "energy limit (integral over the cycle)"}
 
 
 @dataclass

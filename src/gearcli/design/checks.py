@@ -12,6 +12,9 @@ and how the samples of a duty cycle are reduced to the value compared with the l
 * ``life``: ISO 281 rating life in hours >= limit (``rating`` = C, ``exponent`` = p);
 * ``fatigue``: gear tooth life in hours (rainflow + Miner, :mod:`gearcli.design.fatigue`)
   >= limit (``rating`` = the allowable stress).
+* ``energy``: the integral of the signal over each trajectory (a cycle), worst one <= limit.
+
+Servo sizing (inertia ratio, torque-speed envelope, regenerative energy) is in :mod:`.sizing`.
 """
 from __future__ import annotations
 
@@ -23,6 +26,7 @@ from ..errors import Collector
 from .iso281 import life_exponent
 from .fatigue import dynamic_factor
 from .gears import lewis_form_factor, virtual_helical_teeth, virtual_spur
+from .sizing import sizing_checks
 
 MODULE_RTOL = 0.01
 """Relative tolerance of module * teeth / 2 against the pitch radius from the geometry."""
@@ -51,7 +55,7 @@ class Check:
     quantity: str
     unit: str            # unit of the value compared with the limit
     limit: float
-    kind: str            # "peak" | "rms" | "safety" | "life"
+    kind: str            # "peak" | "rms" | "safety" | "life" | "energy"
     signal: tuple
     signal_unit: str     # unit of the signal (what a plot shows)
     rating: float = 0.0  # safety: allowable of the signal; life: C
@@ -65,7 +69,7 @@ class Check:
 
 def build_checks(an, req: Requirements, col: Collector) -> list[Check]:
     """Every check of the analysed mechanism ``an`` under ``req``; problems go to ``col``."""
-    checks = _motor_checks(an) + _bearing_checks(an, req, col) + _gear_checks(an, req, col)
+    checks = _motor_checks(an) + sizing_checks(an, Check) + _bearing_checks(an, req, col) + _gear_checks(an, req, col)
     checks += _joint_limit_checks(an) + _column_checks(an, req, col)
     return checks
 

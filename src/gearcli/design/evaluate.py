@@ -15,6 +15,7 @@ import numpy as np
 from . import bearings as B
 from . import fatigue as F
 from . import iso281
+from . import sizing
 from .checks import Check
 from ..report.rms import running_rms, rms_of, square_integral
 from .gears import hertz_contact_stress, lewis_bending_stress
@@ -69,6 +70,8 @@ def _signal(check: Check, s: Samples, mech, cache: dict) -> np.ndarray:
         return np.abs(s.rates[:, check.signal[1]])
     if kind == "running_rms":
         return running_rms(s.cols[check.signal[1]], s.t, check.signal[2])
+    if kind in sizing.SIGNALS:
+        return sizing.signal(check, s.cols)
     if kind in ("bearing_P", "bearing_P0"):
         jt = mech.joints[check.signal[1]]
         b = jt.bearings[check.signal[2]]
@@ -112,6 +115,8 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
         if ch.kind == "rms":
             total, wsum = float(square_integral(x, s.t)), span
             score = rms_of(total, wsum, peak)
+        elif ch.kind == "energy":          # per trajectory (cycle): the integral, not a sample
+            peak = score = sizing.cycle_integral(x, s.t)
         elif ch.kind == "life":
             n = _revolutions(cache, s, ch.signal[1])
             total = B.life_sum(x, n, ch.exponent, iso281.life_factor(bearing_of(ch, mech), x))
@@ -184,7 +189,7 @@ def combine(check: Check, parts: list[tuple], rates) -> Verdict:
     worst = int(np.argmax(scores))
     t_worst = parts[worst][1]
     peak = max(p[0] for p in parts)
-    if check.kind == "peak":
+    if check.kind in ("peak", "energy"):
         value, sig_lim = peak, check.limit
     elif check.kind == "rms":
         value = rms_of(sum(r * p[2] for r, p in zip(w, parts)), sum(r * p[3] for r, p in zip(w, parts)), peak)
@@ -203,7 +208,7 @@ def combine(check: Check, parts: list[tuple], rates) -> Verdict:
         rev_h = sum(r * p[4] for r, p in zip(per_hour, parts))
         value = B.rating_life_hours(B.rating_life_mrev(check.rating, P_eq, check.exponent), rev_h)
         sig_lim = B.required_equivalent_load(check.rating, check.limit, rev_h, check.exponent)
-    if check.kind in ("peak", "rms"):
+    if check.kind in ("peak", "rms", "energy"):
         margin = 100.0 * (check.limit - value) / check.limit
     else:
         margin = math.inf if math.isinf(value) else 100.0 * (value - check.limit) / check.limit

@@ -35,6 +35,8 @@ from .solve import solve
 
 CHUNK = 2_000
 """Forward samples per batched solve (each becomes dof + 1 inverse-dynamics samples)."""
+SMALL = 16
+"""Up to this many samples :func:`solve_spd` calls LAPACK (its Python loop costs more)."""
 
 
 def _arrays(an, named: dict) -> list[np.ndarray]:
@@ -139,7 +141,9 @@ def solve_spd(M: np.ndarray, b: np.ndarray) -> np.ndarray:
     ~25 times faster than ``np.linalg.solve`` on (N, d, d), whose cost is ~1 us a matrix
     (3 x 3: 0.02 against 0.5 us a sample), and as fast for d = 8-12.
     """
-    d = M.shape[0]
+    d, n = M.shape[0], M.shape[2]
+    if n <= SMALL:                                  # a few samples (an integrator's step): LAPACK
+        return np.linalg.solve(np.moveaxis(M, 2, 0), b[:, :, None])[:, :, 0]
     y = np.array(b.T, dtype=float)                  # (d, N), a copy
     for i in range(d - 1):
         f = M[i + 1:, i] / M[i, i]

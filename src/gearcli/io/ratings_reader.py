@@ -20,7 +20,8 @@ from ..model.ratings import (BEARING_FACTOR_DEFAULTS, STEEL_ELASTIC_COEFFICIENT,
 from .planets import item_path
 
 NS = "https://gearcli.dev/urdf/1"
-MOTOR_KEYS = ("peak_torque", "rms_torque", "max_speed", "max_power", "thermal_window")
+MOTOR_KEYS = ("peak_torque", "rms_torque", "max_speed", "max_power", "thermal_window", "rotor_inertia",
+              "max_inertia_ratio", "max_regen_energy")   # and torque_speed (YAML only: a table)
 BEARING_KEYS = ("name", "position", "C", "C0", "type", "X", "Y", "e", "X0", "Y0", "locating", "M", "f0", "a_ISO",
                 "kappa", "e_C", "Cu", "friction_coefficient", "bore")
 RATING_KEYS = ("C", "C0", "type")     # a rated bearing has all three (the design checks need them)
@@ -42,10 +43,20 @@ def motor_rating(spec: dict, path: str, add) -> MotorRating:
     _positive(spec, MOTOR_KEYS, path, add)
     if spec["rms_torque"] > spec["peak_torque"]:
         add(f"{path}.rms_torque", f"rms_torque {spec['rms_torque']:g} exceeds peak_torque {spec['peak_torque']:g}")
-    power, window = spec.get("max_power"), spec.get("thermal_window")
+    opt = {k: (None if spec.get(k) is None else float(spec[k])) for k in MOTOR_KEYS[3:]}
+    if opt["max_inertia_ratio"] is not None and opt["rotor_inertia"] is None:
+        add(f"{path}.max_inertia_ratio", "max_inertia_ratio needs the motor's rotor_inertia")
+    table = spec.get("torque_speed")
+    if table is not None:
+        table = tuple((float(w), float(T)) for w, T in table)
+        w = [r[0] for r in table]
+        if w[0] < 0 or any(b <= a for a, b in zip(w, w[1:])) or any(r[1] < 0 for r in table):
+            add(f"{path}.torque_speed", "torque_speed rows [omega, T_max] need omega increasing from 0 or more "
+                "and T_max not negative")
     return MotorRating(float(spec["peak_torque"]), float(spec["rms_torque"]), float(spec["max_speed"]),
-                       None if power is None else float(power), path,
-                       thermal_window=None if window is None else float(window))
+                       opt["max_power"], path, thermal_window=opt["thermal_window"], rotor_inertia=opt["rotor_inertia"],
+                       max_inertia_ratio=opt["max_inertia_ratio"], torque_speed=table,
+                       max_regen_energy=opt["max_regen_energy"])
 
 
 def motor_model(spec: dict, path: str, add) -> MotorModel:
@@ -282,7 +293,7 @@ def attach_urdf_ratings(mech: Mechanism, root, file: str) -> Mechanism:
                                        ("gear", gears, GEAR_KEYS, gear_rating)):
         required = [k for k in keys if k not in ("max_power", "elastic_coefficient", "application_factor",
                                                  "load_sharing_factor", "thermal_window", "quality_number",
-                                                 "pitch_line_velocity")]
+                                                 "pitch_line_velocity", *MOTOR_KEYS[5:])]
         for el in _ext(root, f"{kind}_rating"):
             path = f"gearcli:{kind}_rating '{el.get(kind)}'"
             lines[path] = el.sourceline

@@ -33,7 +33,12 @@ ISO 76 X0 = 0.5, Y0 = 0.22 cot a."""
 class MotorRating:
     """``peak_torque`` and ``rms_torque`` (continuous) in N*m (N for a linear input),
     ``max_speed`` in rad/s (m/s), optional ``max_power`` in W, optional ``thermal_window``
-    in s (the running RMS over that window is checked against ``rms_torque`` too)."""
+    in s (the running RMS over that window is checked against ``rms_torque`` too).
+
+    Servo sizing (optional, :mod:`gearcli.design.sizing`): ``rotor_inertia`` (kg*m^2) with
+    ``max_inertia_ratio`` (load-to-rotor, dimensionless); ``torque_speed`` ((omega, T_max),
+    ...) the torque-speed envelope (rad/s, N*m; omega increasing from 0); ``max_regen_energy``
+    the regenerative energy one cycle may return (J)."""
 
     peak_torque: float
     rms_torque: float
@@ -41,6 +46,10 @@ class MotorRating:
     max_power: float | None = None
     path: str = field(default="", compare=False)   # where it was read (for messages)
     thermal_window: float | None = None
+    rotor_inertia: float | None = None
+    max_inertia_ratio: float | None = None
+    torque_speed: tuple | None = None
+    max_regen_energy: float | None = None
 
 
 @dataclass(frozen=True)

@@ -33,7 +33,8 @@ def add_rating_elements(mech, root, joint_elements: dict) -> None:
     for m in mech.motors:
         if m.rating is not None:
             etree.SubElement(root, _q("motor_rating"), {"motor": m.name,
-                             **_attrs(m.rating, ("peak_torque", "rms_torque", "max_speed", "max_power", "thermal_window"))})
+                             **_attrs(m.rating, ("peak_torque", "rms_torque", "max_speed", "max_power", "thermal_window", "rotor_inertia",
+                                                 "max_inertia_ratio", "max_regen_energy"))})
     for g in mech.gears:
         if g.rating is not None:
             etree.SubElement(root, _q("gear_rating"), {"gear": g.name, **_attrs(g.rating, (
