@@ -146,3 +146,12 @@ def test_verify_prints_the_sizing_checks(run_cli, tmp_path):
     import json
     rows = {row["quantity"]: row for row in json.loads((tmp_path / "r.json").read_text())["checks"]}
     assert rows["regenerative energy per cycle"]["passed"]
+
+
+def test_sizing_ratings_are_exported_to_urdf_and_read_back(tmp_path):
+    from gearcli import load_mechanism
+    from gearcli.report.urdf_writer import export_urdf
+    an = analyse(parse_mechanism(rated_stage(f", rotor_inertia: {J_ROTOR}, max_inertia_ratio: 10, max_regen_energy: 100")))
+    export_urdf(an, str(tmp_path / "m.urdf"))
+    r = load_mechanism(tmp_path / "m.urdf").motors[0].rating
+    assert (r.rotor_inertia, r.max_inertia_ratio, r.max_regen_energy) == (J_ROTOR, 10.0, 100.0)
