@@ -20,7 +20,7 @@ STAGE = {
     "dynamics": 4,
     "report": 5,
     "design": 6,
-    "pipeline": 7,
+    "pipeline": 7, "simulation": 7,   # simulation: gearcli simulate file to file (beside pipeline)
     "batch": 8,
     "cli": 9, "exits": 9,      # exits: how a command ends (statuses, stderr lines), for cli
 }

@@ -246,3 +246,24 @@ def test_few_and_many_samples_solve_alike():
     few = np.vstack([forward_dynamics(an, q[i], qd[i], T[i]) for i in range(0, 40, 8)])
     assert 40 > forward.SMALL
     assert rel_err(few, many[::8]) < 1e-13
+
+
+# --- with losses: the implicit equation ---------------------------------------------------------
+
+@pytest.mark.parametrize("name", ["paper_2dof.yaml", "bendix_wrist.yaml", "rack_axis.yaml", "planetary_3p.yaml",
+                                  "helical_reduction.yaml"])
+def test_round_trip_with_losses(name, monkeypatch):
+    """Mesh friction (c = 0.03) and joint friction on every element: tau is piecewise linear
+    in qdd; forward_dynamics solves the implicit equation (losses issue 19) so that solve
+    returns the torques.  One secant step alone (MAX_STEPS = 0) does not."""
+    from test_losses import with_losses
+    an = analyse(with_losses(load_mechanism(MECH_DIR / name)))
+    assert an.mech.has_losses
+    q, qd, T = random_state(an, 40, seed=11)
+    assert round_trip_error(an, forward_dynamics, q, qd, T) < 1e-10
+    # the mass matrix is the lossless one (at rest no mesh slides, friction is 0)
+    lossless = analyse(load_mechanism(MECH_DIR / name))
+    assert rel_err(mass_matrix(an, q), mass_matrix(lossless, q)) < 1e-10    # numpy vs llvm rounding
+    monkeypatch.setattr(forward, "MAX_STEPS", 0)
+    with pytest.raises(ValueError, match=r"forward dynamics with losses did not settle at sample \d+ in 0 steps"):
+        forward_dynamics(an, q, qd, T)

@@ -265,56 +265,31 @@ def _print_summary(console, report, verify: bool) -> None:
 @reports_bad_input
 def simulate(
     mech: Path = typer.Argument(..., metavar="MECH", help=MECH_HELP, show_default=False),
-    drive: Path = typer.Argument(..., metavar="INPUT.csv", show_default=False,
-                                 help="Motor inputs over time: t (s) and, per motor, motor:<m> (torque, N*m) or "
-                                      "voltage:<m> (V, needs motors[].model); linear between rows."),
-    output: str = typer.Option(..., "-o", "--output", metavar="TRAJ.csv",
-                                help="Trajectory to write: t, q:, qd:, qdd: columns (what 'gearcli solve' reads)."),
-    t_end: float = typer.Option(None, "--t-end", metavar="T", help="End time, s (default: the input's last t; "
-                                "the last row's values hold after it)."),
-    q0: str = typer.Option(None, "--q0", metavar="Q1,Q2,...", help="Initial independent joint angles, rad (m), "
-                           "in the order 'gearcli graph' lists them (default 0)."),
+    drive: Path = typer.Argument(..., metavar="INPUT.csv", show_default=False, help="t, motor:<m> (N*m) or voltage:<m> (V)."),
+    output: str = typer.Option(..., "-o", "--output", metavar="TRAJ.csv", help="Trajectory to write (t, q:, qd:, qdd:)."),
+    t_end: float = typer.Option(None, "--t-end", metavar="T", help="End time, s (default: the input's last t)."),
+    q0: str = typer.Option(None, "--q0", metavar="Q1,Q2,...", help="Initial joint angles, rad (m) (default 0)."),
     qd0: str = typer.Option(None, "--qd0", metavar="V1,V2,...", help="Initial rates, rad/s (m/s) (default 0)."),
     dt: float = typer.Option(1e-3, "--dt", metavar="S", help="Output time step, s."),
     rtol: float = typer.Option(1e-6, "--rtol", metavar="R", help="Relative tolerance of the integrator."),
     atol: float = typer.Option(1e-9, "--atol", metavar="A", help="Absolute tolerance (rad, rad/s, A)."),
-    method: str = typer.Option("RK45", "--method", metavar="RK45|DOP853|Radau|...",
-                               help="scipy solve_ivp method: RK45, DOP853, RK23, Radau, BDF, LSODA (stiff: "
-                                    "Radau, e.g. with a small motor inductance)."),
-    loads: str = typer.Option(None, "--loads", metavar="LOADS.csv|parquet|...",
-                               help="Also write the loads along the motion (the columns of 'gearcli solve')."),
+    method: str = typer.Option("RK45", "--method", metavar="NAME", help="solve_ivp: RK45, DOP853, RK23, Radau, BDF, LSODA."),
+    loads: str = typer.Option(None, "--loads", metavar="LOADS.csv", help="Also write the loads, as 'gearcli solve'."),
 ) -> None:
-    """Forward dynamics over time: integrate the exact geared model (every gear and rotor)
-    under given motor torques or DC-motor voltages, from --q0/--qd0 at the input's first
-    time.  Stops at a joint's position limit (URDF <limit lower upper>): the trajectory up to
-    there is written, the stop printed, exit status 1.  Exit 2 on bad input."""
-    from rich.progress import BarColumn, Progress, TextColumn  # noqa: PLC0415
-
-    from .pipeline import simulate_file  # noqa: PLC0415
+    """Integrate the exact geared dynamics under motor torques or DC-motor voltages (linear between
+    the input's rows, voltages need motors[].model) from --q0/--qd0; a joint position limit stops it
+    (trajectory written up to there, exit 1).  Joints in 'gearcli graph' order; exit 2 on bad input."""
+    from .report.tables import time_progress  # noqa: PLC0415
+    from .simulation import simulate_file  # noqa: PLC0415
 
     an = load_analysis(mech)
-    err = stderr_console()
-    progress = Progress(TextColumn("simulating"), BarColumn(), TextColumn("t = {task.completed:.3f} s"),
-                        console=err, transient=True, disable=not err.is_terminal)
-    task = None
-
-    def tick(total=None, t=None):
-        nonlocal task
-        if total is not None:
-            task = progress.add_task("simulate", total=total)
-        else:
-            progress.update(task, completed=t)
-
+    progress, tick = time_progress("simulating", stderr_console())
     with progress:
         report = simulate_file(mech, drive, output, t_end=t_end, q0=q0, qd0=qd0, dt=dt, rtol=rtol, atol=atol,
                                method=method, loads_path=loads, progress=tick, analysis=an)
-    sim = report.simulation
-    typer.echo(f"Wrote {counted(len(sim.t), 'row')} to {output} (t = {sim.t[0]:g} to {sim.t[-1]:g} s, "
-               f"{counted(sim.nfev, 'evaluation')} of the dynamics)")
-    if report.loads is not None:
-        typer.echo(f"Wrote {counted(report.loads.samples, 'row')} of loads to {loads}")
-    if sim.stop:
-        print_problems([f"{drive}: stopped: {sim.stop} (the trajectory up to there is written)"])
+    typer.echo("\n".join(report.summary(output, loads)))
+    if report.simulation.stop:
+        print_problems([f"{drive}: stopped: {report.simulation.stop} (the trajectory up to there is written)"])
         raise typer.Exit(EXIT_CHECK_FAILED)
 
 

@@ -180,3 +180,21 @@ def summary_table(report) -> Table:
         else:
             table.add_row(st.name, st.unit, fmt_num(st.peak), fmt_num(st.rms), fmt_num(st.t_peak))
     return table
+
+
+def time_progress(label: str, console):
+    """A transient progress bar of simulated time on ``console`` (shown on a terminal only)
+    and its ``tick(total=None, t=None)`` callback: ``total`` (s) once, then the time reached."""
+    from rich.progress import BarColumn, Progress, TextColumn  # noqa: PLC0415
+
+    progress = Progress(TextColumn(label), BarColumn(), TextColumn("t = {task.completed:.3f} s"), console=console,
+                        transient=True, disable=not console.is_terminal)
+    task = []
+
+    def tick(total=None, t=None):
+        if total is not None:
+            task.append(progress.add_task(label, total=total))
+        else:
+            progress.update(task[0], completed=t)
+
+    return progress, tick

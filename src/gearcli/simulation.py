@@ -1,0 +1,117 @@
+"""File to file: mechanism + motor inputs CSV -> trajectory CSV (``gearcli simulate``).
+
+Data flow: :func:`~gearcli.io.load_mechanism` -> :func:`~gearcli.analyse` ->
+:func:`~gearcli.io.drive_input.read_drive_input` -> :func:`~gearcli.dynamics.simulate.simulate`
+(scipy ``solve_ivp`` on :func:`~gearcli.dynamics.forward.forward_dynamics`) -> the trajectory
+CSV, and with ``--loads`` :func:`gearcli.pipeline.solve_file` on it.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .analysis.graph import Analysis
+from .dynamics.determinacy import analyse
+from .errors import GearcliError, counted
+from .io import load_mechanism
+from .io.output import OutputError, atomic_output, output_target
+from .pipeline import SolveReport, _output_format, solve_file
+
+MAX_SIMULATE_SAMPLES = 10_000_000
+
+
+@dataclass
+class SimulateReport:
+    """What :func:`simulate_file` did: the simulation (:class:`~gearcli.dynamics.simulate.
+    Simulation`: samples, why it stopped early, right-hand side evaluations), the output
+    path, and the loads run (``--loads``: a :class:`SolveReport`, else None)."""
+
+    analysis: Analysis = field(repr=False)
+    simulation: object = field(repr=False)
+    output: Path
+    loads: SolveReport | None = None
+
+    def summary(self, output: str, loads: str | None) -> list[str]:
+        """What ``gearcli simulate`` prints on stdout."""
+        sim = self.simulation
+        out = [f"Wrote {counted(len(sim.t), 'row')} to {output} (t = {sim.t[0]:g} to {sim.t[-1]:g} s, "
+               f"{counted(sim.nfev, 'evaluation')} of the dynamics)"]
+        if self.loads is not None:
+            out.append(f"Wrote {counted(self.loads.samples, 'row')} of loads to {loads}")
+        return out
+
+
+def state_option(text: str | None, an: Analysis, option: str) -> np.ndarray:
+    """The (dof,) values of ``--q0``/``--qd0`` ("v1,v2,..." in ``an.independent_names``
+    order; SI units), zeros when not given; GearcliError naming the option otherwise."""
+    if text is None:
+        return np.zeros(an.dof)
+    cells = [c.strip() for c in text.split(",")]
+    try:
+        x = np.array([float(c) for c in cells])
+    except ValueError:
+        raise GearcliError(f"{option}: expected {an.dof} comma-separated numbers (joints "
+                           f"{', '.join(an.independent_names)}), got '{text}'") from None
+    if len(x) != an.dof or not np.isfinite(x).all():
+        raise GearcliError(f"{option}: expected {an.dof} finite comma-separated numbers (joints "
+                           f"{', '.join(an.independent_names)}), got '{text}'")
+    return x
+
+
+def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None, q0: str | None = None,
+                  qd0: str | None = None, dt: float = 1e-3, rtol: float = 1e-6, atol: float = 1e-9,
+                  method: str = "RK45", loads_path=None, progress=None,
+                  analysis: Analysis | None = None) -> SimulateReport:
+    """``gearcli simulate``: integrate the mechanism under the motor torques or voltages of
+    ``input_path`` (:mod:`gearcli.io.drive_input`) from its first time to ``t_end`` (default
+    its last), writing the trajectory CSV ``out_path`` (``t, q:, qd:, qdd:`` every ``dt``
+    seconds, 17 digits: what ``gearcli solve`` reads) atomically; with ``loads_path``,
+    then the loads along it as ``gearcli solve`` writes them.  ``progress(total=..)`` once,
+    then ``progress(t=...)`` with the time reached."""
+    from .dynamics.simulate import METHODS, SimulationError, joint_limits, simulate  # noqa: PLC0415
+    from .io.drive_input import read_drive_input  # noqa: PLC0415
+
+    inputs = (mech_path, input_path)
+    if str(out_path) == "-":
+        raise OutputError("-", "simulate writes its trajectory to a file, not to stdout (give -o TRAJ.csv)")
+    output_target(out_path, inputs)
+    if loads_path is not None:
+        _output_format(loads_path, inputs + (out_path,), None)
+    if method not in METHODS:
+        raise GearcliError(f"--method: expected one of {', '.join(METHODS)}, got '{method}'")
+    for name, v in (("--rtol", rtol), ("--atol", atol), ("--dt", dt)):
+        if not (math.isfinite(v) and v > 0):
+            raise GearcliError(f"{name}: expected a positive number, got {v:g}")
+    an = analysis or analyse(load_mechanism(mech_path))
+    x0, v0 = state_option(q0, an, "--q0"), state_option(qd0, an, "--qd0")
+    for ji, name, lo, hi in joint_limits(an):
+        if not lo <= an.S[ji] @ x0 <= hi:
+            raise GearcliError(f"--q0: joint '{name}' starts at {an.S[ji] @ x0:g}, outside its limits [{lo:g}, {hi:g}]")
+    drive = read_drive_input(input_path, an.mech.motors)
+    t0, t1 = float(drive.t[0]), float(drive.t[-1] if t_end is None else t_end)
+    if not (math.isfinite(t1) and t1 > t0):
+        raise GearcliError(f"--t-end: expected a time after the input's first t = {t0:g} s, got {t1:g}")
+    if (t1 - t0) / dt > MAX_SIMULATE_SAMPLES:
+        raise GearcliError(f"--dt: {dt:g} s gives more than {MAX_SIMULATE_SAMPLES:,} samples over {t1 - t0:g} s")
+    t_eval = t0 + dt * np.arange(int(math.floor((t1 - t0) / dt * (1 + 1e-12))) + 1)
+    if t_eval[-1] < t1 - 1e-9 * dt:
+        t_eval = np.append(t_eval, t1)
+    if progress is not None:
+        progress(total=t1 - t0)
+    try:
+        sim = simulate(an, drive, t_eval, x0, v0, rtol=rtol, atol=atol, method=method,
+                       progress=None if progress is None else (lambda t: progress(t=t - t0)))
+    except SimulationError as exc:
+        raise GearcliError(f"{input_path}: simulation failed: {exc} (nothing written)") from None
+    names = an.independent_names
+    header = ",".join(["t"] + [f"{p}:{n}" for p in ("q", "qd", "qdd") for n in names])
+    with atomic_output(out_path, inputs) as f:
+        f.write(header + "\n")
+        np.savetxt(f, np.column_stack([sim.t, sim.q, sim.qd, sim.qdd]), delimiter=",", fmt="%.17g")
+    report = SimulateReport(an, sim, Path(out_path))
+    if loads_path is not None:
+        report.loads = solve_file(mech_path, out_path, loads_path, analysis=an)
+    return report
