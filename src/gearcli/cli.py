@@ -276,17 +276,14 @@ def simulate(
     method: str = typer.Option("RK45", "--method", metavar="NAME", help="solve_ivp: RK45, DOP853, RK23, Radau, BDF, LSODA."),
     loads: str = typer.Option(None, "--loads", metavar="LOADS.csv", help="Also write the loads, as 'gearcli solve'."),
 ) -> None:
-    """Integrate the exact geared dynamics under motor torques or DC-motor voltages (linear between
-    the input's rows, voltages need motors[].model) from --q0/--qd0; a joint position limit stops it
-    (trajectory written up to there, exit 1).  Joints in 'gearcli graph' order; exit 2 on bad input."""
+    """Integrate the exact geared dynamics under motor torques or DC-motor voltages (motors[].model) from
+    --q0/--qd0 (joints in 'gearcli graph' order); a joint limit stops it (exit 1); bad input: exit 2."""
     from .report.tables import time_progress  # noqa: PLC0415
     from .simulation import simulate_file  # noqa: PLC0415
 
-    an = load_analysis(mech)
-    progress, tick = time_progress("simulating", stderr_console())
-    with progress:
+    with time_progress("simulating", stderr_console()) as tick:
         report = simulate_file(mech, drive, output, t_end=t_end, q0=q0, qd0=qd0, dt=dt, rtol=rtol, atol=atol,
-                               method=method, loads_path=loads, progress=tick, analysis=an)
+                               method=method, loads_path=loads, progress=tick, analysis=load_analysis(mech))
     typer.echo("\n".join(report.summary(output, loads)))
     if report.simulation.stop:
         print_problems([f"{drive}: stopped: {report.simulation.stop} (the trajectory up to there is written)"])

@@ -9,6 +9,7 @@ from __future__ import annotations
 import errno
 import math
 import os
+from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
 from ..errors import counted
@@ -182,9 +183,11 @@ def summary_table(report) -> Table:
     return table
 
 
+@contextmanager
 def time_progress(label: str, console):
-    """A transient progress bar of simulated time on ``console`` (shown on a terminal only)
-    and its ``tick(total=None, t=None)`` callback: ``total`` (s) once, then the time reached."""
+    """Context yielding the ``tick(total=None, t=None)`` callback of a transient progress bar
+    of simulated time on ``console`` (drawn on a terminal only): ``total`` (s) once, then
+    the time reached."""
     from rich.progress import BarColumn, Progress, TextColumn  # noqa: PLC0415
 
     progress = Progress(TextColumn(label), BarColumn(), TextColumn("t = {task.completed:.3f} s"), console=console,
@@ -197,4 +200,5 @@ def time_progress(label: str, console):
         else:
             progress.update(task[0], completed=t)
 
-    return progress, tick
+    with progress:
+        yield tick
