@@ -16,7 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import counted
-from .trajectory import SEPARATORS, TrajectoryReader, _check_utf8, _fail, _place, _split, show
+from .csv_rows import check_utf8, column_place, fail, show, split_row
+from .trajectory import SEPARATORS, TrajectoryReader
 
 
 @dataclass
@@ -48,10 +49,10 @@ class _DriveReader(TrajectoryReader):
         with self._open() as f:
             head = self._readline(f, 1).removeprefix("\ufeff")
         if not head.strip():
-            raise _fail(self.file, 1, "", "empty file (expected a header row: t,motor:<motor>,...)")
-        _check_utf8(self.file, [head], [1])
+            raise fail(self.file, 1, "", "empty file (expected a header row: t,motor:<motor>,...)")
+        check_utf8(self.file, [head], [1])
         self.sep = next((s for s in SEPARATORS if s in head), ",")
-        self.header = _split(head, self.sep)
+        self.header = split_row(head, self.sep)
         self.cols = {"t": self._drive_columns(motors)}
         self.scale = np.ones(len(self.header))
 
@@ -59,7 +60,7 @@ class _DriveReader(TrajectoryReader):
         pos: dict[str, int] = {}
         for i, h in enumerate(self.header):
             if h in pos:
-                raise _fail(self.file, 1, _place(self.header, i), "duplicate column")
+                raise fail(self.file, 1, column_place(self.header, i), "duplicate column")
             pos[h] = i
         names = {m.name: m for m in motors}
         expected = "expected t and, for every motor, motor:<motor> (N*m) or voltage:<motor> (V)"
@@ -67,17 +68,17 @@ class _DriveReader(TrajectoryReader):
             kind, _, name = h.partition(":")
             if h != "t" and (kind not in ("motor", "voltage") or name not in names):
                 what = f"'{show(name)}' is not a motor of the mechanism" if kind in ("motor", "voltage") else "unknown column"
-                raise _fail(self.file, 1, _place(self.header, i), f"{what} ({expected}: {', '.join(names)})")
+                raise fail(self.file, 1, column_place(self.header, i), f"{what} ({expected}: {', '.join(names)})")
             if kind == "voltage" and names[name].model is None:
-                raise _fail(self.file, 1, _place(self.header, i), f"motor '{name}' has no DC model "
+                raise fail(self.file, 1, column_place(self.header, i), f"motor '{name}' has no DC model "
                             "(motors[].model: kt, resistance, supply_voltage) to turn a voltage into a torque")
         if "t" not in pos:
-            raise _fail(self.file, 1, "", "missing column 't' (time, s)")
+            raise fail(self.file, 1, "", "missing column 't' (time, s)")
         for m in motors:
             both = [f"{k}:{m.name}" for k in ("motor", "voltage") if f"{k}:{m.name}" in pos]
             if len(both) != 1:
                 what = "both motor: and voltage: columns" if both else "no column"
-                raise _fail(self.file, 1, "", f"motor '{m.name}' has {what} (give one of 'motor:{m.name}' "
+                raise fail(self.file, 1, "", f"motor '{m.name}' has {what} (give one of 'motor:{m.name}' "
                             f"(torque, N*m) and 'voltage:{m.name}' (V))")
         self.motor_cols = [pos.get(f"motor:{m.name}", pos.get(f"voltage:{m.name}")) for m in motors]
         self.voltage = np.array([f"voltage:{m.name}" in pos for m in motors])
@@ -92,16 +93,16 @@ def read_drive_input(path, motors) -> DriveInput:
     data = np.concatenate([d for d, _ in parts]) if parts else np.zeros((0, len(r.header)))
     lines = np.concatenate([ln for _, ln in parts]) if parts else np.zeros(0, int)
     if len(data) == 0:
-        raise _fail(r.file, None, "", "no samples after the header")
+        raise fail(r.file, None, "", "no samples after the header")
     values = data[:, r.motor_cols]
     for k, m in enumerate(motors):
         if r.voltage[k]:
             over = np.flatnonzero(np.abs(values[:, k]) > m.model.supply_voltage)
             if over.size:
                 i = int(over[0])
-                raise _fail(r.file, int(lines[i]), _place(r.header, r.motor_cols[k]),
+                raise fail(r.file, int(lines[i]), column_place(r.header, r.motor_cols[k]),
                             f"voltage {values[i, k]:g} V exceeds motor '{m.name}''s supply_voltage "
                             f"{m.model.supply_voltage:g} V")
     if len(data) < 2:
-        raise _fail(r.file, None, "", f"{counted(len(data), 'row')}: give at least 2 (values are linear between rows)")
+        raise fail(r.file, None, "", f"{counted(len(data), 'row')}: give at least 2 (values are linear between rows)")
     return DriveInput(data[:, r.cols["t"]], values, r.voltage, lines, r.file)
