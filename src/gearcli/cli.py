@@ -276,8 +276,7 @@ def simulate(
     method: str = typer.Option("RK45", "--method", metavar="NAME", help="solve_ivp: RK45, DOP853, RK23, Radau, BDF, LSODA."),
     loads: str = typer.Option(None, "--loads", metavar="LOADS.csv", help="Also write the loads, as 'gearcli solve'."),
 ) -> None:
-    """Integrate the exact geared dynamics under motor torques or DC-motor voltages (motors[].model) from
-    --q0/--qd0 (joints in 'gearcli graph' order); a joint limit stops it (exit 1); bad input: exit 2."""
+    """Integrate the exact geared dynamics under motor torques or voltages; a joint limit stops it (exit 1)."""
     from .report.tables import time_progress  # noqa: PLC0415
     from .simulation import simulate_file  # noqa: PLC0415
 
