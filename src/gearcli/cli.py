@@ -277,13 +277,8 @@ def simulate(
     loads: str = typer.Option(None, "--loads", metavar="LOADS.csv", help="Also write the loads, as 'gearcli solve'."),
 ) -> None:
     """Integrate the exact geared dynamics under motor torques or voltages; a joint limit stops it (exit 1)."""
-    from .report.tables import time_progress  # noqa: PLC0415
-    from .simulation import simulate_file  # noqa: PLC0415
-
-    with time_progress("simulating", stderr_console()) as tick:
-        report = simulate_file(mech, drive, output, t_end=t_end, q0=q0, qd0=qd0, dt=dt, rtol=rtol, atol=atol,
-                               method=method, loads_path=loads, progress=tick, analysis=load_analysis(mech))
-    typer.echo("\n".join(report.summary(output, loads)))
+    from .simulation import simulate_with_progress  # noqa: PLC0415
+    report = simulate_with_progress(mech, drive, output, stderr_console(), load_analysis(mech), t_end, q0, qd0, dt, rtol, atol, method, loads)
     if report.simulation.stop:
         print_problems([f"{drive}: stopped: {report.simulation.stop} (the trajectory up to there is written)"])
         raise typer.Exit(EXIT_CHECK_FAILED)

@@ -115,3 +115,17 @@ def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None
     if loads_path is not None:
         report.loads = solve_file(mech_path, out_path, loads_path, analysis=an)
     return report
+
+
+def simulate_with_progress(mech_path, input_path, out_path, console, analysis, t_end, q0, qd0, dt, rtol, atol,
+                           method, loads_path) -> SimulateReport:
+    """:func:`simulate_file` (the same arguments) with a progress bar of simulated time on
+    ``console`` (stderr), then its summary lines on stdout: what ``gearcli simulate`` shows
+    (the caller handles a stop at a joint limit)."""
+    from .report.tables import stdout_console, time_progress  # noqa: PLC0415
+
+    with time_progress("simulating", console) as tick:
+        report = simulate_file(mech_path, input_path, out_path, t_end=t_end, q0=q0, qd0=qd0, dt=dt, rtol=rtol,
+                               atol=atol, method=method, loads_path=loads_path, progress=tick, analysis=analysis)
+    stdout_console().print("\n".join(report.summary(str(out_path), loads_path)))
+    return report
