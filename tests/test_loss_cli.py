@@ -201,3 +201,31 @@ def test_plausible_losses_give_no_warning(run_cli, tmp_path):
     path.write_text(SPUR.replace("efficiency: 0.97", "efficiency: 0.5").replace("bore: 0.008}", "bore: 2.0}"))
     r = run_cli("check", "--strict", path)
     assert r.exit_code == 0 and r.stderr == ""
+
+
+def test_csv_loss_columns_are_drawn_with_their_units(run_cli, tmp_path, monkeypatch):
+    """A CSV carries no units: the plot takes them from the names, W for gear:<p>:loss and
+    joint:<J>:loss, N*m for joint:<J>:friction of a revolute joint (was: no unit, all three
+    on one axis labelled 'value'); the Parquet of the same solve carries the same units."""
+    pytest.importorskip("matplotlib")
+    from gearcli.report import plots
+    mech, traj = tmp_path / "spur.yaml", tmp_path / "traj.csv"
+    mech.write_text(SPUR)
+    traj.write_text(TRAJ)
+    units = {}
+    for ext in (".csv", ".parquet"):
+        assert run_cli("solve", mech, traj, "-o", tmp_path / f"loads{ext}").exit_code == 0
+        header, _, units[ext] = plots.read_loads(tmp_path / f"loads{ext}")
+    assert [units[".csv"][n] for n in ("gear:mesh:loss", "joint:Jp:friction", "joint:Jp:loss")] == ["W", "N·m", "W"]
+    assert units[".csv"] == units[".parquet"]
+    seen = {}
+    save = plots._save
+
+    def spy(fig, path):
+        seen["ylabels"] = sorted(ax.get_ylabel() for ax in fig.axes)
+        save(fig, path)
+    monkeypatch.setattr(plots, "_save", spy)
+    r = run_cli("plot", tmp_path / "loads.csv", "gear:*:loss", "joint:Jp:friction", "joint:*:loss",
+                "-o", tmp_path / "f.png")
+    assert r.exit_code == 0, r.stderr
+    assert seen["ylabels"] == ["[N·m]", "[W]"]

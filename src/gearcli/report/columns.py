@@ -123,7 +123,8 @@ def column_unit(name: str) -> str:
         return "W"
     if name == "t":
         return "s"
-    if name.startswith("tau:") or last in ("torque", "mx", "my", "mz", "bending"):
+    if name.startswith("tau:") or last in ("torque", "mx", "my", "mz", "bending") or (
+            last == "friction" and name.startswith("joint:")):
         return "N·m"
     return "N"
 

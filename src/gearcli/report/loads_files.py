@@ -303,12 +303,14 @@ def _open_arrow(path, fmt: str) -> LoadsFile:
 # --- CSV units ----------------------------------------------------------------------------
 def csv_unit(name: str) -> str:
     """Unit of a CSV column from its name (a CSV carries none): that of the output column
-    of that name (N*m for tau:/motor: columns, also of a prismatic joint: only the binary
-    formats know), none ('') for a name that is not an output column (e.g. q:J1)."""
+    of that name (N*m for tau:/motor: and joint:<J>:friction columns, also of a prismatic
+    joint: only the binary formats know), none ('') for a name that is not an output column
+    (e.g. q:J1)."""
     from .columns import column_unit  # noqa: PLC0415
 
     return column_unit(name) if OUTPUT_COLUMN.fullmatch(name) else ""
 
 
-OUTPUT_COLUMN = re.compile(r"t|tau:[^:]+|motor:[^:]+(:speed|:power)?|gear:[^:]+:(t|sep|torque)"
-                           r"|gear:[^:]+:[^:]+:(radial|axial)|joint:[^:]+:(fx|fy|fz|mx|my|mz|radial|axial|bending)")
+OUTPUT_COLUMN = re.compile(r"t|tau:[^:]+|motor:[^:]+(:speed|:power)?|gear:[^:]+:(t|sep|torque|loss)"
+                           r"|gear:[^:]+:[^:]+:(radial|axial)"
+                           r"|joint:[^:]+:(fx|fy|fz|mx|my|mz|radial|axial|bending|friction|loss)")
