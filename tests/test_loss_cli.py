@@ -5,6 +5,9 @@ and line efficiency are the hand values of a 15/60 mm spur pair (README, "Losses
 from __future__ import annotations
 
 import json
+import re
+import textwrap
+from pathlib import Path
 
 import pytest
 
@@ -229,3 +232,32 @@ def test_csv_loss_columns_are_drawn_with_their_units(run_cli, tmp_path, monkeypa
                 "-o", tmp_path / "f.png")
     assert r.exit_code == 0, r.stderr
     assert seen["ylabels"] == ["[N·m]", "[W]"]
+
+
+def _readme_example() -> tuple[str, list[str]]:
+    """The YAML and the console lines of the README's losses example (indented 2 spaces)."""
+    text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    part = text[text.index("* **Example** (a 15/60 mm spur pair"):]
+    blocks = re.findall(r"\n  ```(yaml|console)\n(.*?)\n  ```\n", part, re.S)[:2]
+    assert [b[0] for b in blocks] == ["yaml", "console"]
+    yaml_text, console = (textwrap.dedent(b[1]) for b in blocks)
+    return yaml_text + "\n", console.splitlines()
+
+
+def test_readme_loss_example_runs_as_written(run_cli, tmp_path, monkeypatch):
+    yaml_text, console = _readme_example()
+    monkeypatch.chdir(tmp_path)
+    Path("spur_lossy.yaml").write_text(yaml_text)
+    printf = console[0]
+    assert printf.startswith("$ printf '") and printf.endswith("' > spur_traj.csv")
+    Path("spur_traj.csv").write_text(printf[len("$ printf '"):-len("' > spur_traj.csv")].replace("\\n", "\n"))
+    i_check = console.index("$ gearcli check spur_lossy.yaml")
+    i_solve = console.index("$ gearcli solve spur_lossy.yaml spur_traj.csv -o loads.csv")
+    r = run_cli("check", "spur_lossy.yaml")
+    assert r.exit_code == 0 and r.stderr == ""
+    assert r.stdout.splitlines() == console[i_check + 1:i_solve]
+    r = run_cli("solve", "spur_lossy.yaml", "spur_traj.csv", "-o", "loads.csv")
+    assert r.exit_code == 0 and r.stderr == ""
+    tail = console[i_solve + 2:]                 # after the '…' line standing for the table
+    assert console[i_solve + 1].startswith("…")
+    assert r.stdout.splitlines()[-len(tail):] == tail
