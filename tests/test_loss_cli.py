@@ -261,3 +261,20 @@ def test_readme_loss_example_runs_as_written(run_cli, tmp_path, monkeypatch):
     tail = console[i_solve + 2:]                 # after the '…' line standing for the table
     assert console[i_solve + 1].startswith("…")
     assert r.stdout.splitlines()[-len(tail):] == tail
+
+
+def test_export_writes_the_mesh_loss_as_the_file_gave_it(run_cli, mech_dir, tmp_path):
+    """efficiency 0.98 is exported as efficiency="0.98" (was loss_factor="0.020000000000000018"),
+    loss_factor 0.015 as loss_factor="0.015"; both read back to the same loss factor."""
+    from gearcli import load_mechanism
+    plan = (mech_dir / "planetary_3p.yaml").read_text()
+    plan = plan.replace("    stiffness: 3.0e8                   # N/m\n", "    stiffness: 3.0e8\n    efficiency: 0.98\n")
+    plan = plan.replace("    stiffness: 3.5e8\n", "    stiffness: 3.5e8\n    loss_factor: 0.015\n")
+    (tmp_path / "p.yaml").write_text(plan)
+    assert run_cli("export", tmp_path / "p.yaml", "-o", tmp_path / "p.urdf").exit_code == 0
+    urdf = (tmp_path / "p.urdf").read_text()
+    assert urdf.count('efficiency="0.98"') == 3 and urdf.count('loss_factor="0.015"') == 3
+    assert "0.020000000000000018" not in urdf
+    before = {g.name: g.loss_factor for g in load_mechanism(tmp_path / "p.yaml").gears}
+    after = {g.name: g.loss_factor for g in load_mechanism(tmp_path / "p.urdf").gears}
+    assert after == before and before["sun-planet1"] == 1.0 - 0.98

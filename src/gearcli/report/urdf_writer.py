@@ -44,6 +44,16 @@ def _num(x: float) -> str:
     return repr(float(x) + 0.0)
 
 
+def _mesh_loss(c: float) -> tuple[str, str]:
+    """``("efficiency", "0.98")`` when 1 - c reads back to exactly c and is the shorter
+    figure (a file's ``efficiency: 0.98`` is c = 0.020000000000000018), else
+    ``("loss_factor", repr(c))``."""
+    eta = 1.0 - c
+    if 1.0 - float(_num(eta)) == c and len(_num(eta)) < len(_num(c)):
+        return "efficiency", _num(eta)
+    return "loss_factor", _num(c)
+
+
 def _vec(v) -> str:
     return " ".join(_num(x) for x in np.ravel(v))
 
@@ -271,4 +281,4 @@ def _gear_attrs(el, gp, mesh_point) -> None:
     if gp.stiffness is not None:
         el.set("stiffness", _num(gp.stiffness))
     if gp.loss_factor:
-        el.set("loss_factor", _num(gp.loss_factor))
+        el.set(*_mesh_loss(gp.loss_factor))
