@@ -104,11 +104,18 @@ def compiled_backend(an) -> None:
     assert sol.llvm_available() and sol.backend() == "llvm"
 
 
+def numba_only(an, backend) -> None:
+    """Skip the numba kernel where its program cannot hold a block (a LowRank block)."""
+    if backend == "kernel" and not solver_for(an).kernel_program().numba_ok:
+        pytest.skip("a block with more sign patterns than the numba kernel's program holds")
+
+
 @pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("key", BUNDLED + GENERATED)
 def test_kernel_equals_numpy(key, backend):
     an = analyse(mechanism(key))
     compiled_backend(an)
+    numba_only(an, backend)
     q, qd, qdd = trajectory(an, 600)
     loads = per_sample_loads(an, 600)
     ref = solve(an, q, qd, qdd, backend="numpy", loads=loads)
@@ -130,6 +137,26 @@ def test_kernel_equals_numpy_on_robots(case, backend, tmp_path):
     compiled_backend(an)
     q, qd, qdd = trajectory(an, 200)
     assert worst(solve(an, q, qd, qdd, backend=backend), solve(an, q, qd, qdd, backend="numpy")) < TOL
+
+
+def test_low_rank_block_without_hot_patterns():
+    """planetary_5p's block (10 signed meshes, 1,024 patterns) solved from one base matrix
+    (pattern_maps.LowRank): with no hot pattern every trial is the generated k x k solve
+    (llvm_solve), which must equal the numpy path's direct pattern maps too."""
+    from gearcli.dynamics.external import load_values
+    from gearcli.dynamics.llvm_driver import LlvmKernel
+    from gearcli.dynamics.result_arrays import result_arrays, work_arrays
+
+    an = analyse(mechanism("planetary_5p.yaml"))
+    prog = solver_for(an).kernel_program()
+    assert prog.lowrank and not prog.numba_ok and prog.hot[0][0][0] == 0
+    cold = dataclasses.replace(prog, hot={})
+    n = 600
+    q, qd, qdd = trajectory(an, n)
+    ref = solve(an, q, qd, qdd, backend="numpy")
+    arrays, work = result_arrays(an, n, None), work_arrays(n, len(prog.signed), None)
+    LlvmKernel(cold, an).solve(an, q, qd, qdd, load_values(an.mech, n), 1, n, arrays, work)
+    assert worst(type(ref)(**arrays), ref) < TOL
 
 
 def test_general_blocks_are_exercised():
@@ -160,11 +187,13 @@ def _sign_error(an, q, qd, qdd, backend, chunk):
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
-@pytest.mark.parametrize("key", ["paper_2dof.yaml", "bendix_wrist.yaml", "geared_arm.urdf", "planetary_3p.yaml"])
+@pytest.mark.parametrize("key", ["paper_2dof.yaml", "bendix_wrist.yaml", "geared_arm.urdf", "planetary_3p.yaml",
+                                 "planetary_5p.yaml"])
 def test_sign_error_names_the_same_sample(key, backend):
     """Samples with no consistent sign pattern (a NaN acceleration fails the first geared
     block): the error names the sample, and the meshes, that the numpy path names."""
     an = analyse(mechanism(key))
+    numba_only(an, backend)
     n = 4400
     q, qd, qdd = trajectory(an, n, seed=5)
     rng = np.random.default_rng(9)

@@ -78,7 +78,10 @@ def choose(sol, method: str, backend: str, n: int | None) -> str:
     if backend == "auto" and _auto_llvm(sol, n):
         return "llvm"
     numba = None
-    if sol.kernel_program() is not None:
+    prog = sol.kernel_program()
+    if prog is not None and not prog.numba_ok:
+        numba = "a block has more sign patterns than the numba kernel's program holds (kernel_program.MAX_PATTERNS)"
+    elif prog is not None:
         numba = numba_kernel_problem()
         if numba is None:
             return "kernel"

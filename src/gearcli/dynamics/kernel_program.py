@@ -36,13 +36,14 @@ link's axes gets F = that link and its inverse (:func:`_local_frame`), and keeps
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..analysis.schedule import unknown_groups
 from .blocks import _primary_side, make_plans
 from .output_maps import output_constants
+from .pattern_maps import hot_patterns, low_rank
 from .kernel_terms import general_terms, local_inverse
 
 I64 = np.int64
@@ -58,7 +59,10 @@ class Program:
     offsets: dict        # (kind, index) -> (first column, size)
     signed: list         # (kind, index) of each signs column
     names: list          # per block: names of its signed meshes (SignError)
-    covered: bool        # False: a block the kernel cannot solve (use the numpy path)
+    covered: bool        # False: a block the generated kernel cannot solve (use the numpy path)
+    lowrank: dict = field(default_factory=dict)   # block -> pattern_maps.LowRank (too many patterns to store)
+    hot: dict = field(default_factory=dict)       # block -> (hot pattern indices, their maps (k, n, 6B))
+    numba_ok: bool = True                         # False: the numba kernel cannot run it (a LowRank block)
 
 
 def _joints(an):
@@ -159,8 +163,11 @@ def _block(bd: _Builder, an, bi, p, block_of, offsets, sigcol, terms):
     for gi in p.signed:
         bd.tcol.append(int(p.offs[gi]))
         bd.scol.append(sigcol[(p.groups[gi].kind, p.groups[gi].index)])
-    for A in p.Ainv:
-        bd.add_floats("ainv", A)
+    if p.F is not None and (1 << len(p.signed)) > MAX_PATTERNS:
+        rec[7] = -1                        # solved from its pattern_maps.LowRank (program.lowrank)
+    else:
+        for A in p.Ainv:
+            bd.add_floats("ainv", A)
     for gi, g in enumerate(p.groups):
         later = [L for L in g.links if block_of[L] > bi]
         if later and p.F is not None and bd.propagation(an, p, gi, g, later, rec[8]):
@@ -188,8 +195,10 @@ def _local_frame(bd: _Builder, trec, tflt, p) -> None:
 MAX_PATTERNS = 256
 """Sign patterns of one constant block up to which the program holds every pattern's map:
 a block's maps are made on first use (:class:`.pattern_maps.PatternMaps`), and 2^m of them
-for m signed meshes (2^16 for 8 planets) would take minutes to make; such a mechanism is
-left to the numpy path, which makes only the patterns a motion meets."""
+for m signed meshes (2^16 for 8 planets) would take minutes to make; a block with more
+is solved from one base matrix (:class:`.pattern_maps.LowRank`, ``Program.lowrank``: a
+k x k solve a pattern, k = m or 2m), by the generated kernel only (the numba kernel
+leaves such a mechanism to the numpy path)."""
 
 
 def _csr(M: np.ndarray) -> tuple:
@@ -207,11 +216,10 @@ def _csr(M: np.ndarray) -> tuple:
 
 def build_program(an, plans=None) -> Program:
     """The :class:`Program` of ``an`` (``plans`` from :func:`.blocks.make_plans`); not
-    ``covered`` (and empty) when a constant block has more than :data:`MAX_PATTERNS` sign
-    patterns."""
+    ``covered`` when a redundant block has no constant frame."""
     plans = make_plans(an) if plans is None else plans
-    if any(p.F is not None and (1 << len(p.signed)) > MAX_PATTERNS for p in plans):
-        return Program((), (), 0, {}, [], [], False)
+    lowrank = {bi: low_rank(p.Ainv) for bi, p in enumerate(plans)
+               if p.F is not None and (1 << len(p.signed)) > MAX_PATTERNS}
     groups = unknown_groups(an)
     offsets, c = {}, 0
     for g in groups:
@@ -240,5 +248,43 @@ def build_program(an, plans=None) -> Program:
     flts = (jflt, _links(an), np.ascontiguousarray(S), np.asarray(an.mech.gravity, float),
             cat(bd.ainv), cat(bd.cmat), tflt, np.array(bd.turns + [0.0]), mflt,
             np.ascontiguousarray(A)) + tuple(val for *_, val in sparse)
+    hot = _hot_maps(an, plans, lowrank)
+    flts += (cat([np.ravel(a) for lr in lowrank.values() for a in (lr.Y, lr.G, lr.Z, lr.W)]
+                 + [np.array(h, float) for h, _ in hot.values()] + [np.ravel(t) for _, t in hot.values()]),)
     covered = all(p.F is not None or int(p.offs[-1]) == 6 * len(p.links) for p in plans)
-    return Program(ints, flts, c, offsets, signed, [p.names for p in plans], covered)
+    return Program(ints, flts, c, offsets, signed, [p.names for p in plans], covered,
+                   lowrank=lowrank, hot=hot, numba_ok=not lowrank)
+
+
+def _hot_maps(an, plans, lowrank: dict) -> dict:
+    """{block: (hot pattern indices, their maps)} of the :class:`~.pattern_maps.LowRank`
+    blocks: the patterns the numpy path meets on 256 random motions of the mechanism (a
+    fixed seed; :func:`~.pattern_maps.hot_patterns`), none where that solve fails."""
+    if not lowrank:
+        return {}
+    from .blocks import solve_blocks              # noqa: PLC0415
+    from .inertia import inertia_load             # noqa: PLC0415
+    from .kinematics import forward               # noqa: PLC0415
+    from .signs import SignError, pattern_index   # noqa: PLC0415
+
+    rng = np.random.default_rng(18)
+    n = 256
+    qi = [rng.uniform(-np.pi, np.pi, (n, an.dof)), rng.normal(size=(n, an.dof)) * 3.0,
+          rng.normal(size=(n, an.dof)) * 20.0]
+    q, qd, qdd = (v @ np.asarray(an.S, float).T for v in qi)
+    kin = forward(an.mech, an.tree, q, qd, qdd)
+    try:
+        _, sig = solve_blocks(an, plans, kin, inertia_load(an, kin), q)
+    except (SignError, np.linalg.LinAlgError):
+        return {}
+    out = {}
+    for bi in lowrank:
+        p = plans[bi]
+        signs = np.column_stack([sig[(p.groups[gi].kind, p.groups[gi].index)] for gi in p.signed])
+        counts: dict = {}
+        for row in signs:
+            k = pattern_index(row)
+            counts[k] = counts.get(k, 0) + 1
+        hot = hot_patterns(counts)
+        out[bi] = (hot, np.array([p.Ainv[k] for k in hot]))
+    return out

@@ -17,14 +17,13 @@ from .llvm_build import I64, Emitter
 from .llvm_links import Sample, floats
 from .llvm_signs import SignedBlock, resolve, signs_of, tolerance
 from .llvm_trig import sincos
-from .llvm_world import WorldBlock
+from .llvm_world import LowRankBlock, WorldBlock
 
 
 def problem(prog) -> str | None:
     """Why the generated kernel cannot solve ``prog``'s mechanism, or None."""
     if not prog.covered:
-        return ("a redundant gear set of this mechanism has no constant frame, or a block has more sign "
-                "patterns than the program holds (kernel_program.MAX_PATTERNS)")
+        return "a redundant gear set of this mechanism has no constant frame"
     return None
 
 
@@ -137,6 +136,9 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row) -> None:
     if F < 0:                       # world axes about each link's origin (kernel_world.world_gather)
         r = [v for L in links for v in s.rhs[L]]
         blk = WorldBlock(s, prog, k0, nt, nloc, tcols, term_wrench)
+    elif b in prog.lowrank:          # too many patterns to store: one base matrix (pattern_maps.LowRank)
+        r = gather(e, s, F, links)
+        blk = LowRankBlock(prog.lowrank[b], tcols, prog.hot.get(b))
     else:
         r = gather(e, s, F, links)
         maps = [ainv[a0 + k * nloc * nr:a0 + (k + 1) * nloc * nr].reshape(nloc, nr) for k in range(1 << m)]

@@ -71,8 +71,8 @@ def mech_loads(an) -> list:
     return [(an.tree.index[ld.link], ld.frame == "link", np.asarray(ld.point, float)) for ld in an.mech.loads]
 
 
-GENERATOR = ("llvm_kernel", "llvm_blocks", "llvm_build", "llvm_links", "llvm_outputs", "llvm_signs", "llvm_trig",
-             "llvm_world", "llvm_driver", "result_arrays", "signs")
+GENERATOR = ("llvm_kernel", "llvm_blocks", "llvm_build", "llvm_links", "llvm_outputs", "llvm_signs", "llvm_solve",
+             "llvm_trig", "llvm_world", "llvm_driver", "result_arrays", "signs")
 """The modules of :mod:`gearcli.dynamics` whose code makes a kernel program's IR text (a test
 checks that every module they import from the package is listed or makes only hashed input)."""
 

@@ -12,7 +12,9 @@ from __future__ import annotations
 import llvmlite.ir as ir
 
 from .llvm_build import D, I1, I64, Emitter
+from .llvm_links import floats
 from .llvm_signs import signs_of
+from .llvm_solve import solve_function
 
 
 def _pivot_row(e: Emitter, A, c: int):
@@ -99,3 +101,67 @@ class WorldBlock:
         """Rows ``rows`` of the solution for pattern p (i64)."""
         x = self.solve(e, signs_of(e, p, len(self.tcols)), r)
         return [x[i] for i in rows]
+
+
+class LowRankBlock:
+    """A constant-frame block with too many sign patterns to store their maps, solved from
+    one base matrix (:class:`~.pattern_maps.LowRank`, the Woodbury form, its numpy twin
+    ``LowRank.solve``).  A trial with one of the ``hot`` patterns (pattern 0, the search's
+    first, and the ones random motions meet most, :func:`.kernel_program._hot_maps`) is a
+    product with its map, straight-line with the constants (a ``switch`` over them); any
+    other pattern computes y = Y r and g = G r, solves the k x k system
+    (C_sigma + W) c = g (a call of the loop code of :mod:`.llvm_solve`: such a pattern is
+    rare, its code small) and takes x = y - Z c."""
+
+    def __init__(self, lr, tcols: list, hot):
+        self.lr, self.tcols, self.n = lr, tcols, lr.Y.shape[0]
+        self.hot, self.maps = (list(hot[0]), hot[1]) if hot else ([], [])
+        self.mem = None
+
+    def rows(self, e: Emitter, fn, p, rows: list, r: list, tag: str) -> list:
+        """Rows ``rows`` of the solution for pattern p (i64)."""
+        merge, cold = fn.append_basic_block(f"{tag}_lr"), fn.append_basic_block(f"{tag}_cold")
+        cases = [fn.append_basic_block(f"{tag}_hot{k}") for k in range(len(self.hot))]
+        sw = e.b.switch(p, cold)
+        ends, vals = [], []
+        for h, case, A in zip(self.hot, cases, self.maps):
+            sw.add_case(ir.Constant(I64, h), case)
+            e.b.position_at_end(case)
+            vals.append([e.const(e.dot(floats(A[i]), r)) for i in rows])
+            ends.append(e.b.block)
+            e.b.branch(merge)
+        e.b.position_at_end(cold)
+        vals.append([e.const(v) for v in self._solved(e, fn, p, rows, r)])
+        ends.append(e.b.block)
+        e.b.branch(merge)
+        e.b.position_at_end(merge)
+        out = []
+        for i in range(len(rows)):
+            phi = e.b.phi(D)
+            for end, v in zip(ends, vals):
+                phi.add_incoming(v[i], end)
+            out.append(phi)
+        return out
+
+    def _solved(self, e: Emitter, fn, p, rows: list, r: list) -> list:
+        """Rows ``rows`` of the solution for pattern p by the k x k solve."""
+        m, k = len(self.tcols), self.lr.k
+        if self.mem is None:                  # in the entry block: one stack slot per block
+            ib = ir.IRBuilder(fn.entry_basic_block)
+            ib.position_at_start(fn.entry_basic_block)
+            self.mem = tuple(ib.bitcast(ib.alloca(ir.ArrayType(D, size)), D.as_pointer()) for size in (k * k, k))
+        M, c = self.mem
+        sig = signs_of(e, p, m)
+        W = self.lr.W
+        for i in range(k):
+            for j in range(k):
+                v = float(W[i, j])
+                if self.lr.redundant and (j == i + m or i == j + m):
+                    v = e.add(v, sig[min(i, j)])
+                elif not self.lr.redundant and i == j:
+                    v = e.add(v, sig[i])
+                e.store(v, M, i * k + j)
+            e.store(e.dot(floats(self.lr.G[i]), r), c, i)
+        e.b.call(solve_function(e.module, k), [M, c])
+        cv = [e.load(c, i) for i in range(k)]
+        return [e.sub(e.dot(floats(self.lr.Y[i]), r), e.dot(floats(self.lr.Z[i]), cv)) for i in rows]

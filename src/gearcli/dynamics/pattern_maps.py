@@ -11,10 +11,11 @@ when first asked for and kept: :class:`PatternMaps` is a read-only sequence inde
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
-from .sharing import least_load_map
+from .sharing import kkt, least_load_map
 
 
 class PatternMaps(Sequence):
@@ -57,3 +58,89 @@ class PatternMaps(Sequence):
 
     def __iter__(self):
         return (self[i] for i in range(len(self)))
+
+
+@dataclass(frozen=True, eq=False)
+class LowRank:
+    """Every sign pattern's solution of one constant block from one base matrix (Woodbury).
+
+    The block matrix of pattern sigma differs from A_mid (every signed column at its mean
+    over the two signs: the separating-force-free matrix) by a term of rank m, or 2m for a
+    redundant block (the KKT matrix K of :mod:`.sharing` holds A twice):
+
+        K_sigma = K + P C_sigma P^T,   C_sigma = diag(sigma)  (square, K = A_mid, P = H),
+        C_sigma = [[0, diag sigma], [diag sigma, 0]]  (redundant, P = [[E, 0], [0, H]]),
+
+    with H (6B, m) the halves of the signed columns and E their unit columns; C_sigma^-1 =
+    C_sigma.  By the Woodbury identity the solution x = X_sigma r is
+
+        y = Y r,  g = G r,  (C_sigma + W) c = g,  x = y - Z c,  t = g[:m] - W[:m] c,
+
+    with the constant maps Y (n, 6B) = the first n rows of K^-1 [0; I] (K^-1 for a square
+    block), G = V^T K^-1 [0; I] (k, 6B), Z (n, k) the first n rows of K^-1 U and W = V^T
+    K^-1 U (k, k), where U = H, V = E (square) or U = V = P (redundant), k = m or 2m: a pattern costs one k x k solve instead of a stored map
+    (2^m of them: 1,024 for 5 planets).  ``redundant``: which C_sigma.
+    """
+
+    Y: np.ndarray
+    G: np.ndarray
+    Z: np.ndarray
+    W: np.ndarray
+    redundant: bool
+
+    @property
+    def k(self) -> int:
+        return self.W.shape[0]
+
+    def C(self, signs) -> np.ndarray:
+        """C_sigma (k, k) of the sign vector ``signs`` (m,)."""
+        m = len(signs)
+        if not self.redundant:
+            return np.diag(np.asarray(signs, float))
+        C = np.zeros((2 * m, 2 * m))
+        C[:m, m:] = C[m:, :m] = np.diag(np.asarray(signs, float))
+        return C
+
+    def solve(self, signs, r: np.ndarray) -> np.ndarray:
+        """x (N, n) of the rows r (N, 6B) for the sign vector ``signs`` (the kernel's twin)."""
+        c = np.linalg.solve(self.C(signs) + self.W, (r @ self.G.T).T).T
+        return r @ self.Y.T - c @ self.Z.T
+
+
+def low_rank(maps: PatternMaps) -> LowRank:
+    """The :class:`LowRank` form of a block's :class:`PatternMaps` (its A_mid, halves,
+    signed columns and sharing weights).  Raises :class:`~.sharing.SharingError` (or
+    numpy's LinAlgError for a square block) when the base matrix is singular."""
+    A, H = maps.A_mid, maps.halves.T               # (6B, n), (6B, m)
+    nr, n = A.shape
+    m = len(maps.cols)
+    E = np.zeros((n, m))
+    E[maps.cols, range(m)] = 1.0
+    if maps.w is None:                             # K + H C E^T
+        Y = np.linalg.inv(A)
+        U, V = H, E
+    else:                                          # K + P C P^T
+        Kinv = np.linalg.inv(kkt(A, maps.w))
+        U = np.zeros((n + nr, 2 * m))
+        U[:n, :m], U[n:, m:] = E, H
+        Y, V = Kinv[:, n:], U
+        U = Kinv @ U                               # K^-1 P (Y @ H would miss the top block)
+        return LowRank(np.ascontiguousarray(Y[:n]), np.ascontiguousarray(V.T @ Y), np.ascontiguousarray(U[:n]),
+                       np.ascontiguousarray(V.T @ U), True)
+    Z = Y @ U
+    return LowRank(np.ascontiguousarray(Y), np.ascontiguousarray(V.T @ Y), np.ascontiguousarray(Z),
+                   np.ascontiguousarray(V.T @ Z), False)
+
+
+HOT_PATTERNS = 8
+"""Sign patterns of a :class:`LowRank` block whose maps the generated kernel keeps as a
+table (the ones random motions of the mechanism meet most): a trial with one of them is a
+table product, any other pattern the k x k solve."""
+
+
+def hot_patterns(counts: dict) -> list[int]:
+    """Pattern 0 (every t positive: the search's first trial) and the most frequent other
+    patterns of ``counts`` {pattern index: samples} (ties: the lower index first),
+    :data:`HOT_PATTERNS` in all."""
+    rest = [k for k in sorted(sorted(counts), key=lambda k: -counts[k]) if k != 0]
+    return [0] + rest[:HOT_PATTERNS - 1]

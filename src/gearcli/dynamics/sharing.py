@@ -57,7 +57,7 @@ def mesh_weights(an, groups) -> np.ndarray:
     return np.asarray(w, float)
 
 
-def _kkt(A: np.ndarray, w: np.ndarray) -> np.ndarray:
+def kkt(A: np.ndarray, w: np.ndarray) -> np.ndarray:
     """KKT matrices (..., n+m, n+m) of min x^T diag(w) x subject to A x = r, A (..., m, n);
     D is scaled by the largest |A| entry (the minimiser does not change) for balance."""
     *lead, m, n = A.shape
@@ -75,7 +75,7 @@ def least_load_map(A: np.ndarray, w: np.ndarray) -> np.ndarray:
     m, n = A.shape
     rhs = np.vstack([np.zeros((n, m)), np.eye(m)])
     try:
-        X = np.linalg.solve(_kkt(A, w), rhs)[:n]
+        X = np.linalg.solve(kkt(A, w), rhs)[:n]
     except np.linalg.LinAlgError:
         X = None
     if X is None or not np.all(np.isfinite(X)) or np.max(np.abs(A @ X - np.eye(m))) > 1e-8:
@@ -89,7 +89,7 @@ def least_load_solve(A: np.ndarray, r: np.ndarray, w: np.ndarray) -> np.ndarray:
     N, m, n = A.shape
     rhs = np.concatenate([np.zeros((N, n)), r], axis=1)[:, :, None]
     try:
-        return np.linalg.solve(_kkt(A, w), rhs)[:, :n, 0]
+        return np.linalg.solve(kkt(A, w), rhs)[:, :n, 0]
     except np.linalg.LinAlgError:
         raise SharingError("the load-sharing (KKT) system of a redundant gear set is singular") from None
 

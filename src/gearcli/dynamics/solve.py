@@ -128,8 +128,7 @@ class Solver:
         if self._program is None and self.kernel_problem is None:
             self._program = build_program(self.an, self.plans)
             if not self._program.covered:
-                self.kernel_problem = ("a redundant gear set of this mechanism has no constant frame, or a block "
-                                       "has more sign patterns than the program holds (kernel_program.MAX_PATTERNS)")
+                self.kernel_problem = "a redundant gear set of this mechanism has no constant frame"
         return self._program if self.kernel_problem is None else None
 
     def llvm_kernel(self):

@@ -1,0 +1,123 @@
+"""A generated dense solve with loops (Gaussian elimination, partial pivoting), for the
+k x k systems of :class:`~.llvm_world.LowRankBlock` that a sample meets rarely: one
+function per module and size, its code independent of k's square (straight-line
+elimination of a 20 x 20 system took most of a kernel's compile time).
+
+``solve_k(A, x)``: A (k, k) row-major and x (k) in memory, overwritten: x = A^-1 x (the
+first largest pivot, as :func:`.llvm_world.eliminate`); every x NaN when a pivot is zero
+(a singular matrix, which no sign pattern accepts).
+"""
+from __future__ import annotations
+
+import llvmlite.ir as ir
+
+from .llvm_build import D, DP, I64
+
+FLAGS = ("contract",)
+
+
+def _loop(b: ir.IRBuilder, fn, lo, hi, tag: str, body) -> None:
+    """for (i = lo; i < hi; i++) body(i) (lo, hi i64 values; nothing when lo >= hi)."""
+    pre = b.block
+    head, loop, done = (fn.append_basic_block(f"{tag}_{s}") for s in ("head", "body", "done"))
+    b.branch(head)
+    b.position_at_end(head)
+    i = b.phi(I64)
+    i.add_incoming(lo, pre)
+    b.cbranch(b.icmp_signed("<", i, hi), loop, done)
+    b.position_at_end(loop)
+    body(i)
+    i.add_incoming(b.add(i, ir.Constant(I64, 1)), b.block)
+    b.branch(head)
+    b.position_at_end(done)
+
+
+class _Matrix:
+    """The builder state of one ``solve_<k>``: A (k, k) row-major and x (k) pointers."""
+
+    def __init__(self, b: ir.IRBuilder, fn, k: int):
+        self.b, self.fn, self.k = b, fn, k
+        self.A, self.x = fn.args
+        self.K = ir.Constant(I64, k)
+
+    def at(self, i, j):
+        return self.b.gep(self.A, [self.b.add(self.b.mul(i, self.K), j)])
+
+    def xi(self, i):
+        return self.b.gep(self.x, [i])
+
+    def fabs(self, v):
+        mod = self.fn.module
+        f = mod.globals.get("llvm.fabs.f64") or ir.Function(mod, ir.FunctionType(D, [D]), "llvm.fabs.f64")
+        return self.b.call(f, [v])
+
+
+def _column(s: _Matrix, c, singular, best) -> None:
+    """Column c: the first largest pivot at or below row c swapped up, rows below reduced."""
+    b, one = s.b, ir.Constant(I64, 1)
+    b.store(c, best)
+
+    def pick(i):
+        better = b.fcmp_ordered(">", s.fabs(b.load(s.at(i, c))), s.fabs(b.load(s.at(b.load(best), c))))
+        b.store(b.select(better, i, b.load(best)), best)
+    _loop(b, s.fn, b.add(c, one), s.K, "piv", pick)
+    p = b.load(best)
+
+    def swap(j):
+        a1, a2 = s.at(c, j), s.at(p, j)
+        v1, v2 = b.load(a1), b.load(a2)
+        b.store(v2, a1)
+        b.store(v1, a2)
+    _loop(b, s.fn, c, s.K, "swap", swap)
+    v1, v2 = b.load(s.xi(c)), b.load(s.xi(p))
+    b.store(v2, s.xi(c))
+    b.store(v1, s.xi(p))
+    piv = b.load(s.at(c, c))
+    b.store(b.or_(b.load(singular), b.fcmp_ordered("==", piv, ir.Constant(D, 0.0))), singular)
+
+    def row(i):
+        f = b.fdiv(b.load(s.at(i, c)), piv, flags=FLAGS)
+
+        def entry(j):
+            b.store(b.fsub(b.load(s.at(i, j)), b.fmul(f, b.load(s.at(c, j)), flags=FLAGS), flags=FLAGS), s.at(i, j))
+        _loop(b, s.fn, b.add(c, one), s.K, "elim", entry)
+        b.store(b.fsub(b.load(s.xi(i)), b.fmul(f, b.load(s.xi(c)), flags=FLAGS), flags=FLAGS), s.xi(i))
+    _loop(b, s.fn, b.add(c, one), s.K, "rows", row)
+
+
+def _back_substitute(s: _Matrix, acc) -> None:
+    """x = U^-1 x for the upper triangle U left by the elimination."""
+    b, k = s.b, s.k
+
+    def back(r):                         # c = k-1-r, down to 0
+        c = b.sub(ir.Constant(I64, k - 1), r)
+        b.store(b.load(s.xi(c)), acc)
+
+        def term(j):
+            b.store(b.fsub(b.load(acc), b.fmul(b.load(s.at(c, j)), b.load(s.xi(j)), flags=FLAGS), flags=FLAGS), acc)
+        _loop(b, s.fn, b.add(c, ir.Constant(I64, 1)), s.K, "back", term)
+        b.store(b.fdiv(b.load(acc), b.load(s.at(c, c)), flags=FLAGS), s.xi(c))
+    _loop(b, s.fn, ir.Constant(I64, 0), s.K, "subst", back)
+
+
+def solve_function(module: ir.Module, k: int) -> ir.Function:
+    """The declaration (emitted once) of ``solve_<k>(double* A, double* x)``."""
+    name = f"solve_{k}"
+    if name in module.globals:
+        return module.globals[name]
+    fn = ir.Function(module, ir.FunctionType(ir.VoidType(), [DP, DP]), name)
+    fn.linkage = "internal"
+    b = ir.IRBuilder(fn.append_basic_block("entry"))
+    s = _Matrix(b, fn, k)
+    singular, best, acc = b.alloca(ir.IntType(1)), b.alloca(I64), b.alloca(D)   # in the entry: registers
+    b.store(ir.Constant(ir.IntType(1), 0), singular)
+    _loop(b, fn, ir.Constant(I64, 0), s.K, "col", lambda c: _column(s, c, singular, best))
+    _back_substitute(s, acc)
+    nan, ok = fn.append_basic_block("nan"), fn.append_basic_block("ok")
+    b.cbranch(b.load(singular), nan, ok)
+    b.position_at_end(nan)
+    _loop(b, fn, ir.Constant(I64, 0), s.K, "fill", lambda i: b.store(ir.Constant(D, float("nan")), s.xi(i)))
+    b.ret_void()
+    b.position_at_end(ok)
+    b.ret_void()
+    return fn
