@@ -160,10 +160,15 @@ def test_low_rank_block_without_hot_patterns():
 
 
 def test_general_blocks_are_exercised():
-    """geared_arm.urdf has a block without a constant frame (a transmission): the kernel's
-    world-frame solve is compared above."""
+    """geared_arm.urdf has a block without a constant frame (a transmission), servo_joint.yaml
+    a redundant one (a helical stage into a 3-planet planetary whose sun turns: the sun
+    shaft's meshes are fixed in the housing and in the carrier); the kernel's world-frame
+    solves (square: eliminated; redundant: the KKT system) are compared above."""
     an = analyse(mechanism("geared_arm.urdf"))
     assert any(p.F is None for p in solver_for(an).plans)
+    servo = solver_for(analyse(mechanism("servo_joint.yaml")))
+    assert any(p.F is None and p.offs[-1] > 6 * len(p.links) for p in servo.plans)
+    assert servo.kernel_program().weights and servo.backend() == "llvm"
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
@@ -188,7 +193,7 @@ def _sign_error(an, q, qd, qdd, backend, chunk):
 
 @pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("key", ["paper_2dof.yaml", "bendix_wrist.yaml", "geared_arm.urdf", "planetary_3p.yaml",
-                                 "planetary_5p.yaml"])
+                                 "planetary_5p.yaml", "servo_joint.yaml"])
 def test_sign_error_names_the_same_sample(key, backend):
     """Samples with no consistent sign pattern (a NaN acceleration fails the first geared
     block): the error names the sample, and the meshes, that the numpy path names."""

@@ -80,7 +80,8 @@ def choose(sol, method: str, backend: str, n: int | None) -> str:
     numba = None
     prog = sol.kernel_program()
     if prog is not None and not prog.numba_ok:
-        numba = "a block has more sign patterns than the numba kernel's program holds (kernel_program.MAX_PATTERNS)"
+        numba = ("the numba kernel cannot solve a block of this mechanism (more sign patterns than "
+                 "kernel_program.MAX_PATTERNS, or a redundant gear set without a constant frame)")
     elif prog is not None:
         numba = numba_kernel_problem()
         if numba is None:

@@ -44,6 +44,7 @@ from ..analysis.schedule import unknown_groups
 from .blocks import _primary_side, make_plans
 from .output_maps import output_constants
 from .pattern_maps import hot_patterns, low_rank
+from .sharing import mesh_weights
 from .kernel_terms import general_terms, local_inverse
 
 I64 = np.int64
@@ -62,6 +63,7 @@ class Program:
     covered: bool        # False: a block the generated kernel cannot solve (use the numpy path)
     lowrank: dict = field(default_factory=dict)   # block -> pattern_maps.LowRank (too many patterns to store)
     hot: dict = field(default_factory=dict)       # block -> (hot pattern indices, their maps (k, n, 6B))
+    weights: dict = field(default_factory=dict)   # redundant world-frame block -> sharing.mesh_weights
     numba_ok: bool = True                         # False: the numba kernel cannot run it (a LowRank block)
 
 
@@ -251,9 +253,11 @@ def build_program(an, plans=None) -> Program:
     hot = _hot_maps(an, plans, lowrank)
     flts += (cat([np.ravel(a) for lr in lowrank.values() for a in (lr.Y, lr.G, lr.Z, lr.W)]
                  + [np.array(h, float) for h, _ in hot.values()] + [np.ravel(t) for _, t in hot.values()]),)
-    covered = all(p.F is not None or int(p.offs[-1]) == 6 * len(p.links) for p in plans)
-    return Program(ints, flts, c, offsets, signed, [p.names for p in plans], covered,
-                   lowrank=lowrank, hot=hot, numba_ok=not lowrank)
+    weights = {bi: mesh_weights(an, p.groups) for bi, p in enumerate(plans)
+               if p.F is None and int(p.offs[-1]) > 6 * len(p.links)}
+    flts += (cat([w for w in weights.values()]),)                                    # (hashed)
+    return Program(ints, flts, c, offsets, signed, [p.names for p in plans], True,
+                   lowrank=lowrank, hot=hot, weights=weights, numba_ok=not lowrank and not weights)
 
 
 def _hot_maps(an, plans, lowrank: dict) -> dict:

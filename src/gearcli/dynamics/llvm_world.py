@@ -77,25 +77,69 @@ def eliminate(e: Emitter, A: list, r: list) -> list:
 class WorldBlock:
     """A block solved in world axes: its matrix from the terms, for a sign pattern p.
 
+    A square block is eliminated straight-line (:func:`eliminate`).  A redundant one (a gear
+    set with more unknowns n than its 6B equations, ``weights`` the load-sharing weights of
+    :func:`.sharing.mesh_weights`) solves the KKT system of :func:`.sharing.kkt` (the same
+    matrix, D scaled by the sample's largest |A| entry) with the loop code of
+    :mod:`.llvm_solve`, its (n + 6B)^2 entries in a stack array of the ``fn`` ``run``.
+
     ``full_trial``: a trial solves the whole block (:func:`.llvm_signs.resolve` keeps
     that solution for the pattern it accepts)."""
 
     full_trial = True
 
-    def __init__(self, s, prog, k0: int, nt: int, n: int, tcols: list, wrench):
+    def __init__(self, s, prog, k0: int, nt: int, n: int, tcols: list, wrench, fn=None, weights=None):
         self.s, self.trec, self.tflt = s, prog.ints[10], prog.flts[6]
         self.terms = [k for k in range(k0, k0 + nt) if self.trec[k, 1] >= 0]
         self.n, self.tcols, self.wrench = n, tcols, wrench
+        self.fn, self.weights, self.mem = fn, weights, None
 
     def solve(self, e: Emitter, sig: list, r: list) -> list:
         """x of the block for the signs ``sig`` (values) of its t."""
-        A = [[0.0] * self.n for _ in range(self.n)]
+        A = [[0.0] * self.n for _ in range(len(r))]
         for k in self.terms:
             row, col = int(self.trec[k, 1]), int(self.trec[k, 2])
             w = self.wrench(e, self.s, self.trec[k], self.tflt[k], int(self.trec[k, 0]), sig)
             for h in range(6):
                 A[6 * row + h][col] = e.add(A[6 * row + h][col], w[h])
-        return eliminate(e, A, r)
+        if len(r) == self.n:
+            return eliminate(e, A, r)
+        return self._least_load(e, A, r)
+
+    def _least_load(self, e: Emitter, A: list, r: list) -> list:
+        """The minimiser of sum w x^2 subject to A x = r (:func:`.sharing.least_load_solve`)."""
+        nr, n = len(A), self.n
+        size = n + nr
+        if self.mem is None:                  # in the entry block: one stack slot per block
+            ib = ir.IRBuilder(self.fn.entry_basic_block)
+            ib.position_at_start(self.fn.entry_basic_block)
+            self.mem = tuple(ib.bitcast(ib.alloca(ir.ArrayType(D, k)), D.as_pointer()) for k in (size * size, size))
+        K, x = self.mem
+        scale = 0.0                           # max |A|, NaN-free as numpy's max is not: NaN fails anyway
+        for row in A:
+            for v in row:
+                a = e.call("fabs", v)
+                if isinstance(a, float):
+                    scale = max(scale, a) if isinstance(scale, float) else e.b.select(
+                        e.b.fcmp_ordered(">", e.const(a), scale), e.const(a), scale)
+                elif isinstance(scale, float) and scale == 0.0:
+                    scale = a
+                else:
+                    scale = e.b.select(e.b.fcmp_unordered(">", a, e.const(scale)), a, e.const(scale))
+        for i in range(size):
+            for j in range(size):
+                if i < n and j < n:
+                    v = e.mul(scale, float(self.weights[i])) if i == j else 0.0
+                elif i < n:
+                    v = A[j - n][i]
+                elif j < n:
+                    v = A[i - n][j]
+                else:
+                    v = 0.0
+                e.store(v, K, i * size + j)
+            e.store(0.0 if i < n else r[i - n], x, i)
+        e.b.call(solve_function(e.module, size), [K, x])
+        return [e.load(x, i) for i in range(n)]
 
     def rows(self, e: Emitter, fn, p, rows: list, r: list, tag: str) -> list:
         """Rows ``rows`` of the solution for pattern p (i64)."""
