@@ -159,6 +159,27 @@ def test_low_rank_block_without_hot_patterns():
     assert worst(type(ref)(**arrays), ref) < TOL
 
 
+def test_redundant_world_block_by_kkt_and_by_basis():
+    """servo_joint's redundant world-frame block is solved through a square basis (its two
+    free planet meshes, kernel_program._free_columns); without one, from the KKT system:
+    both generated solves must equal the numpy path (sharing.least_load_solve)."""
+    from gearcli.dynamics.external import load_values
+    from gearcli.dynamics.llvm_driver import LlvmKernel
+    from gearcli.dynamics.result_arrays import result_arrays, work_arrays
+
+    an = analyse(mechanism("servo_joint.yaml"))
+    prog = solver_for(an).kernel_program()
+    assert prog.free and len(prog.free[0]) == 2 and not prog.numba_ok
+    n = 300
+    q, qd, qdd = trajectory(an, n)
+    ref = solve(an, q, qd, qdd, backend="numpy")
+    assert worst(solve(an, q, qd, qdd, backend="llvm"), ref) < TOL
+    arrays, work = result_arrays(an, n, None), work_arrays(n, len(prog.signed), None)
+    LlvmKernel(dataclasses.replace(prog, free={}), an).solve(an, q, qd, qdd, load_values(an.mech, n), 1, n,
+                                                             arrays, work)
+    assert worst(type(ref)(**arrays), ref) < TOL
+
+
 def test_general_blocks_are_exercised():
     """geared_arm.urdf has a block without a constant frame (a transmission), servo_joint.yaml
     a redundant one (a helical stage into a 3-planet planetary whose sun turns: the sun

@@ -64,6 +64,7 @@ class Program:
     lowrank: dict = field(default_factory=dict)   # block -> pattern_maps.LowRank (too many patterns to store)
     hot: dict = field(default_factory=dict)       # block -> (hot pattern indices, their maps (k, n, 6B))
     weights: dict = field(default_factory=dict)   # redundant world-frame block -> sharing.mesh_weights
+    free: dict = field(default_factory=dict)      # redundant world-frame block -> its free columns (_free_columns)
     numba_ok: bool = True                         # False: the numba kernel cannot run it (a LowRank block)
 
 
@@ -255,9 +256,52 @@ def build_program(an, plans=None) -> Program:
                  + [np.array(h, float) for h, _ in hot.values()] + [np.ravel(t) for _, t in hot.values()]),)
     weights = {bi: mesh_weights(an, p.groups) for bi, p in enumerate(plans)
                if p.F is None and int(p.offs[-1]) > 6 * len(p.links)}
-    flts += (cat([w for w in weights.values()]),)                                    # (hashed)
-    return Program(ints, flts, c, offsets, signed, [p.names for p in plans], True,
-                   lowrank=lowrank, hot=hot, weights=weights, numba_ok=not lowrank and not weights)
+    free = {bi: f for bi in weights if (f := _free_columns(an, plans[bi], weights[bi])) is not None}
+    flts += (cat([w for w in weights.values()] + [np.array(f, float) for f in free.values()]),)   # (hashed)
+    return Program(ints, flts, c, offsets, signed, [p.names for p in plans], True, lowrank=lowrank, hot=hot,
+                   weights=weights, free=free, numba_ok=not lowrank and not weights)
+
+
+MAX_BASIS_CONDITION = 1e8
+"""Largest condition number of a redundant block's basis (its matrix without the free
+columns) over the poses and sign patterns :func:`_free_columns` tries."""
+
+
+def _free_columns(an, p, w):
+    """The d weighted columns of a redundant world-frame block (n unknowns, 6B equations,
+    d = n - 6B) whose removal leaves a square basis A_B that is regular on 9 poses (home and
+    8 random, every t positive and every t negative) with a condition number at most
+    :data:`MAX_BASIS_CONDITION`: the generated kernel then solves A_B for the right-hand
+    side and the free columns and minimises over the d free unknowns (a d x d system,
+    :class:`~.llvm_world.WorldBlock`) instead of the (n + 6B)^2 KKT system.  Chosen by
+    QR with column pivoting of the null space's weighted rows at home.  None: none found."""
+    from scipy.linalg import qr                        # noqa: PLC0415
+
+    from .equations import Columns                     # noqa: PLC0415
+    from .general import assemble                      # noqa: PLC0415
+    from .kinematics import forward                    # noqa: PLC0415
+
+    rng = np.random.default_rng(18)
+    J = len(an.mech.joints)
+    q = np.vstack([np.zeros((1, an.dof)), rng.uniform(-np.pi, np.pi, (8, an.dof))]) @ np.asarray(an.S, float).T
+    cols = Columns(an, forward(an.mech, an.tree, q.reshape(-1, J)))
+    A = assemble(cols, p.groups, list(p.links))                       # (9, 6B, n), every t positive
+    nr, n = A.shape[1:]
+    weighted = np.flatnonzero(w > 0)
+    null = np.linalg.svd(A[0])[2][nr:].T                              # (n, d)
+    if null.shape[1] != n - nr:
+        return None
+    piv = qr(null[weighted].T, pivoting=True)[2]
+    free = sorted(int(weighted[i]) for i in piv[:n - nr])
+    basis = [j for j in range(n) if j not in free]
+    minus = A.copy()
+    for gi in p.signed:                                               # every t negative
+        c = int(p.offs[gi])
+        for r, L in enumerate(p.links):
+            if L in p.groups[gi].links:
+                minus[:, 6 * r:6 * r + 6, c] = cols.group(p.groups[gi], L, -1.0)[:, :, 0]
+    conds = np.linalg.cond(np.concatenate([A, minus])[:, :, basis])
+    return free if np.all(np.isfinite(conds)) and conds.max() <= MAX_BASIS_CONDITION else None
 
 
 def _hot_maps(an, plans, lowrank: dict) -> dict:

@@ -135,7 +135,7 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row) -> None:
     tcols = [int(c) for c in tcol[t0:t0 + m]]
     if F < 0:                       # world axes about each link's origin (kernel_world.world_gather)
         r = [v for L in links for v in s.rhs[L]]
-        blk = WorldBlock(s, prog, k0, nt, nloc, tcols, term_wrench, fn, prog.weights.get(b))
+        blk = WorldBlock(s, prog, k0, nt, nloc, tcols, term_wrench, fn, prog.weights.get(b), prog.free.get(b))
     elif b in prog.lowrank:          # too many patterns to store: one base matrix (pattern_maps.LowRank)
         r = gather(e, s, F, links)
         blk = LowRankBlock(prog.lowrank[b], tcols, prog.hot.get(b))

@@ -3,9 +3,9 @@ k x k systems of :class:`~.llvm_world.LowRankBlock` that a sample meets rarely: 
 function per module and size, its code independent of k's square (straight-line
 elimination of a 20 x 20 system took most of a kernel's compile time).
 
-``solve_k(A, x)``: A (k, k) row-major and x (k) in memory, overwritten: x = A^-1 x (the
-first largest pivot, as :func:`.llvm_world.eliminate`); every x NaN when a pivot is zero
-(a singular matrix, which no sign pattern accepts).
+``solve_k_m(A, X)``: A (k, k) and X (k, m) row-major in memory, overwritten: X = A^-1 X
+(the first largest pivot, as :func:`.llvm_world.eliminate`); every X NaN when a pivot is
+zero (a singular matrix, which no sign pattern accepts).
 """
 from __future__ import annotations
 
@@ -33,18 +33,23 @@ def _loop(b: ir.IRBuilder, fn, lo, hi, tag: str, body) -> None:
 
 
 class _Matrix:
-    """The builder state of one ``solve_<k>``: A (k, k) row-major and x (k) pointers."""
+    """The builder state of one ``solve_<k>_<m>``: A (k, k) and X (k, m) row-major pointers."""
 
-    def __init__(self, b: ir.IRBuilder, fn, k: int):
-        self.b, self.fn, self.k = b, fn, k
+    def __init__(self, b: ir.IRBuilder, fn, k: int, m: int):
+        self.b, self.fn, self.k, self.m = b, fn, k, m
         self.A, self.x = fn.args
-        self.K = ir.Constant(I64, k)
+        self.K, self.M = ir.Constant(I64, k), ir.Constant(I64, m)
 
     def at(self, i, j):
         return self.b.gep(self.A, [self.b.add(self.b.mul(i, self.K), j)])
 
-    def xi(self, i):
-        return self.b.gep(self.x, [i])
+    def xi(self, i, h=None):
+        """X[i, h] (h: column, 0 if None)."""
+        return self.b.gep(self.x, [self.b.mul(i, self.M) if h is None else self.b.add(self.b.mul(i, self.M), h)])
+
+    def each(self, tag: str, body) -> None:
+        """body(h) for every column h of X."""
+        _loop(self.b, self.fn, ir.Constant(I64, 0), self.M, tag, body)
 
     def fabs(self, v):
         mod = self.fn.module
@@ -69,9 +74,12 @@ def _column(s: _Matrix, c, singular, best) -> None:
         b.store(v2, a1)
         b.store(v1, a2)
     _loop(b, s.fn, c, s.K, "swap", swap)
-    v1, v2 = b.load(s.xi(c)), b.load(s.xi(p))
-    b.store(v2, s.xi(c))
-    b.store(v1, s.xi(p))
+
+    def swap_x(h):
+        v1, v2 = b.load(s.xi(c, h)), b.load(s.xi(p, h))
+        b.store(v2, s.xi(c, h))
+        b.store(v1, s.xi(p, h))
+    s.each("swapx", swap_x)
     piv = b.load(s.at(c, c))
     b.store(b.or_(b.load(singular), b.fcmp_ordered("==", piv, ir.Constant(D, 0.0))), singular)
 
@@ -81,7 +89,8 @@ def _column(s: _Matrix, c, singular, best) -> None:
         def entry(j):
             b.store(b.fsub(b.load(s.at(i, j)), b.fmul(f, b.load(s.at(c, j)), flags=FLAGS), flags=FLAGS), s.at(i, j))
         _loop(b, s.fn, b.add(c, one), s.K, "elim", entry)
-        b.store(b.fsub(b.load(s.xi(i)), b.fmul(f, b.load(s.xi(c)), flags=FLAGS), flags=FLAGS), s.xi(i))
+        s.each("elimx", lambda h: b.store(b.fsub(b.load(s.xi(i, h)), b.fmul(f, b.load(s.xi(c, h)), flags=FLAGS),
+                                                 flags=FLAGS), s.xi(i, h)))
     _loop(b, s.fn, b.add(c, one), s.K, "rows", row)
 
 
@@ -91,24 +100,28 @@ def _back_substitute(s: _Matrix, acc) -> None:
 
     def back(r):                         # c = k-1-r, down to 0
         c = b.sub(ir.Constant(I64, k - 1), r)
-        b.store(b.load(s.xi(c)), acc)
 
-        def term(j):
-            b.store(b.fsub(b.load(acc), b.fmul(b.load(s.at(c, j)), b.load(s.xi(j)), flags=FLAGS), flags=FLAGS), acc)
-        _loop(b, s.fn, b.add(c, ir.Constant(I64, 1)), s.K, "back", term)
-        b.store(b.fdiv(b.load(acc), b.load(s.at(c, c)), flags=FLAGS), s.xi(c))
+        def column(h):
+            b.store(b.load(s.xi(c, h)), acc)
+
+            def term(j):
+                b.store(b.fsub(b.load(acc), b.fmul(b.load(s.at(c, j)), b.load(s.xi(j, h)), flags=FLAGS),
+                               flags=FLAGS), acc)
+            _loop(b, s.fn, b.add(c, ir.Constant(I64, 1)), s.K, "back", term)
+            b.store(b.fdiv(b.load(acc), b.load(s.at(c, c)), flags=FLAGS), s.xi(c, h))
+        s.each("backx", column)
     _loop(b, s.fn, ir.Constant(I64, 0), s.K, "subst", back)
 
 
-def solve_function(module: ir.Module, k: int) -> ir.Function:
-    """The declaration (emitted once) of ``solve_<k>(double* A, double* x)``."""
-    name = f"solve_{k}"
+def solve_function(module: ir.Module, k: int, m: int = 1) -> ir.Function:
+    """The declaration (emitted once) of ``solve_<k>_<m>(double* A, double* X)``."""
+    name = f"solve_{k}_{m}"
     if name in module.globals:
         return module.globals[name]
     fn = ir.Function(module, ir.FunctionType(ir.VoidType(), [DP, DP]), name)
     fn.linkage = "internal"
     b = ir.IRBuilder(fn.append_basic_block("entry"))
-    s = _Matrix(b, fn, k)
+    s = _Matrix(b, fn, k, m)
     singular, best, acc = b.alloca(ir.IntType(1)), b.alloca(I64), b.alloca(D)   # in the entry: registers
     b.store(ir.Constant(ir.IntType(1), 0), singular)
     _loop(b, fn, ir.Constant(I64, 0), s.K, "col", lambda c: _column(s, c, singular, best))
@@ -116,7 +129,8 @@ def solve_function(module: ir.Module, k: int) -> ir.Function:
     nan, ok = fn.append_basic_block("nan"), fn.append_basic_block("ok")
     b.cbranch(b.load(singular), nan, ok)
     b.position_at_end(nan)
-    _loop(b, fn, ir.Constant(I64, 0), s.K, "fill", lambda i: b.store(ir.Constant(D, float("nan")), s.xi(i)))
+    _loop(b, fn, ir.Constant(I64, 0), ir.Constant(I64, k * m), "fill",
+          lambda i: b.store(ir.Constant(D, float("nan")), b.gep(s.x, [i])))
     b.ret_void()
     b.position_at_end(ok)
     b.ret_void()

@@ -79,20 +79,59 @@ class WorldBlock:
 
     A square block is eliminated straight-line (:func:`eliminate`).  A redundant one (a gear
     set with more unknowns n than its 6B equations, ``weights`` the load-sharing weights of
-    :func:`.sharing.mesh_weights`) solves the KKT system of :func:`.sharing.kkt` (the same
-    matrix, D scaled by the sample's largest |A| entry) with the loop code of
-    :mod:`.llvm_solve`, its (n + 6B)^2 entries in a stack array of the ``fn`` ``run``.
+    :func:`.sharing.mesh_weights`) is solved through a square basis (``free``: the columns
+    left out, :func:`.kernel_program._free_columns`; :meth:`_by_basis`), or where none was
+    found from the KKT system of :func:`.sharing.kkt` (the same matrix, D scaled by the
+    sample's largest |A| entry), each with the loop code of :mod:`.llvm_solve`, the
+    matrices in stack arrays of the ``fn`` ``run``.
 
     ``full_trial``: a trial solves the whole block (:func:`.llvm_signs.resolve` keeps
     that solution for the pattern it accepts)."""
 
     full_trial = True
 
-    def __init__(self, s, prog, k0: int, nt: int, n: int, tcols: list, wrench, fn=None, weights=None):
+    def __init__(self, s, prog, k0: int, nt: int, n: int, tcols: list, wrench, fn=None, weights=None, free=None):
         self.s, self.trec, self.tflt = s, prog.ints[10], prog.flts[6]
         self.terms = [k for k in range(k0, k0 + nt) if self.trec[k, 1] >= 0]
         self.n, self.tcols, self.wrench = n, tcols, wrench
-        self.fn, self.weights, self.mem = fn, weights, None
+        self.fn, self.weights, self.free, self.mem = fn, weights, free, None
+
+    def _stack(self, sizes):
+        """Stack arrays of these sizes (doubles), made once in ``run``'s entry block."""
+        if self.mem is None:
+            ib = ir.IRBuilder(self.fn.entry_basic_block)
+            ib.position_at_start(self.fn.entry_basic_block)
+            self.mem = tuple(ib.bitcast(ib.alloca(ir.ArrayType(D, k)), D.as_pointer()) for k in sizes)
+        return self.mem
+
+    def _by_basis(self, e: Emitter, A: list, r: list) -> list:
+        """The least-load solution through the basis A_B (every column but the d ``free``):
+        [p | Q] = A_B^-1 [r | A_free] (:mod:`.llvm_solve`), then the free unknowns from
+        (Q^T W_B Q + W_free) x_free = Q^T W_B p (d x d, :func:`eliminate`) and x_B = p - Q x_free:
+        the minimiser of sum w x^2 over the solutions of A x = r."""
+        k, free, w = len(r), self.free, self.weights
+        basis = [j for j in range(self.n) if j not in free]
+        m = 1 + len(free)
+        M, X = self._stack((k * k, k * m))
+        for i in range(k):
+            for a, j in enumerate(basis):
+                e.store(A[i][j], M, i * k + a)
+            for h, v in enumerate([r[i]] + [A[i][j] for j in free]):
+                e.store(v, X, i * m + h)
+        e.b.call(solve_function(e.module, k, m), [M, X])
+        P = [[e.load(X, i * m + h) for h in range(m)] for i in range(k)]
+        wb = [(a, float(w[j])) for a, j in enumerate(basis) if w[j] > 0]
+        S = [[e.add(float(w[free[g]]) if g == h else 0.0,
+                    e.dot([e.mul(wj, P[a][1 + g]) for a, wj in wb], [P[a][1 + h] for a, _ in wb]))
+              for h in range(len(free))] for g in range(len(free))]
+        rhs = [e.dot([e.mul(wj, P[a][1 + g]) for a, wj in wb], [P[a][0] for a, _ in wb]) for g in range(len(free))]
+        xf = eliminate(e, S, rhs)
+        x = [0.0] * self.n
+        for g, j in enumerate(free):
+            x[j] = xf[g]
+        for a, j in enumerate(basis):
+            x[j] = e.const(e.sub(P[a][0], e.dot([P[a][1 + h] for h in range(len(free))], xf)))
+        return x
 
     def solve(self, e: Emitter, sig: list, r: list) -> list:
         """x of the block for the signs ``sig`` (values) of its t."""
@@ -104,17 +143,15 @@ class WorldBlock:
                 A[6 * row + h][col] = e.add(A[6 * row + h][col], w[h])
         if len(r) == self.n:
             return eliminate(e, A, r)
+        if self.free is not None:
+            return self._by_basis(e, A, r)
         return self._least_load(e, A, r)
 
     def _least_load(self, e: Emitter, A: list, r: list) -> list:
         """The minimiser of sum w x^2 subject to A x = r (:func:`.sharing.least_load_solve`)."""
         nr, n = len(A), self.n
         size = n + nr
-        if self.mem is None:                  # in the entry block: one stack slot per block
-            ib = ir.IRBuilder(self.fn.entry_basic_block)
-            ib.position_at_start(self.fn.entry_basic_block)
-            self.mem = tuple(ib.bitcast(ib.alloca(ir.ArrayType(D, k)), D.as_pointer()) for k in (size * size, size))
-        K, x = self.mem
+        K, x = self._stack((size * size, size))
         scale = 0.0                           # max |A|, NaN-free as numpy's max is not: NaN fails anyway
         for row in A:
             for v in row:
