@@ -169,7 +169,7 @@ def test_redundant_world_block_by_kkt_and_by_basis():
 
     an = analyse(mechanism("servo_joint.yaml"))
     prog = solver_for(an).kernel_program()
-    assert prog.free and len(prog.free[0]) == 2 and not prog.numba_ok
+    assert prog.free and len(prog.free[0][0]) == 2 and not prog.numba_ok
     n = 300
     q, qd, qdd = trajectory(an, n)
     ref = solve(an, q, qd, qdd, backend="numpy")
@@ -177,6 +177,29 @@ def test_redundant_world_block_by_kkt_and_by_basis():
     arrays, work = result_arrays(an, n, None), work_arrays(n, len(prog.signed), None)
     LlvmKernel(dataclasses.replace(prog, free={}), an).solve(an, q, qd, qdd, load_values(an.mech, n), 1, n,
                                                              arrays, work)
+    assert worst(type(ref)(**arrays), ref) < TOL
+
+
+def test_static_pivots_fall_back_to_pivoting(monkeypatch, tmp_path):
+    """With a pivot growth of 1 nearly every sample's basis solve finds a static pivot
+    smaller than an entry below it and takes the pivoting loop code (llvm_world.static_lu):
+    that branch too must equal the numpy path."""
+    from gearcli.dynamics import llvm_world
+    from gearcli.dynamics.external import load_values
+    from gearcli.dynamics.llvm_driver import LlvmKernel
+    from gearcli.dynamics.result_arrays import result_arrays, work_arrays
+
+    monkeypatch.setattr(llvm_world, "PIVOT_GROWTH", 1.0)
+    monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path))     # compiled with it, not the cached kernel
+    an = analyse(mechanism("servo_joint.yaml"))
+    prog = solver_for(an).kernel_program()
+    n = 300
+    q, qd, qdd = trajectory(an, n)
+    ref = solve(an, q, qd, qdd, backend="numpy")
+    arrays, work = result_arrays(an, n, None), work_arrays(n, len(prog.signed), None)
+    kernel = LlvmKernel(prog, an)
+    assert not kernel.jit.from_cache
+    kernel.solve(an, q, qd, qdd, load_values(an.mech, n), 1, n, arrays, work)
     assert worst(type(ref)(**arrays), ref) < TOL
 
 

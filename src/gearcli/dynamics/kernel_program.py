@@ -44,7 +44,7 @@ from ..analysis.schedule import unknown_groups
 from .blocks import _primary_side, make_plans
 from .output_maps import output_constants
 from .pattern_maps import hot_patterns, low_rank
-from .sharing import mesh_weights
+from .sharing import SharingError, mesh_weights
 from .kernel_terms import general_terms, local_inverse
 
 I64 = np.int64
@@ -221,8 +221,11 @@ def build_program(an, plans=None) -> Program:
     """The :class:`Program` of ``an`` (``plans`` from :func:`.blocks.make_plans`); not
     ``covered`` when a redundant block has no constant frame."""
     plans = make_plans(an) if plans is None else plans
-    lowrank = {bi: low_rank(p.Ainv) for bi, p in enumerate(plans)
-               if p.F is not None and (1 << len(p.signed)) > MAX_PATTERNS}
+    try:
+        lowrank = {bi: low_rank(p.Ainv) for bi, p in enumerate(plans)
+                   if p.F is not None and (1 << len(p.signed)) > MAX_PATTERNS}
+    except (np.linalg.LinAlgError, SharingError):      # a singular base matrix: the numpy path
+        return Program((), (), 0, {}, [], [], False, numba_ok=False)
     groups = unknown_groups(an)
     offsets, c = {}, 0
     for g in groups:
@@ -256,8 +259,8 @@ def build_program(an, plans=None) -> Program:
                  + [np.array(h, float) for h, _ in hot.values()] + [np.ravel(t) for _, t in hot.values()]),)
     weights = {bi: mesh_weights(an, p.groups) for bi, p in enumerate(plans)
                if p.F is None and int(p.offs[-1]) > 6 * len(p.links)}
-    free = {bi: f for bi in weights if (f := _free_columns(an, plans[bi], weights[bi])) is not None}
-    flts += (cat([w for w in weights.values()] + [np.array(f, float) for f in free.values()]),)   # (hashed)
+    free = {bi: f for bi in weights if (f := _basis(an, plans[bi], weights[bi])) is not None}
+    flts += (cat([w for w in weights.values()] + [np.array(f[0] + f[1], float) for f in free.values()]),)  # (hashed)
     return Program(ints, flts, c, offsets, signed, [p.names for p in plans], True, lowrank=lowrank, hot=hot,
                    weights=weights, free=free, numba_ok=not lowrank and not weights)
 
@@ -267,14 +270,23 @@ MAX_BASIS_CONDITION = 1e8
 columns) over the poses and sign patterns :func:`_free_columns` tries."""
 
 
+def _basis(an, p, w):
+    """:func:`_free_columns`, None where its linear algebra fails (the KKT solve then)."""
+    try:
+        return _free_columns(an, p, w)
+    except (np.linalg.LinAlgError, ValueError):
+        return None
+
+
 def _free_columns(an, p, w):
-    """The d weighted columns of a redundant world-frame block (n unknowns, 6B equations,
+    """(free, row order): the d weighted columns of a redundant world-frame block (n unknowns, 6B equations,
     d = n - 6B) whose removal leaves a square basis A_B that is regular on 9 poses (home and
     8 random, every t positive and every t negative) with a condition number at most
     :data:`MAX_BASIS_CONDITION`: the generated kernel then solves A_B for the right-hand
     side and the free columns and minimises over the d free unknowns (a d x d system,
     :class:`~.llvm_world.WorldBlock`) instead of the (n + 6B)^2 KKT system.  Chosen by
-    QR with column pivoting of the null space's weighted rows at home.  None: none found."""
+    QR with column pivoting of the null space's weighted rows at home; the basis' row order
+    of partial pivoting at home (:func:`_pivot_order`).  None: none found."""
     from scipy.linalg import qr                        # noqa: PLC0415
 
     from .equations import Columns                     # noqa: PLC0415
@@ -301,7 +313,20 @@ def _free_columns(an, p, w):
             if L in p.groups[gi].links:
                 minus[:, 6 * r:6 * r + 6, c] = cols.group(p.groups[gi], L, -1.0)[:, :, 0]
     conds = np.linalg.cond(np.concatenate([A, minus])[:, :, basis])
-    return free if np.all(np.isfinite(conds)) and conds.max() <= MAX_BASIS_CONDITION else None
+    if not (np.all(np.isfinite(conds)) and conds.max() <= MAX_BASIS_CONDITION):
+        return None
+    return free, _pivot_order(A[0][:, basis])
+
+
+def _pivot_order(M: np.ndarray) -> list:
+    """The row order partial pivoting takes on the square matrix M (the order the generated
+    kernel eliminates in without pivoting, :func:`.llvm_world.static_lu`)."""
+    from scipy.linalg import lu_factor                # noqa: PLC0415
+
+    order = list(range(M.shape[0]))
+    for c, p in enumerate(lu_factor(M)[1]):
+        order[c], order[p] = order[p], order[c]
+    return order
 
 
 def _hot_maps(an, plans, lowrank: dict) -> dict:
@@ -323,7 +348,7 @@ def _hot_maps(an, plans, lowrank: dict) -> dict:
     kin = forward(an.mech, an.tree, q, qd, qdd)
     try:
         _, sig = solve_blocks(an, plans, kin, inertia_load(an, kin), q)
-    except (SignError, np.linalg.LinAlgError):
+    except (SignError, SharingError, np.linalg.LinAlgError):
         return {}
     out = {}
     for bi in lowrank:

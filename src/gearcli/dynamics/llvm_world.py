@@ -74,6 +74,54 @@ def eliminate(e: Emitter, A: list, r: list) -> list:
     return [e.b.select(singular, nan, e.const(v)) for v in x]
 
 
+PIVOT_GROWTH = 100.0
+"""A static pivot smaller than the largest entry below it by more than this factor sends
+the sample's solve to the pivoting loop code (:func:`static_lu`).  Measured on servo_joint
+(60,000 random samples, q to +-50 rad; against the numpy path's KKT solve): 4 gives 1.5e-15
+of the sample's largest load but takes the loop code for most samples (18,000 samples/s),
+32 1.1e-14 (75,000), 100 3.1e-14 (244,000), 1e4 1.6e-12 (305,000): a moment row's entries
+are a force row's times a lever of ~0.02 m, so ratios of ~50 are the units, not a poor
+pivot."""
+
+
+def static_lu(e: Emitter, A: list, B: list, order: list):
+    """(X, bad): X = A^-1 B (A (k, k), B (k, m), lists of rows of values) by elimination in
+    the fixed row order ``order`` (partial pivoting's order at the home pose,
+    :func:`.kernel_program._free_columns`), straight-line and without selects, so the zeros
+    of the matrix's structure fold away; ``bad`` (i1) is true when a pivot is smaller than
+    the largest entry below it by more than :data:`PIVOT_GROWTH` (the caller then solves
+    with pivoting) or zero."""
+    k = len(A)
+    A = [list(A[i]) for i in order]
+    X = [list(B[i]) for i in order]
+    bad = ir.Constant(I1, 0)
+    for c in range(k):
+        piv = A[c][c]
+        below = [A[i][c] for i in range(c + 1, k) if not (isinstance(A[i][c], float) and A[i][c] == 0.0)]
+        if isinstance(piv, float):
+            if piv == 0.0:
+                return X, ir.Constant(I1, 1)
+        else:
+            a = e.call("fabs", piv)
+            bad = e.b.or_(bad, e.b.fcmp_ordered("==", a, ir.Constant(D, 0.0)))
+            for v in below:
+                bad = e.b.or_(bad, e.b.fcmp_ordered(">", e.const(e.call("fabs", v)), e.const(e.mul(PIVOT_GROWTH, a))))
+        for i in range(c + 1, k):
+            if isinstance(A[i][c], float) and A[i][c] == 0.0:
+                continue
+            f = e.div(A[i][c], piv)
+            for j in range(c + 1, k):
+                A[i][j] = e.sub(A[i][j], e.mul(f, A[c][j]))
+            X[i] = [e.sub(X[i][h], e.mul(f, X[c][h])) for h in range(len(X[i]))]
+    for c in range(k - 1, -1, -1):
+        for h in range(len(X[c])):
+            v = X[c][h]
+            for j in range(c + 1, k):
+                v = e.sub(v, e.mul(A[c][j], X[j][h]))
+            X[c][h] = e.div(v, A[c][c])
+    return X, bad
+
+
 class WorldBlock:
     """A block solved in world axes: its matrix from the terms, for a sign pattern p.
 
@@ -106,20 +154,42 @@ class WorldBlock:
 
     def _by_basis(self, e: Emitter, A: list, r: list) -> list:
         """The least-load solution through the basis A_B (every column but the d ``free``):
-        [p | Q] = A_B^-1 [r | A_free] (:mod:`.llvm_solve`), then the free unknowns from
+        [p | Q] = A_B^-1 [r | A_free] (:func:`static_lu` in the stored row order, or the
+        pivoting loop code of :mod:`.llvm_solve` when a static pivot is poor), then the free unknowns from
         (Q^T W_B Q + W_free) x_free = Q^T W_B p (d x d, :func:`eliminate`) and x_B = p - Q x_free:
         the minimiser of sum w x^2 over the solutions of A x = r."""
-        k, free, w = len(r), self.free, self.weights
+        k, (free, order), w = len(r), self.free, self.weights
         basis = [j for j in range(self.n) if j not in free]
         m = 1 + len(free)
+        AB = [[A[i][j] for j in basis] for i in range(k)]
+        RHS = [[r[i]] + [A[i][j] for j in free] for i in range(k)]
+        fast, bad = static_lu(e, AB, RHS, order)
+        fast = [[e.const(v) for v in row] for row in fast]
+        fn = self.fn
+        slow, done = fn.append_basic_block("basis_pivot"), fn.append_basic_block("basis_done")
+        pre = e.b.block
+        e.b.cbranch(bad, slow, done)
+        e.b.position_at_end(slow)
         M, X = self._stack((k * k, k * m))
         for i in range(k):
-            for a, j in enumerate(basis):
-                e.store(A[i][j], M, i * k + a)
-            for h, v in enumerate([r[i]] + [A[i][j] for j in free]):
-                e.store(v, X, i * m + h)
+            for a in range(k):
+                e.store(AB[i][a], M, i * k + a)
+            for h in range(m):
+                e.store(RHS[i][h], X, i * m + h)
         e.b.call(solve_function(e.module, k, m), [M, X])
-        P = [[e.load(X, i * m + h) for h in range(m)] for i in range(k)]
+        loaded = [[e.load(X, i * m + h) for h in range(m)] for i in range(k)]
+        slow_end = e.b.block
+        e.b.branch(done)
+        e.b.position_at_end(done)
+        P = []
+        for i in range(k):
+            row = []
+            for h in range(m):
+                phi = e.b.phi(D)
+                phi.add_incoming(fast[i][h], pre)
+                phi.add_incoming(loaded[i][h], slow_end)
+                row.append(phi)
+            P.append(row)
         wb = [(a, float(w[j])) for a, j in enumerate(basis) if w[j] > 0]
         S = [[e.add(float(w[free[g]]) if g == h else 0.0,
                     e.dot([e.mul(wj, P[a][1 + g]) for a, wj in wb], [P[a][1 + h] for a, _ in wb]))
