@@ -45,6 +45,7 @@ from .blocks import _primary_side, make_plans
 from .output_maps import output_constants
 from .pattern_maps import hot_patterns, low_rank
 from .sharing import SharingError, mesh_weights
+from .signs import MAX_EXHAUSTIVE
 from .kernel_terms import general_terms, local_inverse
 
 I64 = np.int64
@@ -221,6 +222,8 @@ def build_program(an, plans=None) -> Program:
     """The :class:`Program` of ``an`` (``plans`` from :func:`.blocks.make_plans`); not
     ``covered`` when a redundant block has no constant frame."""
     plans = make_plans(an) if plans is None else plans
+    if any(len(p.signed) > MAX_EXHAUSTIVE for p in plans):   # a pattern is an i64 in the code; numpy's search
+        return Program((), (), 0, {}, [], [], False, numba_ok=False)
     try:
         lowrank = {bi: low_rank(p.Ainv) for bi, p in enumerate(plans)
                    if p.F is not None and (1 << len(p.signed)) > MAX_PATTERNS}
@@ -331,14 +334,15 @@ def _pivot_order(M: np.ndarray) -> list:
 
 def _hot_maps(an, plans, lowrank: dict) -> dict:
     """{block: (hot pattern indices, their maps)} of the :class:`~.pattern_maps.LowRank`
-    blocks: the patterns the numpy path meets on 256 random motions of the mechanism (a
-    fixed seed; :func:`~.pattern_maps.hot_patterns`), none where that solve fails."""
+    blocks: the patterns the sign search settles on within its first m + 1 trials (every t
+    positive, then the trial's own signs) for 256 random motions of the mechanism (a fixed
+    seed; the block's own d'Alembert loads, without the wrenches of earlier blocks: a hint
+    for speed, not a result; :func:`~.pattern_maps.hot_patterns`)."""
     if not lowrank:
         return {}
-    from .blocks import solve_blocks              # noqa: PLC0415
+    from .blocks import _rotate, _shift            # noqa: PLC0415
     from .inertia import inertia_load             # noqa: PLC0415
     from .kinematics import forward               # noqa: PLC0415
-    from .signs import SignError, pattern_index   # noqa: PLC0415
 
     rng = np.random.default_rng(18)
     n = 256
@@ -346,18 +350,44 @@ def _hot_maps(an, plans, lowrank: dict) -> dict:
           rng.normal(size=(n, an.dof)) * 20.0]
     q, qd, qdd = (v @ np.asarray(an.S, float).T for v in qi)
     kin = forward(an.mech, an.tree, q, qd, qdd)
-    try:
-        _, sig = solve_blocks(an, plans, kin, inertia_load(an, kin), q)
-    except (SignError, SharingError, np.linalg.LinAlgError):
-        return {}
+    b = inertia_load(an, kin)
     out = {}
-    for bi in lowrank:
+    for bi, lr in lowrank.items():
         p = plans[bi]
-        signs = np.column_stack([sig[(p.groups[gi].kind, p.groups[gi].index)] for gi in p.signed])
-        counts: dict = {}
-        for row in signs:
-            k = pattern_index(row)
-            counts[k] = counts.get(k, 0) + 1
+        oF = kin.o[p.F]
+        parts = [_shift(b[L], kin.o[L], oF) for L in p.links]
+        r = np.concatenate([w if p.F == an.tree.base else _rotate(kin.R[p.F], w, transpose=True) for w in parts],
+                           axis=1)
+        counts = _settled(lr, r, [int(p.offs[gi]) for gi in p.signed])
         hot = hot_patterns(counts)
-        out[bi] = (hot, np.array([p.Ainv[k] for k in hot]))
+        try:
+            out[bi] = (hot, np.array([p.Ainv[k] for k in hot]))
+        except (np.linalg.LinAlgError, SharingError):
+            continue
     return out
+
+
+def _settled(lr, r: np.ndarray, tcols: list) -> dict:
+    """{pattern index: samples} of the rows r (N, 6B) settled by the first m + 1 trials of
+    the sign search (:func:`~.signs.resolve_signs`), solved by ``lr`` (LowRank.solve)."""
+    from .signs import TOL_SIGN, pattern_index    # noqa: PLC0415
+
+    m = len(tcols)
+    scale = 1.0 + np.abs(r).max(axis=1)
+    todo, signs, counts = np.arange(r.shape[0]), np.ones((r.shape[0], m)), {}
+    for _ in range(m + 1):
+        left = []
+        for k in np.unique([pattern_index(s) for s in signs[todo]]):
+            idx = todo[[pattern_index(s) == k for s in signs[todo]]]
+            sg = signs[idx[0]]
+            with np.errstate(all="ignore"):
+                t = lr.solve(sg, r[idx])[:, tcols]
+            ok = np.all(-sg * t <= TOL_SIGN * scale[idx, None], axis=1)
+            counts[int(k)] = counts.get(int(k), 0) + int(ok.sum())
+            signs[idx[~ok]] = np.where(t[~ok] < 0, -1.0, 1.0)
+            left.append(idx[~ok])
+        todo = np.concatenate(left) if left else todo[:0]
+        if todo.size == 0:
+            break
+    return {k: v for k, v in counts.items() if v}
+

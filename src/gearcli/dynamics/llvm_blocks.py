@@ -23,7 +23,7 @@ from .llvm_world import LowRankBlock, WorldBlock
 def problem(prog) -> str | None:
     """Why the generated kernel cannot solve ``prog``'s mechanism, or None."""
     if not prog.covered:
-        return "a block with many sign patterns has a singular separating-force-free matrix"
+        return "a block has more than 16 signed meshes, or a singular separating-force-free matrix"
     return None
 
 

@@ -128,7 +128,8 @@ class Solver:
         if self._program is None and self.kernel_problem is None:
             self._program = build_program(self.an, self.plans)
             if not self._program.covered:
-                self.kernel_problem = "a block with many sign patterns has a singular separating-force-free matrix"
+                self.kernel_problem = ("a block has more than 16 signed meshes, or a singular "
+                                       "separating-force-free matrix")
         return self._program if self.kernel_problem is None else None
 
     def llvm_kernel(self):
