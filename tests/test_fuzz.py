@@ -25,7 +25,7 @@ reader; the URDF exports of the three new mechanisms, mutated.
 
 Profiles (``GEARCLI_FUZZ``): ``ci`` (default; deterministic, well under 2 minutes) and
 ``long`` (``GEARCLI_FUZZ=long python -m pytest tests/test_fuzz.py``; 2,500 inputs per
-target).  With ``GEARCLI_FUZZ_RECORD=stats.jsonl`` problems are recorded (one JSON line
+target, or ``GEARCLI_FUZZ_EXAMPLES``).  With ``GEARCLI_FUZZ_RECORD=stats.jsonl`` problems are recorded (one JSON line
 per generated input, reproducer bytes included) instead of failing the test, so a long run
 reports figures: inputs, tracebacks, hangs, bad exits, leftover files.
 """
@@ -55,7 +55,8 @@ HANG_SECONDS = 30
 
 settings.register_profile("ci", max_examples=40, deadline=None, derandomize=True, database=None,
                           suppress_health_check=list(HealthCheck), print_blob=True)
-settings.register_profile("long", max_examples=2500, deadline=None, database=None,
+settings.register_profile("long", max_examples=int(os.environ.get("GEARCLI_FUZZ_EXAMPLES", "2500")),
+                          deadline=None, database=None,
                           suppress_health_check=list(HealthCheck), print_blob=True)
 PROFILE = os.environ.get("GEARCLI_FUZZ", "ci")
 settings.load_profile(PROFILE)
