@@ -206,6 +206,8 @@ def table_of(path: Path) -> dict:
 def non_finite_in(path: Path) -> list[str]:
     """A problem when an output file holds a NaN or an infinity (or cannot be read back)."""
     import numpy as np
+    if path.suffix.lower() == ".json":     # strings may say 'inf' (a case named so): parse, look at numbers
+        return _non_finite_json(path)
     if path.suffix.lower() not in (".parquet", ".feather", ".npz"):
         text = path.read_bytes()
         if path.suffix.lower() == ".csv":       # the header holds the file's names ('5-inf' is a fine gear name)
@@ -217,6 +219,17 @@ def non_finite_in(path: Path) -> list[str]:
         return [f"output {path.name} unreadable: {type(exc).__name__}: {exc}"[:300]]
     bad = [k for k, v in cols.items() if v.dtype.kind == "f" and not np.isfinite(v).all()]
     return [f"non-finite number written to {path.name} (column {bad[0]})"] if bad else []
+
+
+def _non_finite_json(path: Path) -> list[str]:
+    """A problem when a JSON output holds NaN/Infinity (not strict JSON) or is unreadable."""
+    def refuse(token):
+        raise ValueError(f"{token} in the JSON")
+    try:
+        json.loads(path.read_text(), parse_constant=refuse)
+    except ValueError as exc:
+        return [f"non-finite number written to {path.name}: {exc}"[:300]]
+    return []
 
 
 def verdict(target: str, problems_found: list[str], files: dict, exit_code=None) -> None:
@@ -238,6 +251,15 @@ def run_case(target: str, files: dict, args_of, outputs=("out.csv",)) -> None:
             (work / name).write_bytes(data)
         result, hung = run_cli(args_of(work))
         verdict(target, problems(result, hung, work, files, outputs), files, None if hung else result.exit_code)
+
+
+def test_non_finite_oracle_reads_json_numbers_not_strings(tmp_path):
+    """A JSON report is flagged for NaN/Infinity among its numbers, not for a case named 'inf'
+    (the final long run's one manifest finding)."""
+    ok, bad = tmp_path / "ok.json", tmp_path / "bad.json"
+    ok.write_text('{"checks": [{"case": "inf", "value": 1.5, "limit": null}]}')
+    bad.write_text('{"checks": [{"case": "c", "value": Infinity}]}')
+    assert non_finite_in(ok) == [] and len(non_finite_in(bad)) == 1
 
 
 def test_non_finite_oracle_reads_csv_data_not_names(tmp_path):

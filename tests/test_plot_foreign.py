@@ -297,3 +297,24 @@ def test_long_patterns_are_names_or_refused(run_cli, tmp_path):
     refused(run_cli("plot", path, "*x" * 65_000, "-o", tmp_path / "g.png"),
             "a pattern with * ? [ of 130,000 characters is too long (at most 1,000")
     assert not (tmp_path / "g.png").exists()
+
+
+def test_bad_npz_archive_leaves_no_file_open(tmp_path):
+    """A zip that np.load cannot read as npz: refused, and the file is closed (np.load left
+    its own file object open, a ResourceWarning the long fuzz run found)."""
+    import gc
+    import warnings
+    import zipfile
+    from gearcli.report.loads_files import open_loads
+    path = tmp_path / "loads.npz"
+    with zipfile.ZipFile(path, "w") as z:
+        z.writestr("columns.npy", b"not an npy array")
+    data = path.read_bytes()                      # a central directory entry with a bad magic number
+    path.write_bytes(data.replace(b"PK\x01\x02", b"PK\x01\x03"))
+    assert zipfile.is_zipfile(path)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with pytest.raises(Exception):
+            open_loads(path)
+        gc.collect()
+    assert not [w for w in caught if issubclass(w.category, ResourceWarning)]

@@ -247,7 +247,8 @@ def _open_csv(path) -> LoadsFile:
 def _open_npz(path) -> LoadsFile:
     if not zipfile.is_zipfile(path):     # np.load: EOFError on an empty file, pickle talk on others
         raise ValueError("not an npz file (no zip archive)")
-    with np.load(path, allow_pickle=False) as z:
+    # our own file object: np.load leaves the file it opened unclosed when the archive is bad
+    with open(path, "rb") as f, np.load(f, allow_pickle=False) as z:
         missing = [k for k in ("columns", "loads") if k not in z.files]
         if missing:
             raise GearcliError(f"{path}: not a loads table written by gearcli solve (no array "
