@@ -16,21 +16,20 @@ BUNDLED = ("paper_2dof", "bendix_wrist", "coaxial_fig5")
 def test_help(run_cli):
     res = run_cli("--help")
     assert res.exit_code == 0
-    assert "Usage" in res.stdout
-    for command in ("check", "graph"):
+    for command in ("check", "graph", "solve", "export", "verify", "plot"):   # gearcli's, not click's words
         assert command in res.stdout
 
 
 def test_no_arguments_shows_help(run_cli):
     res = run_cli()
-    assert "Usage" in res.stdout + res.stderr
+    assert all(command in res.stdout + res.stderr for command in ("check", "graph", "solve"))
 
 
 @pytest.mark.parametrize("command", ["check", "graph"])
 def test_command_help(run_cli, command):
     res = run_cli(command, "--help")
     assert res.exit_code == 0
-    assert "Usage" in res.stdout and "MECH" in res.stdout
+    assert "MECH" in res.stdout   # gearcli's argument name (the usage line's own words are click's)
     assert "kg" in res.stdout  # units are documented
 
 
