@@ -103,7 +103,7 @@ def test_top_level_list(run_cli, tmp_path):
 def test_yaml_syntax_error(run_cli, tmp_path):
     text = replaced("    mass: 4.0", "    mass: 4.0: kg")
     assert_bad(run_cli, tmp_path, text,
-               [("", line_of(text, "4.0: kg"), r"^YAML syntax error: mapping values are not allowed")])
+               [("", line_of(text, "4.0: kg"), r"^YAML syntax error: \S")])   # the problem text is libyaml's
 
 
 def test_yaml_unclosed_flow_mapping(run_cli, tmp_path):
