@@ -12,6 +12,7 @@ from gearcli.design import bearings as B
 from gearcli.design import gears as G
 from gearcli.design import iso281 as I
 from gearcli.model.ratings import BEARING_FACTOR_DEFAULTS
+from gearcli.model.shaft import split_two_bearings
 from gearcli.report import rms as Rms
 
 LBF = 4.4482216152605      # N
@@ -74,11 +75,11 @@ def test_two_bearing_split_is_the_simply_supported_shaft():
     L, a = 0.12, 0.03
     W = np.array([[300.0, -400.0, 50.0], [0.0, 1000.0, 0.0]])
     M = np.cross(np.array([0.0, 0.0, a]), W)
-    R1, R2 = B.split_two_bearings(W, M, 0.0, L)
+    R1, R2 = split_two_bearings(W, M, 0.0, L)
     assert R1 == pytest.approx(W[:, :2] * (L - a) / L)
     assert R2 == pytest.approx(W[:, :2] * a / L)
     # overhung load beyond the second support: the first reaction reverses (lever rule)
-    R1, R2 = B.split_two_bearings(W, np.cross(np.array([0.0, 0.0, 0.2]), W), 0.0, L)
+    R1, R2 = split_two_bearings(W, np.cross(np.array([0.0, 0.0, 0.2]), W), 0.0, L)
     assert R1 == pytest.approx(W[:, :2] * (L - 0.2) / L)
     assert R2 == pytest.approx(W[:, :2] * 0.2 / L)
 

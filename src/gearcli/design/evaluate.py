@@ -19,6 +19,7 @@ from . import sizing
 from .checks import Check
 from ..report.rms import running_rms, rms_of, square_integral
 from .gears import hertz_contact_stress, lewis_bending_stress
+from ..model.shaft import split_two_bearings
 
 
 @dataclass(frozen=True)
@@ -35,7 +36,7 @@ def bearing_loads(s: Samples, joint: str, bearings) -> list[tuple[np.ndarray, np
     """Radial and axial load (N) on each bearing of a joint, per sample.
 
     One bearing takes the whole reaction force; two share its force and tilting moment as
-    a shaft on two supports (:func:`gearcli.design.bearings.split_two_bearings`), the
+    a shaft on two supports (:func:`gearcli.model.shaft.split_two_bearings`), the
     locating one taking the axial force.
     """
     c = s.cols
@@ -45,7 +46,7 @@ def bearing_loads(s: Samples, joint: str, bearings) -> list[tuple[np.ndarray, np
         return [(c[f"joint:{joint}:radial"], axial)]
     F = np.column_stack([c[f"joint:{joint}:f{a}"] for a in "xy"])      # the split needs x, y only
     M = np.column_stack([c[f"joint:{joint}:m{a}"] for a in "xy"])
-    R = B.split_two_bearings(F, M, bearings[0].position, bearings[1].position)
+    R = split_two_bearings(F, M, bearings[0].position, bearings[1].position)
     return [(np.hypot(r[:, 0], r[:, 1]), axial if b.locating else none) for r, b in zip(R, bearings)]
 
 

@@ -8,7 +8,7 @@ relative rotation with
 reversed on the parent, P_b the magnitude of the bearing's load vector (radial and axial
 together), from gearcli's per-bearing split of the joint reaction: one bearing takes the
 whole reaction force, P = |f|; two share the force and the tilting moment as a shaft on two
-supports (:func:`gearcli.design.bearings.split_two_bearings`, positions along the axis from
+supports (:func:`gearcli.model.shaft.split_two_bearings`, positions along the axis from
 the joint origin), the locating one taking the axial force.  Revolute joints only.
 
 The moments depend on the reactions they change, so the balance equations become
