@@ -15,8 +15,8 @@ Sources
   the Palmgren-Miner sum of ISO 281 section 9.3.3).
 * ISO 76:2006, *Rolling bearings -- Static load ratings*: static equivalent load
   P0 = X0 Fr + Y0 Fa, not less than Fr (clause 6), static safety s0 = C0 / P0.
-* The split of a joint reaction between two bearings (:mod:`gearcli.model.shaft`) is the statics of a shaft on two
-  supports (any mechanics text, e.g. Shigley's *Mechanical Engineering Design*, 10th ed.,
+* The split of a joint reaction between two bearings (:mod:`gearcli.model.shaft`) is the
+  statics of a shaft on two supports (any mechanics text, e.g. Shigley's *Mechanical Engineering Design*, 10th ed.,
   ch. 3, shaft reactions; Harris & Kotzalas ch. 3).
 """
 from __future__ import annotations
