@@ -1,4 +1,4 @@
-"""What the generated llvm kernel costs to make, against the numba kernel's start; prints figures.
+"""What the generated llvm kernel costs to make, cold and from the disk cache; prints figures.
 
     python benchmarks/bench_compile.py [--repeat 3] [--startup-repeat 5]
 
@@ -6,14 +6,11 @@ Per mechanism (paper_2dof, Bendix wrist, planetary_3p, UR5, Panda, Talos full), 
 measurement in a fresh Python process (medians over --repeat): the llvm kernel's IR
 generation and LLVM optimisation + machine code (``LlvmKernel.build_seconds``,
 ``compile_seconds``), the size of its IR, the first ``solve(backend="llvm")`` of 100
-samples (import of llvmlite included) and the first ``solve(backend="kernel")`` of 100
-samples (numba import and its compiled code from the disk cache), and the estimates
-"auto" uses (:func:`gearcli.dynamics.backends.llvm_compile_estimate`, without and with the
-kernel on disk).  "cold": each process with an empty llvm disk cache (its own
+samples (import of llvmlite included).  "cold": each process with an empty llvm disk cache (its own
 ``GEARCLI_CACHE_DIR``); "cached": a fresh process whose cache holds the kernel (stored by
 the cold runs): the IR is still built, the O3 passes and code generation are a load.  Then
 the wall time of ``gearcli solve MECH traj.csv -o out.parquet`` on 100 samples (backend
-auto, fresh processes, cold and cached runs interleaved, medians).  Load average at the
+auto: numpy by the first-call rule when cold, llvm when cached; fresh processes, cold and cached runs interleaved, medians).  Load average at the
 start and the end.
 """
 from __future__ import annotations
@@ -38,14 +35,13 @@ t0 = time.perf_counter()
 import numpy as np
 from gearcli import analyse, load_mechanism, solve
 from gearcli.dynamics.solve import solver_for
-from gearcli.dynamics.backends import llvm_compile_estimate
 path, backend = sys.argv[1], sys.argv[2]
 an = analyse(load_mechanism(path))
 q = np.zeros((100, an.dof))
 t1 = time.perf_counter()
 solve(an, q, q, q, backend=backend, jobs=1)
 t2 = time.perf_counter()
-out = {"first": t2 - t1, "estimate": llvm_compile_estimate(an), "on_disk": llvm_compile_estimate(an, True)}
+out = {"first": t2 - t1}
 if backend == "llvm":
     k = solver_for(an).llvm_kernel()
     out.update(build=k.build_seconds, compile=k.compile_seconds, ir_kb=len(k.jit.ir) / 1e3,
@@ -86,17 +82,15 @@ def main() -> None:
     args = ap.parse_args()
     print(f"# llvm kernel: compile cost, fresh processes, medians of {args.repeat}\n{load_line()} at start\n")
     print("| mechanism | moving links | IR build | LLVM (O3), cold | IR text + load, cached | IR size | instructions | "
-          "first llvm solve, cold | first llvm solve, cached | first kernel solve (numba cache) | "
-          "auto's estimate, cold / cached |\n|---|---|---|---|---|---|---|---|---|---|---|")
+          "first llvm solve, cold | first llvm solve, cached |\n|---|---|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
         for name, path in subjects():
             med, warm = llvm_runs(path, args.repeat, Path(tmp) / name)
-            kern = [child(path, "kernel", Path(tmp) / name / "cold0")["first"] for _ in range(args.repeat)]
             from gearcli import analyse, load_mechanism  # noqa: PLC0415
             links = len(analyse(load_mechanism(path)).tree.moving)
             print(f"| {name} | {links} | {med['build']:.3f} s | {med['compile']:.3f} s | {warm['compile']:.3f} s | "
-                  f"{med['ir_kb']:.0f} kB | {med['instructions']:.0f} | {med['first']:.2f} s | {warm['first']:.2f} s | "
-                  f"{np.median(kern):.2f} s | {med['estimate']:.2f} / {med['on_disk']:.2f} s |", flush=True)
+                  f"{med['ir_kb']:.0f} kB | {med['instructions']:.0f} | {med['first']:.2f} s | {warm['first']:.2f} s |",
+                  flush=True)
     print(f"\n{load_line()}\n\n| `gearcli solve`, 100 samples | cold cache | cached | cached / cold |\n|---|---|---|---|")
     for name, path in subjects():
         if name in ("paper_2dof", "bendix_wrist", "Panda", "Talos full"):

@@ -4,10 +4,10 @@
 
 Reports, as medians over --repeat runs, with the load average:
   * samples/s of the library solver core on the bundled paper_2dof and bendix_wrist
-    mechanisms: the compiled kernel (backend="kernel") with 1 and 2 jobs, the numpy block
+    mechanisms: the generated kernel (backend="llvm") with 1 and 2 jobs, the numpy block
     path, the full simultaneous solve, and the ratios kernel/numpy and 2 jobs/1 job;
   * with --first-call: the kernel's first call in a fresh process, compiling (an empty
-    NUMBA_CACHE_DIR) and then loading the compiled code from that disk cache;
+    GEARCLI_CACHE_DIR) and then loading the machine code from that disk cache;
   * wall time of the whole `gearcli solve` command (CSV in and out) on --samples samples of
     paper_2dof;
   * with --big N: peak resident memory of `gearcli solve` on N samples (output discarded).
@@ -50,15 +50,15 @@ def median_rate(fn, n, repeat):
 def core(repeat: int, n: int) -> None:
     """samples/s of the compiled kernel and the numpy path, one and two jobs, same run."""
     print(f"library solver core, {n} random samples, median of {repeat}; {load_line()}")
-    cols = ("kernel j1", "kernel j2", "numpy", "full", "kernel/numpy", "j2/j1")
+    cols = ("llvm j1", "llvm j2", "numpy", "full", "llvm/numpy", "j2/j1")
     print(f"{'mechanism':<16}" + "".join(f"{c:>14}" for c in cols))
     for name in ("paper_2dof", "bendix_wrist"):
         an = analyse(load_mechanism(ROOT / "mechanisms" / f"{name}.yaml"))
         rng = np.random.default_rng(0)
         q, qd, qdd = (rng.normal(size=(n, an.dof)) for _ in range(3))
-        solve(an, q[:100], qd[:100], qdd[:100], backend="kernel")    # compiled (or cached) once
-        k1, _ = median_rate(lambda: solve(an, q, qd, qdd, backend="kernel", jobs=1), n, repeat)
-        k2, _ = median_rate(lambda: solve(an, q, qd, qdd, backend="kernel", jobs=2), n, repeat)
+        solve(an, q[:100], qd[:100], qdd[:100], backend="llvm")    # compiled (or cached) once
+        k1, _ = median_rate(lambda: solve(an, q, qd, qdd, backend="llvm", jobs=1), n, repeat)
+        k2, _ = median_rate(lambda: solve(an, q, qd, qdd, backend="llvm", jobs=2), n, repeat)
         rb, _ = median_rate(lambda: solve(an, q, qd, qdd, backend="numpy"), n, repeat)
         m = max(n // 10, 1000)
         rf, _ = median_rate(lambda: solve(an, q[:m], qd[:m], qdd[:m], method="full"), m, repeat)
@@ -72,10 +72,10 @@ def first_calls() -> None:
     code = ("import time, numpy as np; from pathlib import Path; from gearcli import analyse, load_mechanism, solve; "
             f"an = analyse(load_mechanism(Path({str(ROOT / 'mechanisms' / 'bendix_wrist.yaml')!r}))); "
             "q = np.zeros((10, an.dof)); t = time.process_time(); w = time.perf_counter(); "
-            "solve(an, q, q, q, backend='kernel', jobs=1); "
+            "solve(an, q, q, q, backend='llvm', jobs=1); "
             "print(f'{time.perf_counter() - w:.2f} s wall, {time.process_time() - t:.2f} s CPU')")
     with tempfile.TemporaryDirectory() as d:
-        env = dict(os.environ, NUMBA_CACHE_DIR=d)    # an empty cache: the first run compiles
+        env = dict(os.environ, GEARCLI_CACHE_DIR=d)    # an empty cache: the first run compiles
         for what in ("first call, compiling", "first call of a new process, from the disk cache"):
             out = subprocess.run([sys.executable, "-c", code], env=env, check=True, capture_output=True, text=True)
             print(f"kernel {what}: {out.stdout.strip()}")

@@ -51,7 +51,10 @@ from gearcli import analyse, load_mechanism, solve  # noqa: E402
 from gearcli.report.urdf_writer import export_urdf  # noqa: E402
 
 try:
-    from gearcli.dynamics.solve import BACKENDS  # noqa: E402
+    try:
+        from gearcli.dynamics.backends import BACKENDS  # noqa: E402
+    except ImportError:            # an older gearcli: they were in solve
+        from gearcli.dynamics.solve import BACKENDS  # noqa: E402
 except ImportError:          # an older gearcli
     BACKENDS = ()
 
@@ -157,7 +160,8 @@ def gearcli_rates(an, q, qd, qdd, repeat: int) -> dict:
     """samples/s of gearcli.solve: kernel / numpy backends (1 and 2 workers), full method."""
     n = q.shape[0]
     out = {}
-    backends = ((("llvm",) if "llvm" in BACKENDS else ()) + ("kernel", "numpy")) if "backend" in SOLVE_PARAMS else (None,)
+    backends = ((("llvm",) if "llvm" in BACKENDS else ()) + (("kernel",) if "kernel" in BACKENDS else ())
+                + ("numpy",)) if "backend" in SOLVE_PARAMS else (None,)
     for backend in backends:
         for jobs in ((1, 2) if "jobs" in SOLVE_PARAMS and backend != "numpy" else (None,)):   # numpy: 1 thread
             kw = {} if backend is None else {"backend": backend}
@@ -328,7 +332,8 @@ def links_section(n: int, repeat: int, sizes) -> None:
     from big_mechanisms import geared_chain
     from gearcli.io.yaml_reader import parse_mechanism
 
-    backends = ((("llvm",) if "llvm" in BACKENDS else ()) + ("kernel", "numpy")) if "backend" in SOLVE_PARAMS else ("default",)
+    backends = ((("llvm",) if "llvm" in BACKENDS else ()) + (("kernel",) if "kernel" in BACKENDS else ())
+                + ("numpy",)) if "backend" in SOLVE_PARAMS else ("default",)
     print(f"\n## Per-sample cost against mechanism size: geared chains (link i driven by a spur pinion on "
           f"link i-1), {n:,} samples, one worker, median of {repeat}\n")
     llvm = "llvm" in backends
@@ -386,7 +391,8 @@ print(float(np.median(times)))
 
 
 def samples_section(sizes) -> None:
-    backends = ((("llvm", "llvm+out") if "llvm" in BACKENDS else ()) + ("kernel", "numpy")) if "backend" in SOLVE_PARAMS \
+    backends = ((("llvm", "llvm+out") if "llvm" in BACKENDS else ()) + (("kernel",) if "kernel" in BACKENDS else ())
+                + ("numpy",)) if "backend" in SOLVE_PARAMS \
         else ("default",)
     print("\n## Per-sample cost and peak memory against the number of samples (Bendix wrist, library solve, "
           "one thread, in chunks of 100,000 generated samples, each N in a fresh process; below 1e5 the median "

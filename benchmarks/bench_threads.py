@@ -93,7 +93,7 @@ def fmt(r: float) -> str:
     return f"{r / 1e6:.2f}M" if r >= 1e6 else f"{r / 1e3:.0f}k"
 
 
-def threads_table(sizes, rounds: int, backends=("llvm", "kernel"), conditions=("quiet", "busy"),
+def threads_table(sizes, rounds: int, backends=("llvm",), conditions=("quiet", "busy"),
                   outputs=("fresh", "out=")) -> None:
     """The table (markdown) of every condition, backend, size and output mode."""
     an = analyse(load_mechanism(MECHS / "bendix_wrist.yaml"))

@@ -85,11 +85,9 @@ class Mutation:
     @property
     def default_edits(self) -> tuple:
         """The edit choosing the path the mutated code is on as "auto"'s: numpy for the
-        array implementation, the numba kernel for its modules, llvm for the generator's."""
+        array implementation, llvm for the generator's."""
         if self.numpy_path:
             return (NUMPY_DEFAULT,)
-        if any(e[0].startswith("dynamics/kernel") for e in self.edits):
-            return (KERNEL_DEFAULT,)
         if any(e[0].startswith("dynamics/llvm") for e in self.edits):
             return (LLVM_DEFAULT,)
         return ()
@@ -97,12 +95,9 @@ class Mutation:
 
 NUMPY_ONLY = {"dynamics/kinematics.py", "dynamics/inertia.py", "dynamics/equations.py", "dynamics/losses.py"}
 # the edit that makes "auto" take the numpy path in a copy
-NUMPY_DEFAULT = ("dynamics/backends.py", 'if backend == "numpy" or (backend == "auto" and method == "full"):',
-                 'if backend in ("numpy", "auto") or method == "full":')
-# the edits that make "auto" take the numba kernel / the llvm kernel whenever it can
-KERNEL_DEFAULT = ("dynamics/backends.py", 'if backend == "auto" and _auto_llvm(sol, n):', "if False:")
-LLVM_DEFAULT = ("dynamics/backends.py", 'if backend == "auto" and _auto_llvm(sol, n):',
-                'if backend == "auto" and sol.llvm_available():')
+NUMPY_DEFAULT = ("dynamics/backends.py", 'if backend == "numpy":', 'if backend in ("numpy", "auto"):')
+# the edit that makes "auto" take the llvm kernel whenever it can (no first-call rule)
+LLVM_DEFAULT = ("dynamics/backends.py", "note = _first_call(sol, n)", "note = None")
 
 
 MUTATIONS = [
@@ -177,21 +172,6 @@ MUTATIONS = [
     Mutation("loss-coulomb-sign", "joint Coulomb friction with the rate instead of against it",
              (("dynamics/losses.py", "return -fr.coulomb * np.sign(qd) - fr.viscous * qd",
                "return fr.coulomb * np.sign(qd) - fr.viscous * qd"),)),
-    # the compiled kernel (backend "auto" takes it for every bundled mechanism)
-    Mutation("kernel-gravity-sign", "kernel: gravity with the wrong sign in the d'Alembert force",
-             (("dynamics/kernel_links.py", "F = scale(sub(ac, (g[0], g[1], g[2])), m)",
-               "F = scale(add(ac, (g[0], g[1], g[2])), m)"),)),
-    Mutation("kernel-drop-w-x-z-qd", "kernel: angular acceleration without the w_parent x z qd term",
-             (("dynamics/kernel_links.py", "dwc = add(add(dwp, scale(z, qddk)), scale(cx(wp, z), qdk))",
-               "dwc = add(dwp, scale(z, qddk))"),)),
-    Mutation("kernel-propagation-sign", "kernel: a solved wrench passed on to a later link with the primary's sign",
-             (("dynamics/kernel.py", "s = 1.0 if L == P else -1.0", "s = 1.0"),)),
-    Mutation("kernel-child-basis-turn", "kernel: joint reaction turned to the child's basis by +q instead of -q",
-             (("dynamics/kernel.py", "X[gcol[g0 + c0 + h]] = cq * x0 + sq * x1",
-               "X[gcol[g0 + c0 + h]] = cq * x0 - sq * x1"),)),
-    Mutation("kernel-world-arm", "kernel: world-frame block, moment arm from the frame link's origin",
-             (("dynamics/kernel_world.py", "o[X, 0] + P[0] - o[L, 0], o[X, 1] + P[1] - o[L, 1], o[X, 2] + P[2] - o[L, 2]",
-               "P[0], P[1], P[2]"),)),
     # the generated llvm kernel
     Mutation("llvm-gravity-sign", "llvm: gravity with the wrong sign in the d'Alembert force",
              (("dynamics/llvm_links.py", "F = e.scale(e.vsub(ac, floats(g)), m)", "F = e.scale(e.vadd(ac, floats(g)), m)"),)),

@@ -15,7 +15,7 @@ number of bytes; a failing rename) must give:
 This session's features have their own targets: the bundled ``planetary_3p`` (``planets:``
 expansion, load sharing), ``rack_axis`` and ``helical_reduction`` mutated (also field by
 field: ``planets: 65``, ``kind: rack``, ``hand: x`` ...) under check/graph/export/solve, the
-kernel and numpy backends agreeing on every mutated mechanism; their trajectories solved to
+llvm and numpy backends agreeing on every mutated mechanism; their trajectories solved to
 ``-o`` .csv/.parquet/.feather/.npz/unknown extensions with ``--precision``, ``--jobs``,
 ``--backend`` and ``--method`` (bad values: exit 2, nothing written; binary tables read
 back and checked finite); a planetary with every kind of loss (mesh efficiency, joint and
@@ -357,7 +357,7 @@ class FullDiskRaw(io.FileIO):
        ext=st.sampled_from([".csv", ".csv", ".parquet", ".feather", ".npz"]))
 def test_fuzz_output_faults(fault, command, budget, tmpfile, ext):
     import gearcli.io.output as output
-    warm_kernel()   # numba's modules imported before os.O_TMPFILE is taken away below
+    warm_kernel()   # the compiled modules imported before os.O_TMPFILE is taken away below
 
     files = {"mech.yaml": (MECH_DIR / "paper_2dof.yaml").read_bytes(),
              "traj.csv": short_csv("paper_2dof_traj.csv")}
@@ -430,15 +430,15 @@ _WARM = []
 
 
 def warm_kernel() -> None:
-    """Compile (or load from numba's disk cache) the kernel and CSV writer once, outside the
-    hang alarm: the first compile takes 20 s CPU, more than the alarm on a busy machine."""
+    """Compile (or load from the disk caches) the llvm kernel and the CSV writer once, outside
+    the hang alarm: a first compile can take longer than the alarm on a busy machine."""
     if not _WARM:
         from typer.testing import CliRunner
 
         from gearcli.cli import app
         with tempfile.TemporaryDirectory(prefix="gearcli-fuzz-") as d:
             CliRunner().invoke(app, ["solve", str(MECH_DIR / "rack_axis.yaml"), str(MECH_DIR / "rack_axis_traj.csv"),
-                                     "-o", f"{d}/w.csv", "--backend", "kernel"])
+                                     "-o", f"{d}/w.csv", "--backend", "llvm"])
         _WARM.append(True)
 
 
@@ -493,7 +493,7 @@ def solved(work: Path, backend: str, out: str):
 @given(name=st.sampled_from(NEW_YAMLS), muts=new_mutations,
        command=st.sampled_from(["check", "graph", "json", "dot", "solve", "solve", "export"]))
 def test_fuzz_new_mechanisms(name, muts, command):
-    """Mutated planetary_3p / rack_axis / helical_reduction.  ``solve`` runs the kernel and the
+    """Mutated planetary_3p / rack_axis / helical_reduction.  ``solve`` runs the llvm kernel and the
     numpy backends: same exit status, same message, same numbers (1e-9 of each column's peak)."""
     warm_kernel()
     import numpy as np
@@ -510,7 +510,7 @@ def test_fuzz_new_mechanisms(name, muts, command):
             verdict("new-yaml", found, files, None if hung else result.exit_code)
             return
         found, codes, firsts, tables = [], [], [], []
-        for backend, out in (("kernel", "k.csv"), ("numpy", "n.csv")):
+        for backend, out in (("llvm", "k.csv"), ("numpy", "n.csv")):
             result, hung = solved(work, backend, out)
             found += problems(result, hung, work, files, ("k.csv", "n.csv"))
             if hung:
@@ -520,7 +520,7 @@ def test_fuzz_new_mechanisms(name, muts, command):
             if result.exit_code == 0 and (work / out).is_file():
                 tables.append(table_of(work / out))
         if len(codes) == 2 and (codes[0] != codes[1] or firsts[0] != firsts[1]):
-            found.append(f"backends disagree: kernel exit {codes[0]} {firsts[0]}, numpy exit {codes[1]} {firsts[1]}")
+            found.append(f"backends disagree: llvm exit {codes[0]} {firsts[0]}, numpy exit {codes[1]} {firsts[1]}")
         if len(tables) == 2 and (col := first_differing_column(*tables)) is not None:
             found.append(f"backends differ in column {col}")
         verdict("new-yaml", found, files, codes[-1] if codes else None)
@@ -609,7 +609,7 @@ KNOWN = {".csv", ".parquet", ".feather", ".npz", ""}   # no extension: CSV (READ
 @given(name=st.sampled_from(NEW_YAMLS), muts=st.lists(mutation(), max_size=3), n=st.sampled_from([2, 3, 5, 30]),
        ext=st.sampled_from(EXTS), precision=st.sampled_from([None] * 6 + [1, 6, 9, 17, 17, 0, 18, -1, "x", "9.5"]),
        jobs=st.sampled_from([None] * 4 + [1, 2, 3, 0, -1, "two"]),
-       backend=st.sampled_from([None, None, "auto", "kernel", "kernel", "numpy", "numba", ""]), degrees=st.booleans(),
+       backend=st.sampled_from([None, None, "auto", "llvm", "llvm", "numpy", "kernel", "numba", ""]), degrees=st.booleans(),
        method=st.sampled_from([None, None, "full"]))
 def test_fuzz_new_trajectories(name, muts, n, ext, precision, jobs, backend, degrees, method):
     """Mutated trajectories of the new mechanisms written in every format with every option;
@@ -629,7 +629,7 @@ def test_fuzz_new_trajectories(name, muts, n, ext, precision, jobs, backend, deg
         result, hung = run_cli(["solve", work / "mech.yaml", work / "traj.csv", "-o", work / out, *extra])
         found = problems(result, hung, work, files, (out,))
         bad_option = (ext.lower() not in KNOWN or precision not in (None, 1, 6, 9, 17)
-                      or jobs not in (None, 1, 2, 3) or backend not in (None, "auto", "kernel", "numpy"))
+                      or jobs not in (None, 1, 2, 3) or backend not in (None, "auto", "llvm", "numpy"))
         if not hung and bad_option and result.exit_code != 2:
             found.append(f"bad option or extension {ext!r} not refused (exit {result.exit_code})")
         if not hung and result.exit_code == 0 and not (work / out).is_file():

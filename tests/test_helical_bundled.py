@@ -248,7 +248,7 @@ def test_pinocchio_rnea_per_shaft_with_tooth_forces(mech_dir, an):
             assert rel_err(data.f[jid].vector, want) < 1e-9
 
 
-@pytest.mark.parametrize("backend", ["numpy", "kernel"])
+@pytest.mark.parametrize("backend", ["numpy", "llvm"])
 def test_block_equals_full_on_bundled_trajectory(mech_dir, an, backend):
     """Consistency check: the block schedule (both backends) against the full solve."""
     _, q, qd, qdd = trajectory(mech_dir)

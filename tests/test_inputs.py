@@ -24,7 +24,7 @@ def _motion(an, n=50):
     return [rng.uniform(-1, 1, (n, an.dof)) for _ in range(3)]
 
 
-@pytest.mark.parametrize("backend", ["numpy", "kernel", "llvm"])
+@pytest.mark.parametrize("backend", ["numpy", "llvm"])
 @pytest.mark.parametrize("which, value", [(0, np.nan), (1, np.inf), (2, -np.inf)])
 def test_non_finite_motion_is_named(bendix, backend, which, value):
     arrays = _motion(bendix)

@@ -1,5 +1,5 @@
-"""The generated kernel's own behaviour (backend "llvm"); its results against the numpy
-path are compared in test_kernel.py with the numba kernel's."""
+"""The generated kernel's own behaviour (backend "llvm") and "auto"'s choice; its results
+against the numpy path are compared in test_kernel.py."""
 from __future__ import annotations
 
 import subprocess
@@ -35,33 +35,41 @@ def test_compiled_once_per_solver_and_kept(monkeypatch, tmp_path):
     assert solver_for(an).llvm_kernel() is k
 
 
-def test_auto_policy(monkeypatch, tmp_path):
-    """"auto" takes llvm once compiled, or when its estimated compile time is at most what
-    the numba kernel costs extra for the call (its start when not loaded, then ~1 us a
-    sample more than llvm); a large mechanism (40 links) keeps the kernel for a small call
-    (an empty disk cache: nothing compiled before; see test_llvm_cache.py for a full one)."""
-    monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path))
-    import gearcli.dynamics.kernel  # noqa: F401, PLC0415  (the numba kernel loaded)
+def test_first_call_rule(monkeypatch, tmp_path):
+    """"auto" with the kernel neither compiled nor on disk: a call of fewer than
+    FIRST_CALL_SAMPLES samples (with those solved before) is solved by numpy, says why and
+    compiles nothing; a call reaching it compiles; once compiled (or on disk), every call
+    takes llvm.  Explicit backends ignore the rule."""
+    monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path))   # an empty disk cache
     an = analyse(load_mechanism(MECH / "helical_reduction.yaml"))
     sol = solver_for(an)
-    est = backends.llvm_compile_estimate(an)
-    assert 0 < est < backends.NUMBA_START_SECONDS
-    assert sol.backend(n=10) == "kernel"
-    assert sol.backend(n=int(est / backends.SAVED_SECONDS_PER_SAMPLE) + 1) == "llvm"
-    monkeypatch.delitem(sys.modules, "gearcli.dynamics.kernel")
-    assert sol.backend(n=10) == "llvm"                   # cheaper than starting numba
-    big = solver_for(analyse(parse_mechanism(serial_chain(40))))
-    assert backends.llvm_compile_estimate(big.an) > backends.NUMBA_START_SECONDS
-    assert big.backend(n=10) == "kernel" and big.backend(n=10**7) == "llvm"
-    big.samples_solved = 10**7                           # solved before in many small calls
-    assert big.backend(n=10) == "llvm"
-    monkeypatch.undo()
-    q = np.zeros((3, an.dof))
-    solve(an, q, q, q, backend="llvm")
-    assert sol.backend(n=10) == "llvm"                   # compiled: always
-    assert sol.backend("full", "auto", 10) == "numpy"
+    K = backends.FIRST_CALL_SAMPLES
+    q = np.zeros((10, an.dof))
+    res = solve(an, q, q, q)
+    assert res.backend == "numpy" and "first-call rule" in res.backend_note and not sol.compiled_llvm()
+    assert sol.choice(n=K - 11).path == "numpy" and sol.choice(n=K - 10).path == "llvm"   # 10 solved before
+    assert sol.choice(n=None).path == "llvm"                                               # a large call
+    assert sol.backend(backend="llvm", n=1) == "llvm" and not sol.compiled_llvm()         # choosing compiles nothing
+    big = np.zeros((K, an.dof))
+    res = solve(an, big, big, big)
+    assert res.backend == "llvm" and res.backend_note is None and sol.compiled_llvm()
+    res = solve(an, q, q, q)
+    assert res.backend == "llvm" and res.backend_note is None                            # compiled: always
+    other = solver_for(analyse(load_mechanism(MECH / "helical_reduction.yaml")))          # its code on disk now
+    assert other.choice(n=1).path == "llvm" and not other.compiled_llvm()
+    assert sol.backend("full", "auto", 10) == "numpy" and sol.choice("full", "auto", 10).note is None
     with pytest.raises(ValueError, match="backend 'llvm' solves method 'block' only"):
         sol.backend("full", "llvm")
+
+
+def test_many_small_calls_compile_once_they_add_up(monkeypatch, tmp_path):
+    """A run of small calls (a simulation's steps) counts its samples: numpy until they reach
+    FIRST_CALL_SAMPLES, llvm after (a mutant that forgot the count would stay on numpy)."""
+    monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path))
+    an = analyse(parse_mechanism(serial_chain(6)))
+    q = np.zeros((1000, an.dof))
+    seen = [solve(an, q, q, q).backend for _ in range(6)]
+    assert seen == ["numpy"] * 4 + ["llvm"] * 2
 
 
 def test_unavailable_without_a_kernel_program():
@@ -71,9 +79,11 @@ def test_unavailable_without_a_kernel_program():
     sol = solver_for(an)
     sol.kernel_problem = "a stand-in reason"
     q = np.zeros((3, an.dof))
-    with pytest.raises(ValueError, match="backend 'llvm' unavailable: no kernel program: a stand-in reason"):
+    with pytest.raises(ValueError, match="backend 'llvm' unavailable: a stand-in reason"):
         solve(an, q, q, q, backend="llvm")
-    assert sol.backend() == "numpy"
+    res = solve(an, q, q, q)
+    assert (res.backend, res.backend_note) == ("numpy", "a stand-in reason")
+    assert sol.choice().fallback
 
 
 def test_both_pattern_codings_are_generated():
@@ -154,16 +164,26 @@ def test_inline_sincos_matches_libm():
     assert np.isnan(c).all() and np.isnan(s).all()
 
 
-def test_auto_takes_llvm_when_numba_is_missing(monkeypatch):
-    """Without numba "auto" compiles the llvm kernel whatever it costs (numpy is ~20x slower)."""
-    an = analyse(parse_mechanism(serial_chain(40)))
-    sol = solver_for(an)
-    monkeypatch.setattr(backends, "numba_kernel_problem", lambda: "numba does not import")
-    monkeypatch.delitem(sys.modules, "gearcli.dynamics.kernel", raising=False)
-    assert backends.llvm_compile_estimate(an) > backends.NUMBA_START_SECONDS + 10 * backends.SAVED_SECONDS_PER_SAMPLE
-    assert sol.backend(n=10) == "llvm"
-    with pytest.raises(ValueError, match="backend 'kernel' unavailable: numba does not import"):
-        sol.backend(backend="kernel")
+def test_auto_takes_numpy_when_llvmlite_does_not_import():
+    """Without llvmlite (its import blocked in a fresh process) "auto" solves with numpy and
+    says why, backend "llvm" is refused with the reason, and the CLI prints one notice."""
+    block = "import sys; sys.modules['llvmlite'] = None; sys.modules['llvmlite.binding'] = None; sys.modules['llvmlite.ir'] = None; "
+    code = (block + "import numpy as np; from gearcli import analyse, load_mechanism, solve; "
+            f"an = analyse(load_mechanism({str(MECH / 'bendix_wrist.yaml')!r})); q = np.zeros((9000, an.dof)); "
+            "r = solve(an, q, q, q); print(r.backend, '|', r.backend_note)\n"
+            "try:\n    solve(an, q, q, q, backend='llvm')\nexcept ValueError as e:\n    print(e)")
+    env = {"PYTHONPATH": str(ROOT / "src"), "PATH": "/usr/bin:/bin"}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True)
+    assert out.stdout.splitlines() == ["numpy | llvmlite does not import",
+                                       "backend 'llvm' unavailable: llvmlite does not import"]
+
+
+def test_retired_kernel_backend_is_refused():
+    """The numba kernel was retired (issue 18): backend "kernel" is a ValueError saying so."""
+    an = analyse(load_mechanism(MECH / "paper_2dof.yaml"))
+    q = np.zeros((3, an.dof))
+    with pytest.raises(ValueError, match=r"^backend 'kernel' \(the numba kernel\) was retired: use 'llvm'"):
+        solve(an, q, q, q, backend="kernel")
 
 
 def _paper_with_loads(count: int):

@@ -15,7 +15,7 @@ from gearcli import analyse
 from gearcli.dynamics.signs import SignError
 from gearcli.dynamics.solve import solve
 
-BACKENDS = ["numpy", "kernel", "llvm"]
+BACKENDS = ["numpy", "llvm"]
 
 
 def _poisoned(res):
@@ -76,7 +76,7 @@ def test_out_of_another_shape_is_refused(backend):
         solve(an, q, qd, qdd, backend=backend, out=res)
 
 
-@pytest.mark.parametrize("backend", ["kernel", "llvm"])
+@pytest.mark.parametrize("backend", ["llvm"])
 def test_out_after_a_sign_error(backend):
     """The failing-block record kept with ``out`` is reset sample by sample by the kernel."""
     an = analyse(mechanism("bendix_wrist.yaml"))
@@ -95,7 +95,7 @@ def test_out_after_a_sign_error(backend):
         assert np.array_equal(getattr(out, f), getattr(fresh, f)), f
 
 
-@pytest.mark.parametrize("backend", ["kernel", "llvm"])
+@pytest.mark.parametrize("backend", ["llvm"])
 def test_callers_on_several_threads_share_the_pool(backend):
     """Two threads solving at once (one pool: a caller whose worker is taken does the parts
     itself), each into its own out: the numbers of one-thread solves."""

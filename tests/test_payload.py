@@ -61,11 +61,8 @@ def test_every_backend_carries_the_payload():
     # the link's x axis turned by q about y: x -> (cos q, 0, -sin q), z -> (sin q, 0, cos q)
     gravity_torque = G * (mx * c + mz * s)          # (r x (0, 0, -m g)) . y
     np.testing.assert_allclose(ref.motor[:, 0], J * qdd[:, 0] - gravity_torque, rtol=0, atol=1e-12 * 100)
-    for backend in ("llvm", "kernel"):
-        try:
-            res = gearcli.solve(an, q, qd, qdd, backend=backend)
-        except ValueError:          # backend not available here
-            continue
+    for backend in ("llvm",):
+        res = gearcli.solve(an, q, qd, qdd, backend=backend)
         np.testing.assert_allclose(res.motor, ref.motor, rtol=0, atol=1e-12 * np.abs(ref.motor).max())
         np.testing.assert_allclose(res.joint, ref.joint, rtol=0, atol=1e-12 * np.abs(ref.joint).max())
 

@@ -120,7 +120,7 @@ def test_power_balance_along_bundled_trajectory(mech_dir, text, gravity, method)
     assert np.ptp(p_motor) > 10.0      # the motion really exercises the balance
 
 
-@pytest.mark.parametrize("backend", ["numpy", "kernel"])
+@pytest.mark.parametrize("backend", ["numpy", "llvm"])
 def test_block_equals_full_on_bundled_trajectory(mech_dir, axis, backend):
     """Consistency check: the block schedule (both backends) against the full solve."""
     data = np.loadtxt(mech_dir / "rack_axis_traj.csv", delimiter=",", skiprows=1)

@@ -12,7 +12,7 @@ import pytest
 from gearcli import analyse, parse_mechanism, solve
 from gearcli.dynamics.signs import SignError
 
-BACKENDS = ["numpy", "kernel", "llvm"]
+BACKENDS = ["numpy", "llvm"]
 
 # a 2 kg arm on a horizontal axis (y), driven directly: no gear, so no sign search
 ARM = """
@@ -99,7 +99,7 @@ def test_mechanism_help_says_urdf_too(run_cli):
 def test_solve_help_shows_the_readme_usage(run_cli):
     """The option values as the README's usage line writes them (was '<str>', '<int range>')."""
     text = " ".join(run_cli("solve", "--help").stdout.split())
-    for usage in ("--method block|full", "--chunk N", "-j, --jobs N", "--backend auto|llvm|kernel|numpy",
+    for usage in ("--method block|full", "--chunk N", "-j, --jobs N", "--backend auto|llvm|numpy",
                   "--precision N"):
         assert usage in text, usage
 

@@ -163,3 +163,34 @@ def test_readme_library_example_runs(monkeypatch):
     assert list(cols) == column_names(an)
     assert np.array_equal(cols["motor:motor5"], res.motor[:, 1])
     assert np.allclose(cols["joint:J1:bending"], np.hypot(res.joint[:, 0, 3], res.joint[:, 0, 4]))
+
+
+def test_summary_states_the_backend_and_auto_says_why_numpy(run_cli, mech_dir, tmp_path, monkeypatch):
+    """The summary's Backend line names the path that ran; "auto" on a mechanism the kernel
+    refuses (losses, so far) solves with numpy and prints one notice line on stderr; the
+    first-call rule (an empty disk cache, 2,001 rows) is stated in the summary only."""
+    monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path / "cache"))
+    out = tmp_path / "loads.csv"
+    traj = mech_dir / "bendix_wrist_traj.csv"
+    for backend, line in (("llvm", "Backend: llvm"), ("numpy", "Backend: numpy")):
+        r = run_cli("solve", mech_dir / "bendix_wrist.yaml", traj, "-o", out, "--backend", backend)
+        assert r.exit_code == 0 and line in r.stdout.splitlines() and r.stderr == "", r.stderr
+    r = run_cli("solve", mech_dir / "paper_2dof.yaml", mech_dir / "paper_2dof_traj.csv", "-o", out)
+    assert r.exit_code == 0 and r.stderr == ""
+    assert ("Backend: numpy (auto: first-call rule: fewer than 5,000 samples, and the kernel is neither "
+            "compiled nor in the disk cache)") in r.stdout.splitlines()
+    r = run_cli("solve", mech_dir / "servo_joint_rated.yaml", mech_dir / "servo_joint_duty.csv", "-o", out)
+    reason = "the mechanism has losses, which only the numpy reference solves so far"
+    assert r.exit_code == 0 and f"Backend: numpy (auto: {reason})" in r.stdout.splitlines()
+    assert r.stderr.splitlines() == [f"notice: solved with numpy, not the llvm kernel: {reason}"]
+
+
+def test_retired_kernel_backend_is_one_line_exit_2(run_cli, mech_dir, tmp_path):
+    """``--backend kernel`` (the numba kernel, retired in issue 18): refused with the reason
+    and what to use instead, nothing written."""
+    out = tmp_path / "loads.csv"
+    r = run_cli("solve", mech_dir / "bendix_wrist.yaml", mech_dir / "bendix_wrist_traj.csv", "-o", out,
+                "--backend", "kernel")
+    assert r.exit_code == 2 and not out.exists()
+    assert r.stderr.splitlines() == ["--backend: backend 'kernel' (the numba kernel) was retired: use 'llvm' "
+                                     "(the generated kernel) or 'auto'"]

@@ -498,3 +498,31 @@ def test_mission_profile_shares_cannot_exceed_the_service_time(run_cli, tmp_path
     r = run_cli("verify", man, "-j", "1")
     assert r.exit_code == 2 and "cases[0].trajectories: the profile's shares add up to 1.1 of the service time" \
         in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
+
+
+def test_reports_state_the_backend_each_case_ran_on(run_cli, tmp_path, monkeypatch):
+    """JSON (every check), JUnit (a ``backend`` property per suite), Markdown and the
+    printed summary name the solver path of each case: a 401-sample rotor with an empty
+    disk cache is solved by numpy (the first-call rule, said so), a 6,001-sample one by llvm."""
+    monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path / "cache"))
+    bearings = "[{name: a, position: 0, C: 5000, C0: 2000, type: ball, locating: true}]"
+    short = write_rotor_case(tmp_path, bearings, name="short")
+    long_ = short.replace("short", "long")
+    (tmp_path / "long.yaml").write_text(rotor_yaml(bearings))
+    t = np.linspace(0, T, 6001)
+    np.savetxt(tmp_path / "long.csv", np.column_stack([t, W * t, np.full_like(t, W), 0 * t]),
+               delimiter=",", header="t,q:J,qd:J,qdd:J", comments="")
+    man = tmp_path / "m.yaml"
+    man.write_text("cases:\n" + short + long_)
+    xml, js, md = tmp_path / "r.xml", tmp_path / "r.json", tmp_path / "r.md"
+    r = run_cli("verify", man, "--junit", xml, "--json", js, "--markdown", md, "-j", "1")
+    assert r.exit_code in (0, 1), r.stdout + r.stderr
+    first = ("numpy (auto: first-call rule: fewer than 5,000 samples, and the kernel is neither compiled "
+             "nor in the disk cache)")
+    expect = {"short": first, "long": "llvm"}
+    assert {c["case"]: c["backend"] for c in json.loads(js.read_text())["checks"]} == expect
+    suites = ET.parse(xml).getroot().findall("testsuite")
+    assert {s.get("name"): s.find("properties/property[@name='backend']").get("value") for s in suites} == expect
+    text = md.read_text()
+    assert f"Solver backend of short: {first}\n" in text and "Solver backend of long: llvm\n" in text
+    assert f"Backend of short: {first}" in r.stdout.splitlines() and "Backend of long: llvm" in r.stdout.splitlines()

@@ -188,7 +188,7 @@ TRAJ_HELP = ("Trajectory CSV: header t,q:<joint>,... for every independent joint
 METHOD_OPTION = typer.Option("block", "--method", metavar="block|full", help="'block': level-by-level schedule (fast); 'full': cross-check.")
 JOBS_OPTION = typer.Option(None, "--jobs", "-j", min=1, metavar="N",
                            help="Threads: solve and CSV (default: all cores; same results).")
-BACKEND_OPTION = typer.Option("auto", "--backend", metavar="auto|llvm|kernel|numpy", help="'llvm', 'kernel' (numba), 'numpy' (reference) or 'auto'.")
+BACKEND_OPTION = typer.Option("auto", "--backend", metavar="auto|llvm|numpy", help="'llvm' (kernel generated for the mechanism), 'numpy' (reference) or 'auto': llvm, numpy where it cannot run (a notice says why) or for a short first run.")
 
 
 @app.command()
@@ -235,7 +235,7 @@ def solve(
                             backend=backend, jobs=jobs, strict=strict)
     from .report.unit_warnings import warning_lines  # noqa: PLC0415
 
-    print_problems(warning_lines(report.warnings))
+    print_problems(warning_lines(report.warnings) + report.notices())
     with stderr_may_fail() if to_stdout else nullcontext():   # the table is out: stderr is for information
         _print_summary(err if to_stdout else stdout_console(), report, verify)
     if not to_stdout:
@@ -249,7 +249,7 @@ def _print_summary(console, report, verify: bool) -> None:
     ideal = [an.mech.gears[c.gear].name for c in an.circuits if c.geometry is None]
     if ideal:
         console.print("Ideal pairs (no mesh geometry; mesh torque instead of tooth forces): " + ", ".join(ideal))
-    for line in feature_notes(an) + sharing_notes(an):
+    for line in feature_notes(an) + sharing_notes(an) + [report.backend_line()]:
         console.print(line, markup=False)
     if report.losses is not None:
         for line in report.losses.lines():
@@ -339,7 +339,7 @@ def verify(
     from rich.progress import BarColumn, Progress, TextColumn  # noqa: PLC0415
 
     from .batch.manifest import load_manifest  # noqa: PLC0415
-    from .batch.outputs import rich_table, with_unit  # noqa: PLC0415
+    from .batch.outputs import backends, rich_table, with_unit  # noqa: PLC0415
     from .batch.verify import count_jobs, run_verify  # noqa: PLC0415
     from .report.progress import LateProgress  # noqa: PLC0415
 
@@ -353,8 +353,8 @@ def verify(
         outcome = run_verify(design, jobs=jobs, dask_address=dask, junit=junit, json_path=json_out,
                              markdown_path=markdown, plots_dir=plots, manifest=manifest, spectra_dir=spectra,
                              progress=lambda: progress.update(advance=1))
-    console = stdout_console()
-    console.print(rich_table(outcome.rows))
+    stdout_console().print(rich_table(outcome.rows))
+    typer.echo("".join(f"Backend of {case}: {backend}\n" for case, backend in backends(outcome.rows).items()), nl=False)
     failed = [r for r in outcome.rows if not r.passed]
     for r in failed:
         typer.echo(f"FAILED {r.case}: {r.name}: worst {with_unit(r.value, r.unit)} against limit {with_unit(r.limit, r.unit)}")

@@ -17,7 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .dynamics.solve import BACKENDS, solve, solver_for
+from .dynamics.backends import BACKENDS, Choice
+from .dynamics.solve import solve, solver_for
 from .analysis.graph import Analysis
 from .dynamics.determinacy import analyse
 from . import __version__
@@ -57,6 +58,18 @@ class SolveReport:
     output: Path | None
     losses: LossSummary | None = None   # a mechanism with losses: energy lost, line efficiencies
     warnings: list[Issue] = field(default_factory=list)   # implausible rates (report.unit_warnings.RateWatch)
+    backend: Choice = Choice("numpy")     # the path that solved every chunk, and why "auto" took numpy
+
+    def backend_line(self) -> str:
+        """The summary's line naming the backend that ran (and why "auto" took numpy)."""
+        how = self.backend
+        return f"Backend: {how.path}" + (f" (auto: {how.note})" if how.note else "")
+
+    def notices(self) -> list[str]:
+        """The stderr notice of a run that "auto" solved with numpy because the kernel cannot
+        run here (one line; none for the first-call rule, which the summary states)."""
+        how = self.backend
+        return [f"notice: solved with numpy, not the llvm kernel: {how.note}"] if how.fallback else []
 
 
 def check_solve_options(an: Analysis, method: str, backend: str) -> Analysis:
@@ -64,7 +77,7 @@ def check_solve_options(an: Analysis, method: str, backend: str) -> Analysis:
     must be available for the mechanism when asked for)."""
     if method not in ("block", "full"):
         raise GearcliError(f"--method: expected 'block' or 'full', got '{method}'")
-    if backend not in BACKENDS:
+    if backend not in BACKENDS and backend != "kernel":   # "kernel": the solver's own answer (retired)
         raise GearcliError(f"--backend: expected one of {', '.join(BACKENDS)}, got '{backend}'")
     try:
         solver_for(an).backend(method, backend)
@@ -93,7 +106,10 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
     Every output sample is checked finite before it is written
     (:class:`~gearcli.errors.TrajectoryError` naming the first bad sample and column);
     with ``verify`` the worst residual of every chunk must be finite and at most
-    :data:`VERIFY_TOLERANCE`.  ``backend`` and ``jobs`` as in :func:`~gearcli.dynamics.solve.solve`.
+    :data:`VERIFY_TOLERANCE`.  ``backend`` and ``jobs`` as in :func:`~gearcli.dynamics.solve.solve`;
+    the backend is chosen once for the whole trajectory (its row count; "auto"'s first-call
+    rule, :mod:`gearcli.dynamics.backends`) and every chunk is solved by it: the report's
+    ``backend`` and ``backend_note`` say which and, when "auto" took numpy, why.
 
     Implausible joint angles, joint rates and motor speeds (a trajectory in degrees read as
     radians: :class:`~gearcli.report.unit_warnings.RateWatch`) are listed in the report's
@@ -109,7 +125,7 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
     watch = RateWatch(reader, an, strict)
     if progress is not None:
         progress(total=rows)
-    summary = Summary.for_mechanism(an)
+    summary, how = Summary.for_mechanism(an), solver_for(an).choice(method, backend, rows)   # one backend a run
     losses = LossSummary.for_mechanism(an) if an.mech.has_losses else None
     twin = analyse(lossless_twin(an.mech)) if losses is not None else None
     names = column_names(an)
@@ -123,7 +139,7 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
             for part in parts:
                 with np.errstate(all="ignore"):
                     res = solve(an, part.q, part.qd, part.qdd, method=method, chunk=chunk, verify=verify,
-                                loads=part.loads, backend=backend, jobs=jobs, check_finite=False)  # read checked
+                                loads=part.loads, backend=how.path, jobs=jobs, check_finite=False)  # read checked
                     tab = table(an, part.t, res)
                     if losses is not None:
                         losses.add(an, part.t, res, lossless_motor(twin, part, method, chunk, backend, jobs))
@@ -155,7 +171,7 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
     else:
         with atomic_output(out, (mech_path, traj_path), binary=fmt != "csv") as f:
             _run(solve_chunks, opened(f))
-    return SolveReport(an, n, summary, worst if verify else None, out, losses, watch.issues)
+    return SolveReport(an, n, summary, worst if verify else None, out, losses, watch.issues, how)
 
 
 def lossless_motor(twin: Analysis, part, method: str, chunk: int, backend: str, jobs) -> np.ndarray:

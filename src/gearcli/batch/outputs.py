@@ -1,7 +1,10 @@
 """Reports of a verification run: rich table, JUnit XML, JSON, Markdown.
 
 One row per check: case, component, quantity, worst value, limit, margin in % (positive
-when the check passes), worst trajectory and the time in it; failures first.  Infinite
+when the check passes), worst trajectory and the time in it; failures first.  Each case
+also states the solver path that ran (``backend``: "llvm", or "numpy (auto: why)"): a
+field of every JSON check, a ``backend`` property of every JUnit test suite, a line of the
+Markdown report.  Infinite
 values (a bearing that never turns has an infinite life) are written as ``inf`` in text and
 ``null`` in JSON.
 """
@@ -42,6 +45,7 @@ class Row:
     passed: bool
     trajectory: str
     time: float
+    backend: str = ""
 
     @property
     def name(self) -> str:
@@ -55,7 +59,7 @@ def rows_of(results) -> list[Row]:
         for v in r.verdicts:
             traj = r.case.trajectories[v.trajectory]
             rows.append(Row(r.case.name, v.check.component, v.check.quantity, v.value, v.check.limit,
-                            v.check.unit, v.margin, v.passed, Path(traj).name, v.time))
+                            v.check.unit, v.margin, v.passed, Path(traj).name, v.time, r.backend))
     return sorted(rows, key=lambda row: (row.passed, row.margin))
 
 
@@ -91,6 +95,8 @@ def write_junit(rows: list[Row], path, suite: str) -> None:
         mine = [r for r in rows if r.case == case]
         ts = ET.SubElement(root, "testsuite", name=case, tests=str(len(mine)),
                            failures=str(sum(not r.passed for r in mine)), errors="0", skipped="0")
+        props = ET.SubElement(ts, "properties")
+        ET.SubElement(props, "property", name="backend", value=mine[0].backend)
         for r in mine:
             tc = ET.SubElement(ts, "testcase", classname=f"{suite}.{case}", name=r.name, time="0")
             text = (f"{r.name}: worst {with_unit(r.value, r.unit)} (limit {with_unit(r.limit, r.unit)}), margin "
@@ -112,8 +118,13 @@ def write_json(rows: list[Row], path, manifest: str) -> None:
     doc = {"manifest": manifest, "passed": all(r.passed for r in rows),
            "checks": [{"case": r.case, "component": r.component, "quantity": r.quantity, "value": _num(r.value),
                        "limit": _num(r.limit), "unit": r.unit, "margin_pct": _num(r.margin), "passed": r.passed,
-                       "trajectory": r.trajectory, "time": _num(r.time)} for r in rows]}
+                       "trajectory": r.trajectory, "time": _num(r.time), "backend": r.backend} for r in rows]}
     write_text(path, json.dumps(doc, indent=2, allow_nan=False) + "\n")   # strict JSON: never NaN/Infinity
+
+
+def backends(rows: list[Row]) -> dict:
+    """{case: the solver path that ran} in row order."""
+    return {r.case: r.backend for r in rows}
 
 
 def markdown(rows: list[Row], manifest: str) -> str:
@@ -121,6 +132,7 @@ def markdown(rows: list[Row], manifest: str) -> str:
     head = (f"## Design checks: {manifest}\n\n"
             + (f"**{failed} of {counted(len(rows), 'check')} failed.**\n\n" if failed else
                f"{'All ' if len(rows) > 1 else ''}{counted(len(rows), 'check')} passed.\n\n"))
+    head += "".join(f"Solver backend of {case}: {backend}\n\n" for case, backend in backends(rows).items())
     lines = ["| | case | component | quantity | worst | limit | unit | margin % | trajectory | t [s] |",
              "|---|---|---|---|---:|---:|---|---:|---|---:|"]
     for r in rows:

@@ -46,15 +46,23 @@ def solve_samples(an, traj_path, degrees: bool, threads: int | None = None) -> S
     res = solve(an, tr.q, tr.qd, tr.qdd, loads=tr.loads, jobs=threads, check_finite=False)   # read checked them
     cols = named_columns(an, res, tr.t)
     cols.update(inertia_columns(an, tr.q))     # servo sizing: inertia at the rated motors
-    return Samples(tr.t, cols, tr.qd @ an.S.T)
+    return Samples(tr.t, cols, tr.qd @ an.S.T, backend_text(res))
 
 
-def run_job(job: Job, threads: int | None = None) -> list[tuple]:
-    """The partials of every check of the job's case on the job's trajectory (``threads``:
-    the solver's threads; the pools give each worker its share of the cores)."""
+def backend_text(res) -> str:
+    """The solver path of a :class:`~gearcli.dynamics.solve.Result`: "llvm", "numpy", or
+    "numpy (auto: why)" when backend "auto" took numpy."""
+    return res.backend + (f" (auto: {res.backend_note})" if res.backend_note else "")
+
+
+def run_job(job: Job, threads: int | None = None) -> tuple[list[tuple], str]:
+    """(the partials of every check of the job's case on the job's trajectory, the solver
+    path that ran, :func:`backend_text`) (``threads``: the solver's threads; the pools give
+    each worker its share of the cores)."""
     an = case_analysis(job.mechanism)
     checks = build_checks(an, job.req, Collector(job.mechanism))
-    return partials(checks, solve_samples(an, job.path, job.degrees, threads), an.mech)
+    samples = solve_samples(an, job.path, job.degrees, threads)
+    return partials(checks, samples, an.mech), samples.backend
 
 
 def jobs_of(manifest: Manifest) -> list[Job]:
@@ -66,6 +74,7 @@ def jobs_of(manifest: Manifest) -> list[Job]:
 class CaseResult:
     case: Case
     verdicts: tuple[Verdict, ...]
+    backend: str = ""     # the solver paths of its trajectories (backend_text), distinct ones joined by "; "
 
 
 def run_manifest(manifest: Manifest, jobs: int | None = None, dask_address: str | None = None,
@@ -83,12 +92,13 @@ def run_manifest(manifest: Manifest, jobs: int | None = None, dask_address: str 
         results = _run_local(todo, jobs or os.cpu_count() or 1, progress)
     out = []
     for ci, case in enumerate(manifest.cases):
-        parts = [results[(ci, ti)] for ti in range(len(case.trajectories))]
+        parts = [results[(ci, ti)][0] for ti in range(len(case.trajectories))]
+        backend = "; ".join(dict.fromkeys(results[(ci, ti)][1] for ti in range(len(case.trajectories))))
         spans = [p[0][6] if p else 0.0 for p in parts]
         rates = profile_rates(case.shares or (None,) * len(parts), spans, case.req.cycles_per_hour,
                               case.req.service_life_h)
         verdicts = [combine(ch, [p[k] for p in parts], rates) for k, ch in enumerate(case.checks)]
-        out.append(CaseResult(case, tuple(verdicts)))
+        out.append(CaseResult(case, tuple(verdicts), backend))
     return out
 
 

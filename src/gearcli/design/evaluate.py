@@ -30,6 +30,7 @@ class Samples:
     t: np.ndarray
     cols: dict
     rates: np.ndarray
+    backend: str = ""     # the solver path that ran: "llvm", or "numpy (auto: why)" (gearcli.batch)
 
 
 def bearing_loads(s: Samples, joint: str, bearings) -> list[tuple[np.ndarray, np.ndarray]]:

@@ -1,35 +1,59 @@
-"""Which implementation a solve takes: "llvm", "kernel" (numba) or "numpy" (the reference).
+"""Which implementation a solve takes: "llvm" (the generated kernel) or "numpy" (the reference).
 
-"auto" follows a cost model: the generated llvm kernel is compiled once per analysis
-(:class:`~.llvm_driver.LlvmKernel`; ~0.15-0.3 s for 5-10 links, ~4 s for Talos' 44, or
-0.02-0.4 s when its machine code is in the disk cache, :func:`llvm_on_disk`) and
-then saves about :data:`SAVED_SECONDS_PER_SAMPLE` a sample against the numba kernel,
-whose first use in a process costs :data:`NUMBA_START_SECONDS` (import and its disk
-cache).  So "auto" takes llvm once it is compiled, or when its estimated compile time
-(:func:`llvm_compile_estimate`) is at most what the numba kernel would cost extra for
-this call and the samples this analysis solved before (rent-or-buy: a run of many small
-calls, like the CLI's chunks, switches to llvm once the kernel's extra time would have
-paid for the compile); else the numba kernel where it is available (numba imports); else llvm where it
-is available whatever its compile time; else numpy.
+Two paths solve the same equations: the numpy reference (:mod:`.blocks`, :mod:`.general`:
+covers everything, method "full" and ``verify`` included) and the kernel generated for each
+mechanism as LLVM IR (:mod:`.llvm_kernel`: method "block"; its machine code is kept on disk,
+:mod:`.llvm_cache`).  ``backend`` is one of :data:`BACKENDS`:
+
+* "llvm": the generated kernel, or a ValueError saying why it cannot run here;
+* "numpy": the reference;
+* "auto": numpy for method "full" (only the reference assembles the full system), else
+  llvm, except (each a :class:`Choice` with its one-line ``note``)
+
+  - llvmlite does not import, or the kernel refuses the mechanism
+    (:attr:`.solve.Solver.kernel_problem`, e.g. losses, which the kernel does not model
+    yet): numpy for every call;
+  - the first-call rule: while the kernel is neither compiled in this process nor its
+    machine code in the disk cache, a call of fewer than :data:`FIRST_CALL_SAMPLES` samples
+    (counting the samples this solver already solved by the block method) is solved by
+    numpy and compiles nothing: numpy solves such a call in less time than a cold compile
+    takes (0.15-0.3 s for 5-10 moving links, ~4 s for Talos' 44; numpy solves 20,000-80,000
+    samples/s of a 5-10 link mechanism).  A longer run of small calls (a simulation's
+    steps) compiles once its samples reach the threshold.
+
+The old "kernel" backend (numba, retired in issue 18) is refused with
+:data:`KERNEL_RETIRED`.
 """
 from __future__ import annotations
 
-import sys
-from functools import lru_cache
+from dataclasses import dataclass
 
-BACKENDS = ("auto", "llvm", "kernel", "numpy")
-NUMBA_START_SECONDS = 0.4          # import numba and load the cached kernel (measured: 0.42 s)
-SAVED_SECONDS_PER_SAMPLE = 1e-6    # numba kernel minus llvm kernel, a sample (measured: 0.8-1.3 us)
+BACKENDS = ("auto", "llvm", "numpy")
+FIRST_CALL_SAMPLES = 5_000
+"""Samples (this call plus those solved before by the same solver) from which "auto" compiles
+a kernel that is neither compiled nor in the disk cache; below, numpy solves the call."""
+KERNEL_RETIRED = ("backend 'kernel' (the numba kernel) was retired: use 'llvm' (the generated kernel) "
+                  "or 'auto'")
 
 
-def llvm_compile_estimate(an, on_disk: bool = False) -> float:
-    """Rough seconds to generate and compile the llvm kernel of ``an`` (measured: 0.14 s
-    for 5 moving links, 0.25 s for 8, 4.4 s for 44; superlinear in the code size), or with
-    ``on_disk`` (its machine code in the disk cache, :mod:`.llvm_cache`, found by its kernel
-    program: loaded without generating the IR; measured 0.002-0.006 s from 5 to 44 links,
-    ``benchmarks/bench_compile.py``): a flat 0.01 s."""
-    n = len(an.tree.moving)
-    return 0.01 if on_disk else 0.015 * n ** 1.5
+@dataclass(frozen=True)
+class Choice:
+    """The path a solve takes (``path``: "llvm" or "numpy") and, when "auto" took numpy,
+    why (``note``, one line; None otherwise); ``fallback``: the kernel cannot run here at
+    all (not the first-call rule)."""
+
+    path: str
+    note: str | None = None
+    fallback: bool = False
+
+
+def llvm_refusal(prog) -> str | None:
+    """Why the generated kernel cannot solve the kernel program ``prog`` here, or None."""
+    try:
+        from .llvm_driver import llvm_problem  # noqa: PLC0415  (imports llvmlite)
+    except ImportError:
+        return "llvmlite does not import"
+    return llvm_problem(prog)
 
 
 def llvm_on_disk(sol) -> bool:
@@ -40,52 +64,36 @@ def llvm_on_disk(sol) -> bool:
     return kernel_on_disk(sol.kernel_program(), sol.an)
 
 
-@lru_cache(maxsize=1)
-def numba_kernel_problem() -> str | None:
-    """Why the numba kernel cannot run in this process, or None (imports it; once)."""
-    try:
-        from . import kernel_driver  # noqa: F401, PLC0415  (imports numba)
-    except ImportError:
-        return "numba does not import"
-    except RuntimeError as exc:        # numba found no writable cache directory
-        return f"numba: {exc}"
-    return None
+def _first_call(sol, n: int | None) -> str | None:
+    """The first-call rule's note when a call of n samples (None: a large call) should be
+    solved by numpy rather than pay a cold compile, else None."""
+    if n is None or sol.compiled_llvm():
+        return None
+    seen = n + sol.samples_solved
+    if seen >= FIRST_CALL_SAMPLES or llvm_on_disk(sol):
+        return None
+    return (f"first-call rule: fewer than {FIRST_CALL_SAMPLES:,} samples, and the kernel is neither "
+            f"compiled nor in the disk cache")
 
 
-def _auto_llvm(sol, n: int | None) -> bool:
-    """True when "auto" takes llvm for a call of n samples (None: a large call)."""
-    if not sol.llvm_available():
-        return False
-    if sol.compiled_llvm() or n is None:
-        return True
-    numba_extra = 0.0 if "gearcli.dynamics.kernel" in sys.modules else NUMBA_START_SECONDS
-    seen = n + sol.samples_solved          # a long run in many calls (the CLI's chunks) pays too
-    return llvm_compile_estimate(sol.an, llvm_on_disk(sol)) <= numba_extra + seen * SAVED_SECONDS_PER_SAMPLE
-
-
-def choose(sol, method: str, backend: str, n: int | None) -> str:
-    """The path a solve of n samples by the :class:`~.solve.Solver` ``sol`` takes."""
+def choose(sol, method: str, backend: str, n: int | None) -> Choice:
+    """The path a solve of n samples (None: a large call) by the :class:`~.solve.Solver`
+    ``sol`` takes."""
+    if backend == "kernel":
+        raise ValueError(KERNEL_RETIRED)
     if backend not in BACKENDS:
         raise ValueError(f"unknown backend '{backend}' (expected one of {', '.join(BACKENDS)})")
-    if backend == "numpy" or (backend == "auto" and method == "full"):
-        return "numpy"
+    if backend == "numpy":
+        return Choice("numpy")
     if method == "full":
-        raise ValueError(f"backend '{backend}' solves method 'block' only")
-    if backend == "llvm":
-        if not sol.llvm_available():
+        if backend == "llvm":
+            raise ValueError("backend 'llvm' solves method 'block' only")
+        return Choice("numpy")           # asked for: only the reference assembles the full system
+    if not sol.llvm_available():
+        if backend == "llvm":
             raise ValueError(f"backend 'llvm' unavailable: {sol.llvm_problem}")
-        return "llvm"
-    if backend == "auto" and _auto_llvm(sol, n):
-        return "llvm"
-    numba = None
-    prog = sol.kernel_program()
-    if prog is not None and not prog.numba_ok:
-        numba = ("the numba kernel cannot solve a block of this mechanism (more sign patterns than "
-                 "kernel_program.MAX_PATTERNS, or a redundant gear set without a constant frame)")
-    elif prog is not None:
-        numba = numba_kernel_problem()
-        if numba is None:
-            return "kernel"
-    if backend == "kernel":
-        raise ValueError(f"backend 'kernel' unavailable: {sol.kernel_problem or numba}")
-    return "llvm" if sol.llvm_available() else "numpy"     # llvm even where it costs more than numba would
+        return Choice("numpy", sol.llvm_problem, fallback=True)
+    if backend == "llvm":
+        return Choice("llvm")
+    note = _first_call(sol, n)
+    return Choice("numpy", note) if note else Choice("llvm")

@@ -1,6 +1,6 @@
-"""Splitting a trajectory over threads, and the sign error of a compiled solve (no numba).
+"""Splitting a trajectory over threads, and the sign error of a compiled solve.
 
-Shared by the compiled backends (:mod:`.kernel_driver`, :mod:`.llvm_driver`): the samples
+Used by the generated kernel's driver (:mod:`.llvm_driver`): the samples
 are split into contiguous ranges that the threads take in turn (:func:`run_parts`: the
 calling thread and workers of a persistent pool, created on first use, so that a call pays
 no thread creation); a compiled kernel releases the GIL and each sample's arithmetic does

@@ -1,7 +1,7 @@
 """The compiled kernel's "program": one analysed mechanism flattened into a few arrays.
 
-The kernel (:mod:`.kernel`) is data-driven: one compiled function serves every mechanism,
-reading what to do from the arrays built here once per analysis (from the
+The generated kernel (:mod:`.llvm_kernel`) is made from the arrays built here once per
+analysis (from the
 :class:`~gearcli.analysis.graph.Analysis` and the block plans of :func:`.blocks.make_plans`):
 
 * ``jrec`` (J, 5) int: per real joint in tree order [joint index, parent link, child link,
@@ -24,7 +24,7 @@ reading what to do from the arrays built here once per analysis (from the
   reactions solved in another link's basis, turned to the child's by -q of the joint, or
   by -(q @ row) with the (J,) row at the offset in ``turns`` (a basis carried by a third
   coaxial link, :mod:`.coaxial_frames`); ``meta`` [base link id];
-* the output maps of :func:`.kernel_output.output_constants` and the structure matrix A;
+* the output maps of :func:`.output_maps.output_constants` and the structure matrix A;
 * last, S (q = S q_ind), A (tau = A motor) and A^T (motor speed = A^T qd) by rows of
   nonzeros (:func:`_csr`): ``ints[15:21]`` their row pointers and column indices,
   ``flts[10:13]`` their values.
@@ -66,7 +66,6 @@ class Program:
     hot: dict = field(default_factory=dict)       # block -> (hot pattern indices, their maps (k, n, 6B))
     weights: dict = field(default_factory=dict)   # redundant world-frame block -> sharing.mesh_weights
     free: dict = field(default_factory=dict)      # redundant world-frame block -> its free columns (_free_columns)
-    numba_ok: bool = True                         # False: the numba kernel cannot run it (a LowRank block)
 
 
 def _joints(an):
@@ -201,8 +200,7 @@ MAX_PATTERNS = 256
 a block's maps are made on first use (:class:`.pattern_maps.PatternMaps`), and 2^m of them
 for m signed meshes (2^16 for 8 planets) would take minutes to make; a block with more
 is solved from one base matrix (:class:`.pattern_maps.LowRank`, ``Program.lowrank``: a
-k x k solve a pattern, k = m or 2m), by the generated kernel only (the numba kernel
-leaves such a mechanism to the numpy path)."""
+k x k solve a pattern, k = m or 2m)."""
 
 
 def _csr(M: np.ndarray) -> tuple:
@@ -223,12 +221,12 @@ def build_program(an, plans=None) -> Program:
     ``covered`` when a redundant block has no constant frame."""
     plans = make_plans(an) if plans is None else plans
     if any(len(p.signed) > MAX_EXHAUSTIVE for p in plans):   # a pattern is an i64 in the code; numpy's search
-        return Program((), (), 0, {}, [], [], False, numba_ok=False)
+        return Program((), (), 0, {}, [], [], False)
     try:
         lowrank = {bi: low_rank(p.Ainv) for bi, p in enumerate(plans)
                    if p.F is not None and (1 << len(p.signed)) > MAX_PATTERNS}
     except (np.linalg.LinAlgError, SharingError):      # a singular base matrix: the numpy path
-        return Program((), (), 0, {}, [], [], False, numba_ok=False)
+        return Program((), (), 0, {}, [], [], False)
     groups = unknown_groups(an)
     offsets, c = {}, 0
     for g in groups:
@@ -265,7 +263,7 @@ def build_program(an, plans=None) -> Program:
     free = {bi: f for bi in weights if (f := _basis(an, plans[bi], weights[bi])) is not None}
     flts += (cat([w for w in weights.values()] + [np.array(f[0] + f[1], float) for f in free.values()]),)  # (hashed)
     return Program(ints, flts, c, offsets, signed, [p.names for p in plans], True, lowrank=lowrank, hot=hot,
-                   weights=weights, free=free, numba_ok=not lowrank and not weights)
+                   weights=weights, free=free)
 
 
 MAX_BASIS_CONDITION = 1e8

@@ -1,6 +1,6 @@
 """Generated block solves (the second half of :mod:`.llvm_kernel`), one sample.
 
-Per block of the schedule, as :func:`.kernel._blocks` does: gather the block links'
+Per block of the schedule, as :func:`.blocks.solve_blocks` does: gather the block links'
 right-hand sides in its frame F about o_F, solve x = Ainv[pattern] r (straight-line for a
 block without signed meshes, else with the sign search of :mod:`.llvm_signs`), pass the
 solved wrenches on to the later links (the propagation records and their C_plus, C_sep
@@ -28,7 +28,7 @@ def problem(prog) -> str | None:
 
 
 def gather(e: Emitter, s: Sample, F: int, links) -> list:
-    """r (6B) = the block links' right-hand sides in F's axes about o_F (kernel._gather)."""
+    """r (6B) = the block links' right-hand sides in F's axes about o_F (blocks' gather)."""
     RF, oF = s.R[F], s.o[F]
     r = []
     for L in links:
@@ -56,7 +56,7 @@ def _subtract(e: Emitter, s: Sample, L: int, w, scale) -> None:
 
 
 def propagate(e: Emitter, s: Sample, F: int, recs, prog, x: list) -> None:
-    """rhs[L] -= the solved wrenches of the block's groups on their later links (kernel._propagate)."""
+    """rhs[L] -= the solved wrenches of the block's groups on their later links (blocks' propagation)."""
     cmat, later = prog.flts[5], prog.ints[7]
     RF, oF = s.R[F], s.o[F]
     for rec in recs:
@@ -70,7 +70,7 @@ def propagate(e: Emitter, s: Sample, F: int, recs, prog, x: list) -> None:
 
 def term_wrench(e: Emitter, s: Sample, trec_k, tflt_k, L: int, sig: list):
     """Wrench (6-tuple, base axes, about o_L) of one column term per unit of its unknown
-    (kernel_world.term_wrench)."""
+    (the column of :meth:`.equations.Columns.group`)."""
     X = int(trec_k[4])
     coef = float(tflt_k[0])
     if trec_k[5] >= 0:
@@ -86,7 +86,7 @@ def term_wrench(e: Emitter, s: Sample, trec_k, tflt_k, L: int, sig: list):
 
 def propagate_terms(e: Emitter, s: Sample, k0: int, nt: int, prog, x: list, sig: list) -> None:
     """rhs[L] -= the solved wrenches on the later links from the terms with no block row
-    (kernel_world.world_propagate)."""
+    (as :func:`.blocks.solve_blocks` propagates)."""
     trec, tflt = prog.ints[10], prog.flts[6]
     for k in range(k0, k0 + nt):
         if trec[k, 1] >= 0:
@@ -96,7 +96,7 @@ def propagate_terms(e: Emitter, s: Sample, k0: int, nt: int, prog, x: list, sig:
 
 
 def store(e: Emitter, s: Sample, rec, prog, x: list) -> None:
-    """The block's solution into the sample's row ``s.sol`` (kernel._store): joint
+    """The block's solution into the sample's row ``s.sol``: joint
     reactions solved in another basis turned to their child's by -q (or -(q @ row))."""
     gcol, cbrec, turns = prog.ints[3], prog.ints[8], prog.flts[7]
     nloc, g0, cb0, ncb = int(rec[3]), int(rec[4]), int(rec[10]), int(rec[11])
@@ -124,7 +124,7 @@ def _on_fail(e: Emitter, fail, n, b: int):
 
 
 def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row) -> None:
-    """Block b of the schedule for sample n (kernel._blocks): ``fail`` (i64*) gets the first
+    """Block b of the schedule for sample n: ``fail`` (i64*) gets the first
     block with no consistent sign pattern (it comes filled with -1), ``sg_row`` (double*)
     the sign of each t used."""
     blinks, tcol, scol, prec, ainv = prog.ints[2], prog.ints[4], prog.ints[5], prog.ints[6], prog.flts[4]
@@ -133,7 +133,7 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row) -> None:
     nr = 6 * B
     links = [int(v) for v in blinks[lk0:lk0 + B]]
     tcols = [int(c) for c in tcol[t0:t0 + m]]
-    if F < 0:                       # world axes about each link's origin (kernel_world.world_gather)
+    if F < 0:                       # world axes about each link's origin
         r = [v for L in links for v in s.rhs[L]]
         blk = WorldBlock(s, prog, k0, nt, nloc, tcols, term_wrench, fn, prog.weights.get(b), prog.free.get(b))
     elif b in prog.lowrank:          # too many patterns to store: one base matrix (pattern_maps.LowRank)

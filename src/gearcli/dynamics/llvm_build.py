@@ -10,8 +10,7 @@ an infinity that x might carry; the inputs are checked finite upstream
 overflows still reaches the sign search through the products that remain.  Only the
 ``contract`` fast-math flag is set (fused multiply-adds): NaN must reach the sign search.
 
-A 3-vector is a 3-tuple of values, a 3x3 matrix a row-major 9-tuple (as in
-:mod:`.kernel_math`).
+A 3-vector is a 3-tuple of values, a 3x3 matrix a row-major 9-tuple.
 """
 from __future__ import annotations
 

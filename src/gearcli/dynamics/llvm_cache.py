@@ -30,7 +30,7 @@ optimising and generating it again.  The cache dir is :func:`gearcli.io.cache_ro
 ``<program key>.prog`` notes hold their own program key and the object key of that kernel
 program (its arrays and loads, hashed without building the IR, see :func:`program_key`); a
 note that does not name itself (moved from another program's name, damaged) is deleted.
-:func:`.backends.llvm_compile_estimate` asks :func:`has_program` whether a compile would be a load, and
+:func:`.backends.llvm_on_disk` (the first-call rule) asks :func:`has_program` whether a compile would be a load, and
 :class:`.llvm_driver.Jit` loads the object code through :func:`load_program` without
 generating the IR at all (~0.05 s for the Bendix wrist) when the program key also hashes
 the source of the IR generator (:func:`.llvm_driver.generator_digest`).

@@ -204,7 +204,7 @@ class LlvmKernel:
         self._load_groups = np.array([[k0, k1] for _, k0, k1 in groups] or [[0, 0]], np.int64)
 
     def solve(self, an, q, qd, qdd, values: dict, jobs: int | None, chunk: int, out: dict, work: tuple) -> dict:
-        """The loads of every sample into ``out``, as :func:`.kernel_driver.kernel_solve` does."""
+        """The loads of every sample into ``out``, as the numpy path (:func:`.blocks.solve_blocks`) does."""
         prog = self.prog
         n = q.shape[0]
         SG, fail = work

@@ -5,7 +5,7 @@
     run(qi, qdi, qddi, vals, ldpt, ldrow, ldgrp, motor, tau, joint, gear_t, gear_sep, gear_radial,
         gear_axial, motor_speed, signs, fail, start, stop)
 
-whose loop over the samples start..stop-1 does what :func:`.kernel.run` does per sample,
+whose loop over the samples start..stop-1 does what the numpy path does for all of them,
 with every structural integer and every constant of the program (fixed transforms,
 masses, inertias, inverse block matrices, propagation columns, output coefficients) in
 the code: joint space, kinematics, inertia and external loads (:mod:`.llvm_links`), the

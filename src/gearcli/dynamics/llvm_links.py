@@ -1,6 +1,6 @@
 """Generated per-sample kinematics and link loads (the first half of :mod:`.llvm_kernel`).
 
-The same formulas as :mod:`.kernel_links` (paper Eqs. 2-5 and 17-18, the external loads
+The same formulas as :func:`.kinematics.forward` and :func:`.inertia.inertia_load` (paper Eqs. 2-5 and 17-18, the external loads
 of :func:`.external.external_wrenches`), emitted straight-line per joint and link with
 every fixed transform, mass, inertia and load point of the :class:`~.kernel_program.Program`
 as a constant (:class:`~.llvm_build.Emitter` folds the zeros and ones: a joint on the base,
@@ -55,7 +55,7 @@ def joint_space(e: Emitter, S, qi: list, qdi: list, qddi: list) -> Sample:
 
 
 def _joint_frame(e: Emitter, f, Rp, op, qk, prismatic: bool):
-    """(R, o, cos, sin) of the joint frame at qk, base axes (kernel_links._joint_frame)."""
+    """(R, o, cos, sin) of the joint frame at qk, base axes."""
     R0 = e.mm(Rp, f[0:9])
     oj = e.vadd(op, e.mv(Rp, f[9:12]))
     if prismatic:
@@ -80,7 +80,7 @@ def at_rest(s: Sample, base: int) -> None:
 
 def joint(e: Emitter, s: Sample, rec, flt) -> None:
     """The child link of one joint record (``rec`` a row of ``jrec``, ``flt`` of ``jflt``):
-    its R, o, w, dw, a, and the joint's cos, sin (kernel_links._joint)."""
+    its R, o, w, dw, a, and the joint's cos, sin."""
     ji, p, c, pr = (int(v) for v in rec[:4])
     f = floats(flt)
     qdk, qddk = s.qd[ji], s.qdd[ji]

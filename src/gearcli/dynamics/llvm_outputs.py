@@ -1,4 +1,4 @@
-"""Generated writing of one sample's results (what :mod:`.kernel_output` does).
+"""Generated writing of one sample's results (what :func:`.solve._result` does).
 
 From the sample's solution row (:attr:`.llvm_links.Sample.sol`): the joint reaction
 wrenches with the zero component along (about) the joint's own axis, the motor torques,

@@ -1,6 +1,6 @@
 """Generated world-frame block solve (a block without a constant frame), one sample.
 
-As :mod:`.kernel_world`: the block's balances in base axes about each link's origin,
+As the numpy path (:func:`.blocks.solve_blocks`, a general block): the block's balances in base axes about each link's origin,
 assembled from the column terms of :mod:`.kernel_terms` (the pose-dependent wrenches
 :func:`.llvm_blocks.term_wrench` emits) for a sign pattern of its t, then solved by
 Gaussian elimination with partial pivoting (the first largest pivot), straight-line: the

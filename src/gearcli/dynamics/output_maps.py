@@ -1,4 +1,4 @@
-"""Constant output maps of the compiled kernels (no numba: the llvm backend uses them too).
+"""Constant output maps of the compiled kernels (the generated kernel's).
 
 :func:`output_constants` says, from an analysed mechanism and the column offsets of its
 unknowns, where each output of a sample comes from in the solution row and the

@@ -27,7 +27,7 @@ from threadpoolctl import ThreadpoolController
 
 from ..analysis.schedule import unknown_groups
 from ..model.gears import helical_terms
-from .backends import BACKENDS, choose
+from .backends import Choice, choose, llvm_refusal
 from .blocks import make_plans, solve_blocks
 from .equations import Columns
 from .general import is_geared, solve_full
@@ -65,6 +65,7 @@ class Result:
     positive axis, N.
     ``residual``: with ``verify``, the worst relative Newton-Euler residual of any link and
     sample, and of the sign of every t against the sign pattern used (else None).
+    ``backend``: the path that ran, "llvm" or "numpy"; ``backend_note``: why "auto" took numpy.
     """
 
     motor: np.ndarray
@@ -81,6 +82,8 @@ class Result:
     joint_friction: np.ndarray | None = None
     joint_loss: np.ndarray | None = None
     bearing_iterations: np.ndarray | None = None
+    backend: str | None = None
+    backend_note: str | None = None
 
 
 @lru_cache(maxsize=1)
@@ -119,7 +122,7 @@ class Solver:
             if an.mech.has_losses else None
         self._llvm = None
         self.llvm_problem: str | None = None
-        self.samples_solved = 0          # by the block method, every backend ("auto"'s cost model)
+        self.samples_solved = 0          # by the block method, every backend ("auto"'s first-call rule)
 
     def kernel_program(self):
         """The compiled kernel's program of this mechanism (:mod:`.kernel_program`), or None
@@ -146,10 +149,9 @@ class Solver:
         if self.llvm_problem is None and self._llvm is None:
             prog = self.kernel_program()
             if prog is None:
-                self.llvm_problem = f"no kernel program: {self.kernel_problem}"
+                self.llvm_problem = self.kernel_problem
             else:
-                from .llvm_driver import llvm_problem  # noqa: PLC0415
-                self.llvm_problem = llvm_problem(prog)
+                self.llvm_problem = llvm_refusal(prog)
         return self.llvm_problem is None
 
     def compiled_llvm(self) -> bool:
@@ -157,8 +159,11 @@ class Solver:
         return self._llvm is not None
 
     def backend(self, method: str = "block", backend: str = "auto", n: int | None = None) -> str:
-        """The path a solve of n samples takes: "llvm", "kernel" or "numpy" (see :func:`solve`
-        and :mod:`.backends`)."""
+        """The path a solve of n samples (None: a large call) takes: "llvm" or "numpy"."""
+        return choose(self, method, backend, n).path
+
+    def choice(self, method: str = "block", backend: str = "auto", n: int | None = None) -> Choice:
+        """:meth:`backend` with the note of why "auto" took numpy (:class:`.backends.Choice`)."""
         return choose(self, method, backend, n)
 
     def solve(self, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK,
@@ -174,33 +179,30 @@ class Solver:
         if out is not None:
             check_out(self.an, q.shape[0], out, {"q": q, "qd": qd, "qdd": qdd,
                                                   **{f"load '{k}'": v for k, v in values.items()}})
-        path = self.backend(method, backend, q.shape[0])
+        how = self.choice(method, backend, q.shape[0])
         if method == "block":
             self.samples_solved += q.shape[0]
-        if path != "numpy" and not verify:     # no BLAS call: the limit would cost ~30 us a call
-            return self._by_kernel(path, q, qd, qdd, values, jobs, chunk, verify, out)
+        if how.path != "numpy" and not verify:     # no BLAS call: the limit would cost ~30 us a call
+            return self._by_kernel(how, q, qd, qdd, values, jobs, chunk, verify, out)
         # the operands are 3x3 to 48x48 matrices: BLAS threads only contend (2-3x slower
         # with a busy second core), so one BLAS thread, whatever the environment says
         with one_blas_thread():
-            if path != "numpy":
-                return self._by_kernel(path, q, qd, qdd, values, jobs, chunk, verify, out)
+            if how.path != "numpy":
+                return self._by_kernel(how, q, qd, qdd, values, jobs, chunk, verify, out)
             res = self._by_numpy(q, qd, qdd, method, chunk, verify, values)
         res.motor_speed = qd @ self.an.A
-        if out is None:
-            return res
-        copy_into(out, res)
-        return out
+        if out is not None:
+            copy_into(out, res)
+            res = out
+        res.backend, res.backend_note = how.path, how.note
+        return res
 
-    def _by_kernel(self, path, q, qd, qdd, values, jobs, chunk, verify, out=None) -> Result:
+    def _by_kernel(self, how, q, qd, qdd, values, jobs, chunk, verify, out=None) -> Result:
         arrays = result_arrays(self.an, q.shape[0], out)
         work = work_arrays(q.shape[0], len(self.kernel_program().signed), out)
-        if path == "llvm":
-            sig = self.llvm_kernel().solve(self.an, q, qd, qdd, values, jobs, chunk, arrays, work)
-        else:
-            from .kernel_driver import kernel_solve  # noqa: PLC0415  (imports numba)
-            sig = kernel_solve(self.kernel_program(), self.an, q, qd, qdd, values, jobs, chunk, arrays, work)
+        sig = self.llvm_kernel().solve(self.an, q, qd, qdd, values, jobs, chunk, arrays, work)
         res = Result(**arrays) if out is None else out
-        res.residual = None
+        res.residual, res.backend, res.backend_note = None, how.path, how.note
         if verify:
             x_all = _unknowns(self.an, res)
             worst = 0.0
@@ -291,16 +293,14 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
         ``{load name: array (N, 6) or (6,)}``: [fx, fy, fz, mx, my, mz] of an external load
         of ``an.mech.loads`` (N, N*m about the load point, in the load's frame: base or
         link), overriding the constant of the mechanism file; loads not given keep it.
-    backend : {"auto", "llvm", "kernel", "numpy"}
-        "llvm": a kernel generated for this mechanism as LLVM IR (:mod:`.llvm_kernel`,
-        llvmlite; compiled on first use, 0.1-0.3 s, and kept with the analysis; method
-        "block" only; not for a block without a constant frame); "kernel": the compiled
-        data-driven kernel (:mod:`.kernel`, numba, cached on disk; method "block" only);
-        "numpy": the array implementation (the readable reference); "auto" (default):
-        llvm where it is available and its compile time pays off (once compiled, always;
-        the cost model of :mod:`.backends`), else the kernel where numba imports and it
-        covers the mechanism (every block square), else numpy.  All give the same results
-        to rounding (~1e-15 relative).
+    backend : {"auto", "llvm", "numpy"}
+        "llvm": a kernel generated for this mechanism (:mod:`.llvm_kernel`; compiled on
+        first use, 0.1-0.3 s for 5-10 links, kept with the analysis and on disk; method
+        "block" only); "numpy": the array implementation (the reference); "auto" (default):
+        llvm, except numpy for method "full", where llvmlite does not import or the kernel
+        refuses the mechanism (losses, so far), and by the first-call rule of :mod:`.backends`
+        (``Result.backend`` says which ran, ``Result.backend_note`` why numpy).  Both give the
+        same results to rounding.  "kernel" (the retired numba kernel) is a ValueError.
     jobs : int, optional
         Threads a compiled kernel splits the samples over (contiguous ranges; results
         bitwise identical for any number); None: every usable core.  The numpy path uses one.
@@ -323,7 +323,7 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
     ValueError
         for bad shapes (of ``out`` too), a non-finite motion value, an unknown load name or a
         load value that is not finite, an unknown
-        backend, or backend "llvm" or "kernel" where it is unavailable.
+        backend, the retired backend "kernel", or backend "llvm" where it is unavailable.
     """
     return solver_for(an).solve(q, qd, qdd, method=method, chunk=chunk, verify=verify, loads=loads,
                                 backend=backend, jobs=jobs, out=out, check_finite=check_finite)
