@@ -62,16 +62,38 @@ def cycles_to_failure(sigma, allowable: float, kind: str) -> np.ndarray:
     inf at sigma = 0.  The branch is the one whose range holds the result."""
     (n_hi, a_hi, b_hi), (_, a_lo, b_lo) = _BENDING if kind == "bending" else _CONTACT
     s = np.abs(np.asarray(sigma, float))
+    flat = s.reshape(-1)
     with np.errstate(divide="ignore", over="ignore"):
-        hi = (a_hi * allowable / s) ** (1.0 / b_hi)
-        lo = (a_lo * allowable / s) ** (1.0 / b_lo)
-    return np.where(hi >= n_hi, hi, np.minimum(lo, n_hi))
+        out = (a_hi * allowable / flat) ** (1.0 / b_hi)
+        low = out < n_hi            # the low-cycle branch, computed only where it applies
+        out[low] = np.minimum((a_lo * allowable / flat[low]) ** (1.0 / b_lo), n_hi)
+    return out.reshape(s.shape)
+
+
+def turning_points(y: np.ndarray) -> np.ndarray:
+    """The samples of ``y`` (N,) that are not strictly inside a strictly monotone run: the
+    two ends and every sample where the history stops rising or falling (flat runs kept).
+
+    fatpack's reversals are the turning points of the history classified into load classes
+    (a non-decreasing map of the values, the classes spanning min(y) .. max(y), which this
+    subsequence keeps); a sample strictly between its two neighbours falls in a class
+    between theirs, so leaving it out changes neither the classes
+    nor the reversal values, only the work (a smooth duty of 20,000 samples has a few dozen
+    turning points).  ``tests/test_gear_fatigue.py`` compares the counts with and without it."""
+    if y.size < 3:
+        return y
+    d = np.diff(y)
+    inside = ((d[:-1] > 0) & (d[1:] > 0)) | ((d[:-1] < 0) & (d[1:] < 0))
+    keep = np.ones(y.size, bool)
+    keep[1:-1] = ~inside
+    return y[keep]
 
 
 def rainflow_peaks(sigma) -> np.ndarray:
     """The largest |stress| of every rainflow cycle of ``sigma`` (N,), closed as a repeating
     sequence (``fatpack``; module notes).  A constant history has no cycle; a history with a
-    single swing 0 -> s -> 0 has one cycle at s."""
+    single swing 0 -> s -> 0 has one cycle at s, and so has a ramp 0 -> s (repeated, it
+    returns to 0)."""
     try:
         import fatpack  # noqa: PLC0415  (design extra)
     except ImportError:
@@ -81,7 +103,12 @@ def rainflow_peaks(sigma) -> np.ndarray:
     y = np.asarray(sigma, float)
     if y.size < 2 or np.ptp(y) == 0.0:
         return np.zeros(0)
-    rev, _ = fatpack.find_reversals(y, k=RAINFLOW_CLASSES)
+    y = turning_points(y)
+    try:
+        rev, _ = fatpack.find_reversals(y, k=RAINFLOW_CLASSES)
+    except IndexError:      # fatpack needs a reversal inside the classified history; a ramp has none,
+        # but the duty repeats: the ramp and the return to its start are one swing
+        rev, _ = fatpack.find_reversals(np.append(y, y[0]), k=RAINFLOW_CLASSES)
     if rev.size < 2:
         return np.zeros(0)
     cycles, residue = fatpack.find_rainflow_cycles(rev)
