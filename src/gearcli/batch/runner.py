@@ -22,7 +22,8 @@ from ..dynamics.solve import solve
 from ..errors import Collector, GearcliError
 from ..io.trajectory import read_trajectory
 from ..pipeline import prismatic_independent
-from ..report.columns import named_columns
+from ..report.columns import LazyColumns
+from .heap import keep_freed_memory
 from .manifest import Case, Manifest, case_analysis
 
 
@@ -39,12 +40,13 @@ class Job:
 
 
 def solve_samples(an, traj_path, degrees: bool, threads: int | None = None) -> Samples:
-    """Solve a trajectory file: times, every output column, and every real joint's rate;
-    ``threads``: the solver's threads (None: every core)."""
+    """Solve a trajectory file: times, every output column (each computed when a check
+    first reads it: :class:`~gearcli.report.columns.LazyColumns`), and every real joint's
+    rate; ``threads``: the solver's threads (None: every core)."""
     tr = read_trajectory(traj_path, an.independent_names, degrees=degrees, linear=prismatic_independent(an),
                          loads=an.mech.loads)
     res = solve(an, tr.q, tr.qd, tr.qdd, loads=tr.loads, jobs=threads, check_finite=False)   # read checked them
-    cols = named_columns(an, res, tr.t)
+    cols = LazyColumns(an, res, tr.t)
     cols.update(inertia_columns(an, tr.q))     # servo sizing: inertia at the rated motors
     return Samples(tr.t, cols, tr.qd @ an.S.T, backend_text(res))
 
@@ -59,6 +61,7 @@ def run_job(job: Job, threads: int | None = None) -> tuple[list[tuple], str]:
     """(the partials of every check of the job's case on the job's trajectory, the solver
     path that ran, :func:`backend_text`) (``threads``: the solver's threads; the pools give
     each worker its share of the cores)."""
+    keep_freed_memory()          # no page faults for every new array (:mod:`.heap`)
     an = case_analysis(job.mechanism)
     checks = build_checks(an, job.req, Collector(job.mechanism))
     samples = solve_samples(an, job.path, job.degrees, threads)

@@ -64,42 +64,88 @@ def column_names(an) -> list[str]:
     return cols
 
 
+def column_sources(an, t: np.ndarray, res: Result) -> dict:
+    """``{column name: function computing that (N,) column}`` for every output column of
+    :func:`column_names`, in its order: the one definition of the columns' values, used by
+    :func:`table` (all of them) and :class:`LazyColumns` (those asked for)."""
+    if res.motor_speed is None:
+        raise ValueError("Result.motor_speed is missing (results come from gearcli.solve)")
+    if an.mech.has_losses and res.gear_loss is None:
+        raise ValueError("Result.gear_loss is missing (results of a lossy mechanism come from gearcli.solve)")
+    names = iter(column_names(an))
+    out = {next(names): lambda: t}
+
+    def put(f):
+        out[next(names)] = f
+
+    for mi in range(res.motor.shape[1]):
+        put(lambda mi=mi: res.motor[:, mi])
+    for di in range(res.tau.shape[1]):
+        put(lambda di=di: res.tau[:, di])
+    for ci, circ in enumerate(an.circuits):
+        put(lambda ci=ci: res.gear_t[:, ci])
+        if circ.geometry is not None:
+            put(lambda ci=ci: res.gear_sep[:, ci])
+            for side in (0, 1):
+                put(lambda ci=ci, side=side: res.gear_radial[:, ci, side])
+                put(lambda ci=ci, side=side: res.gear_axial[:, ci, side])
+    wrenches: dict = {}
+
+    def wrench(ji: int) -> np.ndarray:
+        """Joint ji's reaction wrench as (6, N), rows contiguous: one pass over the result's
+        (N, J, 6) array gives all six columns of the joint."""
+        if ji not in wrenches:
+            wrenches[ji] = np.ascontiguousarray(res.joint[:, ji, :].T)
+        return wrenches[ji]
+
+    for ji in range(res.joint.shape[1]):
+        for a in range(6):
+            put(lambda ji=ji, a=a: wrench(ji)[a])
+        put(lambda ji=ji: np.hypot(wrench(ji)[0], wrench(ji)[1]))
+        put(lambda ji=ji: np.abs(wrench(ji)[2]))
+        put(lambda ji=ji: np.hypot(wrench(ji)[3], wrench(ji)[4]))
+    for mi in range(res.motor_speed.shape[1]):
+        put(lambda mi=mi: res.motor_speed[:, mi])
+        put(lambda mi=mi: res.motor[:, mi] * res.motor_speed[:, mi])
+    if an.mech.has_losses:
+        for ci, circ in enumerate(an.circuits):
+            if circ.geometry is not None:
+                put(lambda ci=ci: res.gear_loss[:, ci])
+        for ji in range(res.joint.shape[1]):
+            put(lambda ji=ji: res.joint_friction[:, ji])
+            put(lambda ji=ji: res.joint_loss[:, ji])
+    if next(names, None) is not None:     # pragma: no cover (column_names and this list disagree)
+        raise AssertionError("column_sources does not cover column_names")
+    return out
+
+
 def table(an, t: np.ndarray, res: Result) -> np.ndarray:
     """The output columns of :func:`column_names` as one (N, ncol) array, in Fortran order
     (each column contiguous: a Parquet/Arrow column without copy)."""
-    if res.motor_speed is None:
-        raise ValueError("Result.motor_speed is missing (results come from gearcli.solve)")
-    n = len(t)
-    out = np.empty((n, len(column_names(an))), order="F")
-    c = 0
-
-    def put(*cols):
-        nonlocal c
-        for x in cols:
-            x = np.asarray(x).reshape(n, -1)
-            out[:, c:c + x.shape[1]] = x
-            c += x.shape[1]
-
-    put(t, res.motor, res.tau)
-    for ci, circ in enumerate(an.circuits):
-        put(res.gear_t[:, ci])
-        if circ.geometry is not None:
-            put(res.gear_sep[:, ci], res.gear_radial[:, ci, 0], res.gear_axial[:, ci, 0],
-                res.gear_radial[:, ci, 1], res.gear_axial[:, ci, 1])
-    for ji in range(res.joint.shape[1]):
-        w = res.joint[:, ji]
-        put(w, np.hypot(w[:, 0], w[:, 1]), np.abs(w[:, 2]), np.hypot(w[:, 3], w[:, 4]))
-    for mi in range(res.motor_speed.shape[1]):
-        put(res.motor_speed[:, mi], res.motor[:, mi] * res.motor_speed[:, mi])
-    if an.mech.has_losses:
-        if res.gear_loss is None:
-            raise ValueError("Result.gear_loss is missing (results of a lossy mechanism come from gearcli.solve)")
-        for ci, circ in enumerate(an.circuits):
-            if circ.geometry is not None:
-                put(res.gear_loss[:, ci])
-        for ji in range(res.joint.shape[1]):
-            put(res.joint_friction[:, ji], res.joint_loss[:, ji])
+    sources = column_sources(an, t, res)
+    out = np.empty((len(t), len(sources)), order="F")
+    for i, f in enumerate(sources.values()):
+        out[:, i] = f()
     return out
+
+
+class LazyColumns(dict):
+    """The output columns as :func:`named_columns` gives them, each computed (and kept) when
+    first looked up (``cols[name]``): verify's checks read a few of the ~100 columns of a
+    mechanism.  Values are those of :func:`named_columns` bit for bit (the same
+    :func:`column_sources`); ``in``, ``len`` and iteration see the columns looked up so far
+    and any set by hand."""
+
+    def __init__(self, an, res: Result, t: np.ndarray):
+        super().__init__()
+        if np.shape(t) != res.motor.shape[:1]:
+            raise ValueError(f"t has shape {np.shape(t)}, the result has {counted(res.motor.shape[0], 'sample')}")
+        self._sources = column_sources(an, np.asarray(t, float), res)
+
+    def __missing__(self, name: str) -> np.ndarray:
+        x = np.ascontiguousarray(self._sources[name]())    # KeyError for an unknown column
+        self[name] = x
+        return x
 
 
 def named_columns(an, res: Result, t: np.ndarray | None = None) -> dict[str, np.ndarray]:
