@@ -174,15 +174,15 @@ MUTATIONS = [
                "return fr.coulomb * np.sign(qd) - fr.viscous * qd"),)),
     # the generated llvm kernel
     Mutation("llvm-gravity-sign", "llvm: gravity with the wrong sign in the d'Alembert force",
-             (("dynamics/llvm_links.py", "F = e.scale(e.vsub(ac, floats(g)), m)", "F = e.scale(e.vadd(ac, floats(g)), m)"),)),
+             (("dynamics/llvm/links.py", "F = e.scale(e.vsub(ac, floats(g)), m)", "F = e.scale(e.vadd(ac, floats(g)), m)"),)),
     Mutation("llvm-propagation-sign", "llvm: a solved wrench passed on to a later link with the primary's sign",
-             (("dynamics/llvm_blocks.py", "1.0 if L == P else -1.0", "1.0"),)),
+             (("dynamics/llvm/blocks.py", "1.0 if L == P else -1.0", "1.0"),)),
     Mutation("llvm-child-basis-turn", "llvm: joint reaction turned to the child's basis by +q instead of -q",
-             (("dynamics/llvm_blocks.py", "e.add(e.mul(cq, x0), e.mul(sq, x1))", "e.sub(e.mul(cq, x0), e.mul(sq, x1))"),)),
+             (("dynamics/llvm/blocks.py", "e.add(e.mul(cq, x0), e.mul(sq, x1))", "e.sub(e.mul(cq, x0), e.mul(sq, x1))"),)),
     Mutation("llvm-world-arm", "llvm: world-frame term, moment arm from the frame link's origin",
-             (("dynamics/llvm_blocks.py", "arm = e.vsub(e.vadd(s.o[X], P), s.o[L])", "arm = P"),)),
+             (("dynamics/llvm/blocks.py", "arm = e.vsub(e.vadd(s.o[X], P), s.o[L])", "arm = P"),)),
     Mutation("llvm-sin-quadrant", "llvm: inline sin with the quadrant's sign flipped",
-             (("dynamics/llvm_trig.py", "b.select(sin_neg, e.neg(sin_mag), sin_mag)", "b.select(sin_neg, sin_mag, e.neg(sin_mag))"),)),
+             (("dynamics/llvm/trig.py", "b.select(sin_neg, e.neg(sin_mag), sin_mag)", "b.select(sin_neg, sin_mag, e.neg(sin_mag))"),)),
 ]
 
 

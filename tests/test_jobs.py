@@ -1,4 +1,4 @@
-"""The persistent worker pool of the compiled backends (:func:`gearcli.dynamics.jobs.run_parts`)."""
+"""The persistent worker pool of the compiled backends (:func:`gearcli.dynamics.llvm.jobs.run_parts`)."""
 from __future__ import annotations
 
 import multiprocessing
@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-from gearcli.dynamics.jobs import job_ranges, run_parts
+from gearcli.dynamics.llvm.jobs import job_ranges, run_parts
 
 
 def _recording(log: list):

@@ -2,7 +2,7 @@
 
 The numpy path (:func:`gearcli.dynamics.blocks.solve_blocks` over arrays) is the reference:
 the kernel shares none of its arithmetic (its own scalar kinematics, loads, column terms
-and sign search, the code :mod:`gearcli.dynamics.llvm_kernel` generates), only the
+and sign search, the code :mod:`gearcli.dynamics.llvm.kernel` generates), only the
 constant block matrices.  Every result
 must agree to 1e-12 of the largest load of the sample, on every bundled mechanism and on the
 test factories' mechanisms, along random trajectories large enough that tooth forces change
@@ -24,7 +24,7 @@ from big_mechanisms import binary_tree_urdf, geared_chain, serial_chain  # noqa:
 from factories import paper_2dof_variant, planetary_2dof, spatial_3dof  # noqa: E402
 from factories_own import PUMA_YAML, dh_geared, urdf_prismatic_chain  # noqa: E402
 from gearcli import analyse, load_mechanism, parse_mechanism  # noqa: E402
-from gearcli.dynamics.jobs import job_ranges, threads_for  # noqa: E402
+from gearcli.dynamics.llvm.jobs import job_ranges, threads_for  # noqa: E402
 from gearcli.dynamics import backends  # noqa: E402
 from gearcli.dynamics.signs import SignError  # noqa: E402
 from gearcli.dynamics.solve import solve, solver_for  # noqa: E402
@@ -158,9 +158,9 @@ def test_kernel_equals_numpy_on_robots(case, backend, tmp_path):
 def test_low_rank_block_without_hot_patterns():
     """planetary_5p's block (10 signed meshes, 1,024 patterns) solved from one base matrix
     (pattern_maps.LowRank): with no hot pattern every trial is the generated k x k solve
-    (llvm_solve), which must equal the numpy path's direct pattern maps too."""
+    (llvm.solve), which must equal the numpy path's direct pattern maps too."""
     from gearcli.dynamics.external import load_values
-    from gearcli.dynamics.llvm_driver import LlvmKernel
+    from gearcli.dynamics.llvm.driver import LlvmKernel
     from gearcli.dynamics.result_arrays import result_arrays, work_arrays
 
     an = analyse(mechanism("planetary_5p.yaml"))
@@ -177,10 +177,10 @@ def test_low_rank_block_without_hot_patterns():
 
 def test_redundant_world_block_by_kkt_and_by_basis():
     """servo_joint's redundant world-frame block is solved through a square basis (its two
-    free planet meshes, kernel_program._free_columns); without one, from the KKT system:
+    free planet meshes, llvm.program._free_columns); without one, from the KKT system:
     both generated solves must equal the numpy path (sharing.least_load_solve)."""
     from gearcli.dynamics.external import load_values
-    from gearcli.dynamics.llvm_driver import LlvmKernel
+    from gearcli.dynamics.llvm.driver import LlvmKernel
     from gearcli.dynamics.result_arrays import result_arrays, work_arrays
 
     an = analyse(mechanism("servo_joint.yaml"))
@@ -198,11 +198,11 @@ def test_redundant_world_block_by_kkt_and_by_basis():
 
 def test_static_pivots_fall_back_to_pivoting(monkeypatch, tmp_path):
     """With a pivot growth of 1 nearly every sample's basis solve finds a static pivot
-    smaller than an entry below it and takes the pivoting loop code (llvm_world.static_lu):
+    smaller than an entry below it and takes the pivoting loop code (llvm.world.static_lu):
     that branch too must equal the numpy path."""
-    from gearcli.dynamics import llvm_world
+    from gearcli.dynamics.llvm import world as llvm_world
     from gearcli.dynamics.external import load_values
-    from gearcli.dynamics.llvm_driver import LlvmKernel
+    from gearcli.dynamics.llvm.driver import LlvmKernel
     from gearcli.dynamics.result_arrays import result_arrays, work_arrays
 
     monkeypatch.setattr(llvm_world, "PIVOT_GROWTH", 1.0)

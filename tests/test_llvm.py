@@ -14,7 +14,7 @@ pytest.importorskip("llvmlite")
 from big_mechanisms import serial_chain  # noqa: E402
 from gearcli import analyse, load_mechanism, parse_mechanism  # noqa: E402
 from gearcli.dynamics import backends  # noqa: E402
-from gearcli.dynamics.llvm_signs import SWITCH_LIMIT  # noqa: E402
+from gearcli.dynamics.llvm.signs import SWITCH_LIMIT  # noqa: E402
 from gearcli.dynamics.solve import solve, solver_for  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -115,14 +115,14 @@ def test_llvm_path_does_not_import_numba():
 
 
 def _compiled_sincos():
-    """A function f(x, c, s, n) writing the generated cos, sin of x[i] (llvm_trig.sincos)."""
+    """A function f(x, c, s, n) writing the generated cos, sin of x[i] (llvm.trig.sincos)."""
     import ctypes
 
     import llvmlite.ir as ir
 
-    from gearcli.dynamics.llvm_build import DP, I64, Emitter
-    from gearcli.dynamics.llvm_driver import Jit
-    from gearcli.dynamics.llvm_trig import sincos
+    from gearcli.dynamics.llvm.build import DP, I64, Emitter
+    from gearcli.dynamics.llvm.driver import Jit
+    from gearcli.dynamics.llvm.trig import sincos
 
     mod = ir.Module("sincos_test")
     fn = ir.Function(mod, ir.FunctionType(ir.VoidType(), [DP, DP, DP, I64]), "f")

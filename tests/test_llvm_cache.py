@@ -17,7 +17,8 @@ pytest.importorskip("llvmlite")
 from big_mechanisms import serial_chain  # noqa: E402
 from cache_faults import SPECIAL, make_special  # noqa: E402
 from gearcli import analyse, load_mechanism, parse_mechanism  # noqa: E402
-from gearcli.dynamics import backends, llvm_cache  # noqa: E402
+from gearcli.dynamics import backends  # noqa: E402
+from gearcli.dynamics.llvm import cache as llvm_cache  # noqa: E402
 from gearcli.dynamics.solve import solve, solver_for  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -30,7 +31,8 @@ CHILD = """
 import json, sys, numpy as np
 from gearcli import analyse, load_mechanism
 from gearcli.dynamics.solve import solve, solver_for
-from gearcli.dynamics import llvm_cache, llvm_driver
+from gearcli.dynamics.llvm import cache as llvm_cache
+from gearcli.dynamics.llvm import driver as llvm_driver
 if sys.argv[2] == "off":
     jit = llvm_driver.Jit
     llvm_driver.Jit = lambda module: jit(module, cache=False)
@@ -94,19 +96,23 @@ def test_another_generator_source_does_not_load_by_program(tmp_path):
 def test_generator_lists_every_module_the_ir_comes_from():
     """Every module of gearcli.dynamics that a GENERATOR module imports is in GENERATOR,
     except those whose output the program key hashes (the program, the cache's own key format)
-    or that only run the code (threads); so is every llvm_* module."""
+    or that only run the code (threads); so is every module of dynamics/llvm/."""
     import ast  # noqa: PLC0415
 
-    from gearcli.dynamics.llvm_driver import GENERATOR  # noqa: PLC0415
+    from gearcli.dynamics.llvm.driver import GENERATOR  # noqa: PLC0415
 
-    here = ROOT / "src" / "gearcli" / "dynamics"
-    exempt = {"llvm_cache", "kernel_program", "jobs"}
-    assert {p.stem for p in here.glob("llvm_*.py")} - exempt <= set(GENERATOR)
+    here = ROOT / "src" / "gearcli" / "dynamics" / "llvm"
+    exempt = {"cache", "program", "terms", "output_maps", "jobs", "__init__"}
+    assert {p.stem for p in here.glob("*.py")} - exempt <= set(GENERATOR)
     for name in GENERATOR:
+        top = name.startswith("../")          # a module of gearcli.dynamics itself
         for node in ast.walk(ast.parse((here / f"{name}.py").read_text())):
-            if isinstance(node, ast.ImportFrom) and node.level == 1:
-                used = [node.module] if node.module else [a.name for a in node.names]
-                assert set(used) - exempt <= set(GENERATOR), (name, used)
+            if not isinstance(node, ast.ImportFrom) or node.level not in ((1,) if top else (1, 2)):
+                continue
+            used = [node.module] if node.module else [a.name for a in node.names]
+            if top or node.level == 2:
+                used = [f"../{u}" for u in used]
+            assert set(used) - exempt <= set(GENERATOR), (name, used)
 
 
 @pytest.mark.parametrize("damage", ["flip a byte", "truncate", "empty", "header only"])
@@ -230,7 +236,7 @@ def test_concurrent_cold_compiles(tmp_path):
 
 
 def test_host_identity_names_cpu_and_features():
-    from gearcli.dynamics.llvm_driver import _host, host_identity  # noqa: PLC0415
+    from gearcli.dynamics.llvm.driver import _host, host_identity  # noqa: PLC0415
 
     cpu, features = _host()
     assert f"|{cpu}|{features}|" in host_identity() and cpu
@@ -248,7 +254,7 @@ def test_keys_depend_on_ir_and_host():
 
 
 def test_program_key_follows_the_program_and_loads():
-    from gearcli.dynamics.llvm_driver import host_identity, mech_loads  # noqa: PLC0415
+    from gearcli.dynamics.llvm.driver import host_identity, mech_loads  # noqa: PLC0415
 
     a, b = (solver_for(analyse(parse_mechanism(serial_chain(n)))) for n in (3, 3))
     other = solver_for(analyse(parse_mechanism(serial_chain(4))))

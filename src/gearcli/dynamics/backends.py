@@ -2,8 +2,8 @@
 
 Two paths solve the same equations: the numpy reference (:mod:`.blocks`, :mod:`.general`:
 covers everything, method "full" and ``verify`` included) and the kernel generated for each
-mechanism as LLVM IR (:mod:`.llvm_kernel`: method "block"; its machine code is kept on disk,
-:mod:`.llvm_cache`).  ``backend`` is one of :data:`BACKENDS`:
+mechanism as LLVM IR (:mod:`.llvm.kernel`: method "block"; its machine code is kept on disk,
+:mod:`.llvm.cache`).  ``backend`` is one of :data:`BACKENDS`:
 
 * "llvm": the generated kernel, or a ValueError saying why it cannot run here;
 * "numpy": the reference;
@@ -50,7 +50,7 @@ class Choice:
 def llvm_refusal(prog) -> str | None:
     """Why the generated kernel cannot solve the kernel program ``prog`` here, or None."""
     try:
-        from .llvm_driver import llvm_problem  # noqa: PLC0415  (imports llvmlite)
+        from .llvm.driver import llvm_problem  # noqa: PLC0415  (imports llvmlite)
     except ImportError:
         return "llvmlite does not import"
     return llvm_problem(prog)
@@ -59,7 +59,7 @@ def llvm_refusal(prog) -> str | None:
 def llvm_on_disk(sol) -> bool:
     """True when the llvm kernel of the :class:`~.solve.Solver` ``sol`` is in the disk cache
     for this host (keyed by its kernel program, so the IR need not be built to know)."""
-    from .llvm_driver import kernel_on_disk  # noqa: PLC0415  (llvmlite: imported by llvm_available)
+    from .llvm.driver import kernel_on_disk  # noqa: PLC0415  (llvmlite: imported by llvm_available)
 
     return kernel_on_disk(sol.kernel_program(), sol.an)
 

@@ -34,7 +34,7 @@ from .general import is_geared, solve_full
 from .external import external_wrenches, load_values, subtract_external
 from .inertia import inertia_load
 from .inputs import motion_arrays
-from .kernel_program import build_program
+from .llvm.program import build_program
 from .kinematics import forward
 from .bearing_friction import solve_with_bearing_friction
 from .losses import LOSS_FIELDS, fill_losses, subtract_joint_friction
@@ -125,7 +125,7 @@ class Solver:
         self.samples_solved = 0          # by the block method, every backend ("auto"'s first-call rule)
 
     def kernel_program(self):
-        """The compiled kernel's program of this mechanism (:mod:`.kernel_program`), or None
+        """The compiled kernel's program of this mechanism (:mod:`.llvm.program`), or None
         when the kernel cannot be used here (``self.kernel_problem`` says why); built on
         first use."""
         if self._program is None and self.kernel_problem is None:
@@ -136,11 +136,11 @@ class Solver:
         return self._program if self.kernel_problem is None else None
 
     def llvm_kernel(self):
-        """The generated kernel of this mechanism (:class:`.llvm_driver.LlvmKernel`), or None
+        """The generated kernel of this mechanism (:class:`.llvm.driver.LlvmKernel`), or None
         when the llvm backend cannot be used here (``self.llvm_problem`` says why);
         compiled on first use and kept."""
         if self._llvm is None and self.llvm_available():
-            from .llvm_driver import LlvmKernel  # noqa: PLC0415  (imports llvmlite)
+            from .llvm.driver import LlvmKernel  # noqa: PLC0415  (imports llvmlite)
             self._llvm = LlvmKernel(self.kernel_program(), self.an)
         return self._llvm
 
@@ -294,7 +294,7 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
         of ``an.mech.loads`` (N, N*m about the load point, in the load's frame: base or
         link), overriding the constant of the mechanism file; loads not given keep it.
     backend : {"auto", "llvm", "numpy"}
-        "llvm": a kernel generated for this mechanism (:mod:`.llvm_kernel`; compiled on
+        "llvm": a kernel generated for this mechanism (:mod:`.llvm.kernel`; compiled on
         first use, 0.1-0.3 s for 5-10 links, kept with the analysis and on disk; method
         "block" only); "numpy": the array implementation (the reference); "auto" (default):
         llvm, except numpy for method "full", where llvmlite does not import or the kernel

@@ -13,7 +13,7 @@ import math
 
 import llvmlite.ir as ir
 
-from .llvm_build import D, I64, Emitter
+from .build import D, I64, Emitter
 
 REDUCE_LIMIT = 1e5
 PIO2_HI = 1.5707963267948966           # pi/2 rounded to a double

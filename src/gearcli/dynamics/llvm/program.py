@@ -1,8 +1,8 @@
 """The compiled kernel's "program": one analysed mechanism flattened into a few arrays.
 
-The generated kernel (:mod:`.llvm_kernel`) is made from the arrays built here once per
+The generated kernel (:mod:`.kernel`) is made from the arrays built here once per
 analysis (from the
-:class:`~gearcli.analysis.graph.Analysis` and the block plans of :func:`.blocks.make_plans`):
+:class:`~gearcli.analysis.graph.Analysis` and the block plans of :func:`..blocks.make_plans`):
 
 * ``jrec`` (J, 5) int: per real joint in tree order [joint index, parent link, child link,
   1 if prismatic, flags: 1 parent is the base, 2 R_pj = I, 4 R_jc = I, 8 p_jc = 0]; ``jflt`` (J, 24): R_pj (row-major), p_pj, R_jc, p_jc;
@@ -16,21 +16,21 @@ analysis (from the
   the links; ``gcol`` each block column's position in the solution row; ``tcol`` the
   block columns of the signed t; ``scol`` their position in the signs row;
 * ``ainv`` every pattern's (n, 6B) inverse (row-major, patterns in
-  :func:`~.signs.sign_patterns` order: rectangular matrices are fine);
+  :func:`~..signs.sign_patterns` order: rectangular matrices are fine);
 * ``prec`` (P, 7) int per propagated group [first column, size, 1 if signed, cmat offset,
   primary link, later-links offset, count]; ``cmat`` its C_plus (6, size) then C_sep;
   ``later`` the later links;
 * ``cbrec`` (C, 3) int [first column, joint index or -1, offset in ``turns``]: joint
   reactions solved in another link's basis, turned to the child's by -q of the joint, or
   by -(q @ row) with the (J,) row at the offset in ``turns`` (a basis carried by a third
-  coaxial link, :mod:`.coaxial_frames`); ``meta`` [base link id];
+  coaxial link, :mod:`..coaxial_frames`); ``meta`` [base link id];
 * the output maps of :func:`.output_maps.output_constants` and the structure matrix A;
 * last, S (q = S q_ind), A (tau = A motor) and A^T (motor speed = A^T qd) by rows of
   nonzeros (:func:`_csr`): ``ints[15:21]`` their row pointers and column indices,
   ``flts[10:13]`` their values.
 
 Blocks without a constant frame (F = -1 in ``brec``) are solved in world axes from the
-column terms of :mod:`.kernel_terms`; one whose matrix is nevertheless constant in its one
+column terms of :mod:`.terms`; one whose matrix is nevertheless constant in its one
 link's axes gets F = that link and its inverse (:func:`_local_frame`), and keeps its terms
 (term count > 0) for the propagation.
 """
@@ -40,13 +40,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..analysis.schedule import unknown_groups
-from .blocks import _primary_side, make_plans
+from ...analysis.schedule import unknown_groups
+from ..blocks import _primary_side, make_plans
 from .output_maps import output_constants
-from .pattern_maps import hot_patterns, low_rank
-from .sharing import SharingError, mesh_weights
-from .signs import MAX_EXHAUSTIVE
-from .kernel_terms import general_terms, local_inverse
+from ..pattern_maps import hot_patterns, low_rank
+from ..sharing import SharingError, mesh_weights
+from ..signs import MAX_EXHAUSTIVE
+from .terms import general_terms, local_inverse
 
 I64 = np.int64
 
@@ -187,7 +187,7 @@ def _block(bd: _Builder, an, bi, p, block_of, offsets, sigcol, terms):
 
 def _local_frame(bd: _Builder, trec, tflt, p) -> None:
     """A world-frame block whose matrix is constant in its link's axes
-    (:func:`.kernel_terms.local_inverse`) becomes a constant-frame block in that link
+    (:func:`.terms.local_inverse`) becomes a constant-frame block in that link
     (F = the link, its inverse in ``ainv``) that keeps its terms for the propagation."""
     rec = bd.brec[-1]
     Ainv = local_inverse(trec, tflt, rec[12], rec[13], p.links[0], rec[3])
@@ -197,9 +197,9 @@ def _local_frame(bd: _Builder, trec, tflt, p) -> None:
 
 MAX_PATTERNS = 256
 """Sign patterns of one constant block up to which the program holds every pattern's map:
-a block's maps are made on first use (:class:`.pattern_maps.PatternMaps`), and 2^m of them
+a block's maps are made on first use (:class:`..pattern_maps.PatternMaps`), and 2^m of them
 for m signed meshes (2^16 for 8 planets) would take minutes to make; a block with more
-is solved from one base matrix (:class:`.pattern_maps.LowRank`, ``Program.lowrank``: a
+is solved from one base matrix (:class:`..pattern_maps.LowRank`, ``Program.lowrank``: a
 k x k solve a pattern, k = m or 2m)."""
 
 
@@ -217,7 +217,7 @@ def _csr(M: np.ndarray) -> tuple:
 
 
 def build_program(an, plans=None) -> Program:
-    """The :class:`Program` of ``an`` (``plans`` from :func:`.blocks.make_plans`); not
+    """The :class:`Program` of ``an`` (``plans`` from :func:`..blocks.make_plans`); not
     ``covered`` when a redundant block has no constant frame."""
     plans = make_plans(an) if plans is None else plans
     if any(len(p.signed) > MAX_EXHAUSTIVE for p in plans):   # a pattern is an i64 in the code; numpy's search
@@ -285,14 +285,14 @@ def _free_columns(an, p, w):
     8 random, every t positive and every t negative) with a condition number at most
     :data:`MAX_BASIS_CONDITION`: the generated kernel then solves A_B for the right-hand
     side and the free columns and minimises over the d free unknowns (a d x d system,
-    :class:`~.llvm_world.WorldBlock`) instead of the (n + 6B)^2 KKT system.  Chosen by
+    :class:`~.world.WorldBlock`) instead of the (n + 6B)^2 KKT system.  Chosen by
     QR with column pivoting of the null space's weighted rows at home; the basis' row order
     of partial pivoting at home (:func:`_pivot_order`).  None: none found."""
     from scipy.linalg import qr                        # noqa: PLC0415
 
-    from .equations import Columns                     # noqa: PLC0415
-    from .general import assemble                      # noqa: PLC0415
-    from .kinematics import forward                    # noqa: PLC0415
+    from ..equations import Columns                     # noqa: PLC0415
+    from ..general import assemble                      # noqa: PLC0415
+    from ..kinematics import forward                    # noqa: PLC0415
 
     rng = np.random.default_rng(18)
     J = len(an.mech.joints)
@@ -321,7 +321,7 @@ def _free_columns(an, p, w):
 
 def _pivot_order(M: np.ndarray) -> list:
     """The row order partial pivoting takes on the square matrix M (the order the generated
-    kernel eliminates in without pivoting, :func:`.llvm_world.static_lu`)."""
+    kernel eliminates in without pivoting, :func:`.world.static_lu`)."""
     from scipy.linalg import lu_factor                # noqa: PLC0415
 
     order = list(range(M.shape[0]))
@@ -331,16 +331,16 @@ def _pivot_order(M: np.ndarray) -> list:
 
 
 def _hot_maps(an, plans, lowrank: dict) -> dict:
-    """{block: (hot pattern indices, their maps)} of the :class:`~.pattern_maps.LowRank`
+    """{block: (hot pattern indices, their maps)} of the :class:`~..pattern_maps.LowRank`
     blocks: the patterns the sign search settles on within its first m + 1 trials (every t
     positive, then the trial's own signs) for 256 random motions of the mechanism (a fixed
     seed; the block's own d'Alembert loads, without the wrenches of earlier blocks: a hint
-    for speed, not a result; :func:`~.pattern_maps.hot_patterns`)."""
+    for speed, not a result; :func:`~..pattern_maps.hot_patterns`)."""
     if not lowrank:
         return {}
-    from .blocks import _rotate, _shift            # noqa: PLC0415
-    from .inertia import inertia_load             # noqa: PLC0415
-    from .kinematics import forward               # noqa: PLC0415
+    from ..blocks import _rotate, _shift            # noqa: PLC0415
+    from ..inertia import inertia_load             # noqa: PLC0415
+    from ..kinematics import forward               # noqa: PLC0415
 
     rng = np.random.default_rng(18)
     n = 256
@@ -367,8 +367,8 @@ def _hot_maps(an, plans, lowrank: dict) -> dict:
 
 def _settled(lr, r: np.ndarray, tcols: list) -> dict:
     """{pattern index: samples} of the rows r (N, 6B) settled by the first m + 1 trials of
-    the sign search (:func:`~.signs.resolve_signs`), solved by ``lr`` (LowRank.solve)."""
-    from .signs import TOL_SIGN, pattern_index    # noqa: PLC0415
+    the sign search (:func:`~..signs.resolve_signs`), solved by ``lr`` (LowRank.solve)."""
+    from ..signs import TOL_SIGN, pattern_index    # noqa: PLC0415
 
     m = len(tcols)
     scale = 1.0 + np.abs(r).max(axis=1)

@@ -1,17 +1,17 @@
 """A generated dense solve with loops (Gaussian elimination, partial pivoting), for the
-k x k systems of :class:`~.llvm_world.LowRankBlock` that a sample meets rarely: one
+k x k systems of :class:`~.world.LowRankBlock` that a sample meets rarely: one
 function per module and size, its code independent of k's square (straight-line
 elimination of a 20 x 20 system took most of a kernel's compile time).
 
 ``solve_k_m(A, X)``: A (k, k) and X (k, m) row-major in memory, overwritten: X = A^-1 X
-(the first largest pivot, as :func:`.llvm_world.eliminate`); every X NaN when a pivot is
+(the first largest pivot, as :func:`.world.eliminate`); every X NaN when a pivot is
 zero (a singular matrix, which no sign pattern accepts).
 """
 from __future__ import annotations
 
 import llvmlite.ir as ir
 
-from .llvm_build import D, DP, I64
+from .build import D, DP, I64
 
 FLAGS = ("contract",)
 

@@ -1,8 +1,8 @@
 """Generated world-frame block solve (a block without a constant frame), one sample.
 
-As the numpy path (:func:`.blocks.solve_blocks`, a general block): the block's balances in base axes about each link's origin,
-assembled from the column terms of :mod:`.kernel_terms` (the pose-dependent wrenches
-:func:`.llvm_blocks.term_wrench` emits) for a sign pattern of its t, then solved by
+As the numpy path (:func:`..blocks.solve_blocks`, a general block): the block's balances in base axes about each link's origin,
+assembled from the column terms of :mod:`.terms` (the pose-dependent wrenches
+:func:`.blocks.term_wrench` emits) for a sign pattern of its t, then solved by
 Gaussian elimination with partial pivoting (the first largest pivot), straight-line: the
 row swaps are selects on the pivot's row.  A zero pivot (a singular matrix) makes the
 whole solution NaN, which no sign pattern accepts.
@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import llvmlite.ir as ir
 
-from .llvm_build import D, I1, I64, Emitter
-from .llvm_links import floats
-from .llvm_signs import signs_of
-from .llvm_solve import solve_function
+from .build import D, I1, I64, Emitter
+from .links import floats
+from .signs import signs_of
+from .solve import solve_function
 
 
 def _pivot_row(e: Emitter, A, c: int):
@@ -87,7 +87,7 @@ pivot."""
 def static_lu(e: Emitter, A: list, B: list, order: list):
     """(X, bad): X = A^-1 B (A (k, k), B (k, m), lists of rows of values) by elimination in
     the fixed row order ``order`` (partial pivoting's order at the home pose,
-    :func:`.kernel_program._free_columns`), straight-line and without selects, so the zeros
+    :func:`.program._free_columns`), straight-line and without selects, so the zeros
     of the matrix's structure fold away; ``bad`` (i1) is true when a pivot is smaller than
     the largest entry below it by more than :data:`PIVOT_GROWTH` (the caller then solves
     with pivoting) or zero."""
@@ -127,13 +127,13 @@ class WorldBlock:
 
     A square block is eliminated straight-line (:func:`eliminate`).  A redundant one (a gear
     set with more unknowns n than its 6B equations, ``weights`` the load-sharing weights of
-    :func:`.sharing.mesh_weights`) is solved through a square basis (``free``: the columns
-    left out, :func:`.kernel_program._free_columns`; :meth:`_by_basis`), or where none was
-    found from the KKT system of :func:`.sharing.kkt` (the same matrix, D scaled by the
-    sample's largest |A| entry), each with the loop code of :mod:`.llvm_solve`, the
+    :func:`..sharing.mesh_weights`) is solved through a square basis (``free``: the columns
+    left out, :func:`.program._free_columns`; :meth:`_by_basis`), or where none was
+    found from the KKT system of :func:`..sharing.kkt` (the same matrix, D scaled by the
+    sample's largest |A| entry), each with the loop code of :mod:`.solve`, the
     matrices in stack arrays of the ``fn`` ``run``.
 
-    ``full_trial``: a trial solves the whole block (:func:`.llvm_signs.resolve` keeps
+    ``full_trial``: a trial solves the whole block (:func:`.signs.resolve` keeps
     that solution for the pattern it accepts)."""
 
     full_trial = True
@@ -155,7 +155,7 @@ class WorldBlock:
     def _by_basis(self, e: Emitter, A: list, r: list) -> list:
         """The least-load solution through the basis A_B (every column but the d ``free``):
         [p | Q] = A_B^-1 [r | A_free] (:func:`static_lu` in the stored row order, or the
-        pivoting loop code of :mod:`.llvm_solve` when a static pivot is poor), then the free unknowns from
+        pivoting loop code of :mod:`.solve` when a static pivot is poor), then the free unknowns from
         (Q^T W_B Q + W_free) x_free = Q^T W_B p (d x d, :func:`eliminate`) and x_B = p - Q x_free:
         the minimiser of sum w x^2 over the solutions of A x = r."""
         k, (free, order), w = len(r), self.free, self.weights
@@ -218,7 +218,7 @@ class WorldBlock:
         return self._least_load(e, A, r)
 
     def _least_load(self, e: Emitter, A: list, r: list) -> list:
-        """The minimiser of sum w x^2 subject to A x = r (:func:`.sharing.least_load_solve`)."""
+        """The minimiser of sum w x^2 subject to A x = r (:func:`..sharing.least_load_solve`)."""
         nr, n = len(A), self.n
         size = n + nr
         K, x = self._stack((size * size, size))
@@ -256,12 +256,12 @@ class WorldBlock:
 
 class LowRankBlock:
     """A constant-frame block with too many sign patterns to store their maps, solved from
-    one base matrix (:class:`~.pattern_maps.LowRank`, the Woodbury form, its numpy twin
+    one base matrix (:class:`~..pattern_maps.LowRank`, the Woodbury form, its numpy twin
     ``LowRank.solve``).  A trial with one of the ``hot`` patterns (pattern 0, the search's
-    first, and the ones random motions meet most, :func:`.kernel_program._hot_maps`) is a
+    first, and the ones random motions meet most, :func:`.program._hot_maps`) is a
     product with its map, straight-line with the constants (a ``switch`` over them); any
     other pattern computes y = Y r and g = G r, solves the k x k system
-    (C_sigma + W) c = g (a call of the loop code of :mod:`.llvm_solve`: such a pattern is
+    (C_sigma + W) c = g (a call of the loop code of :mod:`.solve`: such a pattern is
     rare, its code small) and takes x = y - Z c."""
 
     def __init__(self, lr, tcols: list, hot):

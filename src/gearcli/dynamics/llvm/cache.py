@@ -1,4 +1,4 @@
-"""The disk cache of the generated llvm kernels' machine code (:class:`.llvm_driver.Jit`).
+"""The disk cache of the generated llvm kernels' machine code (:class:`.driver.Jit`).
 
 An entry is the object code MCJIT made of one IR module for one host, in
 ``<cache dir>/llvm/<key>.obj``: the key hashes the IR text, the target triple, the host
@@ -30,10 +30,10 @@ optimising and generating it again.  The cache dir is :func:`gearcli.io.cache_ro
 ``<program key>.prog`` notes hold their own program key and the object key of that kernel
 program (its arrays and loads, hashed without building the IR, see :func:`program_key`); a
 note that does not name itself (moved from another program's name, damaged) is deleted.
-:func:`.backends.llvm_on_disk` (the first-call rule) asks :func:`has_program` whether a compile would be a load, and
-:class:`.llvm_driver.Jit` loads the object code through :func:`load_program` without
+:func:`..backends.llvm_on_disk` (the first-call rule) asks :func:`has_program` whether a compile would be a load, and
+:class:`.driver.Jit` loads the object code through :func:`load_program` without
 generating the IR at all (~0.05 s for the Bendix wrist) when the program key also hashes
-the source of the IR generator (:func:`.llvm_driver.generator_digest`).
+the source of the IR generator (:func:`.driver.generator_digest`).
 """
 from __future__ import annotations
 
@@ -44,7 +44,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.cache_root import BadEntry, cache_root, read_entry, remove_entry, write_entry
+from ...io.cache_root import BadEntry, cache_root, read_entry, remove_entry, write_entry
 
 FORMAT = 2                          # ours: change when the entry layout or the key changes
 MAGIC = b"gearcli-llvm-obj\x00"
@@ -70,13 +70,13 @@ def _sha(parts) -> str:
 
 
 def object_key(ir: str, host: str) -> str:
-    """The entry name of the object code of IR text ``ir`` on ``host`` (:func:`.llvm_driver.host_identity`)."""
+    """The entry name of the object code of IR text ``ir`` on ``host`` (:func:`.driver.host_identity`)."""
     return _sha(["object", FORMAT, host, ir])
 
 
 def program_fingerprint(prog, loads: list) -> str:
     """SHA-256 of what a kernel's IR is generated from: the kernel program's arrays and
-    fields and the external loads (:func:`.llvm_driver.mech_loads`); kept in each entry."""
+    fields and the external loads (:func:`.driver.mech_loads`); kept in each entry."""
     parts = ["fingerprint", FORMAT, prog.ncols, sorted(prog.offsets.items()), prog.signed, prog.names, prog.covered]
     for a in (*prog.ints, *prog.flts):
         a = np.ascontiguousarray(a)

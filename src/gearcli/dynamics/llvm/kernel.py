@@ -1,6 +1,6 @@
 """The per-mechanism kernel generated as LLVM IR (backend "llvm").
 
-:func:`build_module` writes, from a :class:`~.kernel_program.Program`, one function
+:func:`build_module` writes, from a :class:`~.program.Program`, one function
 
     run(qi, qdi, qddi, vals, ldpt, ldrow, ldgrp, motor, tau, joint, gear_t, gear_sep, gear_radial,
         gear_axial, motor_speed, signs, fail, start, stop)
@@ -8,24 +8,24 @@
 whose loop over the samples start..stop-1 does what the numpy path does for all of them,
 with every structural integer and every constant of the program (fixed transforms,
 masses, inertias, inverse block matrices, propagation columns, output coefficients) in
-the code: joint space, kinematics, inertia and external loads (:mod:`.llvm_links`), the
-blocks in schedule order (:mod:`.llvm_blocks`, :mod:`.llvm_signs`) and the outputs
-(:mod:`.llvm_outputs`), straight-line except for the sign search.  Only the inputs (the
+the code: joint space, kinematics, inertia and external loads (:mod:`.links`), the
+blocks in schedule order (:mod:`.blocks`, :mod:`.signs`) and the outputs
+(:mod:`.outputs`), straight-line except for the sign search.  Only the inputs (the
 independent q, qd, qdd (N, dof), C-ordered), the external loads (their values, points
-``ldpt``, records ``ldrow`` and per loaded link the range ``ldgrp``, :func:`.llvm_links.external`: one loop per loaded link,
+``ldpt``, records ``ldrow`` and per loaded link the range ``ldgrp``, :func:`.links.external`: one loop per loaded link,
 whatever the number of loads) and the output arrays
-(C-ordered rows of :func:`.llvm_outputs.widths`; ``fail`` (N,) int64, which ``run`` sets
+(C-ordered rows of :func:`.outputs.widths`; ``fail`` (N,) int64, which ``run`` sets
 to -1 or the sample's first failing block) are pointers.  ``run`` returns how many of its
-samples failed (the caller checks a sum, not ``fail``).  Compiled by :mod:`.llvm_driver`.
+samples failed (the caller checks a sum, not ``fail``).  Compiled by :mod:`.driver`.
 """
 from __future__ import annotations
 
 import llvmlite.ir as ir
 
-from .llvm_blocks import block
-from .llvm_build import DP, I64, I64P, Emitter
-from .llvm_links import at_rest, external, inertia, joint, joint_space, load_groups
-from .llvm_outputs import OUTPUTS, widths, write_outputs
+from .blocks import block
+from .build import DP, I64, I64P, Emitter
+from .links import at_rest, external, inertia, joint, joint_space, load_groups
+from .outputs import OUTPUTS, widths, write_outputs
 
 ARGS = ("qi", "qdi", "qddi", "vals", "ldpt", "ldrow", "ldgrp") + OUTPUTS + ("signs", "fail", "start", "stop")
 
@@ -63,7 +63,7 @@ def _sample(e: Emitter, fn, prog, loads, n) -> None:
 
 def build_module(prog, loads) -> ir.Module:
     """The IR module of ``prog``'s kernel (``loads``: per external load of the mechanism,
-    its link id first (:func:`.llvm_driver.mech_loads`); only their links shape the code))."""
+    its link id first (:func:`.driver.mech_loads`); only their links shape the code))."""
     mod = ir.Module(name="gearcli_kernel")
     fn = _signature(mod)
     entry, body, done = fn.append_basic_block("entry"), fn.append_basic_block("sample"), fn.append_basic_block("done")

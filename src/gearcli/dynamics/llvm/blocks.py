@@ -1,23 +1,23 @@
-"""Generated block solves (the second half of :mod:`.llvm_kernel`), one sample.
+"""Generated block solves (the second half of :mod:`.kernel`), one sample.
 
-Per block of the schedule, as :func:`.blocks.solve_blocks` does: gather the block links'
+Per block of the schedule, as :func:`..blocks.solve_blocks` does: gather the block links'
 right-hand sides in its frame F about o_F, solve x = Ainv[pattern] r (straight-line for a
-block without signed meshes, else with the sign search of :mod:`.llvm_signs`), pass the
+block without signed meshes, else with the sign search of :mod:`.signs`), pass the
 solved wrenches on to the later links (the propagation records and their C_plus, C_sep
-columns, or the column terms of :mod:`.kernel_terms` for a block solved in its link's
+columns, or the column terms of :mod:`.terms` for a block solved in its link's
 axes) and write the solution into the sample's row (joint reactions turned to their
 child's basis).  A block without a constant frame is solved in world axes by Gaussian
-elimination per sample and per sign trial (:mod:`.llvm_world`).
+elimination per sample and per sign trial (:mod:`.world`).
 """
 from __future__ import annotations
 
 import llvmlite.ir as ir
 
-from .llvm_build import I64, Emitter
-from .llvm_links import Sample, floats
-from .llvm_signs import SignedBlock, resolve, signs_of, tolerance
-from .llvm_trig import sincos
-from .llvm_world import LowRankBlock, WorldBlock
+from .build import I64, Emitter
+from .links import Sample, floats
+from .signs import SignedBlock, resolve, signs_of, tolerance
+from .trig import sincos
+from .world import LowRankBlock, WorldBlock
 
 
 def problem(prog) -> str | None:
@@ -70,7 +70,7 @@ def propagate(e: Emitter, s: Sample, F: int, recs, prog, x: list) -> None:
 
 def term_wrench(e: Emitter, s: Sample, trec_k, tflt_k, L: int, sig: list):
     """Wrench (6-tuple, base axes, about o_L) of one column term per unit of its unknown
-    (the column of :meth:`.equations.Columns.group`)."""
+    (the column of :meth:`..equations.Columns.group`)."""
     X = int(trec_k[4])
     coef = float(tflt_k[0])
     if trec_k[5] >= 0:
@@ -86,7 +86,7 @@ def term_wrench(e: Emitter, s: Sample, trec_k, tflt_k, L: int, sig: list):
 
 def propagate_terms(e: Emitter, s: Sample, k0: int, nt: int, prog, x: list, sig: list) -> None:
     """rhs[L] -= the solved wrenches on the later links from the terms with no block row
-    (as :func:`.blocks.solve_blocks` propagates)."""
+    (as :func:`..blocks.solve_blocks` propagates)."""
     trec, tflt = prog.ints[10], prog.flts[6]
     for k in range(k0, k0 + nt):
         if trec[k, 1] >= 0:

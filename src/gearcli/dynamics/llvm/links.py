@@ -1,9 +1,9 @@
-"""Generated per-sample kinematics and link loads (the first half of :mod:`.llvm_kernel`).
+"""Generated per-sample kinematics and link loads (the first half of :mod:`.kernel`).
 
-The same formulas as :func:`.kinematics.forward` and :func:`.inertia.inertia_load` (paper Eqs. 2-5 and 17-18, the external loads
-of :func:`.external.external_wrenches`), emitted straight-line per joint and link with
-every fixed transform, mass, inertia and load point of the :class:`~.kernel_program.Program`
-as a constant (:class:`~.llvm_build.Emitter` folds the zeros and ones: a joint on the base,
+The same formulas as :func:`..kinematics.forward` and :func:`..inertia.inertia_load` (paper Eqs. 2-5 and 17-18, the external loads
+of :func:`..external.external_wrenches`), emitted straight-line per joint and link with
+every fixed transform, mass, inertia and load point of the :class:`~.program.Program`
+as a constant (:class:`~.build.Emitter` folds the zeros and ones: a joint on the base,
 an identity R_pj, a centre of mass on an axis cost nothing).
 """
 from __future__ import annotations
@@ -12,8 +12,8 @@ from dataclasses import dataclass, field
 
 import llvmlite.ir as ir
 
-from .llvm_build import D, I64, Emitter
-from .llvm_trig import sincos
+from .build import D, I64, Emitter
+from .trig import sincos
 
 EYE = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
 ZERO3 = (0.0, 0.0, 0.0)
@@ -43,7 +43,7 @@ class Sample:
 
 
 def floats(row) -> tuple:
-    """A row of program constants as Python floats (folded by :class:`~.llvm_build.Emitter`)."""
+    """A row of program constants as Python floats (folded by :class:`~.build.Emitter`)."""
     return tuple(float(v) for v in row)
 
 
@@ -135,7 +135,7 @@ def load_groups(loads) -> tuple[list, list]:
 
 
 def external(e: Emitter, s: Sample, fn, links, n, vals, ldrow, ldpt, ldgrp) -> None:
-    """rhs[L] -= the sum of the external loads on L at sample n (:func:`.external.external_wrenches`).
+    """rhs[L] -= the sum of the external loads on L at sample n (:func:`..external.external_wrenches`).
 
     ``links``: the loaded links in the order of :func:`load_groups`, ``ldgrp`` per loaded
     link [first, end] of its loads; per load k (in that order) ``ldrow`` [first row of its values in ``vals`` (rows of 6), 1 if one row a

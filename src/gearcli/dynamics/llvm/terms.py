@@ -2,8 +2,8 @@
 
 A block whose unknowns share no link in which they are all fixed (a motor spread over
 several joints by a transmission, an ideal coupling) is solved per sample in world axes,
-like :func:`~.general.solve_general`.  The kernel assembles its matrix from *terms*: every
-column C_u,L of :class:`~.equations.Columns` is a sum of wrenches
+like :func:`~..general.solve_general`.  The kernel assembles its matrix from *terms*: every
+column C_u,L of :class:`~..equations.Columns` is a sum of wrenches
 
 * ``coef * [d ; (P - o_L) x d]``: a force along d through P, or
 * ``coef * [0 ; d]``: a moment along d,
@@ -11,7 +11,7 @@ column C_u,L of :class:`~.equations.Columns` is a sum of wrenches
 with d = R_X d_X and P = o_X + R_X p_X for a link X (the joint child for a joint frame:
 R_joint = R_child R_jc^T, o_joint = o_child - R_joint p_jc; the carrier for a mesh), and a
 term of a geared mesh's separating force is multiplied by the sign of its t (Eq. 14).
-Written here from the model, independently of :class:`~.equations.Columns`, which the
+Written here from the model, independently of :class:`~..equations.Columns`, which the
 kernel's tests compare against.
 
 ``trec`` (T, 6) int: [target link, row block-link position or -1 (a later link: the term
@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model.gears import helical_terms
-from .general import is_geared
+from ...model.gears import helical_terms
+from ..general import is_geared
 
 
 def _joint_frame(jt):

@@ -1,15 +1,15 @@
-"""Generated writing of one sample's results (what :func:`.solve._result` does).
+"""Generated writing of one sample's results (what :func:`..solve._result` does).
 
-From the sample's solution row (:attr:`.llvm_links.Sample.sol`): the joint reaction
+From the sample's solution row (:attr:`.links.Sample.sol`): the joint reaction
 wrenches with the zero component along (about) the joint's own axis, the motor torques,
 the tooth forces t with their separating, radial and axial components (the constants of
 :func:`.output_maps.output_constants`), tau = A motor and the motor speeds A^T qd.
 """
 from __future__ import annotations
 
-from .llvm_build import Emitter
-from .llvm_links import Sample, floats
-from .result_arrays import FIELDS as OUTPUTS
+from .build import Emitter
+from .links import Sample, floats
+from ..result_arrays import FIELDS as OUTPUTS
 
 
 def widths(prog) -> dict:

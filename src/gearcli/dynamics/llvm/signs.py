@@ -1,8 +1,8 @@
-"""Generated sign resolution of one block (paper Eq. 14; :func:`.signs.resolve_signs`).
+"""Generated sign resolution of one block (paper Eq. 14; :func:`..signs.resolve_signs`).
 
 The sign search is the only control flow of the generated kernel: step 0 tries every t
 positive, steps 1..m the signs of the previous trial's own t, then every pattern in
-:func:`.signs.sign_patterns` order (m <= MAX_EXHAUSTIVE), with the tolerance of the numpy
+:func:`..signs.sign_patterns` order (m <= MAX_EXHAUSTIVE), with the tolerance of the numpy
 path; a sample with no consistent pattern records its first failing block.  A trial of a
 constant-frame block computes only the m signed t.  A trial and the
 accepted pattern's full solution are a ``switch`` over the patterns into straight-line
@@ -15,9 +15,9 @@ from __future__ import annotations
 import llvmlite.ir as ir
 import numpy as np
 
-from .llvm_build import D, I1, I64, Emitter
-from .llvm_links import floats
-from .signs import MAX_EXHAUSTIVE, TOL_SIGN
+from .build import D, I1, I64, Emitter
+from .links import floats
+from ..signs import MAX_EXHAUSTIVE, TOL_SIGN
 
 SWITCH_LIMIT = 8192
 """Constant products (2^m patterns x (n + m) rows x 6B) up to which a signed block's
@@ -134,7 +134,7 @@ def resolve(e: Emitter, fn, blk: SignedBlock, r: list, tol, on_fail, tag: str):
     """(x (n values), p): the block's solution with the first consistent sign pattern p
     (i64) of the search order (module docstring); ``on_fail()`` emits what a sample with
     no consistent pattern does (its x is then that of the last pattern tried).  ``blk``:
-    a :class:`SignedBlock`, or a :class:`~.llvm_world.WorldBlock` whose trials solve the
+    a :class:`SignedBlock`, or a :class:`~.world.WorldBlock` whose trials solve the
     whole block (kept for the pattern accepted)."""
     m = len(blk.tcols)
     steps = 1 + m + ((1 << m) if m <= MAX_EXHAUSTIVE else 0)

@@ -1,6 +1,6 @@
 """Splitting a trajectory over threads, and the sign error of a compiled solve.
 
-Used by the generated kernel's driver (:mod:`.llvm_driver`): the samples
+Used by the generated kernel's driver (:mod:`.driver`): the samples
 are split into contiguous ranges that the threads take in turn (:func:`run_parts`: the
 calling thread and workers of a persistent pool, created on first use, so that a call pays
 no thread creation); a compiled kernel releases the GIL and each sample's arithmetic does
@@ -15,7 +15,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from .signs import SignError
+from ..signs import SignError
 
 MIN_SAMPLES_PER_JOB = 2_000   # fewer samples per thread: the thread costs more than it saves
 MIN_SAMPLES_PER_PART = 500    # smaller parts gain nothing (measured: 250, 500, 2000 samples)

@@ -2,14 +2,14 @@
 
 :func:`output_constants` says, from an analysed mechanism and the column offsets of its
 unknowns, where each output of a sample comes from in the solution row and the
-coefficients of the tooth force components (what :func:`.solve._result` computes over
+coefficients of the tooth force components (what :func:`..solve._result` computes over
 arrays).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ..model.gears import helical_terms
+from ...model.gears import helical_terms
 
 
 def output_constants(an, offsets: dict):

@@ -1,4 +1,4 @@
-"""Arithmetic for the generated kernel (:mod:`.llvm_kernel`): doubles that fold constants.
+"""Arithmetic for the generated kernel (:mod:`.kernel`): doubles that fold constants.
 
 A value is either a Python ``float`` (a constant of the mechanism, known when the code is
 generated) or an LLVM ``double`` (known per sample).  :class:`Emitter` emits an
@@ -6,7 +6,7 @@ instruction only when an operand is a per-sample value and skips what the consta
 trivial: a product with an exact 0.0 is 0.0, a product with 1.0 (-1.0) is the other
 operand (negated), a sum with 0.0 is the other term.  Skipping ``0.0 * x`` drops a NaN or
 an infinity that x might carry; the inputs are checked finite upstream
-(:func:`.external.load_values`, the trajectory readers) and a sample whose own arithmetic
+(:func:`..external.load_values`, the trajectory readers) and a sample whose own arithmetic
 overflows still reaches the sign search through the products that remain.  Only the
 ``contract`` fast-math flag is set (fused multiply-adds): NaN must reach the sign search.
 
