@@ -19,7 +19,7 @@ from ..design.checks import Check, Requirements, build_checks
 from ..errors import Collector, GearcliError
 from ..io import load_mechanism
 from ..io.limits import input_problem
-from ..io.trajectory import TrajectoryReader
+from ..io.trajectory import TrajectoryReader, forget_rows
 from ..io.yaml_reader import json_path, number_issues, schema_messages
 from ..io.yaml_safe import read_text, yaml_lines
 from ..model.validate import MAX_ABS
@@ -139,6 +139,7 @@ def load_manifest(path: str | Path) -> Manifest:
     :class:`ManifestError` listing every problem: numbers (finite, in range), the schema,
     and what the valid parts name (files, columns, requirements), in one round."""
     path = Path(path)
+    forget_rows()            # rows a previous manifest's check kept and no job took
     data, lines = yaml_lines(read_text(path, "design manifest"), str(path))
     col = Collector(str(path), lines)
     if not isinstance(data, dict):
@@ -288,7 +289,8 @@ def _prepare_case(spec: dict, where: str, base: Path, col: Collector, issues: li
     for tp in trajs if degrees is not None else ():   # a bad 'degrees': the rows' scale is unknown
         try:
             TrajectoryReader(tp, an.independent_names, degrees=degrees,
-                             linear=prismatic_independent(an), loads=an.mech.loads).check()   # rows only, no spline
+                             linear=prismatic_independent(an), loads=an.mech.loads).check(keep=True)  # rows only,
+            # no spline; the rows are kept for the job that solves the file in this process
         except GearcliError as exc:
             issues += exc.lines()
     name = spec["name"] if ok("name") else Path(spec["mechanism"]).stem

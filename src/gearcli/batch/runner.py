@@ -20,7 +20,7 @@ from ..design.evaluate import Samples, Verdict, combine, partials, profile_rates
 from ..design.sizing import inertia_columns
 from ..dynamics.solve import solve
 from ..errors import Collector, GearcliError
-from ..io.trajectory import read_trajectory
+from ..io.trajectory import forget_rows, read_trajectory
 from ..pipeline import prismatic_independent
 from ..report.columns import LazyColumns
 from .heap import keep_freed_memory
@@ -89,10 +89,13 @@ def run_manifest(manifest: Manifest, jobs: int | None = None, dask_address: str 
     is ignored).
     """
     todo = jobs_of(manifest)
-    if dask_address is not None:
-        results = _run_dask(todo, dask_address, progress)
-    else:
-        results = _run_local(todo, jobs or os.cpu_count() or 1, progress)
+    try:
+        if dask_address is not None:
+            results = _run_dask(todo, dask_address, progress)
+        else:
+            results = _run_local(todo, jobs or os.cpu_count() or 1, progress)
+    finally:
+        forget_rows()       # rows the manifest's check kept for jobs (taken by the serial ones)
     out = []
     for ci, case in enumerate(manifest.cases):
         parts = [results[(ci, ti)][0] for ti in range(len(case.trajectories))]

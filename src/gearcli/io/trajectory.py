@@ -116,6 +116,31 @@ def _check_time(t: np.ndarray, last_t: float | None, linenos: list[int], place: 
                 f"{MIN_STEP:g} s")
 
 
+KEEP_BYTES = 128 << 20
+"""Most bytes of checked rows held at once (:func:`keep_rows`)."""
+
+_KEPT: dict = {}
+
+
+def keep_rows(key: tuple | None, parts: list) -> bool:
+    """Hold the checked rows ``parts`` ([(rows in SI units, line numbers)], as
+    :meth:`TrajectoryReader._raw` yields them) of a file for its next reader in this process
+    (``gearcli verify`` checks every trajectory before any work, then solves each: read
+    once, not twice).  Taken once; the file's identity and modification time are in
+    ``key``, so a changed file is read again.  Not held beyond :data:`KEEP_BYTES` in all;
+    :func:`forget_rows` drops what was not taken.  True when held."""
+    size = sum(d.nbytes + ln.nbytes for d, ln in parts)
+    if key is None or size + sum(d.nbytes + ln.nbytes for v in _KEPT.values() for d, ln in v) > KEEP_BYTES:
+        return False
+    _KEPT[key] = parts
+    return True
+
+
+def forget_rows() -> None:
+    """Drop every row held by :func:`keep_rows`."""
+    _KEPT.clear()
+
+
 class TrajectoryReader:
     """Reads a trajectory CSV in chunks of ``chunk`` samples (see module docstring).
 
@@ -183,7 +208,14 @@ class TrajectoryReader:
     def _raw(self):
         """Yield (array of rows in SI units (n, ncol), line numbers (n,)), checked: the
         chunks of plain lines straight from the bytes (:meth:`_plain_rows`), from the first
-        other one on (blank or non-ASCII lines, a bad value: to report it) line by line."""
+        other one on (blank or non-ASCII lines, a bad value: to report it) line by line;
+        rows a check kept (:func:`keep_rows`) are taken instead, in chunks of ``chunk``."""
+        kept = _KEPT.pop(self._key(), None) if _KEPT else None
+        if kept is not None:
+            data, lines = (np.concatenate(x) for x in zip(*kept)) if len(kept) > 1 else kept[0]
+            for a in range(0, len(data), self.chunk):
+                yield data[a:a + self.chunk], lines[a:a + self.chunk]
+            return
         last_t = None
         with open(self.path, "rb") as f:
             f.readline()        # the header (checked in __init__)
@@ -223,17 +255,30 @@ class TrajectoryReader:
                 last_t = si[-1, c_t]
                 yield si, np.asarray(linenos)
 
-    def check(self) -> int:
+    def check(self, keep: bool = False) -> int:
         """Read and check every row (cells, ranges, time) without deriving rates; the
         number of samples.  Raises like iteration would for the rows and for too few
-        samples."""
-        n = sum(len(data) for data, _ in self._raw())
+        samples.  ``keep``: hold the checked rows for the next reader of the same unchanged
+        file in this process (:func:`keep_rows`), which then does not read it again."""
+        parts = list(self._raw())
+        n = sum(len(data) for data, _ in parts)
         if n == 0:
             raise fail(self.file, None, "", "no samples after the header")
         need = 1 + (self.cols["qd"] is None) + (self.cols["qdd"] is None)
         if n < need:
             raise self._too_few(n, need, "q" if self.cols["qd"] is None else "qd")
+        if keep:
+            keep_rows(self._key(), parts)
         return n
+
+    def _key(self) -> tuple | None:
+        """What the rows of :meth:`_raw` depend on: the file (device, inode, size, modification
+        time in ns) and the factor to SI of each column; None when it cannot be stat'ed."""
+        try:
+            st = os.stat(self.path)
+        except OSError:
+            return None
+        return (os.path.abspath(self.path), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, self.scale.tobytes())
 
     def __iter__(self):
         prev = None   # rows of the previous chunk (for the spline pad)
