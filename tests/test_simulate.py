@@ -211,3 +211,108 @@ def test_bad_output_is_refused_before_any_work(run_cli, mech_dir, tmp_path, out,
     r = run_cli("simulate", mech_dir / "paper_2dof.yaml", inp, "-o", out if out == "-" else f"{tmp_path}/{out}")
     assert r.exit_code == 2
     assert message in r.stderr and len(r.stderr.strip().splitlines()) == 1
+
+
+# --- energy with losses --------------------------------------------------------------------------
+
+LOSSY_PENDULUM = """
+name: lossy_pendulum
+gravity: [0, 0, -9.81]
+base: frame
+end_effector: wheel
+links:
+  - name: frame
+  - {name: pinion, mass: 0.1, inertia: [1.0e-5, 2.0e-5, 1.0e-5]}
+  - {name: wheel, mass: 1.0, com: [0.03, 0, 0], inertia: [1.0e-3, 1.5e-3, 1.0e-3]}
+joints:
+  - name: Jp
+    parent: frame
+    child: pinion
+    axis: [0, 1, 0]
+    friction: {coulomb: 0.002, viscous: 1.0e-5}
+    bearings:
+      - {name: a, position: 0.0, locating: true, friction_coefficient: 0.0015, bore: 0.008}
+      - {name: b, position: 0.02, friction_coefficient: 0.0015, bore: 0.008}
+  - {name: Jw, parent: frame, child: wheel, origin: {xyz: [0.075, 0, 0]}, axis: [0, 1, 0],
+     friction: {viscous: 2.0e-4}}
+gears:
+  - {name: mesh, links: [pinion, wheel], teeth: [15, 60], mesh_point: [0.015, 0, 0], efficiency: 0.97}
+motors:
+  - {name: motor, link: pinion}
+"""
+
+
+def pendulum_energy(q, w):
+    """Kinetic + potential energy (J) of LOSSY_PENDULUM by hand: horizontal axes along y, the
+    pinion (Iyy 2e-5, centre of mass on its axis) turns at -4 w (15/60 external pair), the
+    wheel (1 kg, Iyy 1.5e-3 about its centre of mass 0.03 m off its axis along its x) at w;
+    rotating x about y by q gives z = -0.03 sin q."""
+    kinetic = 0.5 * 2.0e-5 * (4 * w) ** 2 + 0.5 * (1.5e-3 + 1.0 * 0.03 ** 2) * w ** 2
+    return kinetic, 1.0 * 9.81 * (-0.03 * np.sin(q))
+
+
+def running_integral(t, p):
+    """int_0^t p dt (trapezoid rule) at every sample."""
+    return np.concatenate([[0.0], np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(t))])
+
+
+def test_energy_falls_by_exactly_the_integrated_losses(run_cli, tmp_path):
+    """A gear-train pendulum with mesh friction, joint Coulomb and viscous friction and
+    bearing friction, pushed by the motor for 0.1 s, then free (zero torque from 0.12 s):
+    E(t) - E(0) = work of the motor - integral of every loss column that 'gearcli simulate
+    --loads' writes, and E never rises once the motor is off.  Energy and motor power by
+    hand (pendulum_energy), not from gearcli.  The balance holds to 6e-8 of the largest
+    kinetic energy: the trapezoid rule every 0.1 ms, whose error concentrates where the
+    mesh force or the rates change sign inside an interval (a kink of |t| v); the
+    integrator's own error (rtol 1e-10) is far below."""
+    mech = write(tmp_path / "pendulum.yaml", LOSSY_PENDULUM)
+    inp = write(tmp_path / "in.csv", "t,motor:motor\n0,-0.01\n0.1,-0.01\n0.12,0\n0.4,0\n")
+    r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv", "--q0", "0.8", "--dt", "1e-4",
+                "--method", "DOP853", "--rtol", "1e-10", "--atol", "1e-12", "--loads", tmp_path / "loads.csv")
+    assert r.exit_code == 0, r.stderr
+    tr, lo = read_csv(tmp_path / "traj.csv"), read_csv(tmp_path / "loads.csv")
+    t, w = tr["t"], tr["qd:Jw"]
+    kinetic, potential = pendulum_energy(tr["q:Jw"], w)
+    E = kinetic + potential
+    losses = {c: lo[c] for c in lo if c.endswith(":loss")}
+    assert sorted(losses) == ["gear:mesh:loss", "joint:Jp:loss", "joint:Jw:loss"]
+    lost = running_integral(t, sum(losses.values()))
+    work = running_integral(t, np.interp(t, [0, 0.1, 0.12, 0.4], [-0.01, -0.01, 0, 0]) * (-4 * w))
+    assert work[-1] > 0.1 * lost[-1] > 0 and np.ptp(w) > 10     # the motor and every loss matter
+    for c, p in losses.items():
+        assert running_integral(t, p)[-1] > 0.02 * lost[-1], c
+    assert np.max(np.abs(E - E[0] - work + lost)) < 1e-7 * kinetic.max()
+    free = t >= 0.12
+    assert np.all(np.diff(E[free]) <= 1e-12 * kinetic.max())
+    # a deliberate bug: the bearing friction left out of the losses breaks the balance
+    bearing = 0.5 * 0.0015 * 0.008 * np.abs(-4 * w)           # a floor: at least one bearing's moment
+    assert np.max(np.abs(E - E[0] - work + lost - running_integral(t, bearing))) > 1e-5 * kinetic.max()
+
+
+def test_lossy_forward_dynamics_settles_near_a_static_balance():
+    """The pendulum swinging through its lowest point with the motor off: the torques
+    (given, gravity, h) nearly vanish while the solve still rounds at the size of the
+    inertia and reaction terms; the implicit solve must settle there (it used to stop with
+    'did not settle', ending the simulation above at t = 0.41 s) and invert solve."""
+    from gearcli import analyse, parse_mechanism, solve
+    from gearcli.dynamics.forward import forward_dynamics
+    an = analyse(parse_mechanism(LOSSY_PENDULUM))
+    q = np.array([[np.pi / 2], [1.608406654001242], [np.pi / 2]])     # at rest; gravity = friction; moving
+    qd = np.array([[0.0], [-7.65102391], [-7.65102391]])
+    qdd = forward_dynamics(an, q, qd, np.zeros((3, 1)))
+    res = solve(an, q, qd, qdd)
+    assert np.max(np.abs(res.motor)) < 1e-13
+    assert np.max(np.abs(qdd[:2, 0])) < 1e-12 and qdd[2, 0] > 1.0       # balanced; decelerating
+
+
+def test_unsettled_forward_dynamics_is_one_line(run_cli, tmp_path, monkeypatch):
+    """An acceleration that does not settle (here: no correction step allowed) ends the
+    simulation with gearcli's one-line error naming the time, exit 2, nothing written."""
+    from gearcli.dynamics import forward
+    monkeypatch.setattr(forward, "MAX_STEPS", 0)
+    mech = write(tmp_path / "pendulum.yaml", LOSSY_PENDULUM)
+    inp = write(tmp_path / "in.csv", "t,motor:motor\n0,0\n0.1,0\n")
+    r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv", "--q0", "0.8")
+    assert r.exit_code == 2
+    assert "in.csv: simulation failed: t = 0 s: forward dynamics with losses did not settle" in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and not (tmp_path / "traj.csv").exists()

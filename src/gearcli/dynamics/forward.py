@@ -19,18 +19,21 @@ sample, h = tau(q, qd, 0) and the columns M e_i = tau(q, qd, e_i) - h.  Hence
 uses, and the mass matrix inherits its exactness (no diagonal "armature" approximation of
 the rotors).
 
-Losses (``gears[].efficiency``/``loss_factor``, ``joints[].friction``): the mesh friction
-couple c |t| rho makes tau(q, qd, qdd) piecewise linear in qdd (linear for each sign pattern
-of the tangential forces t, as the separating forces are), no longer linear.
+Losses (``gears[].efficiency``/``loss_factor``, ``joints[].friction``, bearing friction):
+the mesh friction couple c |t| rho makes tau(q, qd, qdd) piecewise linear in qdd (linear for
+each sign pattern of the tangential forces t, as the separating forces are), and the
+bearing friction moments grow with the reactions the accelerations change.
 :func:`forward_dynamics` then solves tau(q, qd, qdd) = A tau_motors as an implicit equation:
 the M and h above give a secant start, then steps qdd -= M^-1 (tau(qdd) - A tau_motors),
 one batched solve of the samples not yet settled each, until the torque residual is below
-1e-12 of the sample's largest torque.  The secant M spans qdd = 0 to e_i, not the sign
-pattern of the solution, so the steps converge linearly: 10-20 of them on the bundled
-mechanisms with c = 0.03 and joint friction (most samples settle in about 10).
-Joint Coulomb and viscous friction depend on the rates only and sit in h.  At zero relative
-speed a mesh has no friction couple (no stiction model); a transmission that self-locks
-under the given torques has no unique acceleration: ValueError.
+1e-12 of the sample's torque scale (the largest of the given torques, h and M: a sample
+near a static balance, where those torques nearly vanish, still rounds at the size of its
+inertia torques).  The secant M spans qdd = 0 to e_i, not the sign pattern of the
+solution, so the steps converge linearly: 10-20 of them on the bundled mechanisms with
+c = 0.03 and joint friction (most samples settle in about 10).  Joint Coulomb and viscous
+friction depend on the rates only and sit in h.  At zero relative speed a mesh has no
+friction couple (no stiction model); a transmission that self-locks under the given
+torques has no unique acceleration: ValueError.
 """
 from __future__ import annotations
 
@@ -150,20 +153,29 @@ def forward_dynamics(an, q, qd, motor_torques, loads: dict | None = None, backen
 def _implicit(an, q, qd, target, M, h, loads, backend, jobs) -> np.ndarray:
     """qdd with tau(q, qd, qdd) = target (N, dof) for a mechanism with losses, where tau is
     piecewise linear in qdd (|t| of the mesh friction): from the secant solution
-    M qdd = target - h, steps qdd -= M^-1 (tau(qdd) - target) on the samples not yet within
-    :data:`TOLERANCE` of their largest torque (one solve of those samples a step; linear
-    convergence, 10-20 steps with c = 0.03); ValueError naming the first
-    sample that does not settle in :data:`MAX_STEPS` (e.g. a self-locking transmission)."""
+    M qdd = target - h, steps qdd -= M^-1 (tau(qdd) - target) on the samples not yet settled
+    (one solve of those samples a step; linear convergence, 10-20 steps with c = 0.03).
+
+    A sample settles when its residual is within :data:`TOLERANCE` of its torque scale, the
+    largest of |target|, |h| and |M| (the torques of unit accelerations: a sample near a
+    static balance, target and h ~ 0, still has inertia torques of that size, and its solve
+    rounds to them), or when a step no longer reduces a residual already within
+    ``sqrt(TOLERANCE)`` of that scale (rounding reached).  ValueError naming the first sample
+    that does not settle in :data:`MAX_STEPS` (e.g. a self-locking transmission)."""
     qdd = np.linalg.solve(M, (target - h)[:, :, None])[:, :, 0]
     values = load_values(an.mech, len(q), loads)
-    scale = np.maximum(np.abs(target).max(axis=1), np.abs(h).max(axis=1))
+    scale = np.maximum(np.maximum(np.abs(target).max(axis=1), np.abs(h).max(axis=1)),
+                       np.abs(M).max(axis=(1, 2)))
     todo = np.arange(len(q))
+    last = np.full(len(q), np.inf)
     for _ in range(MAX_STEPS):
         res = solve(an, q[todo], qd[todo], qdd[todo], loads={k: v[todo] for k, v in values.items()},
                     backend=backend, jobs=jobs, check_finite=False)
         r = res.tau - target[todo]
-        left = np.abs(r).max(axis=1) > TOLERANCE * scale[todo]
-        todo, r = todo[left], r[left]
+        size = np.abs(r).max(axis=1)
+        done = (size <= TOLERANCE * scale[todo]) | ((size >= last[todo]) & (size <= np.sqrt(TOLERANCE) * scale[todo]))
+        last[todo] = size
+        todo, r = todo[~done], r[~done]
         if todo.size == 0:
             return qdd
         qdd[todo] -= np.linalg.solve(M[todo], r[:, :, None])[:, :, 0]

@@ -89,6 +89,16 @@ class Drive:
         return (u - self.R[k] * current - self.kt[k] * w) / self.L
 
 
+def _accelerations(an, q, qd, T, backend, t):
+    """:func:`~.forward.forward_dynamics`, its ValueError (a state that is not finite, an
+    acceleration with losses that does not settle) a :class:`SimulationError` at time(s) t."""
+    try:
+        return forward_dynamics(an, q, qd, T, backend=backend)
+    except ValueError as exc:
+        when = f"t = {t:.9g} s" if np.ndim(t) == 0 else f"t = {t[0]:.9g} to {t[-1]:.9g} s"
+        raise SimulationError(f"{when}: {exc}") from None
+
+
 def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10, method: str = "DOP853",
              progress=None, backend: str = "auto") -> Simulation:
     """Integrate from (q0, qd0) at t_eval[0] to t_eval[-1]; samples at ``t_eval`` (s).
@@ -107,10 +117,7 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
     def rhs(t, x):
         q, qd, cur = x[:dof], x[dof:2 * dof], x[2 * dof:]
         T, _ = d.torques(t, qd, cur)
-        try:
-            qdd = forward_dynamics(an, q, qd, T, backend=backend)[0]
-        except ValueError as exc:
-            raise SimulationError(f"the state is not finite at t = {t:.9g} s ({exc})") from None
+        qdd = _accelerations(an, q, qd, T, backend, t)[0]
         if progress is not None:
             progress(t)
         return np.concatenate([qd, qdd, d.current_rate(t, qd, cur)])
@@ -138,5 +145,5 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
         t, x = np.append(t[t < te], te), np.vstack([x[t < te], sol.y_events[k][:1]])
     q, qd, cur = x[:, :dof], x[:, dof:2 * dof], x[:, 2 * dof:]
     T, current = d.torques(t, qd, cur)
-    qdd = forward_dynamics(an, q, qd, T, backend=backend)
+    qdd = _accelerations(an, q, qd, T, backend, t)
     return Simulation(t, q, qd, qdd, T, current, stop, int(sol.nfev))
