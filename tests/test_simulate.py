@@ -316,3 +316,72 @@ def test_unsettled_forward_dynamics_is_one_line(run_cli, tmp_path, monkeypatch):
     assert r.exit_code == 2
     assert "in.csv: simulation failed: t = 0 s: forward dynamics with losses did not settle" in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and not (tmp_path / "traj.csv").exists()
+
+
+# --- position limits in YAML ---------------------------------------------------------------------
+
+PENDULUM_YAML = """
+name: pendulum
+base: base
+end_effector: arm
+links:
+  - name: base
+  - {name: arm, mass: 2.0, com: [0.5, 0, 0], inertia: [0.01, 0.01, 0.01]}
+joints:
+  - {name: swing, parent: base, child: arm, axis: [0, 1, 0], limits: {lower: -0.5, upper: 1.0}}
+motors:
+  - {name: swing, link: arm}
+"""
+
+
+def test_yaml_joint_limits_stop_the_simulation_as_urdf_limits_do(run_cli, tmp_path):
+    """PENDULUM as a YAML file with joints[].limits: the same stop, message and exit status
+    as the URDF's <limit>, the same trajectory; exported to URDF (a revolute joint with
+    <limit lower upper>, effort and velocity marked as placeholders), read back with the
+    same limits and no invented effort/velocity rating, and simulated identically."""
+    import yourdfpy
+    from gearcli import load_mechanism
+    inp = write(tmp_path / "in.csv", "t,motor:swing\n0,0\n2,0\n")
+    rows = {}
+    for name, text in (("p.urdf", PENDULUM), ("p.yaml", PENDULUM_YAML)):
+        r = run_cli("simulate", write(tmp_path / name, text), inp, "-o", tmp_path / f"{name}.csv")
+        assert r.exit_code == 1
+        assert "in.csv: stopped: joint 'swing' reached its upper limit 1 at t = " in r.stderr
+        rows[name] = read_csv(tmp_path / f"{name}.csv")
+    assert np.array_equal(rows["p.yaml"]["q:swing"], rows["p.urdf"]["q:swing"])
+    r = run_cli("export", tmp_path / "p.yaml", "-o", tmp_path / "back.urdf")
+    assert r.exit_code == 0, r.stderr
+    robot = yourdfpy.URDF.load(str(tmp_path / "back.urdf"), load_meshes=False, build_scene_graph=False)
+    jt = robot.robot.joints[0]
+    assert (jt.type, jt.limit.lower, jt.limit.upper) == ("revolute", -0.5, 1.0)
+    back = load_mechanism(tmp_path / "back.urdf").joints[0]
+    assert back.position_limits == (-0.5, 1.0) and back.limit is None
+    r = run_cli("simulate", tmp_path / "back.urdf", inp, "-o", tmp_path / "back.csv")
+    assert r.exit_code == 1 and "reached its upper limit 1 at" in r.stderr
+    assert (tmp_path / "back.csv").read_text() == (tmp_path / "p.yaml.csv").read_text()
+
+
+def test_prismatic_placeholder_limits_are_not_read_back_as_limits(tmp_path):
+    """A prismatic joint without limits is exported with URDF's required <limit> (+-1000 m)
+    marked as placeholders: read back, it has no position limits and no rating."""
+    from gearcli import load_mechanism, parse_mechanism
+    from gearcli.report.urdf_writer import export_urdf
+    text = PENDULUM_YAML.replace("axis: [0, 1, 0], limits: {lower: -0.5, upper: 1.0}", "type: prismatic, axis: [1, 0, 0]")
+    export_urdf(parse_mechanism(text), tmp_path / "s.urdf")
+    assert 'gearcli:placeholder="lower upper effort velocity"' in (tmp_path / "s.urdf").read_text()
+    back = load_mechanism(tmp_path / "s.urdf").joints[0]
+    assert back.type == "prismatic" and back.position_limits is None and back.limit is None
+
+
+@pytest.mark.parametrize("limits,message", [
+    ("{lower: 1.0, upper: 1.0}", "p.yaml:9: joints[0].limits.upper: upper limit 1 rad must be above the lower limit 1 rad"),
+    ("{lower: 0.5, upper: -0.5}", "p.yaml:9: joints[0].limits.upper: upper limit -0.5 rad must be above the lower limit 0.5 rad"),
+    ("{lower: -.inf, upper: 1.0}", "p.yaml:9: joints[0].limits.lower: -inf is not a finite number"),
+    ("{lower: -0.5}", "p.yaml:9: joints[0].limits: missing required key 'upper'"),
+    ("{lower: -0.5, upper: 1.0, effort: 3}", "p.yaml:9: joints[0].limits"),
+])
+def test_bad_yaml_joint_limits_are_located(run_cli, tmp_path, limits, message):
+    mech = write(tmp_path / "p.yaml", PENDULUM_YAML.replace("{lower: -0.5, upper: 1.0}", limits))
+    r = run_cli("check", mech)
+    assert r.exit_code == 2
+    assert message in r.stderr and len(r.stderr.strip().splitlines()) == 1

@@ -10,9 +10,9 @@ model has an inductance, its winding current i (A, starting at 0).  The motor to
   the motor's speed relative to its stator (rad/s).
 
 The accelerations are :func:`~.forward.forward_dynamics` (exact, every gear and rotor),
-integrated by :func:`scipy.integrate.solve_ivp`.  Joints with position limits (a URDF
-``<limit lower upper>``) stop the integration when they reach one (a terminal event); the
-stop is reported, with the samples up to it.
+integrated by :func:`scipy.integrate.solve_ivp`.  Joints with position limits (YAML
+``joints[].limits``, a URDF ``<limit lower upper>``) stop the integration when they reach
+one (a terminal event); the stop is reported, with the samples up to it.
 """
 from __future__ import annotations
 
@@ -48,14 +48,11 @@ class SimulationError(Exception):
 
 
 def joint_limits(an) -> list[tuple[int, str, float, float]]:
-    """(joint index, name, lower, upper) of every real joint with position limits (a URDF
-    ``<limit lower upper>`` on a revolute or prismatic joint; rad or m)."""
-    out = []
-    for ji, jt in enumerate(an.mech.joints):
-        lim = (jt.source or {}).get("limit")
-        if lim and jt.source.get("urdf_type") in ("revolute", "prismatic") and lim["lower"] < lim["upper"]:
-            out.append((ji, jt.name, float(lim["lower"]), float(lim["upper"])))
-    return out
+    """(joint index, name, lower, upper) of every real joint with position limits
+    (``joints[].limits`` of a YAML file, a URDF ``<limit lower upper>`` on a revolute or
+    prismatic joint; rad or m)."""
+    return [(ji, jt.name, *jt.position_limits) for ji, jt in enumerate(an.mech.joints)
+            if jt.position_limits is not None]
 
 
 class Drive:

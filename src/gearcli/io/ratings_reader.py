@@ -232,9 +232,12 @@ def _urdf_limit(el, path: str, warn, add) -> JointLimit | None:
     lim = el.find("limit")
     if lim is None:
         return None
+    from .urdf_xml import placeholders  # noqa: PLC0415  (URDF only: YAML mechanisms do not import lxml)
+
     vals = {}
+    stand_in = placeholders(lim)
     for key in ("effort", "velocity"):
-        text, v = lim.get(key), None
+        text, v = (None if key in stand_in else lim.get(key)), None
         if text is not None:
             try:
                 v = float(text)

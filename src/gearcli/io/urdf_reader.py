@@ -56,7 +56,7 @@ from .loads_reader import UrdfLoads
 from .urdf_extension import Extension
 from .urdf_mimic import Mimics
 from .urdf_structure import JOINT_TYPES, StructureChecks
-from .urdf_xml import NS, floats as _floats, load_yourdfpy, parse_xml, q, range_problem
+from .urdf_xml import NS, floats as _floats, load_yourdfpy, parse_xml, placeholders, q, range_problem
 
 
 def load_urdf(path: str | Path) -> Mechanism:
@@ -244,16 +244,21 @@ class _Reader(StructureChecks, Mimics, Extension, UrdfLoads):
                              "coupling, but the joint has no <mimic>", sub)
             source = {"origin": {"xyz": T[:3, 3].tolist(), "rpy": matrix_rpy(T[:3, :3]).tolist()},
                       "axis": axis.tolist(), "urdf_type": yj.type}
-            lim = yj.limit
-            if lim is not None and None not in (lim.lower, lim.upper, lim.effort, lim.velocity):
+            lim, bounds = yj.limit, None
+            stand_in = placeholders(el.find("limit"))
+            if lim is not None and None not in (lim.lower, lim.upper, lim.effort, lim.velocity) and not stand_in:
                 source["limit"] = {"lower": lim.lower, "upper": lim.upper, "effort": lim.effort,
                                    "velocity": lim.velocity}
+            if (lim is not None and yj.type in ("revolute", "prismatic") and None not in (lim.lower, lim.upper)
+                    and "lower" not in stand_in and float(lim.lower) < float(lim.upper)):
+                bounds = (float(lim.lower), float(lim.upper))
             d = yj.dynamics
             if d is not None and any(_floats(x, 1) is not None and _floats(x, 1)[0] != 0
                                      for x in (d.damping, d.friction) if x is not None):
                 dyn.append(name)
             joints.append(Joint(name, parent, yj.child, T[:3, :3] @ A, T[:3, 3].copy(), A.T, np.zeros(3),
-                                JOINT_TYPES[yj.type], label, source, path, friction=friction))
+                                JOINT_TYPES[yj.type], label, source, path, friction=friction,
+                                position_limits=bounds))
         if dyn:
             more = f" and {len(dyn) - 4} more" if len(dyn) > 5 else ""
             self.warn("", f"<dynamics> damping and friction of {plural(len(dyn), 'joint')} {', '.join(dyn[:4] if more else dyn)}{more} are ignored "

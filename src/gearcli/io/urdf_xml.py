@@ -31,6 +31,14 @@ def q(tag: str) -> str:
     return f"{{{NS}}}{tag}"
 
 
+def placeholders(limit_el) -> set[str]:
+    """The attributes of a ``<limit>`` element that ``gearcli export`` wrote only because URDF
+    requires them (``gearcli:placeholder="effort velocity"``: a joint with position limits
+    but no effort/velocity ratings; ``"lower upper effort velocity"``: a prismatic joint
+    without any limits); gearcli ignores them on reading."""
+    return set((limit_el.get(q("placeholder")) or "").split()) if limit_el is not None else set()
+
+
 def _fromstring(data: bytes, file: str, resolve):
     parser = etree.XMLParser(remove_comments=True, resolve_entities=resolve, no_network=True,
                              load_dtd=False, dtd_validation=False, huge_tree=False)

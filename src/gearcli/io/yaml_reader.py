@@ -248,8 +248,22 @@ def _joints(data: dict, col: Collector, links: _Names) -> list[Joint]:
         source = {k: spec[k] for k in ("dh", "origin", "axis") if k in spec}
         joints.append(Joint(spec["name"], spec["parent"], spec["child"], R_pj, p_pj, R_jc, p_jc,
                             spec.get("type", "revolute"), spec.get("label"), source, path,
-                            friction=joint_friction(spec, col, path)))
+                            friction=joint_friction(spec, col, path),
+                            position_limits=position_limits(spec, col, path)))
     return joints
+
+
+def position_limits(spec: dict, col: Collector, path: str) -> tuple[float, float] | None:
+    """``joints[].limits`` ({lower, upper}: rad, or m for a prismatic joint; finite: checked
+    before) as (lower, upper); lower < upper, else a located error."""
+    if "limits" not in spec:
+        return None
+    lower, upper = float(spec["limits"]["lower"]), float(spec["limits"]["upper"])
+    if not lower < upper:
+        u = "m" if spec.get("type") == "prismatic" else "rad"
+        col.add(f"{path}.limits.upper", f"upper limit {upper:g} {u} must be above the lower limit {lower:g} {u}")
+        return None
+    return lower, upper
 
 
 def joint_friction(spec: dict, col: Collector, path: str) -> JointFriction | None:

@@ -60,6 +60,7 @@ class Joint:
     bearings: tuple[BearingRating, ...] | None = None   # rated bearings (design checks)
     limit: JointLimit | None = None                     # URDF <limit effort velocity>
     friction: JointFriction | None = None               # joints[].friction (model.friction)
+    position_limits: tuple[float, float] | None = None  # (lower, upper), rad (m): simulate stops there
 
 
 GEAR_KINDS = ("external", "internal", "bevel", "rack")

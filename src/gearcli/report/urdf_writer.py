@@ -5,7 +5,9 @@ write):
 
 * every link with its ``<inertial>`` (centre of mass and full tensor; massless links have
   none) and every joint of the kinematic tree (``continuous`` for a revolute joint without
-  known limits, ``prismatic`` with placeholder limits of +-1000 m when none are known);
+  known limits, ``revolute`` with ``<limit lower upper>`` for position limits, ``prismatic``
+  with placeholder limits of +-1000 m when none are known; attributes written only because
+  URDF requires them are listed in ``gearcli:placeholder`` and ignored on reading);
 * URDF puts a joint's axis through the child frame origin; a gearcli link frame may sit off
   the axis (a D-H ``a``), so each URDF link frame is the gearcli frame moved onto its joint
   axis (``frame_correction``), and centres of mass, inertias, child joints and mesh points
@@ -38,6 +40,7 @@ from ..io.urdf_reader import NS, q
 from .urdf_ratings import add_rating_elements
 
 PRISMATIC_LIMIT = 1000.0  # m, placeholder +- limits of a prismatic joint without known limits
+PLACEHOLDER_EFFORT, PLACEHOLDER_VELOCITY = 1e6, 1e3   # URDF requires both; marked gearcli:placeholder
 
 
 def _num(x: float) -> str:
@@ -111,11 +114,24 @@ def to_element(an: Analysis):
     for el in list(body):
         root.append(el)
     jel = {el.get("name"): el for el in root.findall("joint")}
+    _mark_placeholders(mech, jel)
     _add_mimics(an, jel, corr)
     _add_transmissions(an, root)
     _add_extension(an, root, corr)
     add_rating_elements(mech, root, jel)
     return root
+
+
+def _mark_placeholders(mech: Mechanism, jel: dict) -> None:
+    """``gearcli:placeholder`` on the ``<limit>`` attributes written only because URDF
+    requires them (:func:`gearcli.io.urdf_xml.placeholders`): effort and velocity of a joint
+    with position limits but no known ratings, everything of a prismatic joint without
+    limits.  gearcli reads such a file back without invented ratings or limits."""
+    for jt in mech.joints:
+        el = jel[jt.name].find("limit")
+        if el is None or (isinstance(jt.source, dict) and jt.source.get("limit")):
+            continue
+        el.set(q("placeholder"), "effort velocity" if jt.position_limits is not None else "lower upper effort velocity")
 
 
 def _frame_corrections(mech: Mechanism) -> dict:
@@ -157,11 +173,14 @@ def _urdf_joint(jt, corr: dict):
     T[:3, 3] = Rp.T @ (jt.p_pj - tp)
     limit = None
     lim = jt.source.get("limit") if isinstance(jt.source, dict) else None
+    if lim is None and jt.position_limits is not None:       # YAML joints[].limits: no effort/velocity
+        lim = dict(lower=jt.position_limits[0], upper=jt.position_limits[1], effort=PLACEHOLDER_EFFORT,
+                   velocity=PLACEHOLDER_VELOCITY)
     if jt.type == "prismatic":
         jtype = "prismatic"
         limit = yourdfpy.Limit(**lim) if lim else yourdfpy.Limit(
-            effort=1e6, velocity=1e3, lower=-PRISMATIC_LIMIT, upper=PRISMATIC_LIMIT)
-    elif lim and jt.source.get("urdf_type") == "revolute":
+            effort=PLACEHOLDER_EFFORT, velocity=PLACEHOLDER_VELOCITY, lower=-PRISMATIC_LIMIT, upper=PRISMATIC_LIMIT)
+    elif lim and (jt.source.get("urdf_type") == "revolute" or jt.position_limits is not None):
         jtype, limit = "revolute", yourdfpy.Limit(**lim)
     else:
         jtype = "continuous"
