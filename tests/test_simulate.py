@@ -385,3 +385,48 @@ def test_bad_yaml_joint_limits_are_located(run_cli, tmp_path, limits, message):
     r = run_cli("check", mech)
     assert r.exit_code == 2
     assert message in r.stderr and len(r.stderr.strip().splitlines()) == 1
+
+
+# --- the DC motor model in URDF --------------------------------------------------------------------
+
+def test_dc_motor_model_survives_the_urdf_round_trip(run_cli, tmp_path):
+    """motors[].model exported as <gearcli:motor_model/> and read back exactly (with and
+    without inductance); a voltage-driven simulation of the exported URDF writes the same
+    trajectory as the YAML's."""
+    from gearcli import load_mechanism
+    for L in (None, 1e-3):
+        mech = write(tmp_path / "stage.yaml", dc_stage(inductance=L))
+        r = run_cli("export", mech, "-o", tmp_path / "stage.urdf")
+        assert r.exit_code == 0, r.stderr
+        text = (tmp_path / "stage.urdf").read_text()
+        assert "<gearcli:motor_model " in text and ("inductance=" in text) == (L is not None)
+        yaml_model = load_mechanism(mech).motors[0].model
+        back = load_mechanism(tmp_path / "stage.urdf").motors[0].model
+        assert back == yaml_model and back.inductance == L and back.kt == 0.05
+    inp = write(tmp_path / "in.csv", "t,voltage:servo\n0,12\n0.05,12\n")
+    for name in ("stage.yaml", "stage.urdf"):
+        r = run_cli("simulate", tmp_path / name, inp, "-o", tmp_path / f"{name}.csv", "--method", "Radau")
+        assert r.exit_code == 0, r.stderr
+    assert read_csv(tmp_path / "stage.urdf.csv")["qd:Jd"][-1] != 0.0
+    assert (tmp_path / "stage.yaml.csv").read_text() == (tmp_path / "stage.urdf.csv").read_text()
+
+
+@pytest.mark.parametrize("element,message", [
+    ('<gearcli:motor_model motor="servo" kt="0.05" resistance="2"/>',
+     "gearcli:motor_model 'servo': missing attribute 'supply_voltage'"),
+    ('<gearcli:motor_model motor="servo" kt="-0.05" resistance="2" supply_voltage="24"/>',
+     "gearcli:motor_model 'servo'.kt: kt must be positive, got -0.05"),
+    ('<gearcli:motor_model motor="nope" kt="0.05" resistance="2" supply_voltage="24"/>',
+     "gearcli:motor_model 'nope': unknown motor 'nope' (known: servo)"),
+    ('<gearcli:motor_model motor="servo" kt="0.05" resistance="2" supply_voltage="24" volts="3"/>',
+     "gearcli:motor_model 'servo': unknown attribute 'volts'"),
+])
+def test_bad_urdf_motor_model_is_located(run_cli, tmp_path, element, message):
+    r = run_cli("export", write(tmp_path / "stage.yaml", spur_stage_yaml()), "-o", tmp_path / "s.urdf")
+    assert r.exit_code == 0, r.stderr
+    text = (tmp_path / "s.urdf").read_text().replace("</robot>", f"  {element}\n</robot>")
+    mech = write(tmp_path / "s.urdf", text)
+    line = text[:text.index("<gearcli:motor_model")].count("\n") + 1
+    r = run_cli("check", mech)
+    assert r.exit_code == 2
+    assert f"s.urdf:{line}: {message}" in r.stderr and len(r.stderr.strip().splitlines()) == 1

@@ -22,6 +22,7 @@ from .planets import item_path
 NS = "https://gearcli.dev/urdf/1"
 MOTOR_KEYS = ("peak_torque", "rms_torque", "max_speed", "max_power", "thermal_window", "rotor_inertia",
               "max_inertia_ratio", "max_regen_energy")   # and torque_speed (YAML only: a table)
+MODEL_KEYS = ("kt", "resistance", "inductance", "supply_voltage")   # motors[].model, <gearcli:motor_model>
 BEARING_KEYS = ("name", "position", "C", "C0", "type", "X", "Y", "e", "X0", "Y0", "locating", "M", "f0", "a_ISO",
                 "kappa", "e_C", "Cu", "friction_coefficient", "bore")
 RATING_KEYS = ("C", "C0", "type")     # a rated bearing has all three (the design checks need them)
@@ -61,7 +62,7 @@ def motor_rating(spec: dict, path: str, add) -> MotorRating:
 
 def motor_model(spec: dict, path: str, add) -> MotorModel:
     """A :class:`MotorModel` from ``motors[].model`` (kt, resistance, inductance, supply_voltage)."""
-    _positive(spec, ("kt", "resistance", "inductance", "supply_voltage"), path, add)
+    _positive(spec, MODEL_KEYS, path, add)
     ind = spec.get("inductance")
     return MotorModel(float(spec["kt"]), float(spec["resistance"]), float(spec["supply_voltage"]),
                       None if ind is None else float(ind), path)
@@ -309,7 +310,27 @@ def attach_urdf_ratings(mech: Mechanism, root, file: str) -> Mechanism:
                 adder(el)(path, "a gear rating needs the mesh geometry (a gearcli:gear with mesh_point)")
             else:
                 table[spec[kind]] = replace(table[spec[kind]], rating=builder(spec, path, adder(el)))
+    _urdf_motor_models(root, motors, lines, adder)
     if issues:
         raise MechanismError(issues)
     return replace(mech, joints=tuple(joints.values()), motors=tuple(motors.values()),
                    gears=tuple(gears.values()), warnings=tuple(warnings), lines=lines)
+
+
+def _urdf_motor_models(root, motors: dict, lines: dict, adder) -> None:
+    """``<gearcli:motor_model motor="NAME" kt resistance supply_voltage [inductance]/>`` (children
+    of ``robot``; as ``motors[].model``) onto ``motors`` (by name), in place."""
+    seen: set = set()
+    for el in _ext(root, "motor_model"):
+        path = f"gearcli:motor_model '{el.get('motor')}'"
+        lines[path] = el.sourceline
+        spec = _urdf_spec(el, ("motor", *MODEL_KEYS), ("motor", "kt", "resistance", "supply_voltage"), path, adder(el))
+        if spec is None:
+            continue
+        if spec["motor"] not in motors:
+            adder(el)(path, f"unknown motor '{spec['motor']}' (known: {', '.join(motors)})")
+        elif spec["motor"] in seen:
+            adder(el)(path, f"a second gearcli:motor_model for motor '{spec['motor']}'")
+        else:
+            seen.add(spec["motor"])
+            motors[spec["motor"]] = replace(motors[spec["motor"]], model=motor_model(spec, path, adder(el)))

@@ -56,7 +56,7 @@ class Extension:
                 ext["motors"].append(el)
             elif local == "load":
                 ext["loads"].append(el)
-            elif local in ("motor_rating", "gear_rating"):
+            elif local in ("motor_rating", "gear_rating", "motor_model"):
                 continue  # read by io.ratings_reader
             else:
                 self.add(f"gearcli:{local}", f"unknown gearcli element gearcli:{local} (expected gearcli:mechanism, "

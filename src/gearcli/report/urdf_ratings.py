@@ -1,6 +1,7 @@
 """Ratings in exported URDFs: the gearcli extension elements read by
-:mod:`gearcli.io.ratings_reader` (``gearcli:bearing`` inside a joint, ``gearcli:motor_rating``
-and ``gearcli:gear_rating`` under the robot), numbers written exactly (``repr``)."""
+:mod:`gearcli.io.ratings_reader` (``gearcli:bearing`` inside a joint, ``gearcli:motor_rating``,
+``gearcli:motor_model`` (the DC model of ``gearcli simulate``) and ``gearcli:gear_rating``
+under the robot), numbers written exactly (``repr``)."""
 from __future__ import annotations
 
 from lxml import etree
@@ -35,6 +36,9 @@ def add_rating_elements(mech, root, joint_elements: dict) -> None:
             etree.SubElement(root, _q("motor_rating"), {"motor": m.name,
                              **_attrs(m.rating, ("peak_torque", "rms_torque", "max_speed", "max_power", "thermal_window", "rotor_inertia",
                                                  "max_inertia_ratio", "max_regen_energy"))})
+        if m.model is not None:
+            etree.SubElement(root, _q("motor_model"), {"motor": m.name, **_attrs(m.model, (
+                "kt", "resistance", "inductance", "supply_voltage"))})
     for g in mech.gears:
         if g.rating is not None:
             etree.SubElement(root, _q("gear_rating"), {"gear": g.name, **_attrs(g.rating, (
