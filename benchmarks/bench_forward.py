@@ -3,10 +3,12 @@
     python benchmarks/bench_forward.py [--repeat 5] [--samples 20000] [--jobs 1]
 
 For the Bendix wrist (bundled) and Panda (example-robot-data, if installed), in the same
-run: samples/s of ``gearcli.solve`` and of ``gearcli.forward_dynamics`` on the same random
-states (median of --repeat calls, after a warm-up call that compiles the llvm kernel), their
-ratio against the limit 1/(dof + 1) (what dof + 1 inverse-dynamics calls cost: the issue 20
-target is ratio >= limit), and ``mass_matrix`` alone.  Also the wall time of ``gearcli
+run: samples/s of ``gearcli.solve`` (with fresh result arrays, and with ``out=`` reusing them
+as forward_dynamics does) and of ``gearcli.forward_dynamics`` on the same random states
+(--repeat interleaved rounds after a warm-up call that compiles the llvm kernel; medians,
+and the median of the same-round ratios), those ratios against the limit 1/(dof + 1) (what
+dof + 1 inverse-dynamics calls cost: the issue 20 target is ratio >= limit), and
+``mass_matrix`` alone.  Also the wall time of ``gearcli
 simulate`` of 2 s of the Bendix wrist with default tolerances (target < 5 s), when the
 command exists.
 """
@@ -43,15 +45,26 @@ def bench(name: str, path: Path, n: int, repeat: int, jobs: int | None) -> None:
     T = rng.uniform(-1, 1, (n, len(an.mech.motors)))
     qdd = rng.uniform(-1, 1, (n, an.dof))
     gearcli.solve(an, q[:10], qd[:10], qdd[:10], jobs=jobs)        # compile / load the kernel
-    t_inv = median_time(lambda: gearcli.solve(an, q, qd, qdd, jobs=jobs), repeat)
-    t_fwd = median_time(lambda: forward_dynamics(an, q, qd, T, jobs=jobs), repeat)
-    t_mm = median_time(lambda: mass_matrix(an, q, jobs=jobs), repeat)
-    ratio, limit = t_inv / t_fwd, 1.0 / (an.dof + 1)
-    print(f"{name} (dof {an.dof}), {n:,} samples, jobs {jobs or 'all'}:")
-    print(f"  solve            {n / t_inv:12,.0f} samples/s")
-    print(f"  forward_dynamics {n / t_fwd:12,.0f} samples/s   ratio {ratio:.3f}, limit 1/(dof+1) = {limit:.3f}: "
-          f"{ratio / limit:.0%} of the limit ({'meets' if ratio >= limit else 'misses'} the target)")
-    print(f"  mass_matrix      {n / t_mm:12,.0f} samples/s")
+    out = gearcli.solve(an, q, qd, qdd, jobs=jobs)
+    calls = {"solve": lambda: gearcli.solve(an, q, qd, qdd, jobs=jobs),
+             "solve out=": lambda: gearcli.solve(an, q, qd, qdd, jobs=jobs, out=out),
+             "forward": lambda: forward_dynamics(an, q, qd, T, jobs=jobs),
+             "mass_matrix": lambda: mass_matrix(an, q, jobs=jobs)}
+    times = {k: [] for k in calls}
+    for _ in range(repeat):              # interleaved, so that a change of load hits all alike
+        for k, fn in calls.items():
+            times[k].append(median_time(fn, 1))
+    t = {k: float(np.median(v)) for k, v in times.items()}
+    limit = 1.0 / (an.dof + 1)
+    print(f"{name} (dof {an.dof}), {n:,} samples, jobs {jobs or 'all'}, medians of {repeat} interleaved rounds:")
+    print(f"  solve            {n / t['solve']:12,.0f} samples/s   (fresh result arrays, as a caller gets them)")
+    print(f"  solve out=       {n / t['solve out=']:12,.0f} samples/s   (result arrays reused, as forward_dynamics does)")
+    for label in ("solve", "solve out="):
+        ratio = float(np.median(np.array(times[label]) / np.array(times["forward"])))   # same-round ratios
+        print(f"  forward_dynamics {n / t['forward']:12,.0f} samples/s   against {label}: ratio {ratio:.3f}, limit "
+              f"1/(dof+1) = {limit:.3f}: {ratio / limit:.0%} of the limit "
+              f"({'meets' if ratio >= limit else 'misses'} the target)")
+    print(f"  mass_matrix      {n / t['mass_matrix']:12,.0f} samples/s")
 
 
 def bench_simulate() -> None:

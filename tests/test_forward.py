@@ -267,3 +267,22 @@ def test_round_trip_with_losses(name, monkeypatch):
     monkeypatch.setattr(forward, "MAX_STEPS", 0)
     with pytest.raises(ValueError, match=r"forward dynamics with losses did not settle at sample \d+ in 0 steps"):
         forward_dynamics(an, q, qd, T)
+
+
+def test_reused_result_arrays_never_leak_into_returned_values():
+    """forward_dynamics and mass_matrix reuse their solve's result arrays between calls (per
+    thread): what a call returned stays as it was after later calls, from this thread and
+    from another one."""
+    import threading
+    an = analyse(load_mechanism(MECH_DIR / "bendix_wrist.yaml"))
+    q, qd, T = random_state(an, 50, seed=21)
+    first, M = forward_dynamics(an, q, qd, T), mass_matrix(an, q)
+    kept = first.copy(), M.copy()
+    other = []
+    worker = threading.Thread(target=lambda: other.append(forward_dynamics(an, q[::-1], qd[::-1], T[::-1])))
+    worker.start()
+    second = forward_dynamics(an, q[::-1], qd[::-1], T[::-1])
+    worker.join()
+    mass_matrix(an, q[::-1])
+    assert np.array_equal(first, kept[0]) and np.array_equal(M, kept[1])
+    assert np.array_equal(second, other[0]) and np.array_equal(second, first[::-1])

@@ -37,6 +37,9 @@ torques has no unique acceleration: ValueError.
 """
 from __future__ import annotations
 
+import threading
+import weakref
+
 import numpy as np
 
 from .external import load_values
@@ -76,16 +79,16 @@ def _joints(an) -> list[str]:
     return [f"joint '{n}'" for n in an.independent_names]
 
 
-def _stacked_tau(an, q, qd, loads, backend, jobs):
-    """tau (N, dof + 1, dof): [:, 0] = tau(q, qd, 0) = h, [:, 1 + i] = tau(q, qd, e_i), from
-    one solve of N * (dof + 1) samples per chunk."""
+def _stacked_chunks(an, q, qd, loads, backend, jobs):
+    """Yield (slice, tau (m, dof + 1, dof)) chunk by chunk: [:, 0] = tau(q, qd, 0) = h,
+    [:, 1 + i] = tau(q, qd, e_i), from one solve of m * (dof + 1) samples per chunk.  The
+    chunk's tau is a view of the solve's result arrays, reused by the next chunk (and
+    kept between calls, :func:`_result_buffer`): use it before asking for the next."""
     n, dof = q.shape
     k = dof + 1
     loads = load_values(an.mech, n, loads)     # checked, (n, 6) each
-    out = np.empty((n, k, dof))
     unit = np.zeros((k, dof))
     unit[1:] = np.eye(dof)
-    res = None
     for s in range(0, n, CHUNK):
         sl = slice(s, min(s + CHUNK, n))
         m = sl.stop - sl.start
@@ -93,9 +96,37 @@ def _stacked_tau(an, q, qd, loads, backend, jobs):
         QD = np.repeat(qd[sl], k, axis=0)
         QDD = np.tile(unit, (m, 1))
         part = {name: np.repeat(w[sl], k, axis=0) for name, w in loads.items()}
-        reuse = res if res is not None and res.tau.shape[0] == m * k else None
-        res = solve(an, Q, QD, QDD, loads=part, backend=backend, jobs=jobs, out=reuse, check_finite=False)
-        out[sl] = res.tau.reshape(m, k, dof)
+        big = m > SMALL                # a few samples (an integrator's step): fresh arrays cost less than out='s checks
+        res = solve(an, Q, QD, QDD, loads=part, backend=backend, jobs=jobs,
+                    out=_result_buffer(an, m * k) if big else None, check_finite=False)
+        if big:
+            _keep_buffer(an, m * k, res)
+        yield sl, res.tau.reshape(m, k, dof)
+
+
+_BUFFERS = threading.local()
+
+
+def _result_buffer(an, rows: int):
+    """The result arrays of this thread's last solve of ``rows`` samples of ``an`` (None at
+    first): reused, so that a stream of forward calls (an integrator's steps, a benchmark's
+    repeats) does not allocate and fault in fresh result pages each time."""
+    cache = getattr(_BUFFERS, "results", None)
+    hit = cache.get(an) if cache is not None else None
+    return hit[1] if hit is not None and hit[0] == rows else None
+
+
+def _keep_buffer(an, rows: int, res) -> None:
+    if not hasattr(_BUFFERS, "results"):
+        _BUFFERS.results = weakref.WeakKeyDictionary()
+    _BUFFERS.results[an] = (rows, res)
+
+
+def _stacked_tau(an, q, qd, loads, backend, jobs):
+    """tau (N, dof + 1, dof) of :func:`_stacked_chunks`, all chunks."""
+    out = np.empty((q.shape[0], an.dof + 1, an.dof))
+    for sl, tau in _stacked_chunks(an, q, qd, loads, backend, jobs):
+        out[sl] = tau
     return out
 
 
@@ -118,7 +149,10 @@ def mass_matrix(an, q, backend: str = "auto", jobs: int | None = None) -> np.nda
     that is not finite.
     """
     (q,) = _arrays(an, {"q": (q, an.dof, _joints(an))})
-    return _columns(_stacked_tau(an, q, np.zeros_like(q), {}, backend, jobs))
+    M = np.empty((q.shape[0], an.dof, an.dof))
+    for sl, tau in _stacked_chunks(an, q, np.zeros_like(q), {}, backend, jobs):
+        M[sl] = _columns(tau)
+    return M
 
 
 def forward_dynamics(an, q, qd, motor_torques, loads: dict | None = None, backend: str = "auto",
@@ -142,12 +176,23 @@ def forward_dynamics(an, q, qd, motor_torques, loads: dict | None = None, backen
     motors = [f"motor '{m.name}'" for m in an.mech.motors]
     q, qd, T = _arrays(an, {"q": (q, an.dof, _joints(an)), "qd": (qd, an.dof, _joints(an)),
                             "motor_torques": (motor_torques, len(motors), motors)})
-    tau = _stacked_tau(an, q, qd, loads, backend, jobs)
-    cols = tau[:, 1:, :] - tau[:, :1, :]                 # [s, i, :] = column i of M
+    target = np.einsum("nm,dm->nd", T, an.A)    # A T per sample; not matmul: BLAS threads would
+    # start, then spin on the second core through the kernel calls below (up to 2x slower)
     if an.mech.has_losses:
-        return _implicit(an, q, qd, T @ an.A.T, np.swapaxes(cols, 1, 2), tau[:, 0, :], loads, backend, jobs)
-    rows = np.ascontiguousarray(np.transpose(cols, (2, 1, 0)))   # M[j, i, s]
-    return solve_spd(rows, T @ an.A.T - tau[:, 0, :])
+        tau = _stacked_tau(an, q, qd, loads, backend, jobs)
+        cols = tau[:, 1:, :] - tau[:, :1, :]                 # [s, i, :] = column i of M
+        return _implicit(an, q, qd, target, np.swapaxes(cols, 1, 2), tau[:, 0, :], loads, backend, jobs)
+    qdd = np.empty_like(q)
+    for sl, tau in _stacked_chunks(an, q, qd, loads, backend, jobs):     # each chunk while it is in cache
+        h = tau[:, 0, :]
+        if tau.shape[0] <= SMALL:                                       # a few samples: LAPACK
+            M = np.swapaxes(tau[:, 1:, :] - h[:, None, :], 1, 2)
+            qdd[sl] = np.linalg.solve(M, (target[sl] - h)[:, :, None])[:, :, 0]
+        else:
+            rows = np.subtract(np.transpose(tau[:, 1:, :], (2, 1, 0)), h.T[:, None, :],
+                               out=np.empty((q.shape[1], q.shape[1], tau.shape[0])))   # M[j, i, s], C order
+            qdd[sl] = solve_spd(rows, target[sl] - h)
+    return qdd
 
 
 def _implicit(an, q, qd, target, M, h, loads, backend, jobs) -> np.ndarray:

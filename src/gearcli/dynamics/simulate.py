@@ -73,7 +73,7 @@ class Drive:
         """(..., M) motor torques at time(s) t with rates qd (..., dof) and the inductive
         motors' currents (..., n_L); also the winding currents (NaN for torque columns)."""
         u = self.drive.at(t)
-        w = qd @ self.an.A                                    # motor speeds A^T qd
+        w = np.einsum("...d,dm->...m", qd, self.an.A)         # motor speeds A^T qd (no BLAS threads)
         i = np.where(self.volt, (u - self.kt * w) / self.R, np.nan)
         i[..., self.inductive] = current
         return np.where(self.volt, self.kt * i, u), i
@@ -82,7 +82,7 @@ class Drive:
         """dI/dt (n_L,) of the inductive motors: (V - R i - kt omega) / L."""
         k = self.inductive
         u = self.drive.at(t)[..., k]
-        w = (qd @ self.an.A)[..., k]
+        w = np.einsum("...d,dm->...m", qd, self.an.A)[..., k]
         return (u - self.R[k] * current - self.kt[k] * w) / self.L
 
 
@@ -117,7 +117,7 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
         qdd = _accelerations(an, q, qd, T, backend, t)[0]
         if progress is not None:
             progress(t)
-        return np.concatenate([qd, qdd, d.current_rate(t, qd, cur)])
+        return np.concatenate([qd, qdd, d.current_rate(t, qd, cur)]) if nL else np.concatenate([qd, qdd])
 
     events = []
     for ji, name, lo, hi in joint_limits(an):
