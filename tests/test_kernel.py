@@ -344,28 +344,30 @@ def test_verify_with_the_kernel(backend):
 
 # --- the comparison catches a wrong program ----------------------------------------------------
 BENDIX = "loaded:bendix_wrist.yaml"
-MUTATIONS = [(BENDIX, "flts", 0, 10), (BENDIX, "flts", 1, None), (BENDIX, "flts", 4, 7), (BENDIX, "flts", 5, 3),
-             ("geared_arm.urdf", "flts", 6, 2), ("planetary_3p.yaml", "flts", 4, "t row")]
+MUTATIONS = [(BENDIX, "poses", 10), (BENDIX, "bodies", None), (BENDIX, "ainv", 7), (BENDIX, "cmat", 3),
+             ("geared_arm.urdf", "term_values", 2), ("planetary_3p.yaml", "ainv", "t row")]
 
 
 def _t_row(prog) -> np.ndarray:
     """Flat positions in ``ainv`` of the first block's first t row, in every pattern's map."""
-    rec = prog.ints[1][0]
-    n, nr, a0, t = int(rec[3]), 6 * int(rec[2]), int(rec[7]), int(prog.ints[4][rec[6]])
-    return np.concatenate([a0 + k * n * nr + t * nr + np.arange(nr) for k in range(1 << int(rec[5]))])
+    rec = prog.blocks[0]
+    n, nr, a0, t = int(rec.n), 6 * int(rec.nlinks), int(rec.ainv0), int(prog.t_col[rec.t0])
+    return np.concatenate([a0 + k * n * nr + t * nr + np.arange(nr) for k in range(1 << int(rec.m))])
 
 
-def _mutated(prog, an, field, which, flat):
-    arrays = list(getattr(prog, field))
-    bad = arrays[which].copy()
+def _mutated(prog, an, field, flat):
+    """``prog`` with one float of its array ``field`` (a record array: its floats in
+    order) changed by 1e-6 of its size."""
+    bad = np.array(getattr(prog, field))                  # a copy
+    values = bad.view(np.float64).reshape(-1)
     flat = _t_row(prog) if flat == "t row" else 13 * an.tree.moving[-1] + 5 if flat is None else flat
-    bad.reshape(-1)[flat] += 1e-6 * (1.0 + abs(bad.reshape(-1)[flat]))
-    return dataclasses.replace(prog, **{field: tuple(bad if i == which else x for i, x in enumerate(arrays))})
+    values[flat] += 1e-6 * (1.0 + abs(values[flat]))
+    return dataclasses.replace(prog, **{field: bad.view(type(getattr(prog, field)))})
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
-@pytest.mark.parametrize("key,field,which,flat", MUTATIONS)
-def test_a_wrong_program_entry_is_caught(key, field, which, flat, backend):
+@pytest.mark.parametrize("key,field,flat", MUTATIONS)
+def test_a_wrong_program_entry_is_caught(key, field, flat, backend):
     """Perturb one entry of the program (a joint placement, an inertia, an inverse block
     matrix, a propagation column, a world-frame term; for planetary_3p, whose llvm code
     reads its 64 pattern maps from a table, one row of them): the comparison of
@@ -378,10 +380,26 @@ def test_a_wrong_program_entry_is_caught(key, field, which, flat, backend):
     ref = solve(an, q, qd, qdd, backend="numpy", loads=loads)
     assert worst(solve(an, q, qd, qdd, backend=backend, loads=loads), ref) < TOL
     kept = sol._llvm
-    sol._program, sol._llvm = _mutated(prog, an, field, which, flat), None
+    sol._program, sol._llvm = _mutated(prog, an, field, flat), None
     try:
         res = solve(an, q, qd, qdd, backend=backend, loads=loads)
     finally:
         sol._program, sol._llvm = prog, kept
     assert worst(res, ref) > 1e3 * TOL
 
+
+
+def test_record_columns_are_read_by_name():
+    """Every record layout of the program (llvm/records.py) names its columns so that
+    ``rec.<name>`` is the column, never a numpy record attribute (a column named ``size``
+    read 1 for every record: Bendix's first motor torque was 2x off)."""
+    from gearcli.dynamics.llvm import records  # noqa: PLC0415
+
+    layouts = [v for v in vars(records).values() if isinstance(v, np.dtype) and v.names]
+    assert len(layouts) >= 10
+    for layout in layouts:
+        assert not set(layout.names) & set(dir(np.record)), layout.names
+        rec = records.records([tuple(range(1, len(layout.names) + 1))] if all(
+            layout[n].shape == () for n in layout.names) else [], layout)
+        for k, name in enumerate(layout.names if len(rec) else ()):
+            assert getattr(rec[0], name) == k + 1, name

@@ -39,8 +39,8 @@ def gather(e: Emitter, s: Sample, F: int, links) -> list:
 
 
 def _wrench_in_F(e: Emitter, rec, cmat, x: list):
-    """C_plus x + C_sep |x| of one propagation record: (f, m) on its primary link, F axes."""
-    c0, size, signed, co = (int(v) for v in rec[:4])
+    """C_plus x + C_sep |x| of one :data:`.records.PROPAGATION` record: (f, m) on its primary link, F axes."""
+    c0, size, signed, co = int(rec.col0), int(rec.ncols), int(rec.signed), int(rec.cmat0)
     xs = x[c0:c0 + size]
     w = [e.dot(floats(cmat[co + h * size:co + (h + 1) * size]), xs) for h in range(6)]
     if signed:
@@ -57,29 +57,29 @@ def _subtract(e: Emitter, s: Sample, L: int, w, scale) -> None:
 
 def propagate(e: Emitter, s: Sample, F: int, recs, prog, x: list) -> None:
     """rhs[L] -= the solved wrenches of the block's groups on their later links (blocks' propagation)."""
-    cmat, later = prog.flts[5], prog.ints[7]
+    cmat, later = prog.cmat, prog.later
     RF, oF = s.R[F], s.o[F]
     for rec in recs:
         f, mo = _wrench_in_F(e, rec, cmat, x)
         f, mo = e.mv(RF, f), e.mv(RF, mo)                    # world axes, about o_F
-        P, l0, nl = (int(v) for v in rec[4:7])
+        P, l0, nl = int(rec.primary), int(rec.later0), int(rec.nlater)
         for L in (int(v) for v in later[l0:l0 + nl]):
             m = e.vadd(mo, e.cx(e.vsub(oF, s.o[L]), f))
             _subtract(e, s, L, f + m, 1.0 if L == P else -1.0)
 
 
-def term_wrench(e: Emitter, s: Sample, trec_k, tflt_k, L: int, sig: list):
-    """Wrench (6-tuple, base axes, about o_L) of one column term per unit of its unknown
-    (the column of :meth:`..equations.Columns.group`)."""
-    X = int(trec_k[4])
-    coef = float(tflt_k[0])
-    if trec_k[5] >= 0:
-        coef = e.mul(coef, sig[int(trec_k[5])])
-    f = floats(tflt_k)
-    d = e.mv(s.R[X], f[1:4])
-    if trec_k[3] == 1:
+def term_wrench(e: Emitter, s: Sample, term, value, L: int, sig: list):
+    """Wrench (6-tuple, base axes, about o_L) of one column term (:data:`.records.TERM`,
+    its :data:`.records.TERM_VALUE`) per unit of its unknown (the column of
+    :meth:`..equations.Columns.group`)."""
+    X = int(term.frame)
+    coef = float(value.coef)
+    if term.sign >= 0:
+        coef = e.mul(coef, sig[int(term.sign)])
+    d = e.mv(s.R[X], floats(value.d))
+    if term.moment == 1:
         return (0.0, 0.0, 0.0) + e.scale(d, coef)
-    P = e.mv(s.R[X], f[4:7])
+    P = e.mv(s.R[X], floats(value.p))
     arm = e.vsub(e.vadd(s.o[X], P), s.o[L])
     return e.scale(d, coef) + e.scale(e.cx(arm, d), coef)
 
@@ -87,22 +87,21 @@ def term_wrench(e: Emitter, s: Sample, trec_k, tflt_k, L: int, sig: list):
 def propagate_terms(e: Emitter, s: Sample, k0: int, nt: int, prog, x: list, sig: list) -> None:
     """rhs[L] -= the solved wrenches on the later links from the terms with no block row
     (as :func:`..blocks.solve_blocks` propagates)."""
-    trec, tflt = prog.ints[10], prog.flts[6]
-    for k in range(k0, k0 + nt):
-        if trec[k, 1] >= 0:
+    for term, value in zip(prog.terms[k0:k0 + nt], prog.term_values[k0:k0 + nt]):
+        if term.row >= 0:
             continue
-        L = int(trec[k, 0])
-        _subtract(e, s, L, term_wrench(e, s, trec[k], tflt[k], L, sig), x[int(trec[k, 2])])
+        L = int(term.link)
+        _subtract(e, s, L, term_wrench(e, s, term, value, L, sig), x[int(term.col)])
 
 
 def store(e: Emitter, s: Sample, rec, prog, x: list) -> None:
     """The block's solution into the sample's row ``s.sol``: joint
     reactions solved in another basis turned to their child's by -q (or -(q @ row))."""
-    gcol, cbrec, turns = prog.ints[3], prog.ints[8], prog.flts[7]
-    nloc, g0, cb0, ncb = int(rec[3]), int(rec[4]), int(rec[10]), int(rec[11])
+    gcol, turns = prog.group_col, prog.turns
+    nloc, g0, cb0, ncb = int(rec.n), int(rec.col0), int(rec.cb0), int(rec.ncb)
     for i in range(nloc):
         s.sol[int(gcol[g0 + i])] = x[i]
-    for c0, j, off in ((int(v) for v in cbrec[k]) for k in range(cb0, cb0 + ncb)):
+    for c0, j, off in ((int(cb.col0), int(cb.joint), int(cb.turn0)) for cb in prog.child_basis[cb0:cb0 + ncb]):
         if j >= 0:
             cq, sq = s.cs[j]
         else:
@@ -127,9 +126,10 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row) -> None:
     """Block b of the schedule for sample n: ``fail`` (i64*) gets the first
     block with no consistent sign pattern (it comes filled with -1), ``sg_row`` (double*)
     the sign of each t used."""
-    blinks, tcol, scol, prec, ainv = prog.ints[2], prog.ints[4], prog.ints[5], prog.ints[6], prog.flts[4]
-    rec = prog.ints[1][b]
-    F, lk0, B, nloc, m, t0, a0, p0, np_, k0, nt = (int(rec[i]) for i in (0, 1, 2, 3, 5, 6, 7, 8, 9, 12, 13))
+    rec = prog.blocks[b]
+    F, lk0, B, nloc, m, t0, a0 = (int(v) for v in (rec.F, rec.link0, rec.nlinks, rec.n, rec.m, rec.t0, rec.ainv0))
+    p0, np_, k0, nt = int(rec.prop0), int(rec.nprop), int(rec.term0), int(rec.nterm)
+    blinks, tcol, scol, ainv = prog.block_links, prog.t_col, prog.sign_col, prog.ainv
     nr = 6 * B
     links = [int(v) for v in blinks[lk0:lk0 + B]]
     tcols = [int(c) for c in tcol[t0:t0 + m]]
@@ -153,5 +153,5 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row) -> None:
     if nt > 0:
         propagate_terms(e, s, k0, nt, prog, x, sig)
     else:
-        propagate(e, s, F, prec[p0:p0 + np_], prog, x)
+        propagate(e, s, F, prog.props[p0:p0 + np_], prog, x)
     store(e, s, rec, prog, x)

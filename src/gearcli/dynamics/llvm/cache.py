@@ -78,9 +78,10 @@ def program_fingerprint(prog, loads: list) -> str:
     """SHA-256 of what a kernel's IR is generated from: the kernel program's arrays and
     fields and the external loads (:func:`.driver.mech_loads`); kept in each entry."""
     parts = ["fingerprint", FORMAT, prog.ncols, sorted(prog.offsets.items()), prog.signed, prog.names, prog.covered]
-    for a in (*prog.ints, *prog.flts):
+    for name, a in prog.arrays():
         a = np.ascontiguousarray(a)
-        parts += [a.dtype.str, a.shape, a.tobytes()]
+        parts += [name, str(a.dtype), a.shape, a.tobytes()]
+    parts += [prog.base]
     for link, in_link, point in loads:
         parts += [link, in_link, np.asarray(point, float).tobytes()]
     return _sha(parts)

@@ -208,9 +208,10 @@ class LlvmKernel:
         prog = self.prog
         n = q.shape[0]
         SG, fail = work
-        ldrec, ldpt, vals = load_arrays(an, values, n)
-        order = self._load_order
-        ldrow = np.ascontiguousarray(ldrec[order][:, [2, 3, 1]] if order else np.zeros((1, 3), np.int64))
+        ld, ldpt, vals = load_arrays(an, values, n)
+        order = self._load_order      # ldrow, as the code reads it: [row0, per_sample, in_link] a load
+        ldrow = np.ascontiguousarray(np.column_stack([ld.row0, ld.per_sample, ld.in_link])[order] if order
+                                     else np.zeros((1, 3), np.int64))
         ldpt = np.ascontiguousarray(ldpt[order] if order else np.zeros((1, 3)))
         keep = [np.ascontiguousarray(a, float) for a in (q, qd, qdd)] + [np.ascontiguousarray(vals, float), ldpt,
                                                                        ldrow, self._load_groups]

@@ -43,20 +43,20 @@ def _signature(mod: ir.Module) -> ir.Function:
 def _sample(e: Emitter, fn, prog, loads, n) -> None:
     """The code of sample n (the loop body)."""
     a = dict(zip(ARGS, fn.args))
-    S = prog.flts[2]
+    S = prog.S
     dof = S.shape[1]
     e.b.store(ir.Constant(I64, -1), e.b.gep(a["fail"], [n]))
     ind = [[e.load(e.row(a[k], n, dof), d) for d in range(dof)] for k in ("qi", "qdi", "qddi")]
     s = joint_space(e, S, *ind)
-    at_rest(s, int(prog.ints[11][0]))
-    for k in range(prog.ints[0].shape[0]):
-        joint(e, s, prog.ints[0][k], prog.flts[0][k])
-    for L in prog.ints[9]:
-        inertia(e, s, int(L), prog.flts[1], prog.flts[3])
+    at_rest(s, prog.base)
+    for rec, pose in zip(prog.joints, prog.poses):
+        joint(e, s, rec, pose)
+    for L in prog.moving:
+        inertia(e, s, int(L), prog.bodies[L], prog.gravity)
     external(e, s, fn, [L for L, _, _ in load_groups(loads)[1]], n, a["vals"], a["ldrow"], a["ldpt"], a["ldgrp"])
     w = widths(prog)
     signs = e.row(a["signs"], n, max(w["signs"], 1))
-    for b in range(prog.ints[1].shape[0]):
+    for b in range(len(prog.blocks)):
         block(e, fn, s, prog, b, n, a["fail"], signs)
     write_outputs(e, s, prog, ind[1], {k: e.row(a[k], n, max(w[k], 1)) for k in OUTPUTS})
 

@@ -54,10 +54,10 @@ def joint_space(e: Emitter, S, qi: list, qdi: list, qddi: list) -> Sample:
     return Sample([e.dot(qi, s) for s in rows], [e.dot(qdi, s) for s in rows], [e.dot(qddi, s) for s in rows])
 
 
-def _joint_frame(e: Emitter, f, Rp, op, qk, prismatic: bool):
+def _joint_frame(e: Emitter, pose, Rp, op, qk, prismatic: bool):
     """(R, o, cos, sin) of the joint frame at qk, base axes."""
-    R0 = e.mm(Rp, f[0:9])
-    oj = e.vadd(op, e.mv(Rp, f[9:12]))
+    R0 = e.mm(Rp, floats(pose.R_pj))
+    oj = e.vadd(op, e.mv(Rp, floats(pose.p_pj)))
     if prismatic:
         return R0, e.vadd(oj, e.scale((R0[2], R0[5], R0[8]), qk)), 1.0, 0.0
     cq, sq = sincos(e, qk)
@@ -78,14 +78,13 @@ def at_rest(s: Sample, base: int) -> None:
     s.R[base], s.o[base], s.w[base], s.dw[base], s.a[base] = EYE, ZERO3, ZERO3, ZERO3, ZERO3
 
 
-def joint(e: Emitter, s: Sample, rec, flt) -> None:
-    """The child link of one joint record (``rec`` a row of ``jrec``, ``flt`` of ``jflt``):
-    its R, o, w, dw, a, and the joint's cos, sin."""
-    ji, p, c, pr = (int(v) for v in rec[:4])
-    f = floats(flt)
+def joint(e: Emitter, s: Sample, rec, pose) -> None:
+    """The child link of one joint (``rec`` its :data:`.records.JOINT`, ``pose`` its
+    :data:`.records.POSE`): its R, o, w, dw, a, and the joint's cos, sin."""
+    ji, p, c, pr = int(rec.joint), int(rec.parent), int(rec.child), int(rec.prismatic)
     qdk, qddk = s.qd[ji], s.qdd[ji]
     op, wp, dwp = s.o[p], s.w[p], s.dw[p]
-    Rj, oj, cq, sq = _joint_frame(e, f, s.R[p], op, s.q[ji], pr == 1)
+    Rj, oj, cq, sq = _joint_frame(e, pose, s.R[p], op, s.q[ji], pr == 1)
     s.cs[ji] = (cq, sq)
     z = (Rj[2], Rj[5], Rj[8])
     aj = _arm_accel(e, s.a[p], dwp, wp, e.vsub(oj, op))
@@ -95,17 +94,17 @@ def joint(e: Emitter, s: Sample, rec, flt) -> None:
     else:
         wc = e.vadd(wp, e.scale(z, qdk))
         dwc = e.vadd(e.vadd(dwp, e.scale(z, qddk)), e.scale(e.cx(wp, z), qdk))
-    s.R[c] = e.mm(Rj, f[12:21])
-    rc = e.mv(Rj, f[21:24])
+    s.R[c] = e.mm(Rj, floats(pose.R_jc))
+    rc = e.mv(Rj, floats(pose.p_jc))
     s.o[c] = e.vadd(oj, rc)
     s.a[c] = _arm_accel(e, aj, dwc, wc, rc)
     s.w[c], s.dw[c] = wc, dwc
 
 
-def inertia(e: Emitter, s: Sample, L: int, lflt, g) -> None:
-    """rhs[L] = the d'Alembert wrench of link L about o_L, base frame (Eqs. 17-18)."""
-    f = floats(lflt[L])
-    m, I, com = f[0], f[1:10], f[10:13]
+def inertia(e: Emitter, s: Sample, L: int, body, g) -> None:
+    """rhs[L] = the d'Alembert wrench of link L (``body`` its :data:`.records.BODY`) about
+    o_L, base frame (Eqs. 17-18)."""
+    m, I, com = float(body.mass), floats(body.inertia), floats(body.com)
     RL, wL, dwL = s.R[L], s.w[L], s.dw[L]
     wb = e.mtv(RL, wL)
     Nb = e.vadd(e.mv(I, e.mtv(RL, dwL)), e.cx(wb, e.mv(I, wb)))

@@ -10,18 +10,18 @@ from __future__ import annotations
 import numpy as np
 
 from ...model.gears import helical_terms
+from .records import GEAR_OUT, JOINT_OUT, records
 
 
 def output_constants(an, offsets: dict):
-    """(jout (J, 2) int [first column, 1 if prismatic], mcol (M,) and gcol (G,) columns,
-    mflt (G, 10) [1 if gear geometry, tan(phi_t), t and |t| tan(phi_t) coefficients of the
-    radial and axial components on j and on k])."""
+    """(joint outputs (J,) :data:`.records.JOINT_OUT`, the motors' (M,) and the meshes' (G,)
+    columns, the meshes' output coefficients (G,) :data:`.records.GEAR_OUT`)."""
     mech = an.mech
-    jout = np.array([[offsets[("joint", ji)][0], int(jt.type == "prismatic")] for ji, jt in enumerate(mech.joints)],
-                    np.int64).reshape(-1, 2)
-    mcol = np.array([offsets[("motor", i)][0] for i in range(len(an.motor_links))] + [0], np.int64)
-    gcol = np.array([offsets[("mesh", ci)][0] for ci in range(len(an.circuits))] + [0], np.int64)
-    mflt = np.zeros((len(an.circuits) + 1, 10))
+    jout = records([(offsets[("joint", ji)][0], int(jt.type == "prismatic")) for ji, jt in enumerate(mech.joints)],
+                   JOINT_OUT)
+    mcol = np.array([offsets[("motor", i)][0] for i in range(len(an.motor_links))], np.int64)
+    gcol = np.array([offsets[("mesh", ci)][0] for ci in range(len(an.circuits))], np.int64)
+    mflt = np.zeros((len(an.circuits), 10))
     for ci, c in enumerate(an.circuits):
         if c.geometry is None:
             continue
@@ -30,4 +30,4 @@ def output_constants(an, offsets: dict):
         ua = gm.ut + a
         mflt[ci] = [1.0, tan_t, ua @ gm.rad_j, gm.us @ gm.rad_j, ua @ gm.zj, gm.us @ gm.zj,
                     ua @ gm.rad_k, gm.us @ gm.rad_k, ua @ gm.zk, gm.us @ gm.zk]
-    return jout, mcol, gcol, mflt
+    return jout, mcol, gcol, records(map(tuple, mflt), GEAR_OUT)

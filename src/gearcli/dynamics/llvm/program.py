@@ -1,42 +1,22 @@
-"""The compiled kernel's "program": one analysed mechanism flattened into a few arrays.
+"""The compiled kernel's "program": one analysed mechanism flattened into named arrays.
 
-The generated kernel (:mod:`.kernel`) is made from the arrays built here once per
-analysis (from the
-:class:`~gearcli.analysis.graph.Analysis` and the block plans of :func:`..blocks.make_plans`):
+The generated kernel (:mod:`.kernel`) is made from the :class:`Program` built here once per
+analysis (from the :class:`~gearcli.analysis.graph.Analysis` and the block plans of
+:func:`..blocks.make_plans`): record arrays whose columns are named (:mod:`.records`: the
+joints and their placements, the links' inertia, the blocks of the schedule, the
+propagation, child-basis and column-term records, the output maps), the flat arrays those
+records index (pattern maps ``ainv``, propagation columns ``cmat``, ``later`` links, the
+blocks' links and columns, coaxial ``turns``), and S (q = S q_ind), A (tau = A motor),
+gravity, the moving links and the base.
 
-* ``jrec`` (J, 5) int: per real joint in tree order [joint index, parent link, child link,
-  1 if prismatic, flags: 1 parent is the base, 2 R_pj = I, 4 R_jc = I, 8 p_jc = 0]; ``jflt`` (J, 24): R_pj (row-major), p_pj, R_jc, p_jc;
-* ``lflt`` (L, 13): per link mass, inertia about the centre of mass (link axes, row-major),
-  centre of mass (link frame); ``moving`` the moving link ids;
-* ``ldrec`` (nloads, 4) int [link, 1 if in link axes, row offset in the values array,
-  1 if one row per sample]; ``ldflt`` (nloads, 3) the load point (link frame);
-* ``brec`` (B, 14) int per block (schedule order): [F, links offset, number of links,
-  unknowns n, column offset, signed meshes m, t offset, Ainv offset, propagation offset,
-  propagations, child-basis offset, child-basis count, term offset, term count]; ``blinks``
-  the links; ``gcol`` each block column's position in the solution row; ``tcol`` the
-  block columns of the signed t; ``scol`` their position in the signs row;
-* ``ainv`` every pattern's (n, 6B) inverse (row-major, patterns in
-  :func:`~..signs.sign_patterns` order: rectangular matrices are fine);
-* ``prec`` (P, 7) int per propagated group [first column, size, 1 if signed, cmat offset,
-  primary link, later-links offset, count]; ``cmat`` its C_plus (6, size) then C_sep;
-  ``later`` the later links;
-* ``cbrec`` (C, 3) int [first column, joint index or -1, offset in ``turns``]: joint
-  reactions solved in another link's basis, turned to the child's by -q of the joint, or
-  by -(q @ row) with the (J,) row at the offset in ``turns`` (a basis carried by a third
-  coaxial link, :mod:`..coaxial_frames`); ``meta`` [base link id];
-* the output maps of :func:`.output_maps.output_constants` and the structure matrix A;
-* last, S (q = S q_ind), A (tau = A motor) and A^T (motor speed = A^T qd) by rows of
-  nonzeros (:func:`_csr`): ``ints[15:21]`` their row pointers and column indices,
-  ``flts[10:13]`` their values.
-
-Blocks without a constant frame (F = -1 in ``brec``) are solved in world axes from the
+Blocks without a constant frame (``F`` = -1) are solved in world axes from the
 column terms of :mod:`.terms`; one whose matrix is nevertheless constant in its one
 link's axes gets F = that link and its inverse (:func:`_local_frame`), and keeps its terms
-(term count > 0) for the propagation.
+(``nterm`` > 0) for the propagation.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -46,68 +26,104 @@ from .output_maps import output_constants
 from ..pattern_maps import hot_patterns, low_rank
 from ..sharing import SharingError, mesh_weights
 from ..signs import MAX_EXHAUSTIVE
+from .records import BLOCK, BODY, CHILD_BASIS, JOINT, LOAD, POSE, PROPAGATION, records
 from .terms import general_terms, local_inverse
 
 I64 = np.int64
 
 
+def _arr():
+    """An array field's default: empty (a program that is not ``covered``)."""
+    return field(default_factory=lambda: np.zeros(0))
+
+
 @dataclass(frozen=True, eq=False)
 class Program:
-    """A mechanism flattened for the kernel (see module docstring)."""
+    """A mechanism flattened for the kernel (see module docstring; record layouts in
+    :mod:`.records`).  ``covered`` False: a block the generated kernel cannot solve (the
+    numpy path then), and no arrays."""
 
-    ints: tuple          # int64 arrays, in the kernel's order
-    flts: tuple          # float64 arrays, in the kernel's order
     ncols: int           # unknowns per sample (every group, in unknown_groups order)
     offsets: dict        # (kind, index) -> (first column, size)
     signed: list         # (kind, index) of each signs column
     names: list          # per block: names of its signed meshes (SignError)
-    covered: bool        # False: a block the generated kernel cannot solve (use the numpy path)
+    covered: bool
+    joints: np.ndarray = _arr()           # JOINT records, tree order
+    poses: np.ndarray = _arr()            # POSE of each of those joints
+    bodies: np.ndarray = _arr()           # BODY of each link (by link id)
+    moving: np.ndarray = _arr()           # the moving link ids
+    base: int = 0                         # the base link id
+    gravity: np.ndarray = _arr()          # (3,) m/s^2, base axes
+    S: np.ndarray = _arr()                # (J, dof): q = S q_ind
+    A: np.ndarray = _arr()                # (dof, M): tau = A motor
+    blocks: np.ndarray = _arr()           # BLOCK records, schedule order
+    block_links: np.ndarray = _arr()      # the blocks' links
+    group_col: np.ndarray = _arr()        # each block column's position in the solution row
+    t_col: np.ndarray = _arr()            # the block columns of the signed t
+    sign_col: np.ndarray = _arr()         # their position in the signs row
+    ainv: np.ndarray = _arr()             # every pattern's (n, 6B) inverse, row-major, patterns in sign_patterns order
+    props: np.ndarray = _arr()            # PROPAGATION records
+    cmat: np.ndarray = _arr()             # their C_plus (6, size), then C_sep, row-major
+    later: np.ndarray = _arr()            # their later links
+    child_basis: np.ndarray = _arr()      # CHILD_BASIS records
+    turns: np.ndarray = _arr()            # their (J,) rows
+    terms: np.ndarray = _arr()            # TERM records of the world-frame blocks
+    term_values: np.ndarray = _arr()      # TERM_VALUE of each
+    joint_out: np.ndarray = _arr()        # JOINT_OUT of each joint (mechanism order)
+    motor_col: np.ndarray = _arr()        # each motor's column
+    gear_col: np.ndarray = _arr()         # each mesh's column
+    gear_out: np.ndarray = _arr()         # GEAR_OUT of each mesh
+    hashed: np.ndarray = _arr()           # what only the cache key needs: LowRank, hot and basis data, flat
     lowrank: dict = field(default_factory=dict)   # block -> pattern_maps.LowRank (too many patterns to store)
     hot: dict = field(default_factory=dict)       # block -> (hot pattern indices, their maps (k, n, 6B))
     weights: dict = field(default_factory=dict)   # redundant world-frame block -> sharing.mesh_weights
     free: dict = field(default_factory=dict)      # redundant world-frame block -> its free columns (_free_columns)
 
+    def arrays(self) -> list:
+        """(name, array) of every array field, in field order (the disk cache's fingerprint)."""
+        return [(f.name, getattr(self, f.name)) for f in fields(self) if isinstance(getattr(self, f.name), np.ndarray)]
+
 
 def _joints(an):
+    """(JOINT records, their POSE records) in tree order."""
     mech, tree = an.mech, an.tree
-    rec, flt = [], []
+    rec, pose = [], []
     for ji in tree.order:
         jt = mech.joints[ji]
         c = tree.index[jt.child]
-        eye = np.eye(3)
-        flags = (int(tree.parent[c] == tree.base) | 2 * int(np.array_equal(jt.R_pj, eye))
-                 | 4 * int(np.array_equal(jt.R_jc, eye)) | 8 * int(not np.any(jt.p_jc)))
-        rec.append([ji, tree.parent[c], c, int(jt.type == "prismatic"), flags])
-        flt.append(np.concatenate([np.ravel(jt.R_pj), jt.p_pj, np.ravel(jt.R_jc), jt.p_jc]))
-    return np.array(rec, I64).reshape(-1, 5), np.array(flt, float).reshape(-1, 24)
+        rec.append((ji, tree.parent[c], c, int(jt.type == "prismatic")))
+        pose.append((np.ravel(jt.R_pj), jt.p_pj, np.ravel(jt.R_jc), jt.p_jc))
+    return records(rec, JOINT), records(pose, POSE)
 
 
-def _links(an):
-    out = np.zeros((len(an.tree.links), 13))
+def _bodies(an):
+    """BODY records by link id (zeros for the base)."""
+    out = np.zeros(len(an.tree.links), BODY).view(np.recarray)
     for L in an.tree.moving:
         link = an.mech.bodies[L]          # payloads merged
-        out[L] = np.concatenate([[link.mass], np.ravel(link.inertia), link.com])
+        out[L] = (link.mass, np.ravel(link.inertia), link.com)
     return out
 
 
 def _loads(an, values: dict, n: int):
-    """Load records and the stacked values: one row (constant) or n rows per load."""
+    """LOAD records, the load points (nloads, 3; link frame, m) and the stacked values:
+    one row (constant) or n rows per load."""
     rec, pts, rows = [], [], []
     off = 0
     for ld in an.mech.loads:
         w = values[ld.name]
         per = int(w.strides[0] != 0 and n > 1)
         w = np.ascontiguousarray(w if per else w[:1], float)
-        rec.append([an.tree.index[ld.link], int(ld.frame == "link"), off, per])
+        rec.append((an.tree.index[ld.link], int(ld.frame == "link"), off, per))
         pts.append(np.asarray(ld.point, float))
         rows.append(w)
         off += w.shape[0]
     vals = (rows[0] if len(rows) == 1 else np.concatenate(rows)) if rows else np.zeros((1, 6))  # no copy of one
-    return np.array(rec, I64).reshape(-1, 4), np.array(pts, float).reshape(-1, 3), vals
+    return records(rec, LOAD), np.array(pts, float).reshape(-1, 3), vals
 
 
 def load_arrays(an, values: dict, n: int):
-    """(ldrec, ldflt, vals) of the loads of ``an`` for n samples (see module docstring)."""
+    """(LOAD records, points, values) of the loads of ``an`` for n samples (:func:`_loads`)."""
     return _loads(an, values, n)
 
 
@@ -134,8 +150,8 @@ class _Builder:
         off = self.add_floats("cmat", Cp)
         if Cs is not None:
             self.add_floats("cmat", Cs)
-        self.prec.append([int(p.offs[gi]), g.size, int(Cs is not None), off, _primary_side(an, g),
-                          len(self.later), len(later)])
+        self.prec.append(dict(col0=int(p.offs[gi]), ncols=g.size, signed=int(Cs is not None), cmat0=off,
+                              primary=_primary_side(an, g), later0=len(self.later), nlater=len(later)))
         self.later += later
         return True
 
@@ -146,20 +162,23 @@ class _Builder:
         if len(self.prec) <= first:
             return False
         last = self.prec[-1]
-        if last[2] or last[0] + last[1] != c0 or last[4] != P or self.later[last[5]:last[5] + last[6]] != later:
+        if (last["signed"] or last["col0"] + last["ncols"] != c0 or last["primary"] != P
+                or self.later[last["later0"]:last["later0"] + last["nlater"]] != later):
             return False
-        prev = self.cmat.pop().reshape(6, last[1])
+        prev = self.cmat.pop().reshape(6, last["ncols"])
         self.cmat_len -= prev.size
-        last[3] = self.add_floats("cmat", np.hstack([prev, np.asarray(Cp, float).reshape(6, size)]))
-        last[1] += size
+        last["cmat0"] = self.add_floats("cmat", np.hstack([prev, np.asarray(Cp, float).reshape(6, size)]))
+        last["ncols"] += size
         return True
 
 
 def _block(bd: _Builder, an, bi, p, block_of, offsets, sigcol, terms):
     """Append block ``bi`` (plan ``p``) to the builder."""
     n = int(p.offs[-1])
-    rec = [-1 if p.F is None else p.F, len(bd.blinks), len(p.links), n, len(bd.gcol), len(p.signed),
-           len(bd.tcol), bd.ainv_len, len(bd.prec), 0, len(bd.cbrec), 0, *terms.get(bi, (0, 0))]
+    term0, nterm = terms.get(bi, (0, 0))
+    rec = dict(F=-1 if p.F is None else p.F, link0=len(bd.blinks), nlinks=len(p.links), n=n, col0=len(bd.gcol),
+               m=len(p.signed), t0=len(bd.tcol), ainv0=bd.ainv_len, prop0=len(bd.prec), nprop=0,
+               cb0=len(bd.cbrec), ncb=0, term0=term0, nterm=nterm)
     bd.blinks += list(p.links)
     for g in p.groups:
         bd.gcol += range(offsets[(g.kind, g.index)][0], offsets[(g.kind, g.index)][0] + g.size)
@@ -167,32 +186,32 @@ def _block(bd: _Builder, an, bi, p, block_of, offsets, sigcol, terms):
         bd.tcol.append(int(p.offs[gi]))
         bd.scol.append(sigcol[(p.groups[gi].kind, p.groups[gi].index)])
     if p.F is not None and (1 << len(p.signed)) > MAX_PATTERNS:
-        rec[7] = -1                        # solved from its pattern_maps.LowRank (program.lowrank)
+        rec["ainv0"] = -1                  # solved from its pattern_maps.LowRank (program.lowrank)
     else:
         for A in p.Ainv:
             bd.add_floats("ainv", A)
     for gi, g in enumerate(p.groups):
         later = [L for L in g.links if block_of[L] > bi]
-        if later and p.F is not None and bd.propagation(an, p, gi, g, later, rec[8]):
-            rec[9] += 1
+        if later and p.F is not None and bd.propagation(an, p, gi, g, later, rec["prop0"]):
+            rec["nprop"] += 1
         if p.parent_side.get(gi):
             if gi in p.turn:               # basis carried by a third coaxial link: q @ row
-                bd.cbrec.append([int(p.offs[gi]), -1, len(bd.turns)])
+                bd.cbrec.append((int(p.offs[gi]), -1, len(bd.turns)))
                 bd.turns += [float(v) for v in p.turn[gi]]
             else:
-                bd.cbrec.append([int(p.offs[gi]), g.index, 0])
-            rec[11] += 1
+                bd.cbrec.append((int(p.offs[gi]), g.index, 0))
+            rec["ncb"] += 1
     bd.brec.append(rec)
 
 
-def _local_frame(bd: _Builder, trec, tflt, p) -> None:
+def _local_frame(bd: _Builder, terms, values, p) -> None:
     """A world-frame block whose matrix is constant in its link's axes
     (:func:`.terms.local_inverse`) becomes a constant-frame block in that link
     (F = the link, its inverse in ``ainv``) that keeps its terms for the propagation."""
     rec = bd.brec[-1]
-    Ainv = local_inverse(trec, tflt, rec[12], rec[13], p.links[0], rec[3])
+    Ainv = local_inverse(terms, values, rec["term0"], rec["nterm"], p.links[0], rec["n"])
     if Ainv is not None:
-        rec[0], rec[7] = p.links[0], bd.add_floats("ainv", Ainv)
+        rec["F"], rec["ainv0"] = p.links[0], bd.add_floats("ainv", Ainv)
 
 
 MAX_PATTERNS = 256
@@ -203,30 +222,17 @@ is solved from one base matrix (:class:`..pattern_maps.LowRank`, ``Program.lowra
 k x k solve a pattern, k = m or 2m)."""
 
 
-def _csr(M: np.ndarray) -> tuple:
-    """(row pointers (R+1,), column indices, values) of M's nonzero entries, row by row in
-    column order: a product over them adds exactly what the dense product adds (+0 terms
-    change no sum), in O(nonzeros) instead of O(R C) (S and A are one or two entries a row
-    for a chain of geared links, dense (J, dof) and (dof, M) otherwise)."""
-    rows, cols = np.nonzero(M)
-    ptr = np.zeros(M.shape[0] + 1, I64)
-    np.add.at(ptr, rows + 1, 1)
-    idx = cols.astype(I64)
-    return np.cumsum(ptr).astype(I64), (idx if idx.size else np.zeros(1, I64)), \
-        (M[rows, cols] if rows.size else np.zeros(1))
-
-
 def build_program(an, plans=None) -> Program:
     """The :class:`Program` of ``an`` (``plans`` from :func:`..blocks.make_plans`); not
     ``covered`` when a redundant block has no constant frame."""
     plans = make_plans(an) if plans is None else plans
     if any(len(p.signed) > MAX_EXHAUSTIVE for p in plans):   # a pattern is an i64 in the code; numpy's search
-        return Program((), (), 0, {}, [], [], False)
+        return Program(0, {}, [], [], False)
     try:
         lowrank = {bi: low_rank(p.Ainv) for bi, p in enumerate(plans)
                    if p.F is not None and (1 << len(p.signed)) > MAX_PATTERNS}
     except (np.linalg.LinAlgError, SharingError):      # a singular base matrix: the numpy path
-        return Program((), (), 0, {}, [], [], False)
+        return Program(0, {}, [], [], False)
     groups = unknown_groups(an)
     offsets, c = {}, 0
     for g in groups:
@@ -241,29 +247,26 @@ def build_program(an, plans=None) -> Program:
         _block(bd, an, bi, p, block_of, offsets, sigcol, terms)
         if p.F is None and len(p.links) == 1 and not p.signed:
             _local_frame(bd, trec, tflt, p)
-    jrec, jflt = _joints(an)
-    cat = (lambda xs: np.concatenate(xs) if xs else np.zeros(1))
-    jout, mcol, gcol, mflt = output_constants(an, offsets)
-    ints = (jrec, np.array(bd.brec, I64).reshape(-1, 14), np.array(bd.blinks, I64),
-            np.array(bd.gcol, I64), np.array(bd.tcol + [0], I64), np.array(bd.scol + [0], I64),
-            np.array(bd.prec, I64).reshape(-1, 7), np.array(bd.later + [0], I64),
-            np.array(bd.cbrec, I64).reshape(-1, 3), np.array(an.tree.moving, I64), trec,
-            np.array([an.tree.base], I64), jout, mcol, gcol)
-    S, A = np.asarray(an.S, float), np.asarray(an.A, float)
-    sparse = (_csr(S), _csr(A), _csr(A.T))
-    ints += tuple(a for ptr, idx, _ in sparse for a in (ptr, idx))
-    flts = (jflt, _links(an), np.ascontiguousarray(S), np.asarray(an.mech.gravity, float),
-            cat(bd.ainv), cat(bd.cmat), tflt, np.array(bd.turns + [0.0]), mflt,
-            np.ascontiguousarray(A)) + tuple(val for *_, val in sparse)
+    joints, poses = _joints(an)
+    cat = (lambda xs: np.concatenate(xs) if xs else np.zeros(0))
+    jout, mcol, gcol, gout = output_constants(an, offsets)
     hot = _hot_maps(an, plans, lowrank)
-    flts += (cat([np.ravel(a) for lr in lowrank.values() for a in (lr.Y, lr.G, lr.Z, lr.W)]
-                 + [np.array(h, float) for h, _ in hot.values()] + [np.ravel(t) for _, t in hot.values()]),)
     weights = {bi: mesh_weights(an, p.groups) for bi, p in enumerate(plans)
                if p.F is None and int(p.offs[-1]) > 6 * len(p.links)}
     free = {bi: f for bi in weights if (f := _basis(an, plans[bi], weights[bi])) is not None}
-    flts += (cat([w for w in weights.values()] + [np.array(f[0] + f[1], float) for f in free.values()]),)  # (hashed)
-    return Program(ints, flts, c, offsets, signed, [p.names for p in plans], True, lowrank=lowrank, hot=hot,
-                   weights=weights, free=free)
+    hashed = cat([np.ravel(a) for lr in lowrank.values() for a in (lr.Y, lr.G, lr.Z, lr.W)]
+                 + [np.array(h, float) for h, _ in hot.values()] + [np.ravel(t) for _, t in hot.values()]
+                 + list(weights.values()) + [np.array(f[0] + f[1], float) for f in free.values()])
+    ints = (lambda xs: np.array(xs, I64))
+    return Program(c, offsets, signed, [p.names for p in plans], True, joints=joints, poses=poses,
+                   bodies=_bodies(an), moving=ints(an.tree.moving), base=int(an.tree.base),
+                   gravity=np.asarray(an.mech.gravity, float), S=np.ascontiguousarray(an.S, float),
+                   A=np.ascontiguousarray(an.A, float), blocks=records(bd.brec, BLOCK), block_links=ints(bd.blinks),
+                   group_col=ints(bd.gcol), t_col=ints(bd.tcol), sign_col=ints(bd.scol), ainv=cat(bd.ainv),
+                   props=records(bd.prec, PROPAGATION), cmat=cat(bd.cmat), later=ints(bd.later),
+                   child_basis=records(bd.cbrec, CHILD_BASIS), turns=np.array(bd.turns, float), terms=trec,
+                   term_values=tflt, joint_out=jout, motor_col=mcol, gear_col=gcol, gear_out=gout, hashed=hashed,
+                   lowrank=lowrank, hot=hot, weights=weights, free=free)
 
 
 MAX_BASIS_CONDITION = 1e8

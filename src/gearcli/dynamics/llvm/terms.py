@@ -14,9 +14,8 @@ term of a geared mesh's separating force is multiplied by the sign of its t (Eq.
 Written here from the model, independently of :class:`~..equations.Columns`, which the
 kernel's tests compare against.
 
-``trec`` (T, 6) int: [target link, row block-link position or -1 (a later link: the term
-propagates the solved wrench), block column, 0 force / 1 moment, frame link X, signed-mesh
-position in the block or -1]; ``tflt`` (T, 7): [coef, d_X (3), p_X (3)].
+The terms are :data:`.records.TERM` records (target link, row, column, force or moment,
+frame link X, signed-mesh position) with their :data:`.records.TERM_VALUE` (coef, d_X, p_X).
 """
 from __future__ import annotations
 
@@ -24,6 +23,7 @@ import numpy as np
 
 from ...model.gears import helical_terms
 from ..general import is_geared
+from .records import TERM, TERM_VALUE, records
 
 
 def _joint_frame(jt):
@@ -100,7 +100,8 @@ def group_terms(an, g, L, t_pos):
 
 
 def general_terms(an, plans, block_of):
-    """(trec, tflt, {block: (offset, count)}) of the blocks without a constant frame."""
+    """(terms, their values, {block: (offset, count)}) of the blocks without a constant
+    frame (:data:`.records.TERM`, :data:`.records.TERM_VALUE` records)."""
     rec, flt, where = [], [], {}
     for bi, p in enumerate(plans):
         if p.F is not None:
@@ -114,12 +115,10 @@ def general_terms(an, plans, block_of):
                     continue
                 for j, terms in enumerate(group_terms(an, g, L, t_pos)):
                     for kind, X, sgn, coef, d, pt in terms:
-                        rec.append([L, row, int(p.offs[gi]) + j, kind, X, sgn])
-                        flt.append(np.concatenate([[coef], d, pt]))
+                        rec.append((L, row, int(p.offs[gi]) + j, kind, X, sgn))
+                        flt.append((coef, d, pt))
         where[bi] = (start, len(rec) - start)
-    trec = np.array(rec, np.int64).reshape(-1, 6) if rec else np.zeros((1, 6), np.int64)
-    tflt = np.array(flt, float).reshape(-1, 7) if flt else np.zeros((1, 7))
-    return trec, tflt, where
+    return records(rec, TERM), records(flt, TERM_VALUE), where
 
 
 MAX_LOCAL_CONDITION = 1e8
@@ -127,7 +126,7 @@ MAX_LOCAL_CONDITION = 1e8
 inverts once instead of eliminating per sample."""
 
 
-def local_inverse(trec, tflt, k0: int, nt: int, link: int, n: int):
+def local_inverse(terms, values, k0: int, nt: int, link: int, n: int):
     """The inverse (n, n) of a world-frame block's matrix in ``link``'s axes about its
     origin, when that matrix is constant: the block is the one link ``link``, it has no
     signed mesh (the caller checks both) and every term on it has ``link`` as its frame
@@ -137,14 +136,13 @@ def local_inverse(trec, tflt, k0: int, nt: int, link: int, n: int):
     constant-frame block (rotating its right-hand side into link axes) and still
     propagates its wrenches from the terms."""
     A = np.zeros((n, n))
-    for k in range(k0, k0 + nt):
-        row, col, kind, X = trec[k, 1], trec[k, 2], trec[k, 3], trec[k, 4]
-        if row < 0:
+    for t, v in zip(terms[k0:k0 + nt], values[k0:k0 + nt]):
+        if t.row < 0:
             continue
-        if row != 0 or X != link or trec[k, 5] >= 0:
+        if t.row != 0 or t.frame != link or t.sign >= 0:
             return None
-        coef, d, p = tflt[k, 0], tflt[k, 1:4], tflt[k, 4:7]
-        A[:, col] += coef * (np.concatenate([np.zeros(3), d]) if kind == 1 else np.concatenate([d, np.cross(p, d)]))
+        d = v.d
+        A[:, t.col] += v.coef * (np.concatenate([np.zeros(3), d]) if t.moment == 1 else np.concatenate([d, np.cross(v.p, d)]))
     if n != 6 or not np.isfinite(cond := np.linalg.cond(A)) or cond > MAX_LOCAL_CONDITION:
         return None
     return np.linalg.inv(A)

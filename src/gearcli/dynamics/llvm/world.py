@@ -139,8 +139,8 @@ class WorldBlock:
     full_trial = True
 
     def __init__(self, s, prog, k0: int, nt: int, n: int, tcols: list, wrench, fn=None, weights=None, free=None):
-        self.s, self.trec, self.tflt = s, prog.ints[10], prog.flts[6]
-        self.terms = [k for k in range(k0, k0 + nt) if self.trec[k, 1] >= 0]
+        self.s, self.trec, self.tval = s, prog.terms, prog.term_values
+        self.terms = [k for k in range(k0, k0 + nt) if self.trec[k].row >= 0]
         self.n, self.tcols, self.wrench = n, tcols, wrench
         self.fn, self.weights, self.free, self.mem = fn, weights, free, None
 
@@ -207,8 +207,9 @@ class WorldBlock:
         """x of the block for the signs ``sig`` (values) of its t."""
         A = [[0.0] * self.n for _ in range(len(r))]
         for k in self.terms:
-            row, col = int(self.trec[k, 1]), int(self.trec[k, 2])
-            w = self.wrench(e, self.s, self.trec[k], self.tflt[k], int(self.trec[k, 0]), sig)
+            term = self.trec[k]
+            row, col = int(term.row), int(term.col)
+            w = self.wrench(e, self.s, term, self.tval[k], int(term.link), sig)
             for h in range(6):
                 A[6 * row + h][col] = e.add(A[6 * row + h][col], w[h])
         if len(r) == self.n:
