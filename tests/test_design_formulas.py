@@ -206,6 +206,30 @@ def test_bearing_equivalent_load_uses_given_factors_over_the_table():
     assert I.bearing_equivalent_load(cyl, Fr, Fa) == pytest.approx([100.0, 100.0])     # P = Fr
 
 
+def test_bearing_equivalent_load_without_axial_load_equals_the_formula():
+    # the short cut for a non-locating bearing (no axial load at any sample) gives what the
+    # table and dynamic_equivalent_load give, bit for bit, for every type and factor source
+    from gearcli.model.ratings import BearingRating
+
+    rng = np.random.default_rng(2)
+    Fr = np.r_[rng.uniform(0.0, 5e3, 2000), 0.0, 1e-300]
+    for Fa in (np.zeros_like(Fr), np.full_like(Fr, -0.0)):
+        for kind, f0, X, Y, e in (("ball", 13.0, None, None, None), ("ball", None, None, None, None),
+                                  ("ball", None, 0.56, 1.6, 0.27), ("tapered_roller", None, 0.4, 1.7, 0.35)):
+            b = BearingRating("b", 0.0, 9500.0, 5200.0, kind, X, Y, e, 0.6, 0.5, f0=f0)
+            if None in (X, Y, e):
+                e_t, Y_t = I.ball_factors(Fa, b.C0, f0)
+                ref = I.dynamic_equivalent_load(Fr, Fa, I.BALL_X, Y_t, e_t)
+            else:
+                ref = I.dynamic_equivalent_load(Fr, Fa, X, Y, e)
+            assert I.bearing_equivalent_load(b, Fr, Fa).tobytes() == ref.tobytes()
+    Fa = np.zeros_like(Fr)
+    Fa[7] = 1.0                                    # one sample with axial load: the table again
+    b = BearingRating("b", 0.0, 9500.0, 5200.0, "ball", None, None, None, 0.6, 0.5, f0=13.0)
+    e_t, Y_t = I.ball_factors(Fa, b.C0, 13.0)
+    assert I.bearing_equivalent_load(b, Fr, Fa).tobytes() == I.dynamic_equivalent_load(Fr, Fa, 0.56, Y_t, e_t).tobytes()
+
+
 def test_a_iso_formulas_by_hand_continuity_and_limits():
     # ISO 281:2007 9.3, ball bearing, kappa = 1 (third row): a = 0.1 [1 - (2.5671 - 1.9987)^0.83
     # x^(1/3)]^-9.3 with x = e_C Cu / P = 0.5 * 400 / 2000 = 0.1, by hand:

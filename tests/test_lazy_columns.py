@@ -38,7 +38,7 @@ def expected_column(an, res, t, name):
             "loss": None if res.joint_loss is None else res.joint_loss[:, ji]}[what]
 
 
-def _solved(an, n=60):
+def _solved(an, n=1300):          # more than report.columns.TRANSPOSE_ROWS: several blocks
     rng = np.random.default_rng(5)
     t = np.linspace(0.0, 1.0, n)
     dof = len(an.independent_names)

@@ -104,7 +104,11 @@ def bearing_equivalent_load(b, Fr, Fa) -> np.ndarray:
 
     A factor the rating gives (``X``, ``Y``, ``e``) is used as given; a ball bearing's
     missing ones come from ISO 281 Table 3 at each sample (:func:`ball_factors`, X = 0.56).
+    Without axial load at any sample (a non-locating bearing) Fa <= e Fr holds everywhere,
+    so P = Fr without the table (the same values for finite loads).
     """
+    if not np.any(Fa):
+        return np.abs(np.asarray(Fr, float))
     X, Y, e = b.X, b.Y, b.e
     if None in (X, Y, e):
         e_t, Y_t = ball_factors(Fa, b.C0, b.f0)

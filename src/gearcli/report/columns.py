@@ -64,6 +64,10 @@ def column_names(an) -> list[str]:
     return cols
 
 
+TRANSPOSE_ROWS = 512
+"""Samples per block when the joint reactions are transposed (:func:`column_sources`)."""
+
+
 def column_sources(an, t: np.ndarray, res: Result) -> dict:
     """``{column name: function computing that (N,) column}`` for every output column of
     :func:`column_names`, in its order: the one definition of the columns' values, used by
@@ -89,14 +93,19 @@ def column_sources(an, t: np.ndarray, res: Result) -> dict:
             for side in (0, 1):
                 put(lambda ci=ci, side=side: res.gear_radial[:, ci, side])
                 put(lambda ci=ci, side=side: res.gear_axial[:, ci, side])
-    wrenches: dict = {}
+    wrenches: list = []
 
     def wrench(ji: int) -> np.ndarray:
-        """Joint ji's reaction wrench as (6, N), rows contiguous: one pass over the result's
-        (N, J, 6) array gives all six columns of the joint."""
-        if ji not in wrenches:
-            wrenches[ji] = np.ascontiguousarray(res.joint[:, ji, :].T)
-        return wrenches[ji]
+        """Joint ji's reaction wrench as (6, N), rows contiguous: the result's (N, J, 6) array
+        transposed once to (J, 6, N), by blocks of rows that stay in the cache (a column
+        gathered alone reads a cache line per sample)."""
+        if not wrenches:
+            n, J = res.joint.shape[:2]
+            w = np.empty((J, 6, n))
+            for a in range(0, n, TRANSPOSE_ROWS):
+                w[:, :, a:a + TRANSPOSE_ROWS] = res.joint[a:a + TRANSPOSE_ROWS].transpose(1, 2, 0)
+            wrenches.append(w)
+        return wrenches[0][ji]
 
     for ji in range(res.joint.shape[1]):
         for a in range(6):
