@@ -52,6 +52,9 @@ SMALL = 16
 TOLERANCE = 1e-12
 """With losses: the torque residual at which :func:`forward_dynamics` stops, relative to the
 sample's largest torque."""
+STALLED = 1e-10
+"""With losses: a residual within this of the sample's torque scale ends the iteration when a
+step no longer reduces it (the solve's rounding reached before :data:`TOLERANCE`)."""
 MAX_STEPS = 60
 """With losses: the most correction steps of :func:`forward_dynamics`."""
 
@@ -205,7 +208,7 @@ def _implicit(an, q, qd, target, M, h, loads, backend, jobs) -> np.ndarray:
     largest of |target|, |h| and |M| (the torques of unit accelerations: a sample near a
     static balance, target and h ~ 0, still has inertia torques of that size, and its solve
     rounds to them), or when a step no longer reduces a residual already within
-    ``sqrt(TOLERANCE)`` of that scale (rounding reached).  ValueError naming the first sample
+    :data:`STALLED` of that scale (rounding reached).  ValueError naming the first sample
     that does not settle in :data:`MAX_STEPS` (e.g. a self-locking transmission)."""
     qdd = np.linalg.solve(M, (target - h)[:, :, None])[:, :, 0]
     values = load_values(an.mech, len(q), loads)
@@ -218,7 +221,7 @@ def _implicit(an, q, qd, target, M, h, loads, backend, jobs) -> np.ndarray:
                     backend=backend, jobs=jobs, check_finite=False)
         r = res.tau - target[todo]
         size = np.abs(r).max(axis=1)
-        done = (size <= TOLERANCE * scale[todo]) | ((size >= last[todo]) & (size <= np.sqrt(TOLERANCE) * scale[todo]))
+        done = (size <= TOLERANCE * scale[todo]) | ((size >= last[todo]) & (size <= STALLED * scale[todo]))
         last[todo] = size
         todo, r = todo[~done], r[~done]
         if todo.size == 0:
