@@ -49,3 +49,30 @@ def test_refuses_too_few_or_unordered_sites():
         spline_derivatives(np.arange(5.0), np.zeros((5, 1)))
     with pytest.raises(ValueError, match="increase strictly"):
         spline_derivatives(np.array([0.0, 1, 2, 2, 3, 4, 5]), np.zeros((7, 1)))
+
+
+PROBE = """
+import sys
+import numpy as np
+from gearcli.io.spline import derivatives
+t = np.cumsum(np.random.default_rng(4).uniform(0.5, 1.5, 3000))
+y = np.column_stack([np.sin(t / 40), np.cos(t / 25)])
+d1, d2 = derivatives(t, y, 2)
+print("scipy.linalg" in sys.modules)
+sys.stdout.flush()
+from scipy.linalg import get_lapack_funcs
+import gearcli.io.spline as S
+S.dgbsv = lambda: get_lapack_funcs(("gbsv",), (np.zeros((1, 1)),))[0]    # the scipy.linalg path
+e1, e2 = derivatives(t, y, 2)
+print(d1.tobytes() == e1.tobytes() and d2.tobytes() == e2.tobytes())
+"""
+
+
+def test_spline_loads_lapack_without_the_scipy_linalg_package_same_bits():
+    # a fresh process: the spline's dgbsv comes from scipy's LAPACK extension alone (the
+    # scipy.linalg package costs 0.2-0.4 s to import), and gives what get_lapack_funcs' does
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", PROBE], capture_output=True, text=True, check=True).stdout.split()
+    assert out == ["False", "True"]

@@ -8,12 +8,15 @@ arithmetic: the not-a-knot knots, the collocation matrix by the Cox-de Boor recu
 coefficients of ``splder`` and the evaluation sum of ``evaluate_spline``.  It is
 vectorised over the samples (Python loops over the degree only) and knows the knot
 interval of every data point (no search).  Importing :mod:`scipy.interpolate` costs ~0.2 s
-(scipy.sparse, scipy.special, ...): this module imports only ``scipy.linalg``'s LAPACK
-wrapper.  ``tests/test_spline.py`` checks it against ``make_interp_spline`` (to 1e-12 of
-each column's largest derivative) and against polynomials of degree 5, which the spline
-reproduces exactly.
+(scipy.sparse, scipy.special, ...), the ``scipy.linalg`` package as much: this module loads
+only scipy's LAPACK extension (:func:`dgbsv`).  ``tests/test_spline.py`` checks it against
+``make_interp_spline`` (to 1e-12 of each column's largest derivative) and against
+polynomials of degree 5, which the spline reproduces exactly.
 """
 from __future__ import annotations
+
+import sys
+from functools import lru_cache
 
 import numpy as np
 
@@ -92,11 +95,38 @@ def _evaluate(t: np.ndarray, c: np.ndarray, k: int, x: np.ndarray, shift: int) -
     return out
 
 
+@lru_cache(maxsize=1)
+def dgbsv():
+    """LAPACK ``dgbsv`` as scipy wraps it (``scipy.linalg.get_lapack_funcs`` gives the same
+    function for float64 arrays), loaded from scipy's ``scipy.linalg._flapack`` extension
+    alone: importing the ``scipy.linalg`` package costs 0.2-0.4 s of a fresh process
+    (``gearcli verify`` and ``solve`` of a positions-only file need nothing else of scipy),
+    the extension ~0.01 s.  Falls back to ``get_lapack_funcs`` where scipy keeps it elsewhere."""
+    import glob  # noqa: PLC0415
+    import importlib.machinery  # noqa: PLC0415
+    import importlib.util  # noqa: PLC0415
+    import os  # noqa: PLC0415
+
+    name = "scipy.linalg._flapack"
+    try:
+        if name in sys.modules or "scipy.linalg" in sys.modules:
+            raise ImportError("loaded already")
+        spec = importlib.util.find_spec("scipy")
+        found = sorted(glob.glob(os.path.join(os.path.dirname(spec.origin), "linalg",
+                                              "_flapack" + importlib.machinery.EXTENSION_SUFFIXES[0])))
+        loader = importlib.machinery.ExtensionFileLoader(name, found[0])
+        module = importlib.util.module_from_spec(importlib.util.spec_from_file_location(name, found[0], loader=loader))
+        loader.exec_module(module)
+        return module.dgbsv
+    except (ImportError, AttributeError, IndexError, TypeError, OSError):
+        from scipy.linalg import get_lapack_funcs  # noqa: PLC0415
+
+        return get_lapack_funcs(("gbsv",), (np.zeros((1, 1)),))[0]
+
+
 def _coefficients(t: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """B-spline coefficients (n, m) of the interpolant of ``y`` (n, m) at ``x`` on knots ``t``
     (the banded collocation system of scipy's ``make_interp_spline``, LAPACK ``gbsv``)."""
-    from scipy.linalg import get_lapack_funcs  # noqa: PLC0415 (scipy.linalg: imported by the analysis anyway)
-
     n = len(x)
     h, ell = _all_bases(t, x, K, 0)
     kl = ku = K
@@ -109,8 +139,7 @@ def _coefficients(t: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         col = ell[ends] - K + a
         ab[kl + ku + ends - col, col] = b[ends]
     rhs = np.array(y, dtype=float).reshape(n, -1)
-    gbsv, = get_lapack_funcs(("gbsv",), (ab, rhs))
-    _, _, c, info = gbsv(kl, ku, ab, rhs, overwrite_ab=True, overwrite_b=True)
+    _, _, c, info = dgbsv()(kl, ku, ab, rhs, overwrite_ab=True, overwrite_b=True)
     if info > 0:
         raise np.linalg.LinAlgError("Colocation matrix is singular.")
     if info < 0:   # pragma: no cover
