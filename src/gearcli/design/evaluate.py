@@ -110,7 +110,7 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
     cache: dict = {}
     for ch in checks:
         x = signal(ch, s, mech, cache)
-        k = int(np.argmax(np.abs(x))) if x.size else 0
+        k = _peak_index(cache, ch, x)
         peak, tp = (float(np.abs(x[k])), float(s.t[k])) if x.size else (0.0, math.nan)
         total = wsum = revs = 0.0
         score = peak
@@ -136,6 +136,23 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
             score = total
         out.append((peak, tp, total, wsum, revs, score, span))
     return out
+
+
+NON_NEGATIVE = frozenset({"abs", "rate", "running_rms", "bearing_P", "bearing_P0", "bending", "contact"})
+"""Signals that are never negative by construction: their largest |x| is their largest x."""
+
+
+def _peak_index(cache: dict, check: Check, x: np.ndarray) -> int:
+    """Index of the first largest |x| (0 when empty), once per signal (a gear's stress feeds
+    its safety and its fatigue check); a :data:`NON_NEGATIVE` signal is searched without
+    taking |x| (the same index: -0.0 equals 0.0, a NaN is found first either way)."""
+    key = ("peak", check.signal, check.extra.get("K"))
+    if key not in cache:
+        if not x.size:
+            cache[key] = 0
+        else:
+            cache[key] = int(np.argmax(x if check.signal[0] in NON_NEGATIVE else np.abs(x)))
+    return cache[key]
 
 
 def _revolutions(cache: dict, s: Samples, ji: int) -> np.ndarray:
