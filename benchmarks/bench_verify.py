@@ -11,6 +11,13 @@ CSV reading, splines, solve, checks, JSON), -j 2 (process pool) and a Dask Local
 with 2 worker processes (cluster start-up excluded), their rates, and that the three JSON
 reports are identical (--serial: the library and -j 1 only).  The load average is printed
 with the figures: the machine is shared, so compare the ratios rather than single numbers.
+
+-j 1 is also broken down into its stages (medians over the repeats): the manifest (schema,
+analysis, checks built, every trajectory's rows read and checked), the jobs' reading (the
+spline of the rates; the rows are the manifest's), the solve inside verify (with the
+solver path that ran), the checks, and the rest (reports, merging).  --cli adds `gearcli
+verify -j 1` as a user runs it, in a fresh process each time (imports, the mechanism's
+analysis and its compiled kernel from the disk cache included).
 """
 from __future__ import annotations
 
@@ -18,8 +25,12 @@ import argparse
 import json
 import os
 import statistics
+import subprocess
+import sys
 import tempfile
 import time
+from collections import defaultdict
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -55,6 +66,49 @@ def library_solve(d: Path, repeat: int) -> float:
     return timed(lambda: [solve(an, tr.q, tr.qd, tr.qdd, jobs=1) for tr in trs], repeat)[0]
 
 
+STAGES = (("manifest", "gearcli.batch.verify", "load_manifest"), ("reading + spline", "gearcli.batch.runner", "read_trajectory"),
+          ("solve", "gearcli.batch.runner", "solve"), ("checks", "gearcli.batch.runner", "partials"))
+
+
+@contextmanager
+def stage_clock():
+    """Time the stages of run_verify (wall time summed per stage; module functions wrapped)."""
+    import importlib
+
+    spent: dict = defaultdict(float)
+    saved = []
+    for label, module, name in STAGES:
+        mod = importlib.import_module(module)
+        fn = getattr(mod, name)
+        saved.append((mod, name, fn))
+
+        def wrapped(*a, _fn=fn, _label=label, **k):
+            t0 = time.perf_counter()
+            try:
+                return _fn(*a, **k)
+            finally:
+                spent[_label] += time.perf_counter() - t0
+        setattr(mod, name, wrapped)
+    try:
+        yield spent
+    finally:
+        for mod, name, fn in saved:
+            setattr(mod, name, fn)
+
+
+def cli_runs(man: Path, out: Path, repeat: int) -> float:
+    """Median wall time of `gearcli verify -j 1` in a fresh process (a warm-up run first)."""
+    cmd = [sys.executable, "-c", "from gearcli.cli import app; app()", "verify", str(man), "--json", str(out), "-j", "1"]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "src"), os.environ.get("PYTHONPATH", "")])}
+    subprocess.run(cmd, env=env, capture_output=True)
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        subprocess.run(cmd, env=env, capture_output=True)
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
 def timed(fn, repeat: int) -> tuple[float, object]:
     times, out = [], None
     for _ in range(repeat):
@@ -70,6 +124,7 @@ def main() -> None:
     ap.add_argument("--samples", type=int, default=20_000)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--serial", action="store_true", help="the library solve and -j 1 only")
+    ap.add_argument("--cli", action="store_true", help="also `gearcli verify -j 1` in fresh processes")
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         d = Path(tmp)
@@ -81,7 +136,16 @@ def main() -> None:
             return json.loads(out.read_text())
 
         lib_t = library_solve(d, args.repeat)
-        serial_t, serial = timed(lambda: run("serial", jobs=1), args.repeat)
+        run("serial", jobs=1)                  # warm: this process's analysis and kernel
+        stages = []
+
+        def staged():
+            with stage_clock() as spent:
+                out = run("serial", jobs=1)
+            stages.append(dict(spent))
+            return out
+        serial_t, serial = timed(staged, args.repeat)
+        cli_t = cli_runs(man, d / "cli.json", args.repeat) if args.cli else None
         if not args.serial:
             pool_t, pool = timed(lambda: run("pool", jobs=2), args.repeat)
             from dask.distributed import LocalCluster
@@ -94,6 +158,15 @@ def main() -> None:
     print(f"  library solve       {lib_t:7.2f} s  {total / lib_t:10,.0f} samples/s  (solve() on the same samples)")
     print(f"  -j 1 (serial)       {serial_t:7.2f} s  {total / serial_t:10,.0f} samples/s  "
           f"(end to end; {100 * (1 - lib_t / serial_t):.0f} % outside the solver)")
+    med = {label: statistics.median(st.get(label, 0.0) for st in stages) for label, _, _ in STAGES}
+    med["reports, merging, rest"] = max(serial_t - sum(med.values()), 0.0)
+    backend = sorted({c["backend"] for c in serial["checks"]})
+    for label, v in med.items():
+        note = f"  (solver path: {', '.join(backend)})" if label == "solve" else ""
+        print(f"      {label:22s} {v:6.3f} s  {100 * v / serial_t:4.0f} %{note}")
+    if cli_t is not None:
+        print(f"  gearcli verify -j 1 {cli_t:7.2f} s  {total / cli_t:10,.0f} samples/s  "
+              "(a fresh process each run: imports, analysis, kernel from the disk cache)")
     if args.serial:
         return
     print(f"  -j 2 (processes)    {pool_t:7.2f} s  {total / pool_t:10,.0f} samples/s  speed-up {serial_t / pool_t:.2f}x")
