@@ -27,7 +27,7 @@ def test_compiled_once_per_solver_and_kept(monkeypatch, tmp_path):
     q = np.zeros((5, an.dof))
     solve(an, q, q, q, backend="numpy")
     solve(an, q, q, q, method="full")
-    assert solver_for(an).samples_solved == 5            # counted for "auto" (block method only)
+    assert solver_for(an).samples_solved == backends.CALL_SAMPLES   # a call counts at least that (block method only)
     solve(an, q, q, q, backend="llvm")
     k = solver_for(an).llvm_kernel()
     assert k is not None and k.build_seconds > 0 and k.compile_seconds > 0
@@ -47,7 +47,8 @@ def test_first_call_rule(monkeypatch, tmp_path):
     q = np.zeros((10, an.dof))
     res = solve(an, q, q, q)
     assert res.backend == "numpy" and "first-call rule" in res.backend_note and not sol.compiled_llvm()
-    assert sol.choice(n=K - 11).path == "numpy" and sol.choice(n=K - 10).path == "llvm"   # 10 solved before
+    C = backends.CALL_SAMPLES                                                  # what the 10-sample call counted
+    assert sol.choice(n=K - C - 1).path == "numpy" and sol.choice(n=K - C).path == "llvm"
     assert sol.choice(n=None).path == "llvm"                                               # a large call
     assert sol.backend(backend="llvm", n=1) == "llvm" and not sol.compiled_llvm()         # choosing compiles nothing
     big = np.zeros((K, an.dof))
@@ -63,13 +64,19 @@ def test_first_call_rule(monkeypatch, tmp_path):
 
 
 def test_many_small_calls_compile_once_they_add_up(monkeypatch, tmp_path):
-    """A run of small calls (a simulation's steps) counts its samples: numpy until they reach
-    FIRST_CALL_SAMPLES, llvm after (a mutant that forgot the count would stay on numpy)."""
+    """A run of small calls (a simulation's steps) counts its samples, each call as at least
+    CALL_SAMPLES (numpy's fixed cost a call): numpy until they reach FIRST_CALL_SAMPLES,
+    llvm after (a mutant that forgot the count, or the floor, would stay on numpy)."""
     monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path))
     an = analyse(parse_mechanism(serial_chain(6)))
     q = np.zeros((1000, an.dof))
     seen = [solve(an, q, q, q).backend for _ in range(6)]
     assert seen == ["numpy"] * 4 + ["llvm"] * 2
+    an = analyse(parse_mechanism(serial_chain(5)))          # 4-sample calls count CALL_SAMPLES each
+    q = np.zeros((4, an.dof))
+    calls = backends.FIRST_CALL_SAMPLES // backends.CALL_SAMPLES
+    seen = [solve(an, q, q, q).backend for _ in range(calls + 1)]
+    assert seen == ["numpy"] * (calls - 1) + ["llvm"] * 2
 
 
 def test_unavailable_without_a_kernel_program():

@@ -15,11 +15,11 @@ mechanism as LLVM IR (:mod:`.llvm.kernel`: method "block"; its machine code is k
     yet): numpy for every call;
   - the first-call rule: while the kernel is neither compiled in this process nor its
     machine code in the disk cache, a call of fewer than :data:`FIRST_CALL_SAMPLES` samples
-    (counting the samples this solver already solved by the block method) is solved by
-    numpy and compiles nothing: numpy solves such a call in less time than a cold compile
-    takes (0.15-0.3 s for 5-10 moving links, ~4 s for Talos' 44; numpy solves 20,000-80,000
-    samples/s of a 5-10 link mechanism).  A longer run of small calls (a simulation's
-    steps) compiles once its samples reach the threshold.
+    (counting the samples this solver already solved by the block method, each call as at
+    least :data:`CALL_SAMPLES`) is solved by numpy and compiles nothing: numpy solves such
+    a call in less time than a cold compile takes (0.15-0.3 s for 5-10 moving links, ~4 s
+    for Talos' 44; numpy solves ~200,000 samples/s of Bendix plus ~1.5 ms a call).  A run of
+    small calls (a simulation's steps) compiles once they add up: 4-sample calls at the 20th.
 
 The old "kernel" backend (numba, retired in issue 18) is refused with
 :data:`KERNEL_RETIRED`.
@@ -32,6 +32,9 @@ BACKENDS = ("auto", "llvm", "numpy")
 FIRST_CALL_SAMPLES = 5_000
 """Samples (this call plus those solved before by the same solver) from which "auto" compiles
 a kernel that is neither compiled nor in the disk cache; below, numpy solves the call."""
+CALL_SAMPLES = 250
+"""The least a call counts for, in samples: numpy's fixed cost of a call (~1-1.5 ms for the
+Bendix, measured) is about that many samples' work (~5 us each)."""
 KERNEL_RETIRED = ("backend 'kernel' (the numba kernel) was retired: use 'llvm' (the generated kernel) "
                   "or 'auto'")
 
@@ -69,7 +72,7 @@ def _first_call(sol, n: int | None) -> str | None:
     solved by numpy rather than pay a cold compile, else None."""
     if n is None or sol.compiled_llvm():
         return None
-    seen = n + sol.samples_solved
+    seen = max(n, CALL_SAMPLES) + sol.samples_solved
     if seen >= FIRST_CALL_SAMPLES or llvm_on_disk(sol):
         return None
     return (f"first-call rule: fewer than {FIRST_CALL_SAMPLES:,} samples, and the kernel is neither "

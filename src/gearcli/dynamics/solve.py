@@ -27,7 +27,7 @@ from threadpoolctl import ThreadpoolController
 
 from ..analysis.schedule import unknown_groups
 from ..model.gears import helical_terms
-from .backends import Choice, choose, llvm_refusal
+from .backends import CALL_SAMPLES, Choice, choose, llvm_refusal
 from .blocks import make_plans, solve_blocks
 from .equations import Columns
 from .general import is_geared, solve_full
@@ -181,7 +181,7 @@ class Solver:
                                                   **{f"load '{k}'": v for k, v in values.items()}})
         how = self.choice(method, backend, q.shape[0])
         if method == "block":
-            self.samples_solved += q.shape[0]
+            self.samples_solved += max(q.shape[0], CALL_SAMPLES)
         if how.path != "numpy" and not verify:     # no BLAS call: the limit would cost ~30 us a call
             return self._by_kernel(how, q, qd, qdd, values, jobs, chunk, verify, out)
         # the operands are 3x3 to 48x48 matrices: BLAS threads only contend (2-3x slower
