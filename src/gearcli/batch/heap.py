@@ -2,9 +2,10 @@
 
 verify's checks make and drop many arrays of one trajectory's length (20,000 samples:
 160 kB each).  glibc serves a block of 128 kB or more by ``mmap`` and returns it to the
-system when freed, unless a larger block freed before raised its dynamic threshold; every
-page of every such array is then faulted in afresh (measured: 70,000 page faults a run of
-``benchmarks/bench_verify.py``, about half its wall time).  :func:`keep_freed_memory` sets
+system when freed, unless a larger block freed before raised its dynamic threshold (the
+full output table verify built before it read columns lazily did so, by chance); every
+page of every such array is then faulted in afresh (measured without that table: 46,000 to
+70,000 page faults a run of ``benchmarks/bench_verify.py``, about half its wall time).  :func:`keep_freed_memory` sets
 the thresholds once per process with ``mallopt`` (``M_MMAP_THRESHOLD`` 32 MiB, glibc's
 largest dynamic value, and ``M_TRIM_THRESHOLD`` 256 MiB): blocks below 32 MiB come from the
 heap and freed memory stays for the next array.  Larger arrays still use ``mmap``.  A
