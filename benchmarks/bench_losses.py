@@ -8,11 +8,14 @@ interleaved round by round so that load drift hits all alike, medians of --round
 * lossless, numpy and the compiled llvm kernel (the reference points);
 * mesh + joint friction (every mesh at 3 % loss, every joint with Coulomb + viscous friction),
   numpy: the couples ride in the tooth-force columns (one extra set of block maps per pattern
-  of relative-speed signs met);
-* the same with bearing friction on every bearing (mu 0.0015, bore 20 mm), numpy: a
-  fixed-point iteration per sample, whose iterations are printed (median and worst).
+  of relative-speed signs met); llvm: each block's trial corrected by the rank-ml update of
+  its friction columns (:mod:`gearcli.dynamics.llvm_losses`), the joint friction an input;
+* the same with bearing friction on every bearing (mu 0.0015, bore 20 mm), numpy and llvm:
+  a fixed-point iteration per sample (:func:`gearcli.dynamics.bearing_friction.fixed_point`),
+  whose iterations are printed (median and worst).
 
-The compiled kernels do not model losses yet: a lossy mechanism runs on numpy (``auto``).
+The cost of losses in the compiled path (issue 19's target: at most 20 %) is each llvm row
+over the lossless llvm row of the same run.
 """
 from __future__ import annotations
 
@@ -48,6 +51,8 @@ def main(argv=None) -> int:
     cases = {"lossless, llvm": (analyse(mech), "llvm"), "lossless, numpy": (analyse(mech), "numpy"),
              "mesh + joint friction, numpy": (analyse(lossy(mech, False)), "numpy"),
              "+ bearing friction, numpy": (analyse(lossy(mech, True)), "numpy")}
+    cases["mesh + joint friction, llvm"] = (cases["mesh + joint friction, numpy"][0], "llvm")
+    cases["+ bearing friction, llvm"] = (cases["+ bearing friction, numpy"][0], "llvm")
     rng = np.random.default_rng(0)
     dof = cases["lossless, numpy"][0].dof
     q, qd, qdd = (rng.uniform(-3, 3, (args.samples, dof)) for _ in range(3))
@@ -59,12 +64,19 @@ def main(argv=None) -> int:
             times[name].append(median_time(lambda: solve(an, q, qd, qdd, backend=backend, jobs=1), 1))
     print(f"Bendix wrist (rated), {args.samples:,} random samples, 1 thread, medians of {args.rounds}; {load_line()}")
     base = float(np.median(times["lossless, numpy"]))
+    fast = float(np.median(times["lossless, llvm"]))
     for name, ts in times.items():
         t = float(np.median(ts))
-        print(f"  {name:32s} {t * 1e3:9.1f} ms  {args.samples / t:12,.0f} samples/s  {t / base:5.2f}x numpy lossless")
+        print(f"  {name:32s} {t * 1e3:9.1f} ms  {args.samples / t:12,.0f} samples/s  {t / base:6.3f}x numpy lossless"
+              f"  {t / fast:6.2f}x llvm lossless")
+    for name in ("mesh + joint friction, llvm", "+ bearing friction, llvm"):
+        print(f"  cost of losses in the compiled path, {name.split(',')[0]}: "
+              f"{100 * (float(np.median(times[name])) / fast - 1):+.0f} % (target: at most +20 %)")
     res = solve(cases["+ bearing friction, numpy"][0], q, qd, qdd, backend="numpy")
     it = res.bearing_iterations
     print(f"  bearing friction iterations per sample: median {int(np.median(it))}, worst {int(it.max())}")
+    fast_it = solve(cases["+ bearing friction, llvm"][0], q, qd, qdd, backend="llvm").bearing_iterations
+    print(f"  (llvm: median {int(np.median(fast_it))}, worst {int(fast_it.max())})")
     return 0
 
 

@@ -34,11 +34,10 @@ from test_urdf import ERD, erd, talos_left_arm  # noqa: E402
 MECH = Path(__file__).resolve().parents[1] / "mechanisms"
 FIELDS = ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial", "motor_speed")
 TOL = 1e-12
-# the generated kernel does not model losses yet (issue 19): a lossy bundled file is solved by
-# numpy only (tests/test_losses.py::test_compiled_kernels_refuse_losses_and_auto_takes_numpy)
+# the lossy bundled files too (their loss outputs are compared in tests/test_llvm_losses.py)
 ALL_BUNDLED = sorted(p.name for p in MECH.glob("*.yaml")) + ["geared_arm.urdf"]
 LOSSY = [k for k in ALL_BUNDLED if k.endswith(".yaml") and load_mechanism(MECH / k).has_losses]
-BUNDLED = [k for k in ALL_BUNDLED if k not in LOSSY]
+BUNDLED = ALL_BUNDLED
 BACKENDS = ["llvm"]
 
 
@@ -110,15 +109,9 @@ def compiled_backend(an) -> None:
 @pytest.mark.parametrize("key", ALL_BUNDLED + GENERATED)
 def test_auto_backend_of_every_mechanism(key):
     """The path "auto" takes for a large call on every bundled mechanism (servo_joint.yaml,
-    planetary_5p.yaml among them) and every test-factory mechanism: llvm, except the
-    bundled files with losses (the kernel does not model them yet: numpy, saying why).
-    The robots: test_kernel_equals_numpy_on_robots."""
-    choice = solver_for(analyse(mechanism(key))).choice()
-    if key in LOSSY:
-        assert choice == backends.Choice("numpy", "the mechanism has losses, which only the numpy reference "
-                                                  "solves so far", fallback=True)
-    else:
-        assert choice == backends.Choice("llvm")
+    planetary_5p.yaml and the lossy servo_joint_rated.yaml among them) and every
+    test-factory mechanism: llvm.  The robots: test_kernel_equals_numpy_on_robots."""
+    assert solver_for(analyse(mechanism(key))).choice() == backends.Choice("llvm")
 
 
 def test_auto_backend_cases_are_all_there():

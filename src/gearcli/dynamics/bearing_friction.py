@@ -14,7 +14,7 @@ the joint origin), the locating one taking the axial force.  Revolute joints onl
 The moments depend on the reactions they change, so the balance equations become
 nonlinear.  :func:`solve_with_bearing_friction` iterates: solve with the moments of the
 previous reactions (zero at first), recompute the moments from the new reactions, until
-every sample's moments change by at most ``TOL`` relative (a contraction: one iteration
+a sample's moments change by at most ``TOL`` relative (then kept; a contraction: one iteration
 multiplies the error by about mu d / (2 lever), ~1e-3).  A sample that does not converge in
 ``MAX_ITERATIONS`` is an error naming it, never a silent approximation.
 """
@@ -81,32 +81,77 @@ def solve_with_bearing_friction(an, kin, b: dict, qd_all: np.ndarray, solve_rhs)
     if not joints:
         x_all, sig = solve_rhs(b)
         return x_all, sig, b, None, None
-    N, J = qd_all.shape
-    s = -np.sign(qd_all[:, joints])                 # the moment's sign on the child
     axis = {ji: {L: joint_axis_wrench(an, kin, ji, L) for L in _links(an, ji)} for ji in joints}
+    used = {}
+
+    def solve_moments(Mb, todo):              # every sample (the ones done again, unchanged)
+        rhs = {L: v.copy() for L, v in b.items()}
+        _subtract(rhs, axis, joints, qd_all, Mb)
+        used["rhs"] = rhs
+        x_all, used["sig"] = solve_rhs(rhs)
+        return x_all
+    x_all, moments, iterations = fixed_point(an, qd_all, solve_moments)
+    return x_all, used["sig"], used["rhs"], moments, iterations
+
+
+def _subtract(rhs: dict, axis: dict, joints: list, qd_all: np.ndarray, Mb: np.ndarray) -> None:
+    """rhs[L] -= the bearing friction moments Mb (N, len(joints)) on L, -sign(q'_J) Mb about
+    each joint's axis on its child (``axis``: per joint {L: unit wrench on L})."""
+    for k, ji in enumerate(joints):
+        Q = -np.sign(qd_all[:, ji]) * Mb[:, k]
+        for L, w in axis[ji].items():
+            rhs[L] -= Q[:, None] * w
+
+
+def subtract_bearing_friction(an, kin, b: dict, qd_all: np.ndarray, moments: np.ndarray | None,
+                              rows=slice(None)) -> None:
+    """b[L] -= the converged bearing friction moments ``moments[rows]`` (of :func:`fixed_point`,
+    (N, J); None: none) on L, in place (the right-hand side a solution balances)."""
+    if moments is None:
+        return
+    moments = moments[rows]
+    joints = friction_joints(an.mech)
+    axis = {ji: {L: joint_axis_wrench(an, kin, ji, L) for L in _links(an, ji)} for ji in joints}
+    _subtract(b, axis, joints, qd_all, moments[:, joints])
+
+
+def fixed_point(an, qd_all: np.ndarray, solve_moments):
+    """The fixed point of the bearing friction moments, shared by every solve path.
+
+    ``solve_moments(Mb, todo)`` solves the samples ``todo`` (indices) with the moments
+    Mb[todo] (Mb (N, len(friction_joints)): sum_b M_b >= 0 of each joint with bearing
+    friction, on the child -sign(q'_J) Mb about the axis, reversed on the parent) and
+    returns the unknowns {(kind, index): (N, size)} of every sample (joint reactions in the
+    child's basis; a path may solve the other samples again with their Mb, which no longer
+    changes).  Iterates from zero moments, each sample until its moments change by at most
+    ``TOL`` relative (its Mb is then kept: those of its solution).  Returns (x_all, moments
+    (N, J) of every joint, iterations (N,) int: the iteration at which each sample met the
+    tolerance).  Raises :class:`BearingFrictionError` naming the first sample that does not
+    converge."""
+    joints = friction_joints(an.mech)
+    N, J = qd_all.shape
+    s = qd_all[:, joints] != 0.0                    # at rest: no moment
     Mb = np.zeros((N, len(joints)))
     iterations = np.zeros(N, dtype=np.int64)
+    todo = np.arange(N)
     for it in range(1, MAX_ITERATIONS + 1):
-        rhs = {L: v.copy() for L, v in b.items()}
-        for k, ji in enumerate(joints):
-            Q = s[:, k] * Mb[:, k]
-            for L, w in axis[ji].items():
-                rhs[L] -= Q[:, None] * w
-        x_all, sig = solve_rhs(rhs)
-        new = np.where(s != 0.0, friction_moments(an.mech, joints, x_all), 0.0)
-        change = np.abs(new - Mb)
+        x_all = solve_moments(Mb, todo)
+        x_todo = {k: v[todo] for k, v in x_all.items() if k[0] == "joint"}
+        new = np.where(s[todo], friction_moments(an.mech, joints, x_todo), 0.0)
+        change = np.abs(new - Mb[todo])
         done = np.all(change <= TOL * np.abs(new) + 1e-300, axis=1)
-        iterations[(iterations == 0) & done] = it
-        if done.all():
-            break                   # Mb: the moments of this solve's right-hand side
-        Mb = new
+        iterations[todo[done]] = it
+        Mb[todo[~done]] = new[~done]
+        todo, change = todo[~done], change[~done]
+        if todo.size == 0:
+            break
     else:
-        bad = int(np.flatnonzero(iterations == 0)[0])
-        worst = joints[int(np.argmax(np.abs(change[bad]) / (np.abs(Mb[bad]) + 1e-300)))]
+        bad = int(todo[0])
+        worst = joints[int(np.argmax(change[0] / (np.abs(Mb[bad]) + 1e-300)))]
         raise BearingFrictionError(bad, an.mech.joints[worst].name, MAX_ITERATIONS)
     moments = np.zeros((N, J))
     moments[:, joints] = Mb
-    return x_all, sig, rhs, moments, iterations
+    return x_all, moments, iterations
 
 
 def _links(an, ji: int) -> list[int]:

@@ -58,13 +58,15 @@ def relative_rate(an, kin, ci: int) -> np.ndarray:
     return np.sum((kin.w[c.j] - kin.w[c.carrier]) * zj, axis=1)
 
 
-def mesh_loss(an, kin, ci: int, t: np.ndarray) -> np.ndarray:
-    """Mesh power loss P_p = c_p |t_p| |theta'_{j,c}| r_j (N,), W."""
+def mesh_loss(an, kin, ci: int, t: np.ndarray, rate: np.ndarray | None = None) -> np.ndarray:
+    """Mesh power loss P_p = c_p |t_p| |theta'_{j,c}| r_j (N,), W; ``rate`` theta'_{j,c}
+    (N,) when known (the compiled kernel's), else from ``kin``."""
     c = an.circuits[ci]
     loss = an.mech.gears[c.gear].loss_factor
     if not loss or c.geometry is None:
         return np.zeros_like(t)
-    return loss * np.abs(t) * np.abs(relative_rate(an, kin, ci)) * c.geometry.r_j
+    rate = relative_rate(an, kin, ci) if rate is None else rate
+    return loss * np.abs(t) * np.abs(rate) * c.geometry.r_j
 
 
 def joint_friction_force(jt, qd: np.ndarray) -> np.ndarray:
@@ -111,18 +113,21 @@ LOSS_FIELDS = ("gear_loss", "joint_friction", "joint_loss", "bearing_iterations"
 
 
 def fill_losses(an, kin, qd_all: np.ndarray, res, bearing: np.ndarray | None = None,
-                iterations: np.ndarray | None = None) -> None:
+                iterations: np.ndarray | None = None, rates: dict | None = None) -> None:
     """Set the loss fields of the :class:`~.solve.Result` ``res`` from its tooth forces and
     the joint rates ``qd_all`` (N, J): ``gear_loss`` (N, G) mesh power loss, W (0 for an
     ideal pair); ``joint_friction`` (N, J) the friction on each joint's child about (along)
     its axis, N*m (N), with the bearing friction moments ``bearing`` (N, J) >= 0
     (:mod:`.bearing_friction`) against the rate; ``joint_loss`` (N, J) its power loss, W;
     ``bearing_iterations`` (N,) the fixed-point iterations of the bearing friction (None
-    without it).  Nothing for a lossless mechanism (the fields stay None)."""
+    without it).  ``rates``: {circuit: theta'_{j,c} (N,)} of the lossy meshes when known
+    (the compiled kernel's; ``kin`` may then be None).  Nothing for a lossless mechanism
+    (the fields stay None)."""
     if not an.mech.has_losses:
         return
     N = qd_all.shape[0]
-    res.gear_loss = np.column_stack([mesh_loss(an, kin, ci, res.gear_t[:, ci]) for ci in range(len(an.circuits))]
+    res.gear_loss = np.column_stack([mesh_loss(an, kin, ci, res.gear_t[:, ci], (rates or {}).get(ci))
+                                     for ci in range(len(an.circuits))]
                                     ) if an.circuits else np.zeros((N, 0))
     joints = an.mech.joints
     res.joint_friction = np.column_stack([joint_friction_force(jt, qd_all[:, ji]) for ji, jt in enumerate(joints)])
@@ -131,3 +136,10 @@ def fill_losses(an, kin, qd_all: np.ndarray, res, bearing: np.ndarray | None = N
         res.joint_friction -= np.sign(qd_all) * bearing
         res.joint_loss += bearing * np.abs(qd_all)
         res.bearing_iterations = iterations
+
+
+def fill_kernel_losses(an, res, losses: dict) -> None:
+    """:func:`fill_losses` from what the llvm kernel's driver put in ``losses`` ("qd" the joint
+    rates, "rates" the lossy meshes' theta'_{j,c}, "bearing", "iterations"; empty: none)."""
+    if losses:
+        fill_losses(an, None, losses["qd"], res, losses["bearing"], losses["iterations"], losses["rates"])

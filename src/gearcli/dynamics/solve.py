@@ -36,8 +36,8 @@ from .inertia import inertia_load
 from .inputs import motion_arrays
 from .llvm.program import build_program
 from .kinematics import forward
-from .bearing_friction import solve_with_bearing_friction
-from .losses import LOSS_FIELDS, fill_losses, subtract_joint_friction
+from .bearing_friction import solve_with_bearing_friction, subtract_bearing_friction
+from .losses import LOSS_FIELDS, fill_kernel_losses, fill_losses, subtract_joint_friction
 from .result_arrays import check_out, copy_into, result_arrays, work_arrays
 from .signs import SignError, sign_violation
 
@@ -118,10 +118,8 @@ class Solver:
         self.groups = unknown_groups(an)
         self.plans = make_plans(an)
         self._program = None
-        self.kernel_problem: str | None = "the mechanism has losses, which only the numpy reference solves so far" \
-            if an.mech.has_losses else None
-        self._llvm = None
-        self.llvm_problem: str | None = None
+        self.kernel_problem: str | None = None
+        self._llvm, self.llvm_problem = None, None      # llvm_problem: str | None
         self.samples_solved = 0          # by the block method, every backend ("auto"'s first-call rule)
 
     def kernel_program(self):
@@ -199,16 +197,18 @@ class Solver:
 
     def _by_kernel(self, how, q, qd, qdd, values, jobs, chunk, verify, out=None) -> Result:
         arrays = result_arrays(self.an, q.shape[0], out)
-        work = work_arrays(q.shape[0], len(self.kernel_program().signed), out)
-        sig = self.llvm_kernel().solve(self.an, q, qd, qdd, values, jobs, chunk, arrays, work)
+        work, losses = work_arrays(q.shape[0], len(self.kernel_program().signed), out), {}
+        sig = self.llvm_kernel().solve(self.an, q, qd, qdd, values, jobs, chunk, arrays, work, losses)
         res = Result(**arrays) if out is None else out
         res.residual, res.backend, res.backend_note = None, how.path, how.note
+        fill_kernel_losses(self.an, res, losses)
         if verify:
             x_all = _unknowns(self.an, res)
             worst = 0.0
             for s in range(0, q.shape[0], chunk):
                 sl = slice(s, s + chunk)
-                _, _, kin, b = self._loads(q[sl], qd[sl], qdd[sl], {k: v[sl] for k, v in values.items()})
+                _, qd_all, kin, b = self._loads(q[sl], qd[sl], qdd[sl], {k: v[sl] for k, v in values.items()})
+                subtract_bearing_friction(self.an, kin, b, qd_all, losses.get("bearing"), sl)
                 worst = _worst(worst, residual(self.an, self.groups, Columns(self.an, kin), b,
                                                {k: v[sl] for k, v in x_all.items()}, {k: v[sl] for k, v in sig.items()}))
             res.residual = worst
@@ -298,7 +298,7 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
         first use, 0.1-0.3 s for 5-10 links, kept with the analysis and on disk; method
         "block" only); "numpy": the array implementation (the reference); "auto" (default):
         llvm, except numpy for method "full", where llvmlite does not import or the kernel
-        refuses the mechanism (losses, so far), and by the first-call rule of :mod:`.backends`
+        refuses the mechanism (> 16 signed meshes in a block), and by the first-call rule of :mod:`.backends`
         (``Result.backend`` says which ran, ``Result.backend_note`` why numpy).  Both give the
         same results to rounding.  "kernel" (the retired numba kernel) is a ValueError.
     jobs : int, optional

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import llvmlite.ir as ir
 
+from . import losses as llvm_losses
 from .build import I64, Emitter
 from .links import Sample, floats
 from .signs import SignedBlock, resolve, signs_of, tolerance
@@ -143,6 +144,11 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row) -> None:
         r = gather(e, s, F, links)
         maps = [ainv[a0 + k * nloc * nr:a0 + (k + 1) * nloc * nr].reshape(nloc, nr) for k in range(1 << m)]
         blk = SignedBlock(e, maps, tcols, f"b{b}") if m else None
+    lossy = prog.losses.blocks.get(b) if prog.losses is not None else None
+    if lossy is not None and F < 0:
+        blk.extra = llvm_losses.world_columns(prog.losses, lossy, s)
+    elif lossy is not None:
+        blk = llvm_losses.LossyBlock(blk, lossy, s.sv)
     if m == 0:
         x, sig = (blk.solve(e, [], r) if F < 0 else [e.dot(floats(maps[0][i]), r) for i in range(nloc)]), []
     else:
@@ -154,4 +160,6 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row) -> None:
         propagate_terms(e, s, k0, nt, prog, x, sig)
     else:
         propagate(e, s, F, prog.props[p0:p0 + np_], prog, x)
+    if lossy is not None:
+        llvm_losses.propagate(e, s, prog.losses, lossy, F, x, tcols, sig)
     store(e, s, rec, prog, x)

@@ -84,6 +84,8 @@ def program_fingerprint(prog, loads: list) -> str:
     parts += [prog.base]
     for link, in_link, point in loads:
         parts += [link, in_link, np.asarray(point, float).tobytes()]
+    if getattr(prog, "losses", None) is not None:
+        parts += ["losses", *prog.losses.parts()]
     return _sha(parts)
 
 

@@ -26,6 +26,9 @@ from .blocks import problem
 from .kernel import ARGS, build_module
 from .links import load_groups
 from .outputs import OUTPUTS
+from ..bearing_friction import fixed_point
+from ..losses import joint_friction_force
+from ..signs import SignError
 
 
 @lru_cache(maxsize=1)
@@ -72,7 +75,7 @@ def mech_loads(an) -> list:
 
 
 GENERATOR = ("kernel", "blocks", "build", "links", "outputs", "signs", "solve", "trig", "world", "driver",
-             "../result_arrays", "../signs")
+             "losses", "../result_arrays", "../signs")
 """The modules (paths from :mod:`gearcli.dynamics.llvm`, without .py) whose code makes a kernel program's IR text (a test
 checks that every module they import from the package is listed or makes only hashed input)."""
 
@@ -203,9 +206,46 @@ class LlvmKernel:
         self._load_order, groups = load_groups(loads)
         self._load_groups = np.array([[k0, k1] for _, k0, k1 in groups] or [[0, 0]], np.int64)
 
-    def solve(self, an, q, qd, qdd, values: dict, jobs: int | None, chunk: int, out: dict, work: tuple) -> dict:
-        """The loads of every sample into ``out``, as the numpy path (:func:`..blocks.solve_blocks`) does."""
+    def solve(self, an, q, qd, qdd, values: dict, jobs: int | None, chunk: int, out: dict, work: tuple,
+              losses: dict | None = None) -> dict:
+        """The loads of every sample into ``out``, as the numpy path (:func:`..blocks.solve_blocks`) does.
+
+        A lossy mechanism (``prog.losses``): the joints' friction loads are the kernel's
+        input (:func:`..losses.joint_friction_force` of the joint rates), the bearing
+        friction's fixed point (:func:`..bearing_friction.fixed_point`) runs the kernel again
+        over the samples whose moments have not converged yet; ``losses`` (a dict) receives "rates"
+        {circuit: theta'_{j,c} (N,)}, "bearing" (N, J) moments and "iterations" (N,) (None
+        without bearing friction), "qd" (N, J) the joint rates."""
         prog = self.prog
+        lp = prog.losses
+        if lp is None:
+            self._launch(an, q, qd, qdd, values, jobs, chunk, out, work, np.zeros((1, 1)), np.empty((1, 1)))
+            return {k: work[0][:, i] for i, k in enumerate(prog.signed)}
+        qd_all = qd @ np.asarray(an.S, float).T
+        jq = _joint_forces(an, lp, qd_all)
+        rate = np.empty((q.shape[0], max(len(lp.rate_meshes), 1)))
+        bearing = iterations = None
+        if lp.bearing_joints:
+            cols = [lp.joints[:, 0].tolist().index(ji) for ji in lp.bearing_joints]
+            base = jq[:, cols].copy()
+
+            def solve_moments(Mb, todo):
+                jq[todo[:, None], cols] = base[todo] - np.sign(qd_all[todo][:, lp.bearing_joints]) * Mb[todo]
+                if todo.size == q.shape[0]:
+                    self._launch(an, q, qd, qdd, values, jobs, chunk, out, work, jq, rate)
+                else:                    # the samples not yet converged only
+                    self._rows(an, todo, q, qd, qdd, values, jobs, chunk, out, work, jq, rate)
+                return {("joint", ji): out["joint"][:, ji, :5] for ji in lp.bearing_joints}
+            _, bearing, iterations = fixed_point(an, qd_all, solve_moments)
+        else:
+            self._launch(an, q, qd, qdd, values, jobs, chunk, out, work, jq, rate)
+        if losses is not None:
+            losses.update(rates={ci: rate[:, k] for k, ci in enumerate(lp.rate_meshes)}, bearing=bearing,
+                          iterations=iterations, qd=qd_all)
+        return {k: work[0][:, i] for i, k in enumerate(prog.signed)}
+
+    def _launch(self, an, q, qd, qdd, values, jobs, chunk, out, work, jq, rate) -> None:
+        """One run of the kernel over every sample of q (raises the numpy path's SignError)."""
         n = q.shape[0]
         SG, fail = work
         ld, ldpt, vals = load_arrays(an, values, n)
@@ -215,12 +255,35 @@ class LlvmKernel:
         ldpt = np.ascontiguousarray(ldpt[order] if order else np.zeros((1, 3)))
         keep = [np.ascontiguousarray(a, float) for a in (q, qd, qdd)] + [np.ascontiguousarray(vals, float), ldpt,
                                                                        ldrow, self._load_groups]
-        keep += [out[k] if out[k].size else np.empty((1, 1)) for k in OUTPUTS] + [SG, fail]
+        keep += [out[k] if out[k].size else np.empty((1, 1)) for k in OUTPUTS] + [SG, jq, rate, fail]
         ptrs = [a.ctypes.data for a in keep]
         failed = run_parts(lambda s, e, _: self._run(*ptrs, s, e), job_ranges(n, jobs), threads_for(n, jobs))
         if failed:
-            raise sign_error(prog.names, fail, chunk)
-        return {k: SG[:, i] for i, k in enumerate(prog.signed)}
+            raise sign_error(self.prog.names, fail, chunk)
+
+    def _rows(self, an, rows, q, qd, qdd, values, jobs, chunk, out, work, jq, rate) -> None:
+        """:meth:`_launch` on the samples ``rows`` only, their results written into their rows."""
+        sub = {k: np.ascontiguousarray(v[rows]) for k, v in out.items()}
+        SG, fail = work
+        sw = (np.empty((rows.size, SG.shape[1])), np.empty(rows.size, np.int64))
+        jr, rr = np.ascontiguousarray(jq[rows]), np.empty((rows.size, rate.shape[1]))
+        try:
+            self._launch(an, q[rows], qd[rows], qdd[rows], {k: v[rows] for k, v in values.items()}, jobs, chunk,
+                         sub, sw, jr, rr)
+        except SignError as exc:
+            raise SignError(int(rows[exc.sample]), exc.meshes) from None
+        for k, v in sub.items():
+            out[k][rows] = v
+        SG[rows], fail[rows], rate[rows] = sw[0], sw[1], rr
+
+
+def _joint_forces(an, lp, qd_all: np.ndarray) -> np.ndarray:
+    """(N, Q) the generalised friction force on the child of each friction joint of ``lp``
+    (:func:`..losses.joint_friction_force`; the bearing moments are added by the fixed point)."""
+    out = np.zeros((qd_all.shape[0], max(lp.joints.shape[0], 1)))
+    for k, ji in enumerate(lp.joints[:, 0]):
+        out[:, k] = joint_friction_force(an.mech.joints[ji], qd_all[:, ji])
+    return out
 
 
 _PROGRAM_KEYS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()

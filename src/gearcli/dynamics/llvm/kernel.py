@@ -3,14 +3,16 @@
 :func:`build_module` writes, from a :class:`~.program.Program`, one function
 
     run(qi, qdi, qddi, vals, ldpt, ldrow, ldgrp, motor, tau, joint, gear_t, gear_sep, gear_radial,
-        gear_axial, motor_speed, signs, fail, start, stop)
+        gear_axial, motor_speed, signs, jq, rate, fail, start, stop)
 
 whose loop over the samples start..stop-1 does what the numpy path does for all of them,
 with every structural integer and every constant of the program (fixed transforms,
 masses, inertias, inverse block matrices, propagation columns, output coefficients) in
 the code: joint space, kinematics, inertia and external loads (:mod:`.links`), the
 blocks in schedule order (:mod:`.blocks`, :mod:`.signs`) and the outputs
-(:mod:`.outputs`), straight-line except for the sign search.  Only the inputs (the
+(:mod:`.outputs`), straight-line except for the sign search; a lossy mechanism's losses
+(:mod:`.losses`: the joints' friction loads ``jq`` (N, Q) in, each lossy mesh's relative
+rate ``rate`` (N, R) out, :class:`~.loss_program.LossProgram`).  Only the inputs (the
 independent q, qd, qdd (N, dof), C-ordered), the external loads (their values, points
 ``ldpt``, records ``ldrow`` and per loaded link the range ``ldgrp``, :func:`.links.external`: one loop per loaded link,
 whatever the number of loads) and the output arrays
@@ -22,16 +24,18 @@ from __future__ import annotations
 
 import llvmlite.ir as ir
 
+from . import losses as llvm_losses
 from .blocks import block
 from .build import DP, I64, I64P, Emitter
 from .links import at_rest, external, inertia, joint, joint_space, load_groups
 from .outputs import OUTPUTS, widths, write_outputs
 
-ARGS = ("qi", "qdi", "qddi", "vals", "ldpt", "ldrow", "ldgrp") + OUTPUTS + ("signs", "fail", "start", "stop")
+ARGS = ("qi", "qdi", "qddi", "vals", "ldpt", "ldrow", "ldgrp") + OUTPUTS + ("signs", "jq", "rate", "fail", "start",
+                                                                          "stop")
 
 
 def _signature(mod: ir.Module) -> ir.Function:
-    types = [DP] * 5 + [I64P] * 2 + [DP] * (len(OUTPUTS) + 1) + [I64P, I64, I64]
+    types = [DP] * 5 + [I64P] * 2 + [DP] * (len(OUTPUTS) + 3) + [I64P, I64, I64]
     fn = ir.Function(mod, ir.FunctionType(I64, types), "run")
     for arg, name in zip(fn.args, ARGS):
         arg.name = name
@@ -54,6 +58,10 @@ def _sample(e: Emitter, fn, prog, loads, n) -> None:
     for L in prog.moving:
         inertia(e, s, int(L), prog.bodies[L], prog.gravity)
     external(e, s, fn, [L for L, _, _ in load_groups(loads)[1]], n, a["vals"], a["ldrow"], a["ldpt"], a["ldgrp"])
+    lp = prog.losses
+    if lp is not None:
+        s.sv = llvm_losses.mesh_rates(e, s, lp, e.row(a["rate"], n, max(len(lp.rate_meshes), 1)))
+        llvm_losses.joint_friction(e, s, lp, e.row(a["jq"], n, max(lp.joints.shape[0], 1)))
     w = widths(prog)
     signs = e.row(a["signs"], n, max(w["signs"], 1))
     for b in range(len(prog.blocks)):

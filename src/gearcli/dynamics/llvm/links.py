@@ -40,6 +40,7 @@ class Sample:
     cs: dict = field(default_factory=dict)
     rhs: dict = field(default_factory=dict)
     sol: dict = field(default_factory=dict)
+    sv: list = field(default_factory=list)     # s_v of each lossy mesh (:mod:`.losses`)
 
 
 def floats(row) -> tuple:

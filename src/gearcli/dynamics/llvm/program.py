@@ -28,6 +28,7 @@ from ..sharing import SharingError, mesh_weights
 from ..signs import MAX_EXHAUSTIVE
 from .records import BLOCK, BODY, CHILD_BASIS, JOINT, LOAD, POSE, PROPAGATION, records
 from .terms import general_terms, local_inverse
+from .loss_program import build_loss_program
 
 I64 = np.int64
 
@@ -78,6 +79,7 @@ class Program:
     hot: dict = field(default_factory=dict)       # block -> (hot pattern indices, their maps (k, n, 6B))
     weights: dict = field(default_factory=dict)   # redundant world-frame block -> sharing.mesh_weights
     free: dict = field(default_factory=dict)      # redundant world-frame block -> its free columns (_free_columns)
+    losses: object = None                         # loss_program.LossProgram of a lossy mechanism
 
     def arrays(self) -> list:
         """(name, array) of every array field, in field order (the disk cache's fingerprint)."""
@@ -266,7 +268,8 @@ def build_program(an, plans=None) -> Program:
                    props=records(bd.prec, PROPAGATION), cmat=cat(bd.cmat), later=ints(bd.later),
                    child_basis=records(bd.cbrec, CHILD_BASIS), turns=np.array(bd.turns, float), terms=trec,
                    term_values=tflt, joint_out=jout, motor_col=mcol, gear_col=gcol, gear_out=gout, hashed=hashed,
-                   lowrank=lowrank, hot=hot, weights=weights, free=free)
+                   lowrank=lowrank, hot=hot, weights=weights, free=free,
+                   losses=build_loss_program(an, plans))
 
 
 MAX_BASIS_CONDITION = 1e8

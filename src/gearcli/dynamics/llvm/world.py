@@ -137,6 +137,7 @@ class WorldBlock:
     that solution for the pattern it accepts)."""
 
     full_trial = True
+    extra = None        # the block's mesh friction columns, added per trial (losses.world_columns)
 
     def __init__(self, s, prog, k0: int, nt: int, n: int, tcols: list, wrench, fn=None, weights=None, free=None):
         self.s, self.trec, self.tval = s, prog.terms, prog.term_values
@@ -212,6 +213,8 @@ class WorldBlock:
             w = self.wrench(e, self.s, term, self.tval[k], int(term.link), sig)
             for h in range(6):
                 A[6 * row + h][col] = e.add(A[6 * row + h][col], w[h])
+        if self.extra is not None:
+            self.extra(e, A, self.tcols, sig)
         if len(r) == self.n:
             return eliminate(e, A, r)
         if self.free is not None:

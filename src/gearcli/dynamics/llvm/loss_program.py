@@ -1,0 +1,131 @@
+"""The losses of a mechanism flattened for the generated kernel (:mod:`.losses`).
+
+A :class:`LossProgram` is attached to the kernel's :class:`~.program.Program` as one
+field (None for a lossless mechanism).  It holds, with the model of :mod:`.losses`:
+
+* ``rate_meshes``: the circuits with a loss factor; the kernel writes each one's rate
+  theta'_{j,c} (rad/s) into its ``rate`` output (the mesh power loss and s_v = sign(rate)
+  come from it); ``rate_flt`` (R, 3) their gear j's axis z_j in carrier axes, ``rate_int``
+  (R, 2) [gear j, carrier];
+* ``couple``: circuit -> (3,) the friction couple on gear j per unit of sigma s_v t in
+  carrier axes (:func:`..losses.mesh_friction_moment`; gear k receives the opposite);
+* ``blocks``: block index -> :class:`BlockLosses`, the lossy signed meshes of that block;
+* ``joints`` (Q, 5) int [joint index, child, parent (-1: not moving), 1 if prismatic, 0]
+  and ``joint_flt`` (Q, 6): the joint's axis z and origin in its child's axes (from
+  R_jc, p_jc): the joints with friction (Coulomb, viscous or bearings), whose generalised
+  friction force per sample (:func:`..losses.joint_friction_force`, the bearing moments of
+  :mod:`..bearing_friction`) the kernel takes as its input ``jq`` (N, Q).
+
+Frames and signs as in :mod:`..losses` and :mod:`..blocks`: a constant block's couples are
+in its frame F (``fric`` rows, ``fric_C``), a world-frame block's in base axes per sample.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..bearing_friction import friction_joints
+from ..blocks import _primary_side
+from ..losses import mesh_friction_moment
+
+
+@dataclass(frozen=True, eq=False)
+class BlockLosses:
+    """The lossy signed meshes of one block.
+
+    ``positions``: their positions in the block's signed meshes (its t columns, sign
+    columns); ``rates``: each one's index in :attr:`LossProgram.rate_meshes` (its s_v);
+    ``circuits``: each one's circuit.  Constant frame: ``phi`` (ml, 6B) their friction
+    couples on the block's rows in F per unit of sigma s_v t (:attr:`..blocks.BlockPlan.fric`),
+    ``later`` per mesh [(link, +1 on j / -1 on k)] of the links of later blocks and
+    ``couple_F`` (ml, 3) the couple on j in F.  World frame (``phi`` None): ``rows`` per
+    mesh [(block row of the link, sign)] and ``later`` as above; the couple is
+    :attr:`LossProgram.couple` of the circuit turned by the carrier's R."""
+
+    positions: tuple
+    rates: tuple
+    circuits: tuple
+    phi: np.ndarray | None
+    couple_F: np.ndarray | None
+    later: tuple
+    rows: tuple = ()
+
+
+@dataclass(frozen=True, eq=False)
+class LossProgram:
+    """See the module docstring."""
+
+    rate_meshes: tuple
+    rate_int: np.ndarray
+    rate_flt: np.ndarray
+    couple: dict
+    blocks: dict
+    joints: np.ndarray
+    joint_flt: np.ndarray
+    bearing_joints: tuple = field(default=())     # friction_joints(mech): the fixed point's joints
+
+    def parts(self) -> list:
+        """What the kernel's code is generated from (hashed into the program fingerprint)."""
+        out = [self.rate_meshes, self.rate_int.tobytes(), self.rate_flt.tobytes(), self.joints.tobytes(),
+               self.joint_flt.tobytes(), self.bearing_joints]
+        for ci in sorted(self.couple):
+            out += [ci, self.couple[ci].tobytes()]
+        for b in sorted(self.blocks):
+            bl = self.blocks[b]
+            out += [b, bl.positions, bl.rates, bl.circuits, bl.later, bl.rows]
+            out += [a.tobytes() for a in (bl.phi, bl.couple_F) if a is not None]
+        return out
+
+
+def friction_joint_list(mech) -> list:
+    """Indices of the joints whose friction is a load of the kernel's input ``jq``: own
+    friction (Coulomb, viscous) or bearing friction, in joint order."""
+    bearing = set(friction_joints(mech))
+    return [ji for ji, jt in enumerate(mech.joints)
+            if (jt.friction is not None and jt.friction.active) or ji in bearing]
+
+
+def build_loss_program(an, plans) -> LossProgram | None:
+    """The :class:`LossProgram` of ``an`` (block plans ``plans``), None without losses."""
+    mech, tree = an.mech, an.tree
+    if not mech.has_losses:
+        return None
+    rate_meshes = tuple(ci for ci, c in enumerate(an.circuits)
+                        if mech.gears[c.gear].loss_factor and c.geometry is not None)
+    couple = {ci: mesh_friction_moment(an, ci) for ci in rate_meshes}
+    couple = {ci: np.asarray(v, float) for ci, v in couple.items() if v is not None}
+    rate_int = np.array([[an.circuits[ci].j, an.circuits[ci].carrier] for ci in rate_meshes], np.int64).reshape(-1, 2)
+    rate_flt = np.array([an.circuits[ci].geometry.zj for ci in rate_meshes], float).reshape(-1, 3)
+    block_of = {L: i for i, p in enumerate(plans) for L in p.links}
+    blocks = {}
+    for bi, p in enumerate(plans):
+        pos = [n for n, gi in enumerate(p.signed) if p.groups[gi].kind == "mesh" and p.groups[gi].index in couple]
+        if not pos:
+            continue
+        circ = tuple(p.groups[p.signed[n]].index for n in pos)
+        later = tuple(tuple((L, 1 if L == an.circuits[ci].j else -1) for L in p.groups[p.signed[n]].links
+                            if block_of[L] > bi) for n, ci in zip(pos, circ))
+        rates = tuple(rate_meshes.index(ci) for ci in circ)
+        if p.F is None:
+            rows = tuple(tuple((p.links.index(L), 1 if L == an.circuits[ci].j else -1)
+                               for L in p.groups[p.signed[n]].links if L in p.links) for n, ci in zip(pos, circ))
+            blocks[bi] = BlockLosses(tuple(pos), rates, circ, None, None, later, rows)
+        else:
+            assert p.fric is not None and all(p.signed[n] in p.fric_C for n in pos)
+            assert all(_primary_side(an, p.groups[p.signed[n]]) == an.circuits[ci].j for n, ci in zip(pos, circ))
+            couple_F = np.array([p.fric_C[p.signed[n]][3:, 0] for n in pos], float)
+            blocks[bi] = BlockLosses(tuple(pos), rates, circ, np.ascontiguousarray(p.fric[pos], float),
+                                     couple_F, later)
+    fj = friction_joint_list(mech)
+    jrec, jflt = [], []
+    moving = set(tree.moving)
+    for ji in fj:
+        jt = mech.joints[ji]
+        c, par = tree.index[jt.child], tree.index[jt.parent]
+        R_jc = np.asarray(jt.R_jc, float)
+        # child axes: the joint frame's z is R_jc^T e_z, its origin -R_jc^T p_jc (o_c = o_j + R_j p_jc)
+        jrec.append([ji, c if c in moving else -1, par if par in moving else -1, int(jt.type == "prismatic"), 0])
+        jflt.append(np.concatenate([R_jc[2, :], -R_jc.T @ np.asarray(jt.p_jc, float)]))
+    return LossProgram(rate_meshes, rate_int, rate_flt, couple, blocks, np.array(jrec, np.int64).reshape(-1, 5),
+                       np.array(jflt, float).reshape(-1, 6), tuple(friction_joints(mech)))

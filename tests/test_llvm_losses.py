@@ -1,0 +1,215 @@
+"""The generated llvm kernel solves lossy mechanisms (issue 19) equal to the numpy reference.
+
+The numpy path (:mod:`gearcli.dynamics.losses`, :mod:`gearcli.dynamics.bearing_friction`,
+the friction maps of :func:`gearcli.dynamics.blocks._constant_block`) is the reference; the
+kernel shares none of its per-sample arithmetic (its own kinematics, relative rates, joint
+friction loads, the rank-ml correction of each block's maps and friction columns of the
+world-frame blocks, :mod:`gearcli.dynamics.llvm.losses`), only the constant couples, the
+friction formulas of the joints' loads and the bearing fixed point's iteration.  Every
+output, the loss outputs and the bearing iterations included, must agree to 1e-12 of the
+sample's largest load on every bundled mechanism with losses switched on and on the hand
+cases of tests/test_losses.py, along random motions in which tooth forces and relative
+rates change sign, with samples at rest (s_v = 0); failures must be the numpy path's.
+"""
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gearcli import analyse, load_mechanism, parse_mechanism
+from gearcli.dynamics.bearing_friction import BearingFrictionError
+from gearcli.dynamics.signs import SignError
+from gearcli.dynamics.solve import solve, solver_for
+from test_losses import PLANETARY, RACK, SHAFT, SPUR, with_losses
+
+pytest.importorskip("llvmlite")
+
+MECH = Path(__file__).resolve().parents[1] / "mechanisms"
+DESIGNS = Path(__file__).resolve().parents[1] / "designs"
+FIELDS = ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial", "motor_speed",
+          "gear_loss", "joint_friction", "joint_loss")
+TOL = 1e-12
+LOSSY = sorted(p.name for p in MECH.glob("*.yaml")) + ["geared_arm.urdf"]
+HAND = {
+    "spur": lambda: SPUR.format(eta=0.9, ML=-4.0),
+    "rack": lambda: RACK.format(Fc=12.0, Fv=30.0, eta=0.9, F=-50.0),
+    "planetary": lambda: PLANETARY.format(a=0.03, rs=0.012, rr=0.048, eta=0.98, Tc=-3.0),
+    "shaft": lambda: SHAFT.format(z1=0.02, z2=0.06, mu=0.05, d=0.03, ML=-4.0),
+}
+
+
+def mechanism(key: str):
+    """A bundled file with losses on (``with_losses``), servo_joint_rated.yaml as it is (its
+    own efficiencies, joint and bearing friction), or a hand case of tests/test_losses.py."""
+    if key in HAND:
+        return parse_mechanism(HAND[key]())
+    mech = load_mechanism(MECH / key)
+    return mech if mech.has_losses else with_losses(mech)
+
+
+def motion(an, n, seed=0):
+    """Random q, qd, qdd; every 7th sample at rest (qd = 0: s_v = 0, no Coulomb or bearing
+    friction), every 11th with one joint rate zero."""
+    rng = np.random.default_rng(seed)
+    q, qd, qdd = (rng.uniform(-np.pi, np.pi, (n, an.dof)), rng.normal(size=(n, an.dof)) * 3.0,
+                  rng.normal(size=(n, an.dof)) * 20.0)
+    qd[::7] = 0.0
+    qd[3::11, 0] = 0.0
+    return q, qd, qdd
+
+
+def per_sample_loads(an, n, seed=1):
+    """Per-sample values of the first external load (the others keep their constants)."""
+    if not an.mech.loads:
+        return None
+    rng = np.random.default_rng(seed)
+    return {an.mech.loads[0].name: rng.normal(size=(n, 6)) * 5.0}
+
+
+def worst(a, b) -> float:
+    """max over samples of max|a - b| / (1 + largest load of the sample), every field."""
+    n = b.motor.shape[0]
+    fa = np.concatenate([getattr(a, f).reshape(n, -1) for f in FIELDS], axis=1)
+    fb = np.concatenate([getattr(b, f).reshape(n, -1) for f in FIELDS], axis=1)
+    return float(np.max(np.abs(fa - fb).max(axis=1) / (1.0 + np.abs(fb).max(axis=1))))
+
+
+@pytest.mark.parametrize("key", LOSSY + list(HAND))
+def test_llvm_equals_numpy_with_losses(key):
+    an = analyse(mechanism(key))
+    sol = solver_for(an)
+    assert sol.llvm_available() and sol.backend() == "llvm"       # auto: the compiled path
+    q, qd, qdd = motion(an, 500)
+    loads = per_sample_loads(an, 500)
+    ref = solve(an, q, qd, qdd, backend="numpy", loads=loads)
+    res = solve(an, q, qd, qdd, backend="llvm", jobs=1, loads=loads)
+    assert worst(res, ref) < TOL
+    if ref.bearing_iterations is None:
+        assert res.bearing_iterations is None
+    else:
+        assert np.array_equal(res.bearing_iterations, ref.bearing_iterations)
+    prog = sol.kernel_program()
+    assert prog.losses is not None
+    lossy = [ci for ci, c in enumerate(an.circuits) if c.geometry is not None
+             and an.mech.gears[c.gear].loss_factor]
+    moving = np.any(qd != 0.0, axis=1)
+    for ci in lossy:                   # both signs of t and of the relative rate, and rest
+        t, loss = ref.gear_t[moving, ci], ref.gear_loss[:, ci]
+        assert (t > 0).any() and (t < 0).any()
+        assert np.all(loss[~moving] == 0.0) and np.all(res.gear_loss[~moving, ci] == 0.0)
+
+
+def test_lossy_blocks_of_every_kind_are_covered():
+    """The mechanisms above hold lossy meshes in a block with stored pattern maps
+    (paper_2dof), one solved from a LowRank base matrix (planetary_5p), a world-frame
+    square block (geared_arm.urdf has a transmission) and a redundant world-frame one
+    (servo_joint_rated)."""
+    def lossy_blocks(key):
+        prog = solver_for(analyse(mechanism(key))).kernel_program()
+        return prog, prog.losses.blocks
+    prog, blocks = lossy_blocks("planetary_5p.yaml")
+    assert any(b in prog.lowrank for b in blocks)
+    prog, blocks = lossy_blocks("paper_2dof.yaml")
+    assert blocks and all(bl.phi is not None for bl in blocks.values())
+    prog, blocks = lossy_blocks("servo_joint_rated.yaml")
+    assert any(bl.phi is None and b in prog.weights for b, bl in blocks.items())
+
+
+@pytest.mark.parametrize("key", ["servo_joint_rated.yaml", "shaft"])
+def test_threads_change_no_bit_with_bearing_friction(key):
+    an = analyse(mechanism(key))
+    n = 20_001
+    q, qd, qdd = motion(an, n, seed=3)
+    one = solve(an, q, qd, qdd, jobs=1, backend="llvm")
+    two = solve(an, q, qd, qdd, jobs=2, backend="llvm")
+    for f in FIELDS + ("bearing_iterations",):
+        assert np.array_equal(getattr(one, f), getattr(two, f)), f
+
+
+def test_verify_with_losses_on_the_llvm_path():
+    """The residual of the llvm solution, checked against the right-hand side with the joint
+    and the converged bearing friction."""
+    an = analyse(mechanism("servo_joint_rated.yaml"))
+    q, qd, qdd = motion(an, 300)
+    res = solve(an, q, qd, qdd, backend="llvm", verify=True, chunk=128)
+    assert res.residual is not None and res.residual < 1e-12
+
+
+def _failure(an, q, qd, qdd, backend, error, chunk=20_000):
+    with pytest.raises(error) as info, np.errstate(all="ignore"):
+        solve(an, q, qd, qdd, backend=backend, chunk=chunk, jobs=2, check_finite=False)
+    return info.value
+
+
+@pytest.mark.parametrize("key", ["paper_2dof.yaml", "planetary_3p.yaml", "planetary_5p.yaml",
+                                 "servo_joint_rated.yaml", "geared_arm.urdf"])
+def test_sign_error_names_the_same_sample_with_losses(key):
+    """NaN accelerations: no sign pattern of the first lossy block is consistent; the llvm
+    path names the sample and meshes the numpy path names (every chunk size)."""
+    an = analyse(mechanism(key))
+    n = 2200
+    q, qd, qdd = motion(an, n, seed=5)
+    rng = np.random.default_rng(9)
+    for s in rng.choice(n, 8, replace=False):
+        qdd[s, rng.integers(an.dof)] = np.nan
+    for chunk in (7, 20_000):
+        ref = _failure(an, q, qd, qdd, "numpy", SignError, chunk)
+        got = _failure(an, q, qd, qdd, "llvm", SignError, chunk)
+        assert (got.sample, got.meshes) == (ref.sample, ref.meshes)
+
+
+def test_bearing_friction_that_does_not_converge_is_the_same_error():
+    """Bearing friction so large (mu d k / (2 cos phi r_k) ~ 1.3 > 1) that the fixed point
+    diverges on every moving sample: the llvm path raises the numpy path's
+    BearingFrictionError (the same sample, joint and message); samples at rest converge."""
+    an = analyse(parse_mechanism(SHAFT.format(z1=0.02, z2=0.06, mu=0.5, d=0.15, ML=-4.0)))
+    q = np.zeros((6, 1))
+    qd = np.array([[0.0], [0.0], [0.0], [2.0], [-1.0], [0.0]])
+    ref = _failure(an, q, qd, q, "numpy", BearingFrictionError)
+    got = _failure(an, q, qd, q, "llvm", BearingFrictionError)
+    assert (got.sample, got.joint, got.lines()) == (ref.sample, ref.joint, ref.lines()) and ref.sample == 3
+
+
+# --- the comparison catches a wrong kernel ---------------------------------------------------
+def _reversed_couples(lp):
+    """The LossProgram with every friction couple of the kernel reversed (block maps' phi,
+    propagated couples in F, the world-frame blocks' couples)."""
+    blocks = {b: dataclasses.replace(bl, phi=None if bl.phi is None else -bl.phi,
+                                     couple_F=None if bl.couple_F is None else -bl.couple_F)
+              for b, bl in lp.blocks.items()}
+    return dataclasses.replace(lp, blocks=blocks, couple={ci: -v for ci, v in lp.couple.items()})
+
+
+@pytest.mark.parametrize("key,mutate", [
+    ("paper_2dof.yaml", _reversed_couples), ("servo_joint_rated.yaml", _reversed_couples),
+    ("rack", lambda lp: dataclasses.replace(lp, joint_flt=-lp.joint_flt)),     # joint friction reversed
+    ("spur", lambda lp: dataclasses.replace(lp, rate_flt=-lp.rate_flt)),       # s_v reversed
+])
+def test_a_wrong_loss_program_is_caught(key, mutate):
+    """A kernel with its friction couples, its joint friction loads or its relative rates
+    reversed must fail the comparison of test_llvm_equals_numpy_with_losses."""
+    an = analyse(mechanism(key))
+    sol = solver_for(an)
+    prog = sol.kernel_program()
+    q, qd, qdd = motion(an, 300)
+    ref = solve(an, q, qd, qdd, backend="numpy")
+    assert worst(solve(an, q, qd, qdd, backend="llvm"), ref) < TOL
+    kept = sol._llvm
+    sol._program, sol._llvm = dataclasses.replace(prog, losses=mutate(prog.losses)), None
+    try:
+        res = solve(an, q, qd, qdd, backend="llvm")
+    finally:
+        sol._program, sol._llvm = prog, kept
+    assert worst(res, ref) > 1e3 * TOL
+
+
+def test_bundled_design_with_losses_takes_the_llvm_path():
+    """designs/servo_joint_losses.yaml's mechanism is lossy and solved compiled by default."""
+    import yaml
+    doc = yaml.safe_load((DESIGNS / "servo_joint_losses.yaml").read_text())
+    rel = doc["cases"][0]["mechanism"]
+    an = analyse(load_mechanism((DESIGNS / rel).resolve()))
+    assert an.mech.has_losses and solver_for(an).backend() == "llvm"
