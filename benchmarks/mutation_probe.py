@@ -61,6 +61,7 @@ TESTS = [
     "tests/test_losses.py::test_spur_pair_lifting_then_lowering",
     "tests/test_losses.py::test_rack_axis_with_carriage_friction",
     "tests/test_losses.py::test_three_planet_planetary_efficiency_by_hand",
+    "tests/test_losses.py::test_power_balance_with_losses[block-servo_joint_rated.yaml]",
     "tests/test_helical_bundled.py::test_pinocchio_rnea_per_shaft_with_tooth_forces",
     "tests/test_load_sharing.py::test_each_planet_carries_one_nth_of_the_lumped_planet",
     "tests/test_load_sharing.py::test_unequal_stiffness_shares_in_proportion",
@@ -181,6 +182,13 @@ MUTATIONS = [
              (("dynamics/llvm/blocks.py", "e.add(e.mul(cq, x0), e.mul(sq, x1))", "e.sub(e.mul(cq, x0), e.mul(sq, x1))"),)),
     Mutation("llvm-world-arm", "llvm: world-frame term, moment arm from the frame link's origin",
              (("dynamics/llvm/blocks.py", "arm = e.vsub(e.vadd(s.o[X], P), s.o[L])", "arm = P"),)),
+    # issue 19: losses in the generated kernel
+    Mutation("llvm-loss-couple-sign", "llvm: constant-frame block, mesh friction couple with the rate instead of against it",
+             (("dynamics/llvm/losses.py", "d = [e.mul(sig[i], sv) for", "d = [e.mul(e.neg(sig[i]), sv) for"),)),
+    Mutation("llvm-world-couple-sign", "llvm: world-frame block, mesh friction couple with the rate instead of against it",
+             (("dynamics/llvm/losses.py", "coef = e.mul(sig[n], sv[k])", "coef = e.neg(e.mul(sig[n], sv[k]))"),)),
+    Mutation("llvm-joint-friction-sign", "llvm: joint friction applied to the parent instead of the child",
+             (("dynamics/llvm/losses.py", "((child, 1.0), (parent, -1.0))", "((child, -1.0), (parent, 1.0))"),)),
     Mutation("llvm-sin-quadrant", "llvm: inline sin with the quadrant's sign flipped",
              (("dynamics/llvm/trig.py", "b.select(sin_neg, e.neg(sin_mag), sin_mag)", "b.select(sin_neg, sin_mag, e.neg(sin_mag))"),)),
 ]

@@ -136,7 +136,7 @@ def fixed_point(an, qd_all: np.ndarray, solve_moments):
     todo = np.arange(N)
     for it in range(1, MAX_ITERATIONS + 1):
         x_all = solve_moments(Mb, todo)
-        x_todo = {k: v[todo] for k, v in x_all.items() if k[0] == "joint"}
+        x_todo = x_all if todo.size == N else {k: v[todo] for k, v in x_all.items() if k[0] == "joint"}
         new = np.where(s[todo], friction_moments(an.mech, joints, x_todo), 0.0)
         change = np.abs(new - Mb[todo])
         done = np.all(change <= TOL * np.abs(new) + 1e-300, axis=1)

@@ -69,13 +69,25 @@ def mesh_loss(an, kin, ci: int, t: np.ndarray, rate: np.ndarray | None = None) -
     return loss * np.abs(t) * np.abs(rate) * c.geometry.r_j
 
 
+def friction_force(coulomb, viscous, qd: np.ndarray) -> np.ndarray:
+    """The joint friction law, -F_c sign(qd) - F_v qd (broadcast: one joint's (N,) rates, or
+    (N, J) with per-joint coefficients (J,)); +0.0: no -0 where both are zero."""
+    return -coulomb * np.sign(qd) - viscous * qd + 0.0
+
+
+def friction_coefficients(joints) -> tuple[np.ndarray, np.ndarray]:
+    """(F_c (J,), F_v (J,)) of ``joints`` (0 without friction)."""
+    fr = [(j.friction.coulomb, j.friction.viscous) if j.friction is not None else (0.0, 0.0) for j in joints]
+    return np.array([f[0] for f in fr], float), np.array([f[1] for f in fr], float)
+
+
 def joint_friction_force(jt, qd: np.ndarray) -> np.ndarray:
     """Friction generalised force on the joint's child, -F_c sign(qd) - F_v qd (N,); N*m
     (revolute) or N (prismatic); zeros without friction."""
     fr = jt.friction
     if fr is None:
         return np.zeros_like(qd)
-    return -fr.coulomb * np.sign(qd) - fr.viscous * qd
+    return friction_force(fr.coulomb, fr.viscous, qd)
 
 
 def joint_axis_wrench(an, kin, ji: int, L: int) -> np.ndarray:
@@ -129,9 +141,8 @@ def fill_losses(an, kin, qd_all: np.ndarray, res, bearing: np.ndarray | None = N
     res.gear_loss = np.column_stack([mesh_loss(an, kin, ci, res.gear_t[:, ci], (rates or {}).get(ci))
                                      for ci in range(len(an.circuits))]
                                     ) if an.circuits else np.zeros((N, 0))
-    joints = an.mech.joints
-    res.joint_friction = np.column_stack([joint_friction_force(jt, qd_all[:, ji]) for ji, jt in enumerate(joints)])
-    res.joint_loss = np.column_stack([joint_loss(jt, qd_all[:, ji]) for ji, jt in enumerate(joints)])
+    res.joint_friction = friction_force(*friction_coefficients(an.mech.joints), qd_all)
+    res.joint_loss = -res.joint_friction * qd_all          # joint_loss, all joints at once
     if bearing is not None:
         res.joint_friction -= np.sign(qd_all) * bearing
         res.joint_loss += bearing * np.abs(qd_all)

@@ -298,8 +298,8 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
         first use, 0.1-0.3 s for 5-10 links, kept with the analysis and on disk; method
         "block" only); "numpy": the array implementation (the reference); "auto" (default):
         llvm, except numpy for method "full", where llvmlite does not import or the kernel
-        refuses the mechanism (> 16 signed meshes in a block), and by the first-call rule of :mod:`.backends`
-        (``Result.backend`` says which ran, ``Result.backend_note`` why numpy).  Both give the
+        refuses the mechanism (a block with > 16 signed meshes), and by the first-call rule
+        of :mod:`.backends` (``Result.backend`` says which ran, ``Result.backend_note`` why numpy).  Both give the
         same results to rounding.  "kernel" (the retired numba kernel) is a ValueError.
     jobs : int, optional
         Threads a compiled kernel splits the samples over (contiguous ranges; results

@@ -27,7 +27,7 @@ from .kernel import ARGS, build_module
 from .links import load_groups
 from .outputs import OUTPUTS
 from ..bearing_friction import fixed_point
-from ..losses import joint_friction_force
+from ..losses import friction_coefficients, friction_force
 from ..signs import SignError
 
 
@@ -211,7 +211,7 @@ class LlvmKernel:
         """The loads of every sample into ``out``, as the numpy path (:func:`..blocks.solve_blocks`) does.
 
         A lossy mechanism (``prog.losses``): the joints' friction loads are the kernel's
-        input (:func:`..losses.joint_friction_force` of the joint rates), the bearing
+        input (:func:`..losses.friction_force` of the joint rates), the bearing
         friction's fixed point (:func:`..bearing_friction.fixed_point`) runs the kernel again
         over the samples whose moments have not converged yet; ``losses`` (a dict) receives "rates"
         {circuit: theta'_{j,c} (N,)}, "bearing" (N, J) moments and "iterations" (N,) (None
@@ -227,13 +227,14 @@ class LlvmKernel:
         bearing = iterations = None
         if lp.bearing_joints:
             cols = [lp.joints[:, 0].tolist().index(ji) for ji in lp.bearing_joints]
-            base = jq[:, cols].copy()
+            base, sign = jq[:, cols].copy(), np.sign(qd_all[:, lp.bearing_joints])
 
             def solve_moments(Mb, todo):
-                jq[todo[:, None], cols] = base[todo] - np.sign(qd_all[todo][:, lp.bearing_joints]) * Mb[todo]
                 if todo.size == q.shape[0]:
+                    jq[:, cols] = base - sign * Mb
                     self._launch(an, q, qd, qdd, values, jobs, chunk, out, work, jq, rate)
                 else:                    # the samples not yet converged only
+                    jq[todo[:, None], cols] = base[todo] - sign[todo] * Mb[todo]
                     self._rows(an, todo, q, qd, qdd, values, jobs, chunk, out, work, jq, rate)
                 return {("joint", ji): out["joint"][:, ji, :5] for ji in lp.bearing_joints}
             _, bearing, iterations = fixed_point(an, qd_all, solve_moments)
@@ -279,11 +280,12 @@ class LlvmKernel:
 
 def _joint_forces(an, lp, qd_all: np.ndarray) -> np.ndarray:
     """(N, Q) the generalised friction force on the child of each friction joint of ``lp``
-    (:func:`..losses.joint_friction_force`; the bearing moments are added by the fixed point)."""
-    out = np.zeros((qd_all.shape[0], max(lp.joints.shape[0], 1)))
-    for k, ji in enumerate(lp.joints[:, 0]):
-        out[:, k] = joint_friction_force(an.mech.joints[ji], qd_all[:, ji])
-    return out
+    (:func:`..losses.friction_force`; the bearing moments are added by the fixed point)."""
+    if not lp.joints.shape[0]:
+        return np.zeros((qd_all.shape[0], 1))
+    Fc, Fv = friction_coefficients(an.mech.joints)
+    ji = lp.joints[:, 0]
+    return np.ascontiguousarray(friction_force(Fc[ji], Fv[ji], qd_all[:, ji]))
 
 
 _PROGRAM_KEYS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
