@@ -147,7 +147,9 @@ def test_rms_of_a_sine_over_whole_periods():
 
 
 # -- ISO 281 ------------------------------------------------------------------------------
-ISO281_TABLE3 = [  # ISO 281:2007 Table 3, single-row deep-groove ball bearings: f0 Fa/C0, e, Y
+# ISO 281:2007 Table 3, single-row deep-groove ball bearings: f0 Fa/C0, e, Y (the same rows in
+# independent public bearing calculators, one quoting ISO 281 Table 3, one SKF's catalogue)
+ISO281_TABLE3 = [
     (0.172, 0.19, 2.30), (0.345, 0.22, 1.99), (0.689, 0.26, 1.71), (1.03, 0.28, 1.55), (1.38, 0.30, 1.45),
     (2.07, 0.34, 1.31), (3.45, 0.38, 1.15), (5.17, 0.42, 1.04), (6.89, 0.44, 1.00)]
 

@@ -20,6 +20,16 @@ def test_stress_cycle_factors_shigley_example_14_4():
     assert round(float(F.pitting_cycle_factor(NG)), 3) == 0.973
 
 
+def test_stress_cycle_curves_meet_at_their_knees():
+    # The AGMA curves (Shigley Figs. 14-14, 14-15) are continuous: the bending branches meet
+    # at Y_N = 1.0396 at 3e6 cycles, the pitting ones at Z_N = 1.000 at 1e7, by hand:
+    # 1.3558 (3e6)^-0.0178 = 2.3194 (3e6)^-0.0538 = 1.0396; 1.4488 (1e7)^-0.023 = 2.466 (1e7)^-0.056 = 1.000.
+    # A constant or exponent copied wrong (e.g. 0.0323 with 1.3558) breaks the meeting.
+    for N, factor, value in ((3e6, F.bending_cycle_factor, 1.0396), (1e7, F.pitting_cycle_factor, 1.0)):
+        above, below = float(factor(N)), float(factor(N * (1 - 1e-12)))
+        assert above == pytest.approx(value, abs=3e-4) and below == pytest.approx(value, abs=3e-4)
+
+
 def test_dynamic_factor_shigley_example_14_4():
     # Same example: Q_v = 6, V = 801.1 ft/min; B = 0.25 (12 - 6)^(2/3) = 0.8255,
     # A = 50 + 56 (1 - 0.8255) = 59.77, K_v = ((59.77 + sqrt(801.1)) / 59.77)^0.8255 = 1.377.

@@ -25,6 +25,24 @@ Sources
   A = 50 + 56 (1 - B), K_v = ((A + sqrt(200 V)) / A)^B, V the pitch-line velocity in m/s
   (200 V is V in ft/min up to 1.6 %: Shigley's SI form), Q_v the transmission accuracy
   level (quality number, 6 ... 11).
+
+Checked against independent published copies (issue 21):
+
+* Y_N = 1.3558 N^-0.0178 and 1.6831 N^-0.0323 (N >= 3e6), the low-cycle curves 9.4518
+  N^-0.148 (400 HB), 6.1514 N^-0.1192 (case carburized), 4.9404 N^-0.1045 (250 HB), 3.517
+  N^-0.0817 and 2.3194 N^-0.0538, and Z_N = 2.466 N^-0.056 (N < 1e7), 1.4488 N^-0.023
+  (N >= 1e7): the same constants in several public gear-rating codes citing Shigley Figs.
+  14-14/14-15 or AGMA 2101-D04 Figs. 17/18.  Two label 2.3194 N^-0.0538 "160 HB", one
+  gives that label to 3.517 N^-0.0817 instead; either way 2.3194 N^-0.0538 is the lowest
+  low-cycle curve (1.60 at 1e3 cycles against 2.0 ... 3.4), and
+  every curve meets the long-life one at Y_N = 1.040 at 3e6 cycles, both Z_N branches at
+  1.000 at 1e7 (tests/test_gear_fatigue.py).
+* K_v: A = 50 + 56 (1 - B) as in github.com/ddjokic/python-gearbox, standards/agma.py
+  (AGMA 2001 form with the accuracy level A_v = 17 - Q_v, B = 0.25 (A_v - 5)^(2/3), and
+  sqrt(196.85 v), the exact m/s -> ft/min factor; Shigley's 200 changes K_v by < 0.1 % at
+  the bundled designs' speeds).
+* Shigley Example 14-4's printed Y_N and Z_N (0.977, 0.996, 0.948, 0.973) follow from these
+  formulas to the printed digits; no public copy of the example itself was found.
 """
 from __future__ import annotations
 

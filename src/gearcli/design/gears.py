@@ -37,7 +37,9 @@ import numpy as np
 
 from ..model.ratings import STEEL_ELASTIC_COEFFICIENT
 
-# Shigley, Table 14-2: Lewis form factor Y, 20 deg pressure angle, full-depth teeth.
+# Shigley, Table 14-2: Lewis form factor Y, 20 deg pressure angle, full-depth teeth (the
+# same 25 rows in several public gear-rating codes that cite the table; the rack's 0.485
+# in one of them).
 LEWIS_TABLE = (
     (12, 0.245), (13, 0.261), (14, 0.277), (15, 0.290), (16, 0.296), (17, 0.303),
     (18, 0.309), (19, 0.314), (20, 0.322), (21, 0.328), (22, 0.331), (24, 0.337),

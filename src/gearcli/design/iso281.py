@@ -33,6 +33,28 @@ Sources
   Under a varying load a_ISO is taken per sample and the lives are combined by the
   Palmgren-Miner rule (ISO 281 §9.3.3 for variable operating conditions): each revolution
   at P_k uses up (P_k / C)^p / a_ISO(P_k) of a million-revolution life.
+
+Checked against independent published copies (issue 21; the standard itself is not public):
+
+* Table 3 rows, e, Y and X = 0.56: the same nine rows in several public bearing
+  calculators (one quoting "ISO 281 Table 3, alpha = 0", one "SKF catalogue table 9,
+  deep groove ball, Normal clearance"); P = Fr for Fa/Fr <= e, P0 = max(0.6 Fr + 0.5 Fa,
+  Fr): SKF, https://www.skf.com/sg/products/bearings-units-housings/ball-bearings/deep-groove-ball-bearings/loads/index.html.
+  (The C3-clearance column of the same catalogue table, e 0.29 ... 0.54, X 0.46, also in
+  public code, is not this one.)
+* Catalogue column: its nine anchor rows 0.014 ... 0.56 are the Table 3 rows divided by
+  f0 = 12.3 (public copies of Shigley Table 11-1 / Mott Table 14-5 carry them); the three
+  rows 0.021, 0.042, 0.070 are the midpoints (e 0.21, 0.24, 0.27; Y 2.15, 1.85, 1.63), as
+  in a public copy of the 12-row Shigley table (e column) and of Mott's (Y 1.63 at 0.070).
+* a_ISO, ball: 2.5671, (2.2649, 0.054381), (1.9987, 0.19087), (1.9987, 0.071739), 0.83,
+  1/3, -9.3, the cap 50 and kappa in 0.1 ... 4 (clipped above 4) as ISO 281:2007 Eqs.
+  (31)-(33) are quoted in an independent public ISO 281/16281 implementation.  Roller: the
+  same source lists 1.5859, 1.3993, 1.2348 and the exponents 0.4 and -9.185 (Eqs.
+  (34)-(36)); no public copy of the whole roller expression was found.  A public Python
+  copy writes 0.019087 for the middle ball row: a typo (the rows then no longer meet at
+  kappa = 0.4, which tests/test_design_formulas.py checks).
+* Tapered roller e = 1.5 tan a and Y = 0.4 cot a: the same in public bearing calculators
+  (e 0.54 ... 1.5, Y 1.1 ... 0.4 for a = 20 ... 45 deg).
 """
 from __future__ import annotations
 
