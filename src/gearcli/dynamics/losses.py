@@ -75,6 +75,11 @@ def friction_force(coulomb, viscous, qd: np.ndarray) -> np.ndarray:
     return -coulomb * np.sign(qd) - viscous * qd + 0.0
 
 
+def joint_friction_forces(joints, qd_all: np.ndarray) -> np.ndarray:
+    """(N, J) :func:`friction_force` of every joint (0 without friction) at the rates (N, J)."""
+    return friction_force(*friction_coefficients(joints), qd_all)
+
+
 def friction_coefficients(joints) -> tuple[np.ndarray, np.ndarray]:
     """(F_c (J,), F_v (J,)) of ``joints`` (0 without friction)."""
     fr = [(j.friction.coulomb, j.friction.viscous) if j.friction is not None else (0.0, 0.0) for j in joints]
@@ -125,7 +130,8 @@ LOSS_FIELDS = ("gear_loss", "joint_friction", "joint_loss", "bearing_iterations"
 
 
 def fill_losses(an, kin, qd_all: np.ndarray, res, bearing: np.ndarray | None = None,
-                iterations: np.ndarray | None = None, rates: dict | None = None) -> None:
+                iterations: np.ndarray | None = None, rates: dict | None = None,
+                friction: np.ndarray | None = None) -> None:
     """Set the loss fields of the :class:`~.solve.Result` ``res`` from its tooth forces and
     the joint rates ``qd_all`` (N, J): ``gear_loss`` (N, G) mesh power loss, W (0 for an
     ideal pair); ``joint_friction`` (N, J) the friction on each joint's child about (along)
@@ -133,7 +139,8 @@ def fill_losses(an, kin, qd_all: np.ndarray, res, bearing: np.ndarray | None = N
     (:mod:`.bearing_friction`) against the rate; ``joint_loss`` (N, J) its power loss, W;
     ``bearing_iterations`` (N,) the fixed-point iterations of the bearing friction (None
     without it).  ``rates``: {circuit: theta'_{j,c} (N,)} of the lossy meshes when known
-    (the compiled kernel's; ``kin`` may then be None).  Nothing for a lossless mechanism
+    (the compiled kernel's; ``kin`` may then be None); ``friction`` (N, J) the joints' own
+    friction forces when known (:func:`joint_friction_forces`).  Nothing for a lossless mechanism
     (the fields stay None)."""
     if not an.mech.has_losses:
         return
@@ -141,7 +148,7 @@ def fill_losses(an, kin, qd_all: np.ndarray, res, bearing: np.ndarray | None = N
     res.gear_loss = np.column_stack([mesh_loss(an, kin, ci, res.gear_t[:, ci], (rates or {}).get(ci))
                                      for ci in range(len(an.circuits))]
                                     ) if an.circuits else np.zeros((N, 0))
-    res.joint_friction = friction_force(*friction_coefficients(an.mech.joints), qd_all)
+    res.joint_friction = joint_friction_forces(an.mech.joints, qd_all) if friction is None else friction.copy()
     res.joint_loss = -res.joint_friction * qd_all          # joint_loss, all joints at once
     if bearing is not None:
         res.joint_friction -= np.sign(qd_all) * bearing
@@ -153,4 +160,5 @@ def fill_kernel_losses(an, res, losses: dict) -> None:
     """:func:`fill_losses` from what the llvm kernel's driver put in ``losses`` ("qd" the joint
     rates, "rates" the lossy meshes' theta'_{j,c}, "bearing", "iterations"; empty: none)."""
     if losses:
-        fill_losses(an, None, losses["qd"], res, losses["bearing"], losses["iterations"], losses["rates"])
+        fill_losses(an, None, losses["qd"], res, losses["bearing"], losses["iterations"], losses["rates"],
+                    losses["friction"])

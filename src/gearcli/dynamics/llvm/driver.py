@@ -27,7 +27,7 @@ from .kernel import ARGS, build_module
 from .links import load_groups
 from .outputs import OUTPUTS
 from ..bearing_friction import fixed_point
-from ..losses import friction_coefficients, friction_force
+from ..losses import joint_friction_forces
 from ..signs import SignError
 
 
@@ -211,7 +211,7 @@ class LlvmKernel:
         """The loads of every sample into ``out``, as the numpy path (:func:`..blocks.solve_blocks`) does.
 
         A lossy mechanism (``prog.losses``): the joints' friction loads are the kernel's
-        input (:func:`..losses.friction_force` of the joint rates), the bearing
+        input (:func:`..losses.joint_friction_forces` of the joint rates), the bearing
         friction's fixed point (:func:`..bearing_friction.fixed_point`) runs the kernel again
         over the samples whose moments have not converged yet; ``losses`` (a dict) receives "rates"
         {circuit: theta'_{j,c} (N,)}, "bearing" (N, J) moments and "iterations" (N,) (None
@@ -222,7 +222,8 @@ class LlvmKernel:
             self._launch(an, q, qd, qdd, values, jobs, chunk, out, work, np.zeros((1, 1)), np.empty((1, 1)))
             return {k: work[0][:, i] for i, k in enumerate(prog.signed)}
         qd_all = qd @ np.asarray(an.S, float).T
-        jq = _joint_forces(an, lp, qd_all)
+        friction = joint_friction_forces(an.mech.joints, qd_all)        # (N, J), also an output
+        jq = np.ascontiguousarray(friction[:, lp.joints[:, 0]]) if lp.joints.shape[0] else np.zeros((len(q), 1))
         rate = np.empty((q.shape[0], max(len(lp.rate_meshes), 1)))
         bearing = iterations = None
         if lp.bearing_joints:
@@ -242,7 +243,7 @@ class LlvmKernel:
             self._launch(an, q, qd, qdd, values, jobs, chunk, out, work, jq, rate)
         if losses is not None:
             losses.update(rates={ci: rate[:, k] for k, ci in enumerate(lp.rate_meshes)}, bearing=bearing,
-                          iterations=iterations, qd=qd_all)
+                          iterations=iterations, qd=qd_all, friction=friction)
         return {k: work[0][:, i] for i, k in enumerate(prog.signed)}
 
     def _launch(self, an, q, qd, qdd, values, jobs, chunk, out, work, jq, rate) -> None:
@@ -276,16 +277,6 @@ class LlvmKernel:
         for k, v in sub.items():
             out[k][rows] = v
         SG[rows], fail[rows], rate[rows] = sw[0], sw[1], rr
-
-
-def _joint_forces(an, lp, qd_all: np.ndarray) -> np.ndarray:
-    """(N, Q) the generalised friction force on the child of each friction joint of ``lp``
-    (:func:`..losses.friction_force`; the bearing moments are added by the fixed point)."""
-    if not lp.joints.shape[0]:
-        return np.zeros((qd_all.shape[0], 1))
-    Fc, Fv = friction_coefficients(an.mech.joints)
-    ji = lp.joints[:, 0]
-    return np.ascontiguousarray(friction_force(Fc[ji], Fv[ji], qd_all[:, ji]))
 
 
 _PROGRAM_KEYS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
