@@ -25,10 +25,11 @@
 from __future__ import annotations
 
 import llvmlite.ir as ir
+import numpy as np
 
 from .build import D, Emitter
 from .links import Sample, floats
-from .signs import signs_of
+from .signs import SignedBlock, _rows_switch, signs_of
 from .world import eliminate
 
 
@@ -73,22 +74,45 @@ def joint_friction(e: Emitter, s: Sample, lp, row) -> None:
 
 class LossyBlock:
     """A constant-frame block with lossy meshes around its lossless solve ``inner`` (a
-    :class:`~.llvm_signs.SignedBlock` or :class:`~.world.LowRankBlock`): the
+    :class:`~.signs.SignedBlock` or :class:`~.world.LowRankBlock`): the
     module docstring's rank-ml correction of each trial and of the accepted solution."""
 
     def __init__(self, inner, bl, sv: list):
         self.inner, self.bl = inner, bl
         self.tcols, self.n = inner.tcols, inner.n
         self.d_sv = [sv[k] for k in bl.rates]
+        self.aug = None
+        if isinstance(inner, SignedBlock) and inner.table is None:
+            # one switch for X r and the constants X Phi: per pattern the rows [X, 0] and,
+            # for each couple b, [0, (X Phi^T)[:, b] e_b], times [r, 1, ..., 1]
+            ml, (n, nr) = len(bl.positions), inner.maps[0].shape
+            self.aug = []
+            for X in inner.maps:
+                A = np.zeros((n * (1 + ml), nr + ml))
+                A[:n, :nr] = X
+                XP = X @ bl.phi.T
+                for k in range(ml):
+                    A[n * (1 + k):n * (2 + k), nr + k] = XP[:, k]
+                self.aug.append(A)
+
+    def _products(self, e: Emitter, fn, p, need: list, r: list, tag: str):
+        """({row: (X r)[row]}, per couple b {row: (X Phi^T)[row, b]}) of pattern p."""
+        ml, n = len(self.bl.positions), self.n
+        if self.aug is not None:
+            idx = need + [n * (1 + b) + i for b in range(ml) for i in need]
+            vals = _rows_switch(e, fn, p, self.aug, idx, list(r) + [1.0] * ml, tag)
+            k = len(need)
+            return dict(zip(need, vals[:k])), [dict(zip(need, vals[k * (1 + b):k * (2 + b)])) for b in range(ml)]
+        xr = dict(zip(need, self.inner.rows(e, fn, p, need, r, tag)))
+        return xr, [dict(zip(need, self.inner.rows(e, fn, p, need, floats(self.bl.phi[b]), f"{tag}_phi{b}")))
+                    for b in range(ml)]
 
     def rows(self, e: Emitter, fn, p, rows: list, r: list, tag: str) -> list:
         """Rows ``rows`` of the solution of the changed matrix for pattern p (i64)."""
         bl, m = self.bl, len(self.tcols)
         lt = [self.tcols[i] for i in bl.positions]
         need = sorted(set(rows) | set(lt))
-        xr = dict(zip(need, self.inner.rows(e, fn, p, need, r, tag)))
-        xf = [dict(zip(need, self.inner.rows(e, fn, p, need, floats(bl.phi[a]), f"{tag}_phi{a}")))
-              for a in range(len(lt))]
+        xr, xf = self._products(e, fn, p, need, r, tag)
         sig = signs_of(e, p, m)
         d = [e.mul(sig[i], sv) for i, sv in zip(bl.positions, self.d_sv)]
         K = [[e.add(1.0 if a == b else 0.0, e.mul(xf[b][lt[a]], d[b])) for b in range(len(lt))]
