@@ -258,7 +258,7 @@ def build_program(an, plans=None) -> Program:
     free = {bi: f for bi in weights if (f := _basis(an, plans[bi], weights[bi])) is not None}
     hashed = cat([np.ravel(a) for lr in lowrank.values() for a in (lr.Y, lr.G, lr.Z, lr.W)]
                  + [np.array(h, float) for h, _ in hot.values()] + [np.ravel(t) for _, t in hot.values()]
-                 + list(weights.values()) + [np.array(f[0] + f[1], float) for f in free.values()])
+                 + list(weights.values()) + [np.array(f[0] + f[1] + f[2], float) for f in free.values()])
     ints = (lambda xs: np.array(xs, I64))
     return Program(c, offsets, signed, [p.names for p in plans], True, joints=joints, poses=poses,
                    bodies=_bodies(an), moving=ints(an.tree.moving), base=int(an.tree.base),
@@ -286,14 +286,15 @@ def _basis(an, p, w):
 
 
 def _free_columns(an, p, w):
-    """(free, row order): the d weighted columns of a redundant world-frame block (n unknowns, 6B equations,
+    """(free, row order, swaps): the d weighted columns of a redundant world-frame block (n unknowns, 6B equations,
     d = n - 6B) whose removal leaves a square basis A_B that is regular on 9 poses (home and
     8 random, every t positive and every t negative) with a condition number at most
     :data:`MAX_BASIS_CONDITION`: the generated kernel then solves A_B for the right-hand
     side and the free columns and minimises over the d free unknowns (a d x d system,
     :class:`~.world.WorldBlock`) instead of the (n + 6B)^2 KKT system.  Chosen by
     QR with column pivoting of the null space's weighted rows at home; the basis' row order
-    of partial pivoting at home (:func:`_pivot_order`).  None: none found."""
+    of partial pivoting at home (:func:`_pivot_order`) and each column's alternative pivot
+    row (:func:`_swaps`).  None: none found."""
     from scipy.linalg import qr                        # noqa: PLC0415
 
     from ..equations import Columns                     # noqa: PLC0415
@@ -322,7 +323,40 @@ def _free_columns(an, p, w):
     conds = np.linalg.cond(np.concatenate([A, minus])[:, :, basis])
     if not (np.all(np.isfinite(conds)) and conds.max() <= MAX_BASIS_CONDITION):
         return None
-    return free, _pivot_order(A[0][:, basis])
+    order = _pivot_order(A[0][:, basis])
+    q = rng.uniform(-np.pi, np.pi, (SWAP_POSES, an.dof)) @ np.asarray(an.S, float).T
+    poses = assemble(Columns(an, forward(an.mech, an.tree, q.reshape(-1, J))), p.groups, list(p.links))
+    return free, order, _swaps(poses[:, :, basis][:, order])
+
+
+SWAP_POSES = 256
+"""Random poses (a fixed seed) on which :func:`_swaps` chooses each column's alternative pivot row."""
+
+
+def _swaps(M: np.ndarray) -> list:
+    """Per column c of the matrices M (P, k, k) (rows in the static order): the row below
+    c that the generated elimination swaps up where its |entry| is larger than the static
+    pivot's (:func:`.world.static_lu`; -1: none), the row that is largest most often among
+    the poses whose static pivot is smaller than an entry below it by more than 10x
+    (a pivot row that turns with a gear's angle: its twin row takes over), each pose
+    eliminated with the swaps chosen so far."""
+    M = np.array(M, float)
+    k = M.shape[1]
+    out = []
+    for c in range(k - 1):
+        col = np.abs(M[:, c + 1:, c])
+        poor = col.max(axis=1) > 10.0 * np.abs(M[:, c, c])
+        alt = -1
+        if poor.any():
+            rows, counts = np.unique(c + 1 + np.argmax(col[poor], axis=1), return_counts=True)
+            alt = int(rows[np.argmax(counts)])
+            swap = np.abs(M[:, alt, c]) > np.abs(M[:, c, c])
+            M[swap, c], M[swap, alt] = M[swap, alt].copy(), M[swap, c].copy()
+        out.append(alt)
+        with np.errstate(all="ignore"):
+            f = M[:, c + 1:, c] / M[:, c, c][:, None]
+        M[:, c + 1:] -= f[:, :, None] * M[:, c, None, :]
+    return out + [-1]
 
 
 def _pivot_order(M: np.ndarray) -> list:

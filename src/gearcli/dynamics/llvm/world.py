@@ -81,21 +81,41 @@ the sample's solve to the pivoting loop code (:func:`static_lu`).  Measured on s
 of the sample's largest load but takes the loop code for most samples (18,000 samples/s),
 32 1.1e-14 (75,000), 100 3.1e-14 (244,000), 1e4 1.6e-12 (305,000): a moment row's entries
 are a force row's times a lever of ~0.02 m, so ratios of ~50 are the units, not a poor
-pivot."""
+pivot.  Those figures are without the row swaps of :func:`.program._swaps`: 2.5 % of random
+poses had a poor static pivot, one of a planet's pair of rows that turns with its angle;
+with them, 1.1e-15 on the same test and the pivoting loop code is rare."""
 
 
-def static_lu(e: Emitter, A: list, B: list, order: list):
+def _swap_rows(e: Emitter, A: list, X: list, c: int, a: int) -> None:
+    """Rows c and a (> c) exchanged (columns >= c of A, and X) where |A[a][c]| > |A[c][c]|."""
+    if isinstance(A[a][c], float) and A[a][c] == 0.0:
+        return
+    sw = e.b.fcmp_ordered(">", e.const(e.call("fabs", A[a][c])), e.const(e.call("fabs", A[c][c])))
+    for M, lo in ((A, c), (X, 0)):
+        for j in range(lo, len(M[c])):
+            u, v = e.const(M[c][j]), e.const(M[a][j])
+            if M[c][j] is M[a][j] or (isinstance(M[c][j], float) and M[c][j] == M[a][j]):
+                continue
+            M[c][j], M[a][j] = e.b.select(sw, v, u), e.b.select(sw, u, v)
+
+
+def static_lu(e: Emitter, A: list, B: list, order: list, swaps: list | None = None):
     """(X, bad): X = A^-1 B (A (k, k), B (k, m), lists of rows of values) by elimination in
     the fixed row order ``order`` (partial pivoting's order at the home pose,
     :func:`.program._free_columns`), straight-line and without selects, so the zeros
     of the matrix's structure fold away; ``bad`` (i1) is true when a pivot is smaller than
     the largest entry below it by more than :data:`PIVOT_GROWTH` (the caller then solves
-    with pivoting) or zero."""
+    with pivoting) or zero.  ``swaps``: per column a row (in that order) exchanged with the
+    pivot's where its entry is larger (:func:`.program._swaps`; -1: none), the one
+    pivoting a turning frame needs."""
     k = len(A)
     A = [list(A[i]) for i in order]
     X = [list(B[i]) for i in order]
     bad = ir.Constant(I1, 0)
+    inv = [1.0] * k                  # 1 / pivot: a product per row, not a division (latency)
     for c in range(k):
+        if swaps is not None and swaps[c] >= 0:
+            _swap_rows(e, A, X, c, int(swaps[c]))
         piv = A[c][c]
         below = [A[i][c] for i in range(c + 1, k) if not (isinstance(A[i][c], float) and A[i][c] == 0.0)]
         if isinstance(piv, float):
@@ -106,10 +126,11 @@ def static_lu(e: Emitter, A: list, B: list, order: list):
             bad = e.b.or_(bad, e.b.fcmp_ordered("==", a, ir.Constant(D, 0.0)))
             for v in below:
                 bad = e.b.or_(bad, e.b.fcmp_ordered(">", e.const(e.call("fabs", v)), e.const(e.mul(PIVOT_GROWTH, a))))
+        inv[c] = e.div(1.0, piv)
         for i in range(c + 1, k):
             if isinstance(A[i][c], float) and A[i][c] == 0.0:
                 continue
-            f = e.div(A[i][c], piv)
+            f = e.mul(A[i][c], inv[c])
             for j in range(c + 1, k):
                 A[i][j] = e.sub(A[i][j], e.mul(f, A[c][j]))
             X[i] = [e.sub(X[i][h], e.mul(f, X[c][h])) for h in range(len(X[i]))]
@@ -118,7 +139,7 @@ def static_lu(e: Emitter, A: list, B: list, order: list):
             v = X[c][h]
             for j in range(c + 1, k):
                 v = e.sub(v, e.mul(A[c][j], X[j][h]))
-            X[c][h] = e.div(v, A[c][c])
+            X[c][h] = e.mul(v, inv[c])
     return X, bad
 
 
@@ -159,12 +180,12 @@ class WorldBlock:
         pivoting loop code of :mod:`.solve` when a static pivot is poor), then the free unknowns from
         (Q^T W_B Q + W_free) x_free = Q^T W_B p (d x d, :func:`eliminate`) and x_B = p - Q x_free:
         the minimiser of sum w x^2 over the solutions of A x = r."""
-        k, (free, order), w = len(r), self.free, self.weights
+        k, (free, order, swaps), w = len(r), self.free, self.weights
         basis = [j for j in range(self.n) if j not in free]
         m = 1 + len(free)
         AB = [[A[i][j] for j in basis] for i in range(k)]
         RHS = [[r[i]] + [A[i][j] for j in free] for i in range(k)]
-        fast, bad = static_lu(e, AB, RHS, order)
+        fast, bad = static_lu(e, AB, RHS, order, swaps)
         fast = [[e.const(v) for v in row] for row in fast]
         fn = self.fn
         slow, done = fn.append_basic_block("basis_pivot"), fn.append_basic_block("basis_done")
