@@ -81,7 +81,7 @@ the sample's solve to the pivoting loop code (:func:`static_lu`).  Measured on s
 of the sample's largest load but takes the loop code for most samples (18,000 samples/s),
 32 1.1e-14 (75,000), 100 3.1e-14 (244,000), 1e4 1.6e-12 (305,000): a moment row's entries
 are a force row's times a lever of ~0.02 m, so ratios of ~50 are the units, not a poor
-pivot.  Those figures are without the row swaps of :func:`.program._swaps`: 2.5 % of random
+pivot.  Those figures are without the row swaps of :func:`.basis._swaps`: 2.5 % of random
 poses had a poor static pivot, one of a planet's pair of rows that turns with its angle;
 with them, 1.1e-15 on the same test and the pivoting loop code is rare."""
 
@@ -102,11 +102,11 @@ def _swap_rows(e: Emitter, A: list, X: list, c: int, a: int) -> None:
 def static_lu(e: Emitter, A: list, B: list, order: list, swaps: list | None = None):
     """(X, bad): X = A^-1 B (A (k, k), B (k, m), lists of rows of values) by elimination in
     the fixed row order ``order`` (partial pivoting's order at the home pose,
-    :func:`.program._free_columns`), straight-line and without selects, so the zeros
+    :func:`.basis._free_columns`), straight-line and without selects, so the zeros
     of the matrix's structure fold away; ``bad`` (i1) is true when a pivot is smaller than
     the largest entry below it by more than :data:`PIVOT_GROWTH` (the caller then solves
     with pivoting) or zero.  ``swaps``: per column a row (in that order) exchanged with the
-    pivot's where its entry is larger (:func:`.program._swaps`; -1: none), the one
+    pivot's where its entry is larger (:func:`.basis._swaps`; -1: none), the one
     pivoting a turning frame needs."""
     k = len(A)
     A = [list(A[i]) for i in order]
@@ -149,7 +149,7 @@ class WorldBlock:
     A square block is eliminated straight-line (:func:`eliminate`).  A redundant one (a gear
     set with more unknowns n than its 6B equations, ``weights`` the load-sharing weights of
     :func:`..sharing.mesh_weights`) is solved through a square basis (``free``: the columns
-    left out, :func:`.program._free_columns`; :meth:`_by_basis`), or where none was
+    left out, :func:`.basis._free_columns`; :meth:`_by_basis`), or where none was
     found from the KKT system of :func:`..sharing.kkt` (the same matrix, D scaled by the
     sample's largest |A| entry), each with the loop code of :mod:`.solve`, the
     matrices in stack arrays of the ``fn`` ``run``.
