@@ -21,3 +21,22 @@ def rel_err(a, b, tiny: float = TINY) -> float:
     if a.size == 0:
         return 0.0
     return float(np.max(np.abs(a - b)) / max(float(np.max(np.abs(b))), tiny))
+
+
+def sample_err(a, b, fields) -> float:
+    """max over samples of max|a - b| / (1 + largest load of the sample), over the named
+    fields of two solve results (``b`` the reference): the kernel-against-reference metric,
+    judged per sample so that a quiet sample is not measured against a loud one."""
+    n = b.motor.shape[0]
+    fa = np.concatenate([getattr(a, f).reshape(n, -1) for f in fields], axis=1)
+    fb = np.concatenate([getattr(b, f).reshape(n, -1) for f in fields], axis=1)
+    return float(np.max(np.abs(fa - fb).max(axis=1) / (1.0 + np.abs(fb).max(axis=1))))
+
+
+def per_sample_loads(an, n, seed=1):
+    """Random per-sample values (N, 6) of the mechanism's first external load (the others
+    keep their constants), or None when it has none."""
+    if not an.mech.loads:
+        return None
+    rng = np.random.default_rng(seed)
+    return {an.mech.loads[0].name: rng.normal(size=(n, 6)) * 5.0}

@@ -23,6 +23,7 @@ pytest.importorskip("llvmlite")
 from big_mechanisms import binary_tree_urdf, geared_chain, serial_chain  # noqa: E402
 from factories import paper_2dof_variant, planetary_2dof, spatial_3dof  # noqa: E402
 from factories_own import PUMA_YAML, dh_geared, urdf_prismatic_chain  # noqa: E402
+from metrics import per_sample_loads, sample_err  # noqa: E402
 from gearcli import analyse, load_mechanism, parse_mechanism  # noqa: E402
 from gearcli.dynamics.llvm.jobs import job_ranges, threads_for  # noqa: E402
 from gearcli.dynamics import backends  # noqa: E402
@@ -84,20 +85,9 @@ def trajectory(an, n, seed=0):
             rng.normal(size=(n, an.dof)) * 20.0)
 
 
-def per_sample_loads(an, n, seed=1):
-    """Per-sample values of the first load (the others keep their constants)."""
-    if not an.mech.loads:
-        return None
-    rng = np.random.default_rng(seed)
-    return {an.mech.loads[0].name: rng.normal(size=(n, 6)) * 5.0}
-
-
 def worst(a, b) -> float:
-    """max over samples of max|a - b| / (1 + largest load of the sample)."""
-    n = b.motor.shape[0]
-    fa = np.concatenate([getattr(a, f).reshape(n, -1) for f in FIELDS], axis=1)
-    fb = np.concatenate([getattr(b, f).reshape(n, -1) for f in FIELDS], axis=1)
-    return float(np.max(np.abs(fa - fb).max(axis=1) / (1.0 + np.abs(fb).max(axis=1))))
+    """The per-sample error of :func:`metrics.sample_err` over this file's fields."""
+    return sample_err(a, b, FIELDS)
 
 
 def compiled_backend(an) -> None:

@@ -23,6 +23,7 @@ from gearcli import analyse, load_mechanism, parse_mechanism
 from gearcli.dynamics.bearing_friction import BearingFrictionError
 from gearcli.dynamics.signs import SignError
 from gearcli.dynamics.solve import solve, solver_for
+from metrics import per_sample_loads, sample_err
 from test_losses import PLANETARY, RACK, SHAFT, SPUR, with_losses
 
 pytest.importorskip("llvmlite")
@@ -61,20 +62,9 @@ def motion(an, n, seed=0):
     return q, qd, qdd
 
 
-def per_sample_loads(an, n, seed=1):
-    """Per-sample values of the first external load (the others keep their constants)."""
-    if not an.mech.loads:
-        return None
-    rng = np.random.default_rng(seed)
-    return {an.mech.loads[0].name: rng.normal(size=(n, 6)) * 5.0}
-
-
 def worst(a, b) -> float:
-    """max over samples of max|a - b| / (1 + largest load of the sample), every field."""
-    n = b.motor.shape[0]
-    fa = np.concatenate([getattr(a, f).reshape(n, -1) for f in FIELDS], axis=1)
-    fb = np.concatenate([getattr(b, f).reshape(n, -1) for f in FIELDS], axis=1)
-    return float(np.max(np.abs(fa - fb).max(axis=1) / (1.0 + np.abs(fb).max(axis=1))))
+    """The per-sample error of :func:`metrics.sample_err` over this file's fields."""
+    return sample_err(a, b, FIELDS)
 
 
 @pytest.mark.parametrize("key", LOSSY + list(HAND))
