@@ -119,6 +119,26 @@ def test_threads_change_no_bit_with_bearing_friction(key):
         assert np.array_equal(getattr(one, f), getattr(two, f)), f
 
 
+@pytest.mark.parametrize("key", ["servo_joint_rated.yaml", "shaft"])
+def test_bearing_fixed_point_on_a_few_samples(key, monkeypatch):
+    """Nine samples in ten at rest converge at the first iteration: the kernel then solves the
+    few others alone (the driver's gather of their rows), with the numpy path's results."""
+    from gearcli.dynamics.llvm.driver import LlvmKernel
+
+    an = analyse(mechanism(key))
+    q, qd, qdd = motion(an, 400)
+    qd[np.arange(400) % 10 != 0] = 0.0
+    rows, orig = [], LlvmKernel._rows
+    monkeypatch.setattr(LlvmKernel, "_rows", lambda self, an, r, *a: (rows.append(r.size), orig(self, an, r, *a))[1])
+    ref = solve(an, q, qd, qdd, backend="numpy")
+    res = solve(an, q, qd, qdd, backend="llvm", jobs=1)
+    moving = np.any(qd != 0.0, axis=1)
+    assert 0 < moving.sum() < 100 and rows and max(rows) == moving.sum()
+    assert worst(res, ref) < TOL
+    assert np.array_equal(res.bearing_iterations, ref.bearing_iterations)
+    assert np.all(ref.bearing_iterations[moving] > 1) and np.all(ref.bearing_iterations[~moving] == 1)
+
+
 def test_verify_with_losses_on_the_llvm_path():
     """The residual of the llvm solution, checked against the right-hand side with the joint
     and the converged bearing friction."""

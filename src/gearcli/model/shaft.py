@@ -33,8 +33,17 @@ def split_two_bearings(F, M, z1: float, z2: float) -> tuple[np.ndarray, np.ndarr
         x, y components of the radial force on each bearing, N.
     """
     F, M = np.asarray(F, float), np.asarray(M, float)
-    if z1 == z2:
+    R1x, R1y, R2x, R2y = split_components(F[:, 0], F[:, 1], M[:, 0], M[:, 1], z1, z2)
+    return np.column_stack([R1x, R1y]), np.column_stack([R2x, R2y])
+
+
+def split_components(fx, fy, mx, my, z1, z2):
+    """:func:`split_two_bearings` component by component: (R1x, R1y, R2x, R2y) from the
+    force's and moment's x, y components (arrays of any one shape, e.g. (K, N): K shafts at
+    once, with z1, z2 floats or (K, 1) arrays), R2 = (m - z1 F_xy) / (z2 - z1), m = (M_y, -M_x),
+    R1 = F_xy - R2."""
+    if np.any(np.asarray(z1) == np.asarray(z2)):
         raise ValueError("two bearings need different positions")
-    m = np.stack([M[:, 1], -M[:, 0]], axis=1)
-    R2 = (m - z1 * F[:, :2]) / (z2 - z1)
-    return F[:, :2] - R2, R2
+    R2x = (my - z1 * fx) / (z2 - z1)
+    R2y = (-mx - z1 * fy) / (z2 - z1)
+    return fx - R2x, fy - R2y, R2x, R2y
