@@ -2,7 +2,8 @@
 
     python benchmarks/bench_compile.py [--repeat 3] [--startup-repeat 5]
 
-Per mechanism (paper_2dof, Bendix wrist, planetary_3p, UR5, Panda, Talos full), each
+Per mechanism (every bundled one, UR5, Panda, Talos full, geared chains of 16, 32 and 64
+links: the first-call table of the README), each
 measurement in a fresh Python process (medians over --repeat): the llvm kernel's IR
 generation and LLVM optimisation + machine code (``LlvmKernel.build_seconds``,
 ``compile_seconds``), the size of its IR, the first ``solve(backend="llvm")`` of 100
@@ -28,6 +29,7 @@ from cli_stages import startup_time  # noqa: E402 (benchmarks/cli_stages.py)
 from timing import load_line  # noqa: E402 (benchmarks/timing.py)
 
 ROOT = Path(__file__).resolve().parents[1]
+CHAINS = (16, 32, 64)
 
 CHILD = """
 import json, sys, time
@@ -50,14 +52,25 @@ print(json.dumps(out))
 """
 
 
-def subjects() -> list[tuple[str, Path]]:
-    out = [(name, ROOT / "mechanisms" / f"{name}.yaml") for name in ("paper_2dof", "bendix_wrist", "planetary_3p")]
+def subjects(tmp: Path | None = None, chains=CHAINS) -> list[tuple[str, Path]]:
+    """Every bundled mechanism (mechanisms/*.yaml, geared_arm.urdf), UR5, Panda and Talos
+    (example-robot-data, where installed) and, given a folder ``tmp`` to write them in, the
+    geared chains of tests/big_mechanisms.py with ``chains`` links."""
+    out = [(p.stem, p) for p in sorted((ROOT / "mechanisms").glob("*.yaml"))]
+    out.append(("geared_arm (URDF)", ROOT / "mechanisms" / "geared_arm.urdf"))
     for p in map(Path, sys.path):
         d = p / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
         if d.is_dir():
             out += [("UR5", d / "ur_description/urdf/ur5_robot.urdf"), ("Panda", d / "panda_description/urdf/panda.urdf"),
                     ("Talos full", d / "talos_data/robots/talos_full_v2.urdf")]
             break
+    if tmp is not None:
+        sys.path.insert(0, str(ROOT / "tests"))
+        from big_mechanisms import geared_chain  # noqa: PLC0415
+        for links in chains:
+            path = tmp / f"geared{links}.yaml"
+            path.write_text(geared_chain(links))
+            out.append((f"geared chain, {links} links", path))
     return out
 
 
@@ -79,18 +92,22 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--startup-repeat", type=int, default=5)
+    ap.add_argument("--no-cli", action="store_true", help="skip the gearcli solve wall times")
     args = ap.parse_args()
     print(f"# llvm kernel: compile cost, fresh processes, medians of {args.repeat}\n{load_line()} at start\n")
     print("| mechanism | moving links | IR build | LLVM (O3), cold | IR text + load, cached | IR size | instructions | "
           "first llvm solve, cold | first llvm solve, cached |\n|---|---|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
-        for name, path in subjects():
-            med, warm = llvm_runs(path, args.repeat, Path(tmp) / name)
+        for name, path in subjects(Path(tmp)):
+            med, warm = llvm_runs(path, args.repeat, Path(tmp) / name.replace(" ", "_"))
             from gearcli import analyse, load_mechanism  # noqa: PLC0415
             links = len(analyse(load_mechanism(path)).tree.moving)
             print(f"| {name} | {links} | {med['build']:.3f} s | {med['compile']:.3f} s | {warm['compile']:.3f} s | "
                   f"{med['ir_kb']:.0f} kB | {med['instructions']:.0f} | {med['first']:.2f} s | {warm['first']:.2f} s |",
                   flush=True)
+    if args.no_cli:
+        print(f"\n{load_line()} at end")
+        return
     print(f"\n{load_line()}\n\n| `gearcli solve`, 100 samples | cold cache | cached | cached / cold |\n|---|---|---|---|")
     for name, path in subjects():
         if name in ("paper_2dof", "bendix_wrist", "Panda", "Talos full"):
