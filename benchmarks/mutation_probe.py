@@ -171,8 +171,8 @@ MUTATIONS = [
              (("dynamics/losses.py", "return -loss * gm.r_j * u0 / float(u0 @ u0)",
                "return -loss * gm.r_j * u0 / float(np.sqrt(u0 @ u0))"),)),
     Mutation("loss-coulomb-sign", "joint Coulomb friction with the rate instead of against it",
-             (("dynamics/losses.py", "return -coulomb * np.sign(qd) - viscous * qd + 0.0",
-               "return coulomb * np.sign(qd) - viscous * qd + 0.0"),)),
+             (("dynamics/losses.py", "np.multiply(-coulomb, f, out=f)",
+               "np.multiply(coulomb, f, out=f)"),)),
     # the generated llvm kernel
     Mutation("llvm-gravity-sign", "llvm: gravity with the wrong sign in the d'Alembert force",
              (("dynamics/llvm/links.py", "F = e.scale(e.vsub(ac, floats(g)), m)", "F = e.scale(e.vadd(ac, floats(g)), m)"),)),

@@ -69,15 +69,22 @@ def mesh_loss(an, kin, ci: int, t: np.ndarray, rate: np.ndarray | None = None) -
     return loss * np.abs(t) * np.abs(rate) * c.geometry.r_j
 
 
-def friction_force(coulomb, viscous, qd: np.ndarray) -> np.ndarray:
+def friction_force(coulomb, viscous, qd: np.ndarray, out=None, scratch=None) -> np.ndarray:
     """The joint friction law, -F_c sign(qd) - F_v qd (broadcast: one joint's (N,) rates, or
-    (N, J) with per-joint coefficients (J,)); +0.0: no -0 where both are zero."""
-    return -coulomb * np.sign(qd) - viscous * qd + 0.0
+    (N, J) with per-joint coefficients (J,)); +0.0: no -0 where both are zero.  Computed in
+    ``out`` (else a new array), ``scratch`` (an array shaped like qd, else a new one) taking
+    F_v qd: the same bits as the expression written out, without its three other arrays."""
+    f = np.sign(qd, out=out)
+    np.multiply(-coulomb, f, out=f)
+    f -= np.multiply(viscous, qd, out=scratch)
+    f += 0.0
+    return f
 
 
-def joint_friction_forces(joints, qd_all: np.ndarray) -> np.ndarray:
-    """(N, J) :func:`friction_force` of every joint (0 without friction) at the rates (N, J)."""
-    return friction_force(*friction_coefficients(joints), qd_all)
+def joint_friction_forces(joints, qd_all: np.ndarray, out=None, scratch=None) -> np.ndarray:
+    """(N, J) :func:`friction_force` of every joint (0 without friction) at the rates (N, J)
+    (``out``, ``scratch``: as there)."""
+    return friction_force(*friction_coefficients(joints), qd_all, out, scratch)
 
 
 def friction_coefficients(joints) -> tuple[np.ndarray, np.ndarray]:
@@ -131,7 +138,7 @@ LOSS_FIELDS = ("gear_loss", "joint_friction", "joint_loss", "bearing_iterations"
 
 def fill_losses(an, kin, qd_all: np.ndarray, res, bearing: np.ndarray | None = None,
                 iterations: np.ndarray | None = None, rates: dict | None = None,
-                friction: np.ndarray | None = None) -> None:
+                friction: np.ndarray | None = None, into: dict | None = None) -> None:
     """Set the loss fields of the :class:`~.solve.Result` ``res`` from its tooth forces and
     the joint rates ``qd_all`` (N, J): ``gear_loss`` (N, G) mesh power loss, W (0 for an
     ideal pair); ``joint_friction`` (N, J) the friction on each joint's child about (along)
@@ -140,16 +147,19 @@ def fill_losses(an, kin, qd_all: np.ndarray, res, bearing: np.ndarray | None = N
     ``bearing_iterations`` (N,) the fixed-point iterations of the bearing friction (None
     without it).  ``rates``: {circuit: theta'_{j,c} (N,)} of the lossy meshes when known
     (the compiled kernel's; ``kin`` may then be None); ``friction`` (N, J) the joints' own
-    friction forces when known (:func:`joint_friction_forces`).  Nothing for a lossless mechanism
+    friction forces when known (:func:`joint_friction_forces`; taken as ``joint_friction``,
+    changed in place); ``into``: {"gear_loss": (N, G), "joint_loss": (N, J)} arrays to fill
+    (else new ones).  Nothing for a lossless mechanism
     (the fields stay None)."""
     if not an.mech.has_losses:
         return
     N = qd_all.shape[0]
-    res.gear_loss = np.column_stack([mesh_loss(an, kin, ci, res.gear_t[:, ci], (rates or {}).get(ci))
-                                     for ci in range(len(an.circuits))]
-                                    ) if an.circuits else np.zeros((N, 0))
-    res.joint_friction = joint_friction_forces(an.mech.joints, qd_all) if friction is None else friction.copy()
-    res.joint_loss = -res.joint_friction * qd_all          # joint_loss, all joints at once
+    res.gear_loss = np.empty((N, len(an.circuits))) if into is None else into["gear_loss"]
+    for ci in range(len(an.circuits)):
+        res.gear_loss[:, ci] = mesh_loss(an, kin, ci, res.gear_t[:, ci], (rates or {}).get(ci))
+    res.joint_friction = joint_friction_forces(an.mech.joints, qd_all) if friction is None else friction
+    res.joint_loss = np.multiply(res.joint_friction, qd_all, out=None if into is None else into["joint_loss"])
+    np.negative(res.joint_loss, out=res.joint_loss)          # -F q' = F_c |q'| + F_v q'^2, all joints at once
     if bearing is not None:
         res.joint_friction -= np.sign(qd_all) * bearing
         res.joint_loss += bearing * np.abs(qd_all)
@@ -161,4 +171,4 @@ def fill_kernel_losses(an, res, losses: dict) -> None:
     rates, "rates" the lossy meshes' theta'_{j,c}, "bearing", "iterations"; empty: none)."""
     if losses:
         fill_losses(an, None, losses["qd"], res, losses["bearing"], losses["iterations"], losses["rates"],
-                    losses["friction"])
+                    losses["friction"], losses["into"])

@@ -68,6 +68,17 @@ def result_arrays(an, n: int, out=None) -> dict:
     return arrays
 
 
+def one_allocation(shapes: dict) -> dict:
+    """{name: new uninitialised float64 array of shapes[name]}, C-ordered views of one
+    allocation apart from each other (large: huge pages, as :func:`result_arrays`)."""
+    sizes = {k: int(np.prod(shape)) for k, shape in shapes.items()}
+    buf, arrays, at = np.empty(sum(sizes.values())), {}, 0
+    for k, shape in shapes.items():
+        arrays[k] = buf[at:at + sizes[k]].reshape(shape)
+        at += sizes[k]
+    return arrays
+
+
 def work_arrays(n: int, signed: int, out=None) -> tuple:
     """(signs (n, max(signed, 1)), fail (n,) int64) for a compiled kernel: those kept with
     ``out`` when they fit, else new ones (kept with ``out`` when given)."""

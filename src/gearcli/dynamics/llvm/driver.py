@@ -28,6 +28,7 @@ from .links import load_groups
 from .outputs import OUTPUTS
 from ..bearing_friction import fixed_point
 from ..losses import joint_friction_forces
+from ..result_arrays import one_allocation
 from ..signs import SignError
 
 
@@ -221,10 +222,17 @@ class LlvmKernel:
         if lp is None:
             self._launch(an, q, qd, qdd, values, jobs, chunk, out, work, np.zeros((1, 1)), np.empty((1, 1)))
             return {k: work[0][:, i] for i, k in enumerate(prog.signed)}
-        qd_all = qd @ np.asarray(an.S, float).T
-        friction = joint_friction_forces(an.mech.joints, qd_all)        # (N, J), also an output
-        jq = np.ascontiguousarray(friction[:, lp.joints[:, 0]]) if lp.joints.shape[0] else np.zeros((len(q), 1))
-        rate = np.empty((q.shape[0], max(len(lp.rate_meshes), 1)))
+        N, J = q.shape[0], len(an.mech.joints)
+        A = one_allocation({"qd": (N, J), "friction": (N, J), "joint_loss": (N, J), "gear_loss": (N, len(an.circuits)),
+                            "jq": (N, max(lp.joints.shape[0], 1)), "rate": (N, max(len(lp.rate_meshes), 1))})
+        qd_all = np.matmul(qd, np.asarray(an.S, float).T, out=A["qd"])
+        # (N, J), also an output; joint_loss's array as the scratch
+        friction = joint_friction_forces(an.mech.joints, qd_all, A["friction"], A["joint_loss"])
+        jq, rate = A["jq"], A["rate"]
+        if lp.joints.shape[0]:
+            np.take(friction, lp.joints[:, 0], axis=1, out=jq)
+        else:
+            jq[:] = 0.0
         bearing = iterations = None
         if lp.bearing_joints:
             cols = [lp.joints[:, 0].tolist().index(ji) for ji in lp.bearing_joints]
@@ -243,7 +251,8 @@ class LlvmKernel:
             self._launch(an, q, qd, qdd, values, jobs, chunk, out, work, jq, rate)
         if losses is not None:
             losses.update(rates={ci: rate[:, k] for k, ci in enumerate(lp.rate_meshes)}, bearing=bearing,
-                          iterations=iterations, qd=qd_all, friction=friction)
+                          iterations=iterations, qd=qd_all, friction=friction,
+                          into={"gear_loss": A["gear_loss"], "joint_loss": A["joint_loss"]})
         return {k: work[0][:, i] for i, k in enumerate(prog.signed)}
 
     def _launch(self, an, q, qd, qdd, values, jobs, chunk, out, work, jq, rate) -> None:
