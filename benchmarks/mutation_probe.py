@@ -189,6 +189,11 @@ MUTATIONS = [
              (("dynamics/llvm/losses.py", "coef = e.mul(sig[n], sv[k])", "coef = e.neg(e.mul(sig[n], sv[k]))"),)),
     Mutation("llvm-joint-friction-sign", "llvm: joint friction applied to the parent instead of the child",
              (("dynamics/llvm/losses.py", "((child, 1.0), (parent, -1.0))", "((child, -1.0), (parent, 1.0))"),)),
+    Mutation("llvm-bearing-split", "llvm: bearing friction, the tilting moment's x part entering the split with the wrong sign",
+             (("dynamics/llvm/losses.py", "R2y = e.div(e.sub(e.neg(mx), e.mul(z1, fy)), z2 - z1)",
+               "R2y = e.div(e.sub(mx, e.mul(z1, fy)), z2 - z1)"),)),
+    Mutation("llvm-bearing-locating", "llvm: bearing friction, the axial force left out of the locating bearing's load",
+             (("dynamics/llvm/losses.py", "e.mul(loc1, fz2)", "e.mul(0.0, fz2)"),)),
     Mutation("llvm-sin-quadrant", "llvm: inline sin with the quadrant's sign flipped",
              (("dynamics/llvm/trig.py", "b.select(sin_neg, e.neg(sin_mag), sin_mag)", "b.select(sin_neg, sin_mag, e.neg(sin_mag))"),)),
 ]

@@ -139,6 +139,30 @@ def test_bearing_fixed_point_on_a_few_samples(key, monkeypatch):
     assert np.all(ref.bearing_iterations[moving] > 1) and np.all(ref.bearing_iterations[~moving] == 1)
 
 
+@pytest.mark.parametrize("key", ["servo_joint_rated.yaml", "bendix_wrist_rated.yaml", "shaft"])
+def test_kernel_bearing_moments_are_their_numpy_twin(key, monkeypatch):
+    """The moments the kernel computes of its own reactions (llvm.losses.friction_moments, the
+    split and M_b = 1/2 mu_b d_b P_b in IR) are, at every fixed-point iteration, those
+    bearing_friction.friction_moments gives of the same reactions."""
+    import gearcli.dynamics.llvm.driver as drv
+    from gearcli.dynamics.bearing_friction import friction_joints, friction_moments
+
+    an = analyse(mechanism(key))
+    q, qd, qdd = motion(an, 300)
+    seen, real = [], drv.fixed_point
+
+    def spy(an_, qd_all, solve_moments):
+        def checked(Mb, todo):
+            x, own = solve_moments(Mb, todo)
+            ref = friction_moments(an_.mech, friction_joints(an_.mech), x)
+            seen.append(float(np.max(np.abs(own - ref) / (1.0 + np.abs(ref)))))
+            return x, own
+        return real(an_, qd_all, checked)
+    monkeypatch.setattr(drv, "fixed_point", spy)
+    solve(an, q, qd, qdd, backend="llvm", jobs=1)
+    assert len(seen) >= 3 and max(seen) < 1e-14
+
+
 def test_verify_with_losses_on_the_llvm_path():
     """The residual of the llvm solution, checked against the right-hand side with the joint
     and the converged bearing friction."""

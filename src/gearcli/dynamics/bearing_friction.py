@@ -56,7 +56,7 @@ def bearing_loads(mech, joints: list[int], x_all: dict) -> tuple[np.ndarray, np.
     :func:`~gearcli.model.shaft.split_two_bearings` (:func:`~gearcli.model.shaft.split_components`),
     the locating one taking fz too: P = sqrt(R_x^2 + R_y^2 (+ fz^2)).  All joints at once,
     each component a contiguous (K, N) array."""
-    z1, z2, loc, _, single = _layout(mech, joints)
+    z1, z2, loc, _, single = bearing_layout(mech, joints)
     fx, fy, fz, mx, my = (np.array([x_all[("joint", ji)][:, c] for ji in joints]) for c in range(5))
     R1x, R1y, R2x, R2y = split_components(fx, fy, mx, my, z1[:, None], z2[:, None])
     if single.any():
@@ -66,10 +66,12 @@ def bearing_loads(mech, joints: list[int], x_all: dict) -> tuple[np.ndarray, np.
             np.sqrt(R2x * R2x + R2y * R2y + loc[:, 1:] * fz2))
 
 
-def _layout(mech, joints: list[int]):
+def bearing_layout(mech, joints: list[int]):
     """Per joint of ``joints`` (K): bearing positions z1, z2 (K,) (0, 1 for a single
     bearing), locating flags (K, 2) (1.0/0.0; a single bearing: 1, 0), friction arms
-    1/2 mu_b d_b (K, 2) (0 for a missing second bearing), single-bearing mask (K,)."""
+    1/2 mu_b d_b (K, 2) (0 for a missing second bearing), single-bearing mask (K,).  The
+    constants of :func:`friction_moments` and of its generated twin
+    (:func:`gearcli.dynamics.llvm.losses.friction_moments`)."""
     K = len(joints)
     z1, z2, loc, arm, single = np.zeros(K), np.ones(K), np.zeros((K, 2)), np.zeros((K, 2)), np.zeros(K, bool)
     for k, ji in enumerate(joints):
@@ -86,7 +88,7 @@ def _layout(mech, joints: list[int]):
 def friction_moments(mech, joints: list[int], x_all: dict) -> np.ndarray:
     """sum_b M_b = sum_b 1/2 mu_b d_b P_b (N, len(joints)) of each joint with bearing
     friction, N*m (>= 0), from the joint reactions x_all[("joint", ji)] (N, 5)."""
-    arm = _layout(mech, joints)[3]
+    arm = bearing_layout(mech, joints)[3]
     N = x_all[("joint", joints[0])].shape[0]
     out = np.empty((len(joints), N))
     for s in range(0, N, BLOCK):
@@ -154,7 +156,9 @@ def fixed_point(an, qd_all: np.ndarray, solve_moments):
     friction, on the child -sign(q'_J) Mb about the axis, reversed on the parent) and
     returns the unknowns {(kind, index): (N, size)} of every sample (joint reactions in the
     child's basis; a path may solve the other samples again with their Mb, which no longer
-    changes).  Iterates from zero moments, each sample until its moments change by at most
+    changes), or (those unknowns, moments (N, len(friction_joints))): the moments
+    :func:`friction_moments` gives of its own solution (the llvm kernel's twin), then not
+    computed here.  Iterates from zero moments, each sample until its moments change by at most
     ``TOL`` relative (its Mb is then kept: those of its solution).  Returns (x_all, moments
     (N, J) of every joint, iterations (N,) int: the iteration at which each sample met the
     tolerance).  Raises :class:`BearingFrictionError` naming the first sample that does not
@@ -169,9 +173,12 @@ def fixed_point(an, qd_all: np.ndarray, solve_moments):
     todo = np.arange(N)
     for it in range(1, MAX_ITERATIONS + 1):
         x_all = solve_moments(Mb, todo)
+        x_all, own = x_all if isinstance(x_all, tuple) else (x_all, None)
         every = todo.size == N
-        x_todo = x_all if every else {k: x_all[k][todo] for k in keys}
-        new = friction_moments(an.mech, joints, x_todo)
+        if own is not None:
+            new = own if every else own[todo]
+        else:
+            new = friction_moments(an.mech, joints, x_all if every else {k: x_all[k][todo] for k in keys})
         if rest:
             new = np.where(s if every else s[todo], new, 0.0)
         change = np.abs(new - (Mb if every else Mb[todo]))

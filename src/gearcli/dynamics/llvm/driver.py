@@ -224,7 +224,7 @@ class LlvmKernel:
             return {k: work[0][:, i] for i, k in enumerate(prog.signed)}
         N, J = q.shape[0], len(an.mech.joints)
         A = one_allocation({"qd": (N, J), "friction": (N, J), "joint_loss": (N, J), "gear_loss": (N, len(an.circuits)),
-                            "jq": (N, max(lp.joints.shape[0], 1)), "rate": (N, max(len(lp.rate_meshes), 1))})
+                            "jq": (N, max(lp.joints.shape[0], 1)), "rate": (N, lp.out_width)})
         qd_all = np.matmul(qd, np.asarray(an.S, float).T, out=A["qd"])
         # (N, J), also an output; joint_loss's array as the scratch
         friction = joint_friction_forces(an.mech.joints, qd_all, A["friction"], A["joint_loss"])
@@ -245,7 +245,9 @@ class LlvmKernel:
                 else:                    # the samples not yet converged only
                     jq[todo[:, None], cols] = base[todo] - sign[todo] * Mb[todo]
                     self._rows(an, todo, q, qd, qdd, values, jobs, chunk, out, work, jq, rate)
-                return {("joint", ji): out["joint"][:, ji, :5] for ji in lp.bearing_joints}
+                # the kernel's own sum_b M_b of its reactions (the twin of friction_moments)
+                return ({("joint", ji): out["joint"][:, ji, :5] for ji in lp.bearing_joints},
+                        rate[:, len(lp.rate_meshes):])
             _, bearing, iterations = fixed_point(an, qd_all, solve_moments)
         else:
             self._launch(an, q, qd, qdd, values, jobs, chunk, out, work, jq, rate)

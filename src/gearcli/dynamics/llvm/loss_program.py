@@ -14,7 +14,10 @@ field (None for a lossless mechanism).  It holds, with the model of :mod:`.losse
   and ``joint_flt`` (Q, 6): the joint's axis z and origin in its child's axes (from
   R_jc, p_jc): the joints with friction (Coulomb, viscous or bearings), whose generalised
   friction force per sample (:func:`..losses.joint_friction_force`, the bearing moments of
-  :mod:`..bearing_friction`) the kernel takes as its input ``jq`` (N, Q).
+  :mod:`..bearing_friction`) the kernel takes as its input ``jq`` (N, Q);
+* ``bearing_flt``, ``bearing_single``: the bearings of the joints with bearing friction
+  (:func:`..bearing_friction.bearing_layout`), whose sum_b M_b of the sample's reactions
+  the kernel writes after the rates in its ``rate`` row (width :attr:`LossProgram.out_width`).
 
 Frames and signs as in :mod:`..losses` and :mod:`..blocks`: a constant block's couples are
 in its frame F (``fric`` rows, ``fric_C``), a world-frame block's in base axes per sample.
@@ -25,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..bearing_friction import friction_joints
+from ..bearing_friction import bearing_layout, friction_joints
 from ..blocks import _primary_side
 from ..losses import mesh_friction_moment
 
@@ -64,11 +67,20 @@ class LossProgram:
     joints: np.ndarray
     joint_flt: np.ndarray
     bearing_joints: tuple = field(default=())     # friction_joints(mech): the fixed point's joints
+    bearing_flt: np.ndarray | None = None         # (K, 6) [z1, z2, locating 1, 2, arm 1, 2] (bearing_layout)
+    bearing_single: tuple = field(default=())     # (K,) 1: the joint has one bearing
+
+    @property
+    def out_width(self) -> int:
+        """Width of the kernel's ``rate`` output row: each lossy mesh's rate, then each bearing
+        friction joint's sum_b M_b of the sample's reactions (:func:`.losses.friction_moments`)."""
+        return max(len(self.rate_meshes) + len(self.bearing_joints), 1)
 
     def parts(self) -> list:
         """What the kernel's code is generated from (hashed into the program fingerprint)."""
         out = [self.rate_meshes, self.rate_int.tobytes(), self.rate_flt.tobytes(), self.joints.tobytes(),
-               self.joint_flt.tobytes(), self.bearing_joints]
+               self.joint_flt.tobytes(), self.bearing_joints, self.bearing_single,
+               b"" if self.bearing_flt is None else self.bearing_flt.tobytes()]
         for ci in sorted(self.couple):
             out += [ci, self.couple[ci].tobytes()]
         for b in sorted(self.blocks):
@@ -127,5 +139,8 @@ def build_loss_program(an, plans) -> LossProgram | None:
         # child axes: the joint frame's z is R_jc^T e_z, its origin -R_jc^T p_jc (o_c = o_j + R_j p_jc)
         jrec.append([ji, c if c in moving else -1, par if par in moving else -1, int(jt.type == "prismatic"), 0])
         jflt.append(np.concatenate([R_jc[2, :], -R_jc.T @ np.asarray(jt.p_jc, float)]))
+    bj = friction_joints(mech)
+    z1, z2, loc, arm, single = bearing_layout(mech, bj)
+    bflt = np.ascontiguousarray(np.column_stack([z1, z2, loc, arm]).reshape(-1, 6), float)
     return LossProgram(rate_meshes, rate_int, rate_flt, couple, blocks, np.array(jrec, np.int64).reshape(-1, 5),
-                       np.array(jflt, float).reshape(-1, 6), tuple(friction_joints(mech)))
+                       np.array(jflt, float).reshape(-1, 6), tuple(bj), bflt, tuple(int(v) for v in single))
