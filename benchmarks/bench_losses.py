@@ -2,17 +2,18 @@
 
     python benchmarks/bench_losses.py [--samples 20000] [--rounds 5]
 
-The rated Bendix wrist (5 meshes, 5 joints, 7 bearings), random states, one thread.  Rows,
+The rated Bendix wrist (5 meshes, 8 joints, 15 bearings), random states, one thread.  Rows,
 interleaved round by round so that load drift hits all alike, medians of --rounds:
 
 * lossless, numpy and the compiled llvm kernel (the reference points);
 * mesh + joint friction (every mesh at 3 % loss, every joint with Coulomb + viscous friction),
   numpy: the couples ride in the tooth-force columns (one extra set of block maps per pattern
   of relative-speed signs met); llvm: each block's trial corrected by the rank-ml update of
-  its friction columns (:mod:`gearcli.dynamics.llvm_losses`), the joint friction an input;
+  its friction columns (:mod:`gearcli.dynamics.llvm.losses`), the joint friction an input;
 * the same with bearing friction on every bearing (mu 0.0015, bore 20 mm), numpy and llvm:
   a fixed-point iteration per sample (:func:`gearcli.dynamics.bearing_friction.fixed_point`),
-  whose iterations are printed (median and worst).
+  whose iterations are printed (median and worst); llvm: the kernel rerun per iteration,
+  computing the bearing moments of its own reactions.
 
 The cost of losses in the compiled path (issue 19's target: at most 20 %) is each llvm row
 over the lossless llvm row of the same run.
