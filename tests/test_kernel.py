@@ -160,7 +160,7 @@ def test_low_rank_block_without_hot_patterns():
 
 def test_redundant_world_block_by_kkt_and_by_basis():
     """servo_joint's redundant world-frame block is solved through a square basis (its two
-    free planet meshes, llvm.program._free_columns); without one, from the KKT system:
+    free planet meshes, llvm.basis._free_columns); without one, from the KKT system:
     both generated solves must equal the numpy path (sharing.least_load_solve)."""
     from gearcli.dynamics.external import load_values
     from gearcli.dynamics.llvm.driver import LlvmKernel
