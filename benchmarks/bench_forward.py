@@ -8,7 +8,7 @@ as forward_dynamics does) and of ``gearcli.forward_dynamics`` on the same random
 (--repeat interleaved rounds after a warm-up call that compiles the llvm kernel; medians,
 and the median of the same-round ratios), those ratios against the limit 1/(dof + 1) (what
 dof + 1 inverse-dynamics calls cost: the issue 20 target is ratio >= limit), and
-``mass_matrix`` alone.  Also the wall time of ``gearcli
+``mass_matrix`` alone (the mass kernel, :mod:`gearcli.dynamics.llvm.mass`, once warm).  Also the wall time of ``gearcli
 simulate`` of 2 s of the Bendix wrist with default tolerances (target < 5 s), when the
 command exists.
 """
@@ -100,6 +100,7 @@ def main() -> None:
     else:
         bench("panda", panda, args.samples, args.repeat, args.jobs)
     bench_simulate()
+    print(load_line(), "(at the end)")
 
 
 if __name__ == "__main__":

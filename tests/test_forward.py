@@ -8,8 +8,12 @@
   random states (with its external loads, and with per-sample loads).
 * Hand case: a motor, one spur stage and a disc: the inertia at the motor is
   J_rotor + J_load / n^2, the inertia ratio J_load / (n^2 J_rotor).
+* The mass kernel (backend llvm: M and h per sample, sign pattern 0, no search) equals the
+  numpy reference (the stacked solve of dof + 1 inverse-dynamics samples) on every bundled
+  mechanism; the first-call rule keeps small first calls on the reference.
 * Deliberate bugs the checks catch: the structure matrix untransposed (motor torques
-  mapped by A^T), and rotors as a diagonal "armature" (what Drake/MuJoCo/Pinocchio do).
+  mapped by A^T), rotors as a diagonal "armature" (what Drake/MuJoCo/Pinocchio do), and a
+  mass kernel that solves a block with pattern 0 but passes |t| tan(phi) on to the later links.
 """
 from __future__ import annotations
 
@@ -83,7 +87,7 @@ def test_file_parameters_read_as_by_hand():
     assert (p["s1"], p["s2"], p["s4"]) == pytest.approx((0.2, 0.15, 0.2), abs=1e-15)
 
 
-@pytest.mark.parametrize("backend", ["auto", "numpy"])
+@pytest.mark.parametrize("backend", ["llvm", "numpy"])
 def test_mass_matrix_equals_paper_closed_form(backend):
     an = analyse(load_mechanism(MECH_DIR / "paper_2dof.yaml"))
     q = np.random.default_rng(1).uniform(-np.pi, np.pi, (40, 2))
@@ -154,6 +158,78 @@ def test_round_trip_on_every_bundled_mechanism(name):
     an = analyse(load_mechanism(MECH_DIR / name))
     q, qd, T = random_state(an, 60, seed=len(name))
     assert round_trip_error(an, forward_dynamics, q, qd, T) < 1e-10
+    llvm = (lambda an, q, qd, T, loads=None: forward_dynamics(an, q, qd, T, loads=loads, backend="llvm"))
+    assert round_trip_error(an, llvm, q, qd, T) < 1e-10
+
+
+# --- the mass kernel (backend llvm) against the numpy reference ---------------------------------
+
+def kernel_error(an, q, qd, loads=None) -> tuple[float, float]:
+    """max over samples of |M_llvm - M_numpy| and |h_llvm - h_numpy|, each relative to the
+    sample's largest reference torque (of M and h: the reference's columns tau(e_i) - h
+    round at the size of h)."""
+    M, h = forward._mass_and_h(an, q, qd, loads, "llvm", None)
+    Mr, hr = forward._mass_and_h(an, q, qd, loads, "numpy", None)
+    scale = np.maximum(np.abs(Mr).max(axis=(1, 2)), np.abs(hr).max(axis=1))
+    return (float(np.max(np.abs(M - Mr).max(axis=(1, 2)) / scale)),
+            float(np.max(np.abs(h - hr).max(axis=1) / scale)))
+
+
+@pytest.mark.parametrize("name", BUNDLED)
+def test_mass_kernel_equals_the_reference(name):
+    """M and h to 1e-12 of the sample's torque scale, at random states with the file's
+    loads (a lossy mechanism: M only, the lossless one, which the reference gives at rest;
+    the kernel's h is lossless, :func:`forward._mass_and_h`)."""
+    an = analyse(load_mechanism(MECH_DIR / name))
+    q, qd, _ = random_state(an, 50, seed=len(name) + 1)
+    if an.mech.has_losses:
+        qd = np.zeros_like(qd)
+    err_M, err_h = kernel_error(an, q, qd)
+    assert err_M < 1e-12
+    if not an.mech.has_losses:
+        assert err_h < 1e-12
+
+
+def test_mass_kernel_with_per_sample_loads():
+    an = analyse(load_mechanism(MECH_DIR / "rack_axis.yaml"))
+    q, qd, _ = random_state(an, 30, seed=3)
+    W = np.random.default_rng(4).uniform(-100, 100, (30, 6))
+    assert max(kernel_error(an, q, qd, {"payload": W})) < 1e-12
+
+
+def test_mass_kernel_passing_abs_t_on_would_be_caught(monkeypatch, tmp_path):
+    """Pattern 0 in a block but |t| tan(phi) in the wrenches passed on to the later links
+    (the solve kernel's propagation, right only for the consistent pattern): the Bendix
+    wrist's signed bevel block then gets inconsistent forces, and M is off by percents."""
+    from gearcli.dynamics.llvm import blocks
+    from gearcli.dynamics.llvm.mass import MassKernel
+    from gearcli.dynamics.solve import solver_for
+
+    right = blocks._wrench_in_F
+    monkeypatch.setattr(blocks, "_wrench_in_F", lambda e, rec, cmat, x, fixed=False: right(e, rec, cmat, x))
+    monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path))      # not the right code from the cache
+    an = analyse(load_mechanism(MECH_DIR / "bendix_wrist.yaml"))
+    q, _, _ = random_state(an, 20, seed=12)
+    wrong = MassKernel(solver_for(an).kernel_program(), an).run(an, q, np.zeros_like(q), {}, None)[0]
+    assert rel_err(wrong, mass_matrix(an, q, backend="numpy")) > 1e-3
+
+
+def test_first_call_rule_keeps_a_small_first_call_on_the_reference(monkeypatch, tmp_path):
+    """"auto": a first call of fewer than FIRST_CALL_SAMPLES / (dof + 1) samples does not
+    compile the mass kernel (nor the solve kernel) when the disk cache does not hold it; a
+    large one does."""
+    from gearcli.dynamics.backends import FIRST_CALL_SAMPLES
+    from gearcli.dynamics.solve import solver_for
+
+    monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path))
+    an = analyse(load_mechanism(MECH_DIR / "geared_arm.urdf"))
+    sol = solver_for(an)
+    q, qd, T = random_state(an, FIRST_CALL_SAMPLES // (an.dof + 1), seed=13)
+    small = forward_dynamics(an, q[:10], qd[:10], T[:10])
+    assert forward._KERNELS[sol][0] is None and not sol.compiled_llvm()
+    assert rel_err(small, forward_dynamics(an, q[:10], qd[:10], T[:10], backend="numpy")) < 1e-12
+    forward_dynamics(an, q, qd, T)
+    assert forward._KERNELS[sol][0] is not None
 
 
 def test_round_trip_with_per_sample_loads():

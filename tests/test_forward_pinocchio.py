@@ -37,8 +37,9 @@ def pin_config(model, mech, q_all):
 
 
 @needs_erd
+@pytest.mark.parametrize("backend", ["llvm", "numpy"])    # the mass kernel, the stacked reference
 @pytest.mark.parametrize("rel_path", ARMS)
-def test_mass_matrix_and_forward_dynamics_equal_pinocchio(rel_path):
+def test_mass_matrix_and_forward_dynamics_equal_pinocchio(rel_path, backend):
     path = erd(rel_path)
     mech = load_urdf(path)
     an = analyse(mech)
@@ -49,8 +50,8 @@ def test_mass_matrix_and_forward_dynamics_equal_pinocchio(rel_path):
     rng = np.random.default_rng(0)
     n = 12
     q, qd, T = rng.uniform(-2, 2, (n, an.dof)), rng.uniform(-2, 2, (n, an.dof)), rng.uniform(-20, 20, (n, an.dof))
-    M = mass_matrix(an, q)
-    qdd = forward_dynamics(an, q, qd, T)
+    M = mass_matrix(an, q, backend=backend)
+    qdd = forward_dynamics(an, q, qd, T, backend=backend)
     M_pin, qdd_pin = np.zeros_like(M), np.zeros_like(qdd)
     for s in range(n):
         qp, iv = pin_config(model, mech, S @ q[s])

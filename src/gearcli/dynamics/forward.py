@@ -11,13 +11,26 @@ matrix (motor input rotations = A^T q_ind, paper Eq. 22), so ``tau = A tau_motor
 virtual work.  Units: q in rad (m for a prismatic joint), torques in N*m (N); M in kg*m^2
 (kg, or kg*m where a rotation and a slide are coupled).
 
-Everything here is built on the inverse dynamics of :func:`gearcli.solve`, which is linear
-in qdd (the separating tooth forces |t| tan(phi) are normal to the motion and do no work,
-so they never enter tau): one batched solve over N * (dof + 1) samples gives, for every
-sample, h = tau(q, qd, 0) and the columns M e_i = tau(q, qd, e_i) - h.  Hence
-:func:`forward_dynamics` is the exact inverse of ``solve`` on whatever backend ``solve``
-uses, and the mass matrix inherits its exactness (no diagonal "armature" approximation of
-the rotors).
+M and h are those of the inverse dynamics of :func:`gearcli.solve`, which is linear in qdd
+(the separating tooth forces |t| tan(phi) act at the pitch point, where the meshing teeth
+have no relative velocity: they do no work and never enter tau): h = tau(q, qd, 0) and the
+columns M e_i = tau(q, qd, e_i) - h, so :func:`forward_dynamics` is the exact inverse of
+``solve`` and the mass matrix inherits its exactness (no diagonal "armature" approximation
+of the rotors).  Two implementations, equal to 1e-12 of each sample's largest torque
+(tests/test_forward.py):
+
+* the mass kernel (:mod:`.llvm.mass`; backend "llvm", and "auto" where the llvm backend
+  runs): generated per mechanism, compiled once and kept on disk as the solve kernel is;
+  per sample one h pass and dof column passes (qd = 0, qdd = e_i, no gravity, no loads)
+  sharing the pose, every signed block solved with one sign pattern and no search (the
+  torques do not depend on it), writing only M and h.  Then M qdd = A T - h per sample
+  (:func:`solve_spd`, vectorised).  A forward sample costs about 1.3 solve samples on
+  Bendix (dof 3) and 5 on Panda (dof 8), against dof + 1 (``benchmarks/bench_forward.py``,
+  2026-11-26 10:58 UTC, load 3.4, one thread: Bendix 4.04 M forward samples/s against
+  4.92 M for solve, 3.2x the 1/(dof + 1) limit; Panda 339,000 against 1.99 M, 1.9x);
+* the numpy reference (backend "numpy", and "auto"'s first-call rule of :mod:`.backends`,
+  a call counting as n (dof + 1) samples, while the kernel is neither compiled nor on
+  disk): one numpy solve of the N (dof + 1) stacked samples, dof + 1 inverse dynamics.
 
 Losses (``gears[].efficiency``/``loss_factor``, ``joints[].friction``, bearing friction):
 the mesh friction couple c |t| rho makes tau(q, qd, qdd) piecewise linear in qdd (linear for
@@ -25,25 +38,28 @@ each sign pattern of the tangential forces t, as the separating forces are), and
 bearing friction moments grow with the reactions the accelerations change.
 :func:`forward_dynamics` then solves tau(q, qd, qdd) = A tau_motors as an implicit equation:
 the M and h above give a secant start, then steps qdd -= M^-1 (tau(qdd) - A tau_motors),
-one batched solve of the samples not yet settled each, until the torque residual is below
-1e-12 of the sample's torque scale (the largest of the given torques, h and M: a sample
-near a static balance, where those torques nearly vanish, still rounds at the size of its
-inertia torques).  The secant M spans qdd = 0 to e_i, not the sign pattern of the
-solution, so the steps converge linearly: 10-20 of them on the bundled mechanisms with
-c = 0.03 and joint friction (most samples settle in about 10).  Joint Coulomb and viscous
-friction depend on the rates only and sit in h.  At zero relative speed a mesh has no
-friction couple (no stiction model); a transmission that self-locks under the given
-torques has no unique acceleration: ValueError.
+one batched full solve (losses included) of the samples not yet settled each, until the
+torque residual is below 1e-12 of the sample's torque scale (the largest of the given
+torques, h and M: a sample near a static balance, where those torques nearly vanish,
+still rounds at the size of its inertia torques).  The mass kernel's M and h are the
+lossless ones (the reference's span qdd = 0 to e_i with the friction of that pattern);
+neither is the solution's own slope, so the steps converge linearly: with c = 0.03 and
+joint friction on the bundled mechanisms 9-11 steps from the kernel's lossless M (10-20
+from the reference's secant).  Joint Coulomb and viscous friction depend on the rates only
+(the first step takes them in).  At zero relative speed a mesh has no friction couple (no
+stiction model); a transmission that self-locks under the given torques has no unique
+acceleration: ValueError.
 """
 from __future__ import annotations
 
-import threading
 import weakref
 
 import numpy as np
 
+from .backends import CALL_SAMPLES, FIRST_CALL_SAMPLES
 from .external import load_values
-from .solve import solve
+from .llvm.cache import has_program
+from .solve import solve, solver_for
 
 CHUNK = 2_000
 """Forward samples per batched solve (each becomes dof + 1 inverse-dynamics samples)."""
@@ -82,61 +98,66 @@ def _joints(an) -> list[str]:
     return [f"joint '{n}'" for n in an.independent_names]
 
 
-def _stacked_chunks(an, q, qd, loads, backend, jobs):
-    """Yield (slice, tau (m, dof + 1, dof)) chunk by chunk: [:, 0] = tau(q, qd, 0) = h,
-    [:, 1 + i] = tau(q, qd, e_i), from one solve of m * (dof + 1) samples per chunk.  The
-    chunk's tau is a view of the solve's result arrays, reused by the next chunk (and
-    kept between calls, :func:`_result_buffer`): use it before asking for the next."""
+def _stacked_chunks(an, q, qd, loads):
+    """The numpy reference of :func:`_mass_and_h`: yield (slice, tau (m, dof + 1, dof))
+    chunk by chunk, [:, 0] = tau(q, qd, 0) = h, [:, 1 + i] = tau(q, qd, e_i), from one
+    numpy solve of m * (dof + 1) samples per chunk."""
     n, dof = q.shape
     k = dof + 1
-    loads = load_values(an.mech, n, loads)     # checked, (n, 6) each
     unit = np.zeros((k, dof))
     unit[1:] = np.eye(dof)
     for s in range(0, n, CHUNK):
         sl = slice(s, min(s + CHUNK, n))
         m = sl.stop - sl.start
-        Q = np.repeat(q[sl], k, axis=0)
-        QD = np.repeat(qd[sl], k, axis=0)
-        QDD = np.tile(unit, (m, 1))
         part = {name: np.repeat(w[sl], k, axis=0) for name, w in loads.items()}
-        big = m > SMALL                # a few samples (an integrator's step): fresh arrays cost less than out='s checks
-        res = solve(an, Q, QD, QDD, loads=part, backend=backend, jobs=jobs,
-                    out=_result_buffer(an, m * k) if big else None, check_finite=False)
-        if big:
-            _keep_buffer(an, m * k, res)
+        res = solve(an, np.repeat(q[sl], k, axis=0), np.repeat(qd[sl], k, axis=0), np.tile(unit, (m, 1)),
+                    loads=part, backend="numpy", check_finite=False)
         yield sl, res.tau.reshape(m, k, dof)
 
 
-_BUFFERS = threading.local()
+_KERNELS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
-def _result_buffer(an, rows: int):
-    """The result arrays of this thread's last solve of ``rows`` samples of ``an`` (None at
-    first): reused, so that a stream of forward calls (an integrator's steps, a benchmark's
-    repeats) does not allocate and fault in fresh result pages each time."""
-    cache = getattr(_BUFFERS, "results", None)
-    hit = cache.get(an) if cache is not None else None
-    return hit[1] if hit is not None and hit[0] == rows else None
+def _mass_kernel(an, n: int, backend: str):
+    """The mass kernel (:class:`.llvm.mass.MassKernel`) for a call of n samples, or None:
+    the numpy reference then.  ``backend`` as :func:`gearcli.solve`'s: "numpy" None; "llvm"
+    the kernel (or ValueError); "auto" the kernel where the llvm backend can run, by the
+    first-call rule of :mod:`.backends` (a call counting as n (dof + 1) samples, the solve's
+    work it replaces; its own compile and disk cache entries)."""
+    if backend == "numpy":
+        return None
+    sol = solver_for(an)
+    if sol.choice("block", backend, None).path == "numpy":      # ValueError for a bad backend
+        return None
+    from .llvm.mass import MassKernel  # noqa: PLC0415  (imports llvmlite)
+    kernel, seen = _KERNELS.get(sol, (None, 0))
+    if kernel is None:
+        seen += max(n * (an.dof + 1), CALL_SAMPLES)
+        prog = sol.kernel_program()
+        if backend == "auto" and seen < FIRST_CALL_SAMPLES and not has_program(MassKernel.ids(prog, an)[1]):
+            _KERNELS[sol] = (None, seen)
+            return None
+        kernel = MassKernel(prog, an)
+        _KERNELS[sol] = (kernel, seen)
+    return kernel
 
 
-def _keep_buffer(an, rows: int, res) -> None:
-    if not hasattr(_BUFFERS, "results"):
-        _BUFFERS.results = weakref.WeakKeyDictionary()
-    _BUFFERS.results[an] = (rows, res)
-
-
-def _stacked_tau(an, q, qd, loads, backend, jobs):
-    """tau (N, dof + 1, dof) of :func:`_stacked_chunks`, all chunks."""
-    out = np.empty((q.shape[0], an.dof + 1, an.dof))
-    for sl, tau in _stacked_chunks(an, q, qd, loads, backend, jobs):
-        out[sl] = tau
-    return out
-
-
-def _columns(tau: np.ndarray) -> np.ndarray:
-    """M (N, dof, dof) from the stacked torques of :func:`_stacked_tau`, symmetrised."""
-    M = np.swapaxes(tau[:, 1:, :] - tau[:, :1, :], 1, 2)
-    return 0.5 * (M + np.swapaxes(M, 1, 2))
+def _mass_and_h(an, q, qd, loads, backend, jobs, samples_last: bool = False):
+    """(M, h) of every sample: M (N, dof, dof) (or (dof, dof, N) with ``samples_last``), h
+    (N, dof); the mass kernel's (lossless) or the numpy reference's (for a lossy mechanism
+    the secant of the module docstring)."""
+    n, dof = q.shape
+    values = load_values(an.mech, n, loads)      # checked, (n, 6) each
+    kernel = _mass_kernel(an, n, backend)
+    got = None if kernel is None else kernel.run(an, q, qd, values, jobs, samples_last)
+    if got is not None:
+        return got
+    M, h = np.empty((n, dof, dof)), np.empty((n, dof))       # the reference (also a kernel sample not finite:
+    for sl, tau in _stacked_chunks(an, q, qd, values):       # then the solve names it)
+        M[sl] = np.swapaxes(tau[:, 1:, :] - tau[:, :1, :], 1, 2)
+        M[sl] = 0.5 * (M[sl] + np.swapaxes(M[sl], 1, 2))
+        h[sl] = tau[:, 0, :]
+    return (np.moveaxis(M, 0, 2).copy() if samples_last else M), h
 
 
 def mass_matrix(an, q, backend: str = "auto", jobs: int | None = None) -> np.ndarray:
@@ -152,10 +173,7 @@ def mass_matrix(an, q, backend: str = "auto", jobs: int | None = None) -> np.nda
     that is not finite.
     """
     (q,) = _arrays(an, {"q": (q, an.dof, _joints(an))})
-    M = np.empty((q.shape[0], an.dof, an.dof))
-    for sl, tau in _stacked_chunks(an, q, np.zeros_like(q), {}, backend, jobs):
-        M[sl] = _columns(tau)
-    return M
+    return _mass_and_h(an, q, np.zeros_like(q), None, backend, jobs)[0]
 
 
 def forward_dynamics(an, q, qd, motor_torques, loads: dict | None = None, backend: str = "auto",
@@ -171,9 +189,9 @@ def forward_dynamics(an, q, qd, motor_torques, loads: dict | None = None, backen
     mechanism's.  Returns qdd in rad/s^2 (m/s^2).
 
     The exact inverse of :func:`gearcli.solve`: ``solve(an, q, qd, forward_dynamics(an, q,
-    qd, T)).motor == T`` to rounding.  It solves M qdd = A T - h with M and h from dof + 1
-    inverse-dynamics samples per sample; with losses, the implicit equation of the module
-    docstring.  Raises ValueError for bad shapes, a value that is not finite, or (losses)
+    qd, T)).motor == T`` to rounding.  It solves M qdd = A T - h with M and h of the mass
+    kernel (or the numpy reference, module docstring); with losses, the implicit equation
+    of the module docstring.  Raises ValueError for bad shapes, a value that is not finite, or (losses)
     a sample without a settled acceleration.
     """
     motors = [f"motor '{m.name}'" for m in an.mech.motors]
@@ -182,20 +200,10 @@ def forward_dynamics(an, q, qd, motor_torques, loads: dict | None = None, backen
     target = np.einsum("nm,dm->nd", T, an.A)    # A T per sample; not matmul: BLAS threads would
     # start, then spin on the second core through the kernel calls below (up to 2x slower)
     if an.mech.has_losses:
-        tau = _stacked_tau(an, q, qd, loads, backend, jobs)
-        cols = tau[:, 1:, :] - tau[:, :1, :]                 # [s, i, :] = column i of M
-        return _implicit(an, q, qd, target, np.swapaxes(cols, 1, 2), tau[:, 0, :], loads, backend, jobs)
-    qdd = np.empty_like(q)
-    for sl, tau in _stacked_chunks(an, q, qd, loads, backend, jobs):     # each chunk while it is in cache
-        h = tau[:, 0, :]
-        if tau.shape[0] <= SMALL:                                       # a few samples: LAPACK
-            M = np.swapaxes(tau[:, 1:, :] - h[:, None, :], 1, 2)
-            qdd[sl] = np.linalg.solve(M, (target[sl] - h)[:, :, None])[:, :, 0]
-        else:
-            rows = np.subtract(np.transpose(tau[:, 1:, :], (2, 1, 0)), h.T[:, None, :],
-                               out=np.empty((q.shape[1], q.shape[1], tau.shape[0])))   # M[j, i, s], C order
-            qdd[sl] = solve_spd(rows, target[sl] - h)
-    return qdd
+        M, h = _mass_and_h(an, q, qd, loads, backend, jobs)
+        return _implicit(an, q, qd, target, M, h, loads, backend, jobs)
+    M, h = _mass_and_h(an, q, qd, loads, backend, jobs, samples_last=True)
+    return solve_spd(M, target - h)
 
 
 def _implicit(an, q, qd, target, M, h, loads, backend, jobs) -> np.ndarray:

@@ -39,13 +39,14 @@ def gather(e: Emitter, s: Sample, F: int, links) -> list:
     return r
 
 
-def _wrench_in_F(e: Emitter, rec, cmat, x: list):
-    """C_plus x + C_sep |x| of one :data:`.records.PROPAGATION` record: (f, m) on its primary link, F axes."""
+def _wrench_in_F(e: Emitter, rec, cmat, x: list, fixed: bool = False):
+    """C_plus x + C_sep |x| of one :data:`.records.PROPAGATION` record: (f, m) on its primary link, F axes
+    (``fixed``: C_sep x, the separating force of sign pattern 0 the block was solved with)."""
     c0, size, signed, co = int(rec.col0), int(rec.ncols), int(rec.signed), int(rec.cmat0)
     xs = x[c0:c0 + size]
     w = [e.dot(floats(cmat[co + h * size:co + (h + 1) * size]), xs) for h in range(6)]
     if signed:
-        ax = [e.call("fabs", v) for v in xs]
+        ax = xs if fixed else [e.call("fabs", v) for v in xs]
         cs = co + 6 * size
         w = [e.add(w[h], e.dot(floats(cmat[cs + h * size:cs + (h + 1) * size]), ax)) for h in range(6)]
     return tuple(w[:3]), tuple(w[3:])
@@ -56,12 +57,12 @@ def _subtract(e: Emitter, s: Sample, L: int, w, scale) -> None:
     s.rhs[L] = tuple(e.sub(s.rhs[L][h], e.mul(scale, w[h])) for h in range(6))
 
 
-def propagate(e: Emitter, s: Sample, F: int, recs, prog, x: list) -> None:
+def propagate(e: Emitter, s: Sample, F: int, recs, prog, x: list, fixed: bool = False) -> None:
     """rhs[L] -= the solved wrenches of the block's groups on their later links (blocks' propagation)."""
     cmat, later = prog.cmat, prog.later
     RF, oF = s.R[F], s.o[F]
     for rec in recs:
-        f, mo = _wrench_in_F(e, rec, cmat, x)
+        f, mo = _wrench_in_F(e, rec, cmat, x, fixed)
         f, mo = e.mv(RF, f), e.mv(RF, mo)                    # world axes, about o_F
         P, l0, nl = int(rec.primary), int(rec.later0), int(rec.nlater)
         for L in (int(v) for v in later[l0:l0 + nl]):
@@ -123,10 +124,11 @@ def _on_fail(e: Emitter, fail, n, b: int):
     return emit
 
 
-def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row) -> None:
+def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row, search: bool = True) -> None:
     """Block b of the schedule for sample n: ``fail`` (i64*) gets the first
     block with no consistent sign pattern (it comes filled with -1), ``sg_row`` (double*)
-    the sign of each t used."""
+    the sign of each t used.  ``search`` False: lossless, sign pattern 0 without the search
+    (:mod:`.mass`: the torques do not depend on the pattern; ``n``, ``fail``, ``sg_row`` unused)."""
     rec = prog.blocks[b]
     F, lk0, B, nloc, m, t0, a0 = (int(v) for v in (rec.F, rec.link0, rec.nlinks, rec.n, rec.m, rec.t0, rec.ainv0))
     p0, np_, k0, nt = int(rec.prop0), int(rec.nprop), int(rec.term0), int(rec.nterm)
@@ -143,14 +145,20 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row) -> None:
     else:
         r = gather(e, s, F, links)
         maps = [ainv[a0 + k * nloc * nr:a0 + (k + 1) * nloc * nr].reshape(nloc, nr) for k in range(1 << m)]
-        blk = SignedBlock(e, maps, tcols, f"b{b}") if m else None
-    lossy = prog.losses.blocks.get(b) if prog.losses is not None else None
+        blk = SignedBlock(e, maps, tcols, f"b{b}") if m and search else None
+    lossy = prog.losses.blocks.get(b) if prog.losses is not None and search else None
     if lossy is not None and F < 0:
         blk.extra = llvm_losses.world_columns(prog.losses, lossy, s)
     elif lossy is not None:
         blk = llvm_losses.LossyBlock(blk, lossy, s.sv)
-    if m == 0:
-        x, sig = (blk.solve(e, [], r) if F < 0 else [e.dot(floats(maps[0][i]), r) for i in range(nloc)]), []
+    if m == 0 or not search:
+        sig = [1.0] * m
+        if F < 0:
+            x = blk.solve(e, sig, r)
+        elif b in prog.lowrank:
+            x = blk.rows(e, fn, ir.Constant(I64, 0), list(range(nloc)), r, f"b{b}_x")
+        else:
+            x = [e.dot(floats(maps[0][i]), r) for i in range(nloc)]
     else:
         x, p = resolve(e, fn, blk, r, tolerance(e, r), _on_fail(e, fail, n, b), f"b{b}")
         sig = signs_of(e, p, m)
@@ -159,7 +167,7 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row) -> None:
     if nt > 0:
         propagate_terms(e, s, k0, nt, prog, x, sig)
     else:
-        propagate(e, s, F, prog.props[p0:p0 + np_], prog, x)
+        propagate(e, s, F, prog.props[p0:p0 + np_], prog, x, not search)
     if lossy is not None:
         llvm_losses.propagate(e, s, prog.losses, lossy, F, x, tcols, sig)
     store(e, s, rec, prog, x)

@@ -76,7 +76,7 @@ def mech_loads(an) -> list:
 
 
 GENERATOR = ("kernel", "blocks", "build", "links", "outputs", "signs", "solve", "trig", "world", "driver",
-             "losses", "../result_arrays", "../signs")
+             "losses", "mass", "../result_arrays", "../signs")
 """The modules (paths from :mod:`gearcli.dynamics.llvm`, without .py) whose code makes a kernel program's IR text (a test
 checks that every module they import from the package is listed or makes only hashed input)."""
 
@@ -189,23 +189,47 @@ class LlvmKernel:
 
     ``build_seconds`` (IR generation: 0 when the code came from the disk cache by program
     key) and ``compile_seconds`` (LLVM optimisation and code generation, or the cache load)
-    say what it cost; ``jit.ir`` is its IR, ``jit.assembly()`` its machine code."""
+    say what it cost; ``jit.ir`` is its IR, ``jit.assembly()`` its machine code.  A subclass
+    compiles another function of the same program (:class:`.mass.MassKernel`): its
+    ``ENTRY`` name, ``INTS`` (the arguments that are i64, after ``POINTERS`` pointers),
+    :meth:`build` and :meth:`ids`."""
+
+    ENTRY, POINTERS, INTS = "run", len(ARGS) - 2, 2
 
     def __init__(self, prog: Program, an):
         t0 = time.perf_counter()
         loads = mech_loads(an)
-        fingerprint, pkey = _program_ids(prog, an)
-        source = KernelSource(lambda: build_module(prog, loads), pkey if generator_digest() else None, fingerprint)
+        fingerprint, pkey = self.ids(prog, an)
+        source = KernelSource(lambda: self.build(prog, loads), pkey if generator_digest() else None, fingerprint)
         self.jit = Jit(source)
         if self.jit.stored or (self.jit.from_cache and not self.jit.by_program):
             llvm_cache.note_program(pkey, self.jit.key)
-        proto = ctypes.CFUNCTYPE(ctypes.c_int64, *([ctypes.c_void_p] * (len(ARGS) - 2) + [ctypes.c_int64] * 2))
-        self._run = proto(self.jit.address("run"))
+        proto = ctypes.CFUNCTYPE(ctypes.c_int64, *([ctypes.c_void_p] * self.POINTERS + [ctypes.c_int64] * self.INTS))
+        self._run = proto(self.jit.address(self.ENTRY))
         self.build_seconds = source.seconds
         self.compile_seconds = time.perf_counter() - t0 - source.seconds
         self.prog = prog
         self._load_order, groups = load_groups(loads)
         self._load_groups = np.array([[k0, k1] for _, k0, k1 in groups] or [[0, 0]], np.int64)
+
+    @staticmethod
+    def build(prog: Program, loads):
+        """The IR module of the kernel (:func:`.kernel.build_module`)."""
+        return build_module(prog, loads)
+
+    @staticmethod
+    def ids(prog: Program, an) -> tuple[str, str]:
+        """(fingerprint, program key) of the kernel (:func:`_program_ids`)."""
+        return _program_ids(prog, an)
+
+    def load_args(self, an, values: dict, n: int) -> list:
+        """The external loads' arguments of the code (vals, ldpt, ldrow, ldgrp), contiguous."""
+        ld, ldpt, vals = load_arrays(an, values, n)
+        order = self._load_order      # ldrow, as the code reads it: [row0, per_sample, in_link] a load
+        ldrow = np.ascontiguousarray(np.column_stack([ld.row0, ld.per_sample, ld.in_link])[order] if order
+                                     else np.zeros((1, 3), np.int64))
+        ldpt = np.ascontiguousarray(ldpt[order] if order else np.zeros((1, 3)))
+        return [np.ascontiguousarray(vals, float), ldpt, ldrow, self._load_groups]
 
     def solve(self, an, q, qd, qdd, values: dict, jobs: int | None, chunk: int, out: dict, work: tuple,
               losses: dict | None = None) -> dict:
@@ -261,13 +285,7 @@ class LlvmKernel:
         """One run of the kernel over every sample of q (raises the numpy path's SignError)."""
         n = q.shape[0]
         SG, fail = work
-        ld, ldpt, vals = load_arrays(an, values, n)
-        order = self._load_order      # ldrow, as the code reads it: [row0, per_sample, in_link] a load
-        ldrow = np.ascontiguousarray(np.column_stack([ld.row0, ld.per_sample, ld.in_link])[order] if order
-                                     else np.zeros((1, 3), np.int64))
-        ldpt = np.ascontiguousarray(ldpt[order] if order else np.zeros((1, 3)))
-        keep = [np.ascontiguousarray(a, float) for a in (q, qd, qdd)] + [np.ascontiguousarray(vals, float), ldpt,
-                                                                       ldrow, self._load_groups]
+        keep = [np.ascontiguousarray(a, float) for a in (q, qd, qdd)] + self.load_args(an, values, n)
         keep += [out[k] if out[k].size else np.empty((1, 1)) for k in OUTPUTS] + [SG, jq, rate, fail]
         ptrs = [a.ctypes.data for a in keep]
         failed = run_parts(lambda s, e, _: self._run(*ptrs, s, e), job_ranges(n, jobs), threads_for(n, jobs))

@@ -35,11 +35,11 @@ ARGS = ("qi", "qdi", "qddi", "vals", "ldpt", "ldrow", "ldgrp") + OUTPUTS + ("sig
                                                                           "stop")
 
 
-def _signature(mod: ir.Module) -> ir.Function:
-    types = [DP] * 5 + [I64P] * 2 + [DP] * (len(OUTPUTS) + 3) + [I64P, I64, I64]
-    fn = ir.Function(mod, ir.FunctionType(I64, types), "run")
-    for arg, name in zip(fn.args, ARGS):
-        arg.name = name
+def signature(mod: ir.Module, name: str, types: list, names: tuple) -> ir.Function:
+    """Function ``name`` of ``mod`` returning i64, its arguments named (pointers noalias)."""
+    fn = ir.Function(mod, ir.FunctionType(I64, types), name)
+    for arg, arg_name in zip(fn.args, names):
+        arg.name = arg_name
         if isinstance(arg.type, ir.PointerType):
             arg.add_attribute("noalias")
     return fn
@@ -77,25 +77,37 @@ def build_module(prog, loads) -> ir.Module:
     """The IR module of ``prog``'s kernel (``loads``: per external load of the mechanism,
     its link id first (:func:`.driver.mech_loads`); only their links shape the code))."""
     mod = ir.Module(name="gearcli_kernel")
-    fn = _signature(mod)
-    entry, body, done = fn.append_basic_block("entry"), fn.append_basic_block("sample"), fn.append_basic_block("done")
+    types = [DP] * 5 + [I64P] * 2 + [DP] * (len(OUTPUTS) + 3) + [I64P, I64, I64]
+    fn = signature(mod, "run", types, ARGS)
+    fail = fn.args[ARGS.index("fail")]
+
+    def body(e: Emitter, n):
+        _sample(e, fn, prog, loads, n)
+        return e.b.icmp_signed(">=", e.b.load(e.b.gep(fail, [n])), ir.Constant(I64, 0))
+    sample_loop(fn, body)
+    return mod
+
+
+def sample_loop(fn: ir.Function, body) -> None:
+    """The body of ``fn``: a loop over the samples start..stop-1 (its last two arguments)
+    emitting ``body(emitter, n)`` (which returns an i1: the sample failed); ``fn`` returns
+    how many samples failed."""
+    entry, loop, done = fn.append_basic_block("entry"), fn.append_basic_block("sample"), fn.append_basic_block("done")
     b = ir.IRBuilder(entry)
     start, stop = fn.args[-2], fn.args[-1]
-    b.cbranch(b.icmp_signed("<", start, stop), body, done)
-    b.position_at_end(body)
+    b.cbranch(b.icmp_signed("<", start, stop), loop, done)
+    b.position_at_end(loop)
     n, bad = b.phi(I64, "n"), b.phi(I64, "bad")
     n.add_incoming(start, entry)
     bad.add_incoming(ir.Constant(I64, 0), entry)
-    _sample(Emitter(b, mod), fn, prog, loads, n)
-    failed = b.icmp_signed(">=", b.load(b.gep(fn.args[ARGS.index("fail")], [n])), ir.Constant(I64, 0))
+    failed = body(Emitter(b, fn.module), n)
     n1, bad1 = b.add(n, ir.Constant(I64, 1)), b.add(bad, b.zext(failed, I64))
     latch = b.block
     n.add_incoming(n1, latch)
     bad.add_incoming(bad1, latch)
-    b.cbranch(b.icmp_signed("<", n1, stop), body, done)
+    b.cbranch(b.icmp_signed("<", n1, stop), loop, done)
     b.position_at_end(done)
     total = b.phi(I64, "failed")
     total.add_incoming(ir.Constant(I64, 0), entry)
     total.add_incoming(bad1, latch)
     b.ret(total)
-    return mod

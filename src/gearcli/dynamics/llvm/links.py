@@ -26,7 +26,9 @@ class Sample:
     ``q, qd, qdd`` (J,) per real joint; ``R, o, w, dw, a`` per link (base frame; the base
     at rest: identity and zeros, constants); ``cs`` per joint (cos, sin of its angle);
     ``rhs`` per link the 6 right-hand-side entries (base frame, about o_L); ``sol`` per
-    column of the solution row its value (joint reactions in the child's basis).
+    column of the solution row its value (joint reactions in the child's basis);
+    ``frames`` per joint its (R, o, cos, sin) at q, emitted once and shared by the samples
+    of the same pose (:mod:`.mass`).
     """
 
     q: list
@@ -41,6 +43,7 @@ class Sample:
     rhs: dict = field(default_factory=dict)
     sol: dict = field(default_factory=dict)
     sv: list = field(default_factory=list)     # s_v of each lossy mesh (:mod:`.losses`)
+    frames: dict = field(default_factory=dict)
 
 
 def floats(row) -> tuple:
@@ -85,7 +88,9 @@ def joint(e: Emitter, s: Sample, rec, pose) -> None:
     ji, p, c, pr = int(rec.joint), int(rec.parent), int(rec.child), int(rec.prismatic)
     qdk, qddk = s.qd[ji], s.qdd[ji]
     op, wp, dwp = s.o[p], s.w[p], s.dw[p]
-    Rj, oj, cq, sq = _joint_frame(e, pose, s.R[p], op, s.q[ji], pr == 1)
+    if ji not in s.frames:
+        s.frames[ji] = _joint_frame(e, pose, s.R[p], op, s.q[ji], pr == 1)
+    Rj, oj, cq, sq = s.frames[ji]
     s.cs[ji] = (cq, sq)
     z = (Rj[2], Rj[5], Rj[8])
     aj = _arm_accel(e, s.a[p], dwp, wp, e.vsub(oj, op))
