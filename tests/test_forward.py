@@ -168,8 +168,8 @@ def kernel_error(an, q, qd, loads=None) -> tuple[float, float]:
     """max over samples of |M_llvm - M_numpy| and |h_llvm - h_numpy|, each relative to the
     sample's largest reference torque (of M and h: the reference's columns tau(e_i) - h
     round at the size of h)."""
-    M, h = forward._mass_and_h(an, q, qd, loads, "llvm", None)
-    Mr, hr = forward._mass_and_h(an, q, qd, loads, "numpy", None)
+    M, h, _ = forward._mass_and_h(an, q, qd, np.zeros_like(q), loads, "llvm", None)
+    Mr, hr, _ = forward._mass_and_h(an, q, qd, np.zeros_like(q), loads, "numpy", None)
     scale = np.maximum(np.abs(Mr).max(axis=(1, 2)), np.abs(hr).max(axis=1))
     return (float(np.max(np.abs(M - Mr).max(axis=(1, 2)) / scale)),
             float(np.max(np.abs(h - hr).max(axis=1) / scale)))
@@ -210,7 +210,7 @@ def test_mass_kernel_passing_abs_t_on_would_be_caught(monkeypatch, tmp_path):
     monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path))      # not the right code from the cache
     an = analyse(load_mechanism(MECH_DIR / "bendix_wrist.yaml"))
     q, _, _ = random_state(an, 20, seed=12)
-    wrong = MassKernel(solver_for(an).kernel_program(), an).run(an, q, np.zeros_like(q), {}, None)[0]
+    wrong = MassKernel(solver_for(an).kernel_program(), an).run(an, q, np.zeros_like(q), {}, np.zeros_like(q), None)[0]
     assert rel_err(wrong, mass_matrix(an, q, backend="numpy")) > 1e-3
 
 

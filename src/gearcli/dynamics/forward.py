@@ -23,11 +23,11 @@ of the rotors).  Two implementations, equal to 1e-12 of each sample's largest to
   runs): generated per mechanism, compiled once and kept on disk as the solve kernel is;
   per sample one h pass and dof column passes (qd = 0, qdd = e_i, no gravity, no loads)
   sharing the pose, every signed block solved with one sign pattern and no search (the
-  torques do not depend on it), writing only M and h.  Then M qdd = A T - h per sample
-  (:func:`solve_spd`, vectorised).  A forward sample costs about 1.3 solve samples on
-  Bendix (dof 3) and 5 on Panda (dof 8), against dof + 1 (``benchmarks/bench_forward.py``,
-  2026-11-26 10:58 UTC, load 3.4, one thread: Bendix 4.04 M forward samples/s against
-  4.92 M for solve, 3.2x the 1/(dof + 1) limit; Panda 339,000 against 1.99 M, 1.9x);
+  torques do not depend on it), writing only M, h and qdd = M^-1 (A T - h) (in the same
+  loop).  A forward sample costs about 1.3 solve samples on Bendix (dof 3) and 4.5 on
+  Panda (dof 8), against dof + 1 (``benchmarks/bench_forward.py``, 2026-11-26 11:07 UTC,
+  load 3.9, one thread: Bendix 2.02 M forward samples/s against 2.47 M for solve, 3.1x
+  the 1/(dof + 1) limit; Panda 299,000 against 1.32 M, 2.0x);
 * the numpy reference (backend "numpy", and "auto"'s first-call rule of :mod:`.backends`,
   a call counting as n (dof + 1) samples, while the kernel is neither compiled nor on
   disk): one numpy solve of the N (dof + 1) stacked samples, dof + 1 inverse dynamics.
@@ -142,14 +142,14 @@ def _mass_kernel(an, n: int, backend: str):
     return kernel
 
 
-def _mass_and_h(an, q, qd, loads, backend, jobs, samples_last: bool = False):
-    """(M, h) of every sample: M (N, dof, dof) (or (dof, dof, N) with ``samples_last``), h
-    (N, dof); the mass kernel's (lossless) or the numpy reference's (for a lossy mechanism
-    the secant of the module docstring)."""
+def _mass_and_h(an, q, qd, target, loads, backend, jobs):
+    """(M (N, dof, dof), h (N, dof), qdd (N, dof) = M^-1 (target - h)) of every sample: the
+    mass kernel's (lossless) or the numpy reference's (for a lossy mechanism the secant of
+    the module docstring)."""
     n, dof = q.shape
     values = load_values(an.mech, n, loads)      # checked, (n, 6) each
     kernel = _mass_kernel(an, n, backend)
-    got = None if kernel is None else kernel.run(an, q, qd, values, jobs, samples_last)
+    got = None if kernel is None else kernel.run(an, q, qd, values, target, jobs)
     if got is not None:
         return got
     M, h = np.empty((n, dof, dof)), np.empty((n, dof))       # the reference (also a kernel sample not finite:
@@ -157,7 +157,7 @@ def _mass_and_h(an, q, qd, loads, backend, jobs, samples_last: bool = False):
         M[sl] = np.swapaxes(tau[:, 1:, :] - tau[:, :1, :], 1, 2)
         M[sl] = 0.5 * (M[sl] + np.swapaxes(M[sl], 1, 2))
         h[sl] = tau[:, 0, :]
-    return (np.moveaxis(M, 0, 2).copy() if samples_last else M), h
+    return M, h, solve_spd(np.moveaxis(M, 0, 2).copy(), target - h)
 
 
 def mass_matrix(an, q, backend: str = "auto", jobs: int | None = None) -> np.ndarray:
@@ -173,7 +173,7 @@ def mass_matrix(an, q, backend: str = "auto", jobs: int | None = None) -> np.nda
     that is not finite.
     """
     (q,) = _arrays(an, {"q": (q, an.dof, _joints(an))})
-    return _mass_and_h(an, q, np.zeros_like(q), None, backend, jobs)[0]
+    return _mass_and_h(an, q, np.zeros_like(q), np.zeros_like(q), None, backend, jobs)[0]
 
 
 def forward_dynamics(an, q, qd, motor_torques, loads: dict | None = None, backend: str = "auto",
@@ -199,16 +199,13 @@ def forward_dynamics(an, q, qd, motor_torques, loads: dict | None = None, backen
                             "motor_torques": (motor_torques, len(motors), motors)})
     target = np.einsum("nm,dm->nd", T, an.A)    # A T per sample; not matmul: BLAS threads would
     # start, then spin on the second core through the kernel calls below (up to 2x slower)
-    if an.mech.has_losses:
-        M, h = _mass_and_h(an, q, qd, loads, backend, jobs)
-        return _implicit(an, q, qd, target, M, h, loads, backend, jobs)
-    M, h = _mass_and_h(an, q, qd, loads, backend, jobs, samples_last=True)
-    return solve_spd(M, target - h)
+    M, h, qdd = _mass_and_h(an, q, qd, target, loads, backend, jobs)
+    return _implicit(an, q, qd, target, M, h, qdd, loads, backend, jobs) if an.mech.has_losses else qdd
 
 
-def _implicit(an, q, qd, target, M, h, loads, backend, jobs) -> np.ndarray:
+def _implicit(an, q, qd, target, M, h, qdd, loads, backend, jobs) -> np.ndarray:
     """qdd with tau(q, qd, qdd) = target (N, dof) for a mechanism with losses, where tau is
-    piecewise linear in qdd (|t| of the mesh friction): from the secant solution
+    piecewise linear in qdd (|t| of the mesh friction): from ``qdd``, the secant solution
     M qdd = target - h, steps qdd -= M^-1 (tau(qdd) - target) on the samples not yet settled
     (one solve of those samples a step; linear convergence, 10-20 steps with c = 0.03).
 
@@ -218,7 +215,6 @@ def _implicit(an, q, qd, target, M, h, loads, backend, jobs) -> np.ndarray:
     rounds to them), or when a step no longer reduces a residual already within
     :data:`STALLED` of that scale (rounding reached).  ValueError naming the first sample
     that does not settle in :data:`MAX_STEPS` (e.g. a self-locking transmission)."""
-    qdd = np.linalg.solve(M, (target - h)[:, :, None])[:, :, 0]
     values = load_values(an.mech, len(q), loads)
     scale = np.maximum(np.maximum(np.abs(target).max(axis=1), np.abs(h).max(axis=1)),
                        np.abs(M).max(axis=(1, 2)))

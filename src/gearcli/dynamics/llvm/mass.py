@@ -2,7 +2,7 @@
 
 :func:`build_module` writes, from the same :class:`~.program.Program` as :mod:`.kernel`,
 
-    mass(qi, qdi, vals, ldpt, ldrow, ldgrp, M, h, sample_stride, entry_stride, start, stop)
+    mass(qi, qdi, rhs, vals, ldpt, ldrow, ldgrp, M, h, qdd, start, stop)
 
 whose loop does per sample what :mod:`..forward`'s stacked solve does with dof + 1
 inverse-dynamics samples, writing only the torques tau = A motor: the h pass (q, qd loaded,
@@ -18,10 +18,10 @@ relative velocity: they do no work and tau does not depend on the pattern they a
 with (the numpy reference, which takes the consistent pattern, agrees to rounding).
 No losses: M is the lossless inertia of paper Eq. 25.
 
-M is written symmetrised, 0.5 (M + M^T), entry (d, i) of sample n at
-``M[n * sample_stride + (d * dof + i) * entry_stride]`` ((N, dof, dof): dof^2 and 1;
-samples last, (dof, dof, N): 1 and N), h as (N, dof).  ``mass`` returns how many samples
-have an entry that is not finite (a singular world-frame block gives NaN).
+M is written symmetrised, 0.5 (M + M^T), (N, dof, dof), h (N, dof), and the accelerations
+qdd = M^-1 (rhs - h) (N, dof) (``rhs`` (N, dof), forward dynamics' A T; Gaussian
+elimination with partial pivoting, :func:`.world.eliminate`).  ``mass`` returns how many
+samples have an output that is not finite (a singular matrix gives NaN).
 """
 from __future__ import annotations
 
@@ -31,13 +31,14 @@ import llvmlite.ir as ir
 import numpy as np
 
 from .blocks import block
-from .build import DP, I64, I64P, Emitter
+from .build import D, DP, I64, I64P, Emitter
 from .driver import LlvmKernel, _program_ids
 from .jobs import job_ranges, run_parts, threads_for
 from .kernel import sample_loop, signature
 from .links import Sample, at_rest, external, floats, inertia, joint, joint_space, load_groups
+from .world import eliminate
 
-ARGS = ("qi", "qdi", "vals", "ldpt", "ldrow", "ldgrp", "M", "h", "sample_stride", "entry_stride", "start", "stop")
+ARGS = ("qi", "qdi", "rhs", "vals", "ldpt", "ldrow", "ldgrp", "M", "h", "qdd", "start", "stop")
 
 
 def _tau(e: Emitter, fn, prog, s: Sample, gravity, loads=None) -> list:
@@ -68,27 +69,23 @@ def _sample(e: Emitter, fn, prog, loads, n):
              lambda s: external(e, s, fn, loaded, n, a["vals"], a["ldrow"], a["ldpt"], a["ldgrp"]))
     cols = [_tau(e, fn, prog, Sample(s.q, [0.0] * J, list(floats(S[:, i])), frames=s.frames), (0.0, 0.0, 0.0))
             for i in range(dof)]
+    M = [[cols[i][d] if i == d else e.mul(0.5, e.add(cols[i][d], cols[d][i])) for i in range(dof)]
+         for d in range(dof)]
+    rhs = e.row(a["rhs"], n, dof)
+    qdd = eliminate(e, M, [e.sub(e.load(rhs, d), h[d]) for d in range(dof)])
     check = 0.0
-    hrow = e.row(a["h"], n, dof)
-    for d in range(dof):
-        e.store(h[d], hrow, d)
-        check = e.add(check, h[d])
-    base = e.b.mul(n, a["sample_stride"])
-    for d in range(dof):
-        for i in range(dof):
-            v = cols[i][d] if i == d else e.mul(0.5, e.add(cols[i][d], cols[d][i]))
-            at = e.b.add(base, e.b.mul(ir.Constant(I64, d * dof + i), a["entry_stride"]))
-            e.store(v, a["M"], at)
+    for name, values in (("h", h), ("qdd", qdd), ("M", [v for row in M for v in row])):
+        row = e.row(a[name], n, len(values))
+        for k, v in enumerate(values):
+            e.store(v, row, k)
             check = e.add(check, v)
-    if isinstance(check, float):
-        return ir.Constant(ir.IntType(1), 0)
-    return e.b.fcmp_unordered("uno", e.sub(check, check), ir.Constant(check.type, 0.0))   # NaN or an infinity
+    return e.b.fcmp_unordered("uno", e.sub(check, check), ir.Constant(D, 0.0))   # NaN or an infinity
 
 
 def build_module(prog, loads) -> ir.Module:
     """The IR module of ``prog``'s mass kernel (``loads`` as :func:`.kernel.build_module`'s)."""
     mod = ir.Module(name="gearcli_mass")
-    fn = signature(mod, "mass", [DP] * 4 + [I64P] * 2 + [DP] * 2 + [I64] * 4, ARGS)
+    fn = signature(mod, "mass", [DP] * 5 + [I64P] * 2 + [DP] * 3 + [I64] * 2, ARGS)
     sample_loop(fn, lambda e, n: _sample(e, fn, prog, loads, n))
     return mod
 
@@ -101,7 +98,7 @@ class MassKernel(LlvmKernel):
     """The compiled mass kernel of one mechanism (compiled and cached on disk as the
     solve kernel is, :class:`.driver.LlvmKernel`; its own entries)."""
 
-    ENTRY, POINTERS, INTS = "mass", 8, 4
+    ENTRY, POINTERS, INTS = "mass", 10, 2
 
     @staticmethod
     def build(prog, loads):
@@ -112,15 +109,13 @@ class MassKernel(LlvmKernel):
         """(fingerprint, program key): the solve kernel's, derived (another function)."""
         return tuple(_derived(k) for k in _program_ids(prog, an))
 
-    def run(self, an, q, qd, values: dict, jobs: int | None, samples_last: bool = False):
-        """(M, h) of the samples (q, qd (N, dof), ``values`` the external loads of
-        :func:`..external.load_values`): M (N, dof, dof), or (dof, dof, N) with
-        ``samples_last``, and h (N, dof); None when a sample has an entry that is not finite."""
+    def run(self, an, q, qd, values: dict, rhs, jobs: int | None):
+        """(M (N, dof, dof), h (N, dof), qdd (N, dof)) of the samples (q, qd, rhs (N, dof),
+        ``values`` the external loads of :func:`..external.load_values`); None when a sample
+        has an output that is not finite."""
         n, dof = q.shape
-        M = np.empty((dof, dof, n) if samples_last else (n, dof, dof))
-        h = np.empty((n, dof))
-        strides = (1, n) if samples_last else (dof * dof, 1)
-        keep = [np.ascontiguousarray(v, float) for v in (q, qd)] + self.load_args(an, values, n) + [M, h]
+        out = M, h, qdd = np.empty((n, dof, dof)), np.empty((n, dof)), np.empty((n, dof))
+        keep = [np.ascontiguousarray(v, float) for v in (q, qd, rhs)] + self.load_args(an, values, n) + list(out)
         ptrs = [v.ctypes.data for v in keep]
-        bad = run_parts(lambda s, e, _: self._run(*ptrs, *strides, s, e), job_ranges(n, jobs), threads_for(n, jobs))
-        return None if bad else (M, h)
+        bad = run_parts(lambda s, e, _: self._run(*ptrs, s, e), job_ranges(n, jobs), threads_for(n, jobs))
+        return None if bad else out
