@@ -18,7 +18,10 @@ relative velocity: they do no work and tau does not depend on the pattern they a
 with (the numpy reference, which takes the consistent pattern, agrees to rounding).
 No losses: M is the lossless inertia of paper Eq. 25.
 
-M is written symmetrised, 0.5 (M + M^T), (N, dof, dof), h (N, dof), and the accelerations
+M is written symmetric, M[d, i] = M[i, d] = column min(d, i)'s torque on joint max(d, i)
+(LLVM then drops the work that only fed the other half, a column pass's blocks before its
+own joint in a chain ordered root first: Panda 11,000 machine instructions instead of
+13,400), (N, dof, dof), h (N, dof), and the accelerations
 qdd = M^-1 (rhs - h) (N, dof) (``rhs`` (N, dof), forward dynamics' A T; Gaussian
 elimination with partial pivoting, :func:`.world.eliminate`).  ``mass`` returns how many
 samples have an output that is not finite (a singular matrix gives NaN).
@@ -69,8 +72,7 @@ def _sample(e: Emitter, fn, prog, loads, n):
              lambda s: external(e, s, fn, loaded, n, a["vals"], a["ldrow"], a["ldpt"], a["ldgrp"]))
     cols = [_tau(e, fn, prog, Sample(s.q, [0.0] * J, list(floats(S[:, i])), frames=s.frames), (0.0, 0.0, 0.0))
             for i in range(dof)]
-    M = [[cols[i][d] if i == d else e.mul(0.5, e.add(cols[i][d], cols[d][i])) for i in range(dof)]
-         for d in range(dof)]
+    M = [[cols[min(d, i)][max(d, i)] for i in range(dof)] for d in range(dof)]   # the later joint's torque
     rhs = e.row(a["rhs"], n, dof)
     qdd = eliminate(e, M, [e.sub(e.load(rhs, d), h[d]) for d in range(dof)])
     check = 0.0
