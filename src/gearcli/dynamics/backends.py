@@ -50,13 +50,13 @@ class Choice:
     fallback: bool = False
 
 
-def llvm_refusal(prog) -> str | None:
-    """Why the generated kernel cannot solve the kernel program ``prog`` here, or None."""
+def llvm_refusal() -> str | None:
+    """Why the generated kernel cannot run in this process (a covered kernel program), or None."""
     try:
-        from .llvm.driver import llvm_problem  # noqa: PLC0415  (imports llvmlite)
+        import llvmlite.binding  # noqa: F401, PLC0415
     except ImportError:
         return "llvmlite does not import"
-    return llvm_problem(prog)
+    return None
 
 
 def llvm_on_disk(sol) -> bool:

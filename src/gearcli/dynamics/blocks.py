@@ -15,9 +15,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..analysis.schedule import unknown_groups
 from ..spatial import cross
 from .coaxial_frames import coaxial_links, turn_row
+from .determinacy import block_unknowns
 from .equations import Columns
 from .general import is_geared, mesh_names, solve_general
 from .kinematics import Kinematics, forward
@@ -53,6 +53,8 @@ class BlockPlan:
     fric_C: dict = field(default_factory=dict)
     # s_v pattern (tuple of -1/0/1 per signed mesh) -> PatternMaps, made on first use
     fric_maps: dict = field(default_factory=dict)
+    # group position -> the links of later blocks it acts on (its solved wrench is passed on)
+    later: dict = field(default_factory=dict)
 
 
 def _spread(an, g) -> bool:
@@ -93,15 +95,6 @@ def _primary_side(an, g) -> int:
     if g.kind == "motor":
         return an.motor_links[g.index]
     return an.circuits[g.index].j
-
-
-def _owned_groups(an, groups) -> dict[int, list]:
-    """Unknown groups of each block: a group belongs to the first block it acts on."""
-    block_of = {L: i for i, blk in enumerate(an.schedule) for L in blk}
-    owned: dict[int, list] = {i: [] for i in range(len(an.schedule))}
-    for g in groups:
-        owned[min(block_of[L] for L in g.links)].append(g)
-    return owned
 
 
 def _constant_matrices(an, blk, gs, offs, signed, to_F, cols) -> PatternMaps:
@@ -179,7 +172,8 @@ def _frame(an, gs, common: set) -> tuple[int | None, dict]:
 def make_plans(an) -> tuple[BlockPlan, ...]:
     """Block plans of ``an.schedule`` (computed once per analysis, owned by the solver)."""
     tree = an.tree
-    owned = _owned_groups(an, unknown_groups(an))
+    owned = block_unknowns(an)
+    block_of = {L: i for i, blk in enumerate(an.schedule) for L in blk}
     home = forward(an.mech, tree, np.zeros((1, len(an.mech.joints))))
     cols = Columns(an, home)
     plans = []
@@ -188,13 +182,11 @@ def make_plans(an) -> tuple[BlockPlan, ...]:
         offs = np.cumsum([0] + [g.size for g in gs])
         signed = [i for i, g in enumerate(gs) if is_geared(an, g)]
         names = mesh_names(an, gs, signed)
+        later = {gi: [L for L in g.links if block_of[L] > bi] for gi, g in enumerate(gs)}
         common = set.intersection(*[_fixed_in(an, g) for g in gs]) if gs else set()
-        if not common or offs[-1] < 6 * len(blk):
-            plans.append(BlockPlan(tuple(blk), gs, None, signed, offs, [], [], names, {}, {}))
-            continue
-        F, turn = _frame(an, gs, common)
+        F, turn = _frame(an, gs, common) if common and offs[-1] >= 6 * len(blk) else (None, {})
         if F is None:
-            plans.append(BlockPlan(tuple(blk), gs, None, signed, offs, [], [], names, {}, {}))
+            plans.append(BlockPlan(tuple(blk), gs, None, signed, offs, [], [], names, {}, {}, later=later))
             continue
         RF, oF = home.R[F][0], home.o[F][0]
 
@@ -209,7 +201,7 @@ def make_plans(an) -> tuple[BlockPlan, ...]:
         fric, fric_C = _friction_columns(an, blk, gs, signed, to_F, cols)
         pats = sign_patterns(len(signed)) if len(signed) <= MAX_EXHAUSTIVE else []
         plans.append(BlockPlan(tuple(blk), gs, F, signed, offs, pats, Ainv, names,
-                               C, parent_side, turn, fric, fric_C))
+                               C, parent_side, turn, fric, fric_C, later=later))
     return tuple(plans)
 
 
@@ -227,16 +219,12 @@ def _shift(w6, o_from, o_to):
 
 
 def _subtract(acc, sign, w6, o_from, o_to):
-    """acc (N,6) about o_to -= sign * (wrench w6 about o_from), in place."""
-    if sign > 0:
-        acc -= w6
-        acc[:, 3:] -= cross(o_from - o_to, w6[:, :3])
-    else:
-        acc += w6
-        acc[:, 3:] += cross(o_from - o_to, w6[:, :3])
+    """acc (N,6) about o_to -= sign * (wrench w6 about o_from), in place (sign +-1)."""
+    acc -= sign * w6
+    acc[:, 3:] -= sign * cross(o_from - o_to, w6[:, :3])
 
 
-def _general_block(an, p: BlockPlan, cols: Columns, rhs: dict, later: dict, x_all: dict, sig_all: dict):
+def _general_block(an, p: BlockPlan, cols: Columns, rhs: dict, x_all: dict, sig_all: dict):
     """Solve a block without a constant frame (world frame) and pass its loads on."""
     R = np.concatenate([rhs[L] for L in p.links], axis=1)
     x, sig = solve_general(an, cols, p.groups, list(p.links), R)
@@ -244,7 +232,7 @@ def _general_block(an, p: BlockPlan, cols: Columns, rhs: dict, later: dict, x_al
     for gi, g in enumerate(p.groups):
         xg = x[:, p.offs[gi]:p.offs[gi + 1]]
         x_all[(g.kind, g.index)] = xg
-        for L in later[gi]:
+        for L in p.later[gi]:
             C = cols.group(g, L, sig.get((g.kind, g.index), 1.0))
             rhs[L] -= np.einsum("nij,nj->ni", C, xg)
 
@@ -319,28 +307,26 @@ def solve_blocks(an, plans, kin: Kinematics, b: dict, q_all: np.ndarray):
     real joint's coordinate.  Returns ({(kind, index): (N, size)} unknowns, joint reactions
     in their child's basis; {(kind, index): (N,) sign of t}).
     """
-    block_of = {L: i for i, p in enumerate(plans) for L in p.links}
     rhs = {L: b[L].copy() for L in an.tree.moving}
     x_all, sig_all = {}, {}
     cols = None
-    for bi, p in enumerate(plans):
-        later = {gi: [L for L in g.links if block_of[L] > bi] for gi, g in enumerate(p.groups)}
+    for p in plans:
         if p.F is None:
             cols = cols if cols is not None else Columns(an, kin)
-            _general_block(an, p, cols, rhs, later, x_all, sig_all)
+            _general_block(an, p, cols, rhs, x_all, sig_all)
             continue
         x, signs, sv = _constant_block(an, p, kin, rhs)
         at_rest = p.F == an.tree.base
         for gi, g in enumerate(p.groups):
             xg = x[:, p.offs[gi]:p.offs[gi + 1]]
-            if later[gi]:
+            if p.later[gi]:
                 Cp, Cs = p.C[gi]
                 wF = xg @ Cp.T if Cs is None else xg @ Cp.T + np.abs(xg) @ Cs.T
                 if gi in p.fric_C:     # friction couple, sigma s_v t = s_v |t|
                     wF = wF + (np.abs(xg) * sv[:, p.signed.index(gi), None]) @ p.fric_C[gi].T
                 w = wF if at_rest else _rotate(kin.R[p.F], wF)           # world axes, about o_F
                 P = _primary_side(an, g)
-                for L in later[gi]:
+                for L in p.later[gi]:
                     _subtract(rhs[L], 1.0 if L == P else -1.0, w, kin.o[p.F], kin.o[L])
             if gi in p.signed:
                 sig_all[(g.kind, g.index)] = signs[:, p.signed.index(gi)]

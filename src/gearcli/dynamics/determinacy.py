@@ -12,9 +12,8 @@ from ..errors import Collector
 from ..model.mechanism import Mechanism
 from .kinematics import forward
 from .equations import Columns
-from .sharing import mesh_weights, null_directions_without_t
-
-_RTOL = 1e-10
+from .general import assemble
+from .sharing import mesh_weights, null_directions_without_t, numerical_rank
 
 
 def analyse(mech: Mechanism) -> Analysis:
@@ -48,20 +47,7 @@ def block_unknowns(an) -> list[list]:
 
 def _block_matrix(cols: Columns, blk: tuple, groups: list) -> np.ndarray:
     """(6 len(blk), n) matrix of a block's equations in its own unknowns (world frame)."""
-    pos = {x: i for i, x in enumerate(blk)}
-    A = np.zeros((6 * len(blk), sum(g.size for g in groups)))
-    c0 = 0
-    for g in groups:
-        for x in g.links:
-            if x in pos:
-                A[6 * pos[x]:6 * pos[x] + 6, c0:c0 + g.size] = cols.group(g, x, 1.0)[0]
-        c0 += g.size
-    return A
-
-
-def _rank(A: np.ndarray) -> int:
-    sv = np.linalg.svd(A, compute_uv=False)
-    return int(np.sum(sv > _RTOL * sv[0])) if sv.size and sv[0] > 0 else 0
+    return assemble(cols, groups, blk)[0]
 
 
 class _Configurations:
@@ -104,7 +90,7 @@ def check_determinate(an, col: Collector) -> None:
         best = 0
         for c in cols:
             A = _block_matrix(c, blk, groups)
-            best = max(best, _rank(A) if A.shape[0] == n else min(A.shape))
+            best = max(best, numerical_rank(np.linalg.svd(A, compute_uv=False)) if A.shape[0] == n else min(A.shape))
             if best == n == A.shape[0]:
                 break
         rank, total = rank + best, total + n

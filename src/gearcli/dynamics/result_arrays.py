@@ -60,12 +60,7 @@ def result_arrays(an, n: int, out=None) -> dict:
     samples: page faults were a third of a solve's time)."""
     if out is not None:
         return {k: getattr(out, k) for k in FIELDS}
-    sizes = {k: int(np.prod(shape)) for k, shape in shapes(an, n).items()}
-    buf, arrays, at = np.empty(sum(sizes.values())), {}, 0
-    for k, shape in shapes(an, n).items():
-        arrays[k] = buf[at:at + sizes[k]].reshape(shape)
-        at += sizes[k]
-    return arrays
+    return one_allocation(shapes(an, n))
 
 
 def one_allocation(shapes: dict) -> dict:

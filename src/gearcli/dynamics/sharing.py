@@ -97,12 +97,18 @@ def least_load_solve(A: np.ndarray, r: np.ndarray, w: np.ndarray) -> np.ndarray:
 def null_directions_without_t(A: np.ndarray, w: np.ndarray) -> tuple[int, int]:
     """(rank of A (m, n), number of null directions of A that change no weighted unknown):
     the load sharing is unique exactly when the rank is m and that number is 0."""
-    U, sv, Vt = np.linalg.svd(A)
-    rank = int(np.sum(sv > _RTOL * sv[0])) if sv.size and sv[0] > 0 else 0
-    N = Vt[rank:].T                                   # (n, d) null space
+    _, sv, Vt = np.linalg.svd(A)
+    r = numerical_rank(sv)
+    N = Vt[r:].T                                      # (n, d) null space
     Nt = N[w > 0]
     if N.shape[1] == 0:
-        return rank, 0
+        return r, 0
     st = np.linalg.svd(Nt, compute_uv=False) if Nt.size else np.zeros(0)
     seen = int(np.sum(st > 1e-8)) if st.size else 0
-    return rank, N.shape[1] - seen
+    return r, N.shape[1] - seen
+
+
+def numerical_rank(sv: np.ndarray) -> int:
+    """Numerical rank of a matrix from its singular values ``sv`` (largest first): those above
+    _RTOL times the largest."""
+    return int(np.sum(sv > _RTOL * sv[0])) if sv.size and sv[0] > 0 else 0

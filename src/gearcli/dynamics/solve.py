@@ -145,11 +145,7 @@ class Solver:
     def llvm_available(self) -> bool:
         """True when the llvm backend can solve this mechanism (without compiling it)."""
         if self.llvm_problem is None and self._llvm is None:
-            prog = self.kernel_program()
-            if prog is None:
-                self.llvm_problem = self.kernel_problem
-            else:
-                self.llvm_problem = llvm_refusal(prog)
+            self.llvm_problem = self.kernel_problem if self.kernel_program() is None else llvm_refusal()
         return self.llvm_problem is None
 
     def compiled_llvm(self) -> bool:

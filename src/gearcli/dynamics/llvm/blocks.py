@@ -21,13 +21,6 @@ from .trig import sincos
 from .world import LowRankBlock, WorldBlock
 
 
-def problem(prog) -> str | None:
-    """Why the generated kernel cannot solve ``prog``'s mechanism, or None."""
-    if not prog.covered:
-        return "a block has more than 16 signed meshes, or a singular separating-force-free matrix"
-    return None
-
-
 def gather(e: Emitter, s: Sample, F: int, links) -> list:
     """r (6B) = the block links' right-hand sides in F's axes about o_F (blocks' gather)."""
     RF, oF = s.R[F], s.o[F]

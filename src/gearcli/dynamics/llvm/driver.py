@@ -22,7 +22,6 @@ import numpy as np
 from . import cache as llvm_cache
 from .jobs import job_ranges, run_parts, sign_error, threads_for
 from .program import Program, load_arrays
-from .blocks import problem
 from .kernel import ARGS, build_module
 from .links import load_groups
 from .outputs import OUTPUTS
@@ -311,14 +310,9 @@ class LlvmKernel:
 _PROGRAM_KEYS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
-def program_key(prog: Program, an) -> str:
-    """:func:`.cache.program_key` of ``prog`` and ``an``'s loads on this host, gearcli's
-    version and :func:`generator_digest` (once per program)."""
-    return _program_ids(prog, an)[1]
-
-
 def _program_ids(prog: Program, an) -> tuple[str, str]:
-    """(:func:`.cache.program_fingerprint`, :func:`program_key`) of ``prog`` (once per program)."""
+    """(:func:`.cache.program_fingerprint`, :func:`.cache.program_key`) of ``prog`` and
+    ``an``'s loads on this host, gearcli's version and :func:`generator_digest` (once per program)."""
     if prog not in _PROGRAM_KEYS:
         from ... import __version__  # noqa: PLC0415
 
@@ -332,13 +326,5 @@ def kernel_on_disk(prog: Program, an) -> bool:
     """True when the disk cache holds the machine code of ``prog``'s kernel for this host
     (its compile would be a load; without building the IR, so a guess should the generator
     have changed since: then it compiles)."""
-    return llvm_cache.has_program(program_key(prog, an))
+    return llvm_cache.has_program(_program_ids(prog, an)[1])
 
-
-def llvm_problem(prog: Program) -> str | None:
-    """Why the llvm backend cannot solve ``prog``'s mechanism (None: it can)."""
-    try:
-        import llvmlite.binding  # noqa: F401, PLC0415
-    except ImportError:
-        return "llvmlite does not import"
-    return problem(prog)

@@ -108,9 +108,9 @@ def _bodies(an):
     return out
 
 
-def _loads(an, values: dict, n: int):
-    """LOAD records, the load points (nloads, 3; link frame, m) and the stacked values:
-    one row (constant) or n rows per load."""
+def load_arrays(an, values: dict, n: int):
+    """The loads of ``an`` for n samples: LOAD records, the load points (nloads, 3; link
+    frame, m) and the stacked values: one row (constant) or n rows per load."""
     rec, pts, rows = [], [], []
     off = 0
     for ld in an.mech.loads:
@@ -123,11 +123,6 @@ def _loads(an, values: dict, n: int):
         off += w.shape[0]
     vals = (rows[0] if len(rows) == 1 else np.concatenate(rows)) if rows else np.zeros((1, 6))  # no copy of one
     return records(rec, LOAD), np.array(pts, float).reshape(-1, 3), vals
-
-
-def load_arrays(an, values: dict, n: int):
-    """(LOAD records, points, values) of the loads of ``an`` for n samples (:func:`_loads`)."""
-    return _loads(an, values, n)
 
 
 class _Builder:
@@ -175,7 +170,7 @@ class _Builder:
         return True
 
 
-def _block(bd: _Builder, an, bi, p, block_of, offsets, sigcol, terms):
+def _block(bd: _Builder, an, bi, p, offsets, sigcol, terms):
     """Append block ``bi`` (plan ``p``) to the builder."""
     n = int(p.offs[-1])
     term0, nterm = terms.get(bi, (0, 0))
@@ -194,7 +189,7 @@ def _block(bd: _Builder, an, bi, p, block_of, offsets, sigcol, terms):
         for A in p.Ainv:
             bd.add_floats("ainv", A)
     for gi, g in enumerate(p.groups):
-        later = [L for L in g.links if block_of[L] > bi]
+        later = p.later[gi]
         if later and p.F is not None and bd.propagation(an, p, gi, g, later, rec["prop0"]):
             rec["nprop"] += 1
         if p.parent_side.get(gi):
@@ -243,11 +238,10 @@ def build_program(an, plans=None) -> Program:
         c += g.size
     signed = [(p.groups[gi].kind, p.groups[gi].index) for p in plans for gi in p.signed]
     sigcol = {k: i for i, k in enumerate(signed)}
-    block_of = {L: i for i, p in enumerate(plans) for L in p.links}
-    trec, tflt, terms = general_terms(an, plans, block_of)
+    trec, tflt, terms = general_terms(an, plans)
     bd = _Builder()
     for bi, p in enumerate(plans):
-        _block(bd, an, bi, p, block_of, offsets, sigcol, terms)
+        _block(bd, an, bi, p, offsets, sigcol, terms)
         if p.F is None and len(p.links) == 1 and not p.signed:
             _local_frame(bd, trec, tflt, p)
     joints, poses = _joints(an)

@@ -99,9 +99,10 @@ def group_terms(an, g, L, t_pos):
     return _mesh(an, g.index, L, t_pos)
 
 
-def general_terms(an, plans, block_of):
+def general_terms(an, plans):
     """(terms, their values, {block: (offset, count)}) of the blocks without a constant
-    frame (:data:`.records.TERM`, :data:`.records.TERM_VALUE` records)."""
+    frame (:data:`.records.TERM`, :data:`.records.TERM_VALUE` records); a block's groups act
+    on its own links and on later blocks' (:attr:`..blocks.BlockPlan.later`), never earlier."""
     rec, flt, where = [], [], {}
     for bi, p in enumerate(plans):
         if p.F is not None:
@@ -111,8 +112,6 @@ def general_terms(an, plans, block_of):
             t_pos = p.signed.index(gi) if is_geared(an, g) else -1
             for L in g.links:
                 row = p.links.index(L) if L in p.links else -1
-                if row < 0 and block_of[L] < bi:
-                    continue
                 for j, terms in enumerate(group_terms(an, g, L, t_pos)):
                     for kind, X, sgn, coef, d, pt in terms:
                         rec.append((L, row, int(p.offs[gi]) + j, kind, X, sgn))
