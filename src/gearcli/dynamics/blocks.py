@@ -24,7 +24,7 @@ from .kinematics import Kinematics, forward
 from .losses import relative_rate
 from .pattern_maps import PatternMaps
 from .sharing import mesh_weights
-from .signs import MAX_EXHAUSTIVE, SignError, pattern_index, resolve_signs, sign_patterns
+from .signs import MAX_EXHAUSTIVE, SignError, pattern_index, resolve_signs, rows_by_pattern, sign_patterns
 
 
 @dataclass(frozen=True, eq=False)
@@ -237,58 +237,60 @@ def _general_block(an, p: BlockPlan, cols: Columns, rhs: dict, x_all: dict, sig_
             rhs[L] -= np.einsum("nij,nj->ni", C, xg)
 
 
-def _constant_block(an, p: BlockPlan, kin: Kinematics, rhs: dict):
-    """Solve a block in its constant frame F: x (N, n), signs (N, m), r (N, 6B) in F."""
+def block_rhs(an, p: BlockPlan, kin: Kinematics, rhs: dict) -> np.ndarray:
+    """r (N, 6B): the right-hand sides ``rhs`` of the block's links in its frame F's axes, about o_F."""
     at_rest = p.F == an.tree.base        # F = base: world axes about the origin already
     RF, oF = kin.R[p.F], kin.o[p.F]
     parts = []
     for L in p.links:
         w = _shift(rhs[L], kin.o[L], oF) if L != p.F else rhs[L]
         parts.append(w if at_rest else _rotate(RF, w, transpose=True))
-    r = np.concatenate(parts, axis=1) if len(parts) > 1 else parts[0]   # (N, 6B) in F about o_F
+    return np.concatenate(parts, axis=1) if len(parts) > 1 else parts[0]
+
+
+def _constant_block(an, p: BlockPlan, kin: Kinematics, rhs: dict):
+    """Solve a block in its constant frame F: x (N, n), signs (N, m), s_v (N, m) of its
+    meshes (None when no mesh of the block loses power)."""
+    r = block_rhs(an, p, kin, rhs)
     N = r.shape[0]
     if not p.signed:
         return r @ p.Ainv[0].T, np.zeros((N, 0)), None
     scale = 1.0 + np.abs(r).max(axis=1)
     t_cols = [int(p.offs[gi]) for gi in p.signed]
-    if p.fric is None:
-        def solve_pattern(signs, idx):
-            return (r if idx.size == N else r[idx]) @ p.Ainv[pattern_index(signs)].T
-        return (*resolve_signs(solve_pattern, len(p.signed), t_cols, N, scale, p.names), None)
-    # lossy meshes: the block matrix depends on s_v too; one set of maps per s_v pattern met
-    sv = np.column_stack([np.sign(relative_rate(an, kin, p.groups[gi].index)) if gi in p.fric_C
-                          else np.zeros(N) for gi in p.signed])
-    x, signs, first_bad = None, np.empty((N, len(p.signed))), None
-    for rows in _rows_by_pattern(sv):
-        key = tuple(sv[rows[0]])
-        maps = p.fric_maps.get(key)
-        if maps is None:            # the signed columns gain s_v times their friction couple
-            maps = p.fric_maps[key] = PatternMaps(p.Ainv.A_mid, p.Ainv.halves + np.array(key)[:, None] * p.fric,
-                                                  p.Ainv.cols, p.Ainv.w) if any(key) else p.Ainv
-        rr = r[rows]
+    sv, parts = None, [(None, p.Ainv)]       # (rows, their maps): every row, the lossless maps
+    if p.fric is not None:       # lossy meshes: the block matrix depends on s_v too, maps per s_v pattern met
+        sv = np.column_stack([np.sign(relative_rate(an, kin, p.groups[gi].index)) if gi in p.fric_C
+                              else np.zeros(N) for gi in p.signed])
+        parts = [(rows, _friction_maps(p, tuple(sv[rows[0]]))) for rows in rows_by_pattern(sv)]
+    x, signs, first_bad = None, None, None
+    for rows, maps in parts:
+        rr, sc = (r, scale) if rows is None else (r[rows], scale[rows])
 
         def solve_pattern(sg, idx, rr=rr, maps=maps):
             return (rr if idx.size == rr.shape[0] else rr[idx]) @ maps[pattern_index(sg)].T
         try:
-            xs, ss = resolve_signs(solve_pattern, len(p.signed), t_cols, rows.size, scale[rows], p.names)
+            xs, ss = resolve_signs(solve_pattern, len(p.signed), t_cols, rr.shape[0], sc, p.names)
         except SignError as exc:
-            bad = int(rows[exc.sample])
+            bad = exc.sample if rows is None else int(rows[exc.sample])
             first_bad = bad if first_bad is None else min(first_bad, bad)
             continue
+        if rows is None:
+            return xs, ss, None
         if x is None:
-            x = np.empty((N, xs.shape[1]))
+            x, signs = np.empty((N, xs.shape[1])), np.empty((N, len(p.signed)))
         x[rows], signs[rows] = xs, ss
     if first_bad is not None:
         raise SignError(first_bad, p.names)
     return x, signs, sv
 
 
-def _rows_by_pattern(sv: np.ndarray) -> list[np.ndarray]:
-    """Indices of the rows of ``sv`` (N, m) of -1/0/+1 grouped by equal rows (a motion
-    meets few s_v patterns: a loop over patterns, not samples)."""
-    _, which = np.unique(sv, axis=0, return_inverse=True)
-    which = which.reshape(-1)
-    return [np.flatnonzero(which == u) for u in range(which.max() + 1)]
+def _friction_maps(p: BlockPlan, key: tuple) -> PatternMaps:
+    """The block's maps for the s_v pattern ``key`` (made on first use): its signed columns
+    gain s_v times their friction couple."""
+    if key not in p.fric_maps:
+        p.fric_maps[key] = PatternMaps(p.Ainv.A_mid, p.Ainv.halves + np.array(key)[:, None] * p.fric,
+                                       p.Ainv.cols, p.Ainv.w) if any(key) else p.Ainv
+    return p.fric_maps[key]
 
 
 def _child_basis(x: np.ndarray, q: np.ndarray) -> np.ndarray:

@@ -5,12 +5,11 @@ for the sign pattern sigma of its m tangential tooth forces (the separating forc
 adds +-H_i to column i).  Its solution map X_sigma (n, 6B) is A_sigma^-1 for a square block
 and the least-t^2/k map of :func:`.sharing.least_load_map` for a redundant one.  There are
 2^m patterns (m = 2N for N planets) but a motion meets few of them, so each map is computed
-when first asked for and kept: :class:`PatternMaps` is a read-only sequence indexed like
+when first asked for and kept: :class:`PatternMaps` is read-only, indexed like
 :func:`~.signs.sign_patterns` (:func:`~.signs.pattern_index`); iterating it computes all.
 """
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -18,7 +17,7 @@ import numpy as np
 from .sharing import kkt, least_load_map
 
 
-class PatternMaps(Sequence):
+class PatternMaps:
     """(n, 6B) solution map of every sign pattern of one constant block, lazily.
 
     ``A_mid`` (6B, n): the block matrix with each signed column at its mean over the two
@@ -43,11 +42,7 @@ class PatternMaps(Sequence):
             A[:, c] += (-1.0 if index >> (m - 1 - i) & 1 else 1.0) * self.halves[i]
         return A
 
-    def __getitem__(self, index):
-        if isinstance(index, slice):
-            return [self[i] for i in range(*index.indices(len(self)))]
-        if index < 0:
-            index += self.count
+    def __getitem__(self, index: int) -> np.ndarray:
         if not 0 <= index < self.count:
             raise IndexError(index)
         X = self._maps.get(index)
@@ -118,18 +113,14 @@ def low_rank(maps: PatternMaps) -> LowRank:
     E[maps.cols, range(m)] = 1.0
     if maps.w is None:                             # K + H C E^T
         Y = np.linalg.inv(A)
-        U, V = H, E
+        V, Z = E, Y @ H
     else:                                          # K + P C P^T
         Kinv = np.linalg.inv(kkt(A, maps.w))
-        U = np.zeros((n + nr, 2 * m))
-        U[:n, :m], U[n:, m:] = E, H
-        Y, V = Kinv[:, n:], U
-        U = Kinv @ U                               # K^-1 P (Y @ H would miss the top block)
-        return LowRank(np.ascontiguousarray(Y[:n]), np.ascontiguousarray(V.T @ Y), np.ascontiguousarray(U[:n]),
-                       np.ascontiguousarray(V.T @ U), True)
-    Z = Y @ U
-    return LowRank(np.ascontiguousarray(Y), np.ascontiguousarray(V.T @ Y), np.ascontiguousarray(Z),
-                   np.ascontiguousarray(V.T @ Z), False)
+        V = np.zeros((n + nr, 2 * m))
+        V[:n, :m], V[n:, m:] = E, H
+        Y, Z = Kinv[:, n:], Kinv @ V               # K^-1 P (Y @ H would miss the top block)
+    c = np.ascontiguousarray
+    return LowRank(c(Y[:n]), c(V.T @ Y), c(Z[:n]), c(V.T @ Z), maps.w is not None)
 
 
 HOT_PATTERNS = 8

@@ -80,51 +80,70 @@ def resolve_signs(solve_pattern: Callable[[np.ndarray, np.ndarray], np.ndarray],
     SignError
         naming the first sample for which no pattern is consistent.
     """
-    x = None
-    used = np.ones((N, m))
-    todo = np.arange(N)
-
-    def attempt(idx, signs):
-        nonlocal x
-        xs = solve_pattern(signs, idx)
-        t = xs[:, t_cols]
-        ok = np.all(-signs * t <= (TOL_SIGN * scale[idx])[:, None], axis=1)
-        if x is None:
-            if ok.all():                              # the usual case: done in one solve
-                x = xs
-                return idx[:0], t[:0]
-            x = np.empty((N, xs.shape[1]))
-        x[idx[ok]] = xs[ok]
-        used[idx[ok]] = signs
-        return idx[~ok], np.where(t[~ok] < 0, -1.0, 1.0)
-
-    todo, trial = attempt(todo, np.ones(m))
-    for _ in range(m):                                # retry with the solution's own signs
-        if todo.size == 0:
-            break
-        left, nxt = [], []
-        for rows in _same_rows(trial):
-            bad, own = attempt(todo[rows], trial[rows[0]])
-            left.append(bad)
-            nxt.append(own)
-        todo, trial = np.concatenate(left), np.concatenate(nxt)
+    search = OwnSigns(solve_pattern, m, t_cols, N, scale)
+    todo = search.settle()
     if todo.size and m <= MAX_EXHAUSTIVE:             # the rest: every pattern in order
         for signs in sign_patterns(m):
             if todo.size == 0:
                 break
-            todo, _ = attempt(todo, np.array(signs))
+            todo, _ = search.attempt(todo, np.array(signs))
     if todo.size:
         raise SignError(int(todo.min()), mesh_names)   # the first such sample
-    return x, used
+    return search.x, search.used
+
+
+class OwnSigns:
+    """The first m + 1 trials of :func:`resolve_signs` (every t positive, then each sample's
+    own signs); ``x`` (N, n) and ``used`` (N, m) hold the samples settled so far."""
+
+    def __init__(self, solve_pattern, m: int, t_cols: list[int], N: int, scale: np.ndarray):
+        self.solve_pattern, self.m, self.t_cols, self.N, self.scale = solve_pattern, m, t_cols, N, scale
+        self.x, self.used = None, np.ones((N, m))
+
+    def attempt(self, idx: np.ndarray, signs: np.ndarray):
+        """Solve the samples ``idx`` with the signs ``signs`` (m,) of t and keep those it
+        settles; returns the others and the signs of their own t."""
+        xs = self.solve_pattern(signs, idx)
+        t = xs[:, self.t_cols]
+        ok = np.all(-signs * t <= (TOL_SIGN * self.scale[idx])[:, None], axis=1)
+        if self.x is None:
+            if ok.all():                              # the usual case: done in one solve
+                self.x = xs
+                return idx[:0], t[:0]
+            self.x = np.empty((self.N, xs.shape[1]))
+        self.x[idx[ok]] = xs[ok]
+        self.used[idx[ok]] = signs
+        return idx[~ok], np.where(t[~ok] < 0, -1.0, 1.0)
+
+    def settle(self) -> np.ndarray:
+        """Every sample with all t positive, then the unsettled with their own signs (m
+        rounds at most); returns the samples still unsettled."""
+        todo, trial = self.attempt(np.arange(self.N), np.ones(self.m))
+        for _ in range(self.m):                       # retry with the solution's own signs
+            if todo.size == 0:
+                break
+            left, nxt = [], []
+            for rows in _same_rows(trial):
+                bad, own = self.attempt(todo[rows], trial[rows[0]])
+                left.append(bad)
+                nxt.append(own)
+            todo, trial = np.concatenate(left), np.concatenate(nxt)
+        return todo
+
+
+def rows_by_pattern(signs: np.ndarray) -> list[np.ndarray]:
+    """Indices of the rows of ``signs`` (N, m) of -1/0/+1 grouped by equal rows (a motion
+    meets few patterns: a loop over patterns, not samples)."""
+    _, which = np.unique(signs, axis=0, return_inverse=True)
+    which = which.reshape(-1)
+    return [np.flatnonzero(which == u) for u in range(which.max() + 1)]
 
 
 def _same_rows(signs: np.ndarray) -> list[np.ndarray]:
     """Indices of the rows of ``signs`` (n, m) of +-1 grouped by equal rows."""
     m = signs.shape[1]
     if m > 60:                                       # too many bits for an integer key
-        _, which = np.unique(signs, axis=0, return_inverse=True)
-        which = which.reshape(-1)
-        return [np.flatnonzero(which == u) for u in range(which.max() + 1)]
+        return rows_by_pattern(signs)
     key = (signs < 0) @ (1 << np.arange(m, dtype=np.int64))
     order = np.argsort(key, kind="stable")
     cuts = np.flatnonzero(np.diff(key[order])) + 1

@@ -142,3 +142,45 @@ class Emitter:
     def row(self, ptr, n, width: int):
         """A pointer to row n of a (N, width) C-ordered array at ``ptr``."""
         return self.b.gep(ptr, [self.b.mul(n, ir.Constant(I64, width))])
+
+    def stack(self, fn, sizes) -> tuple:
+        """double* to new stack arrays of these sizes, allocated in ``fn``'s entry block
+        (once per caller, not per sample)."""
+        ib = ir.IRBuilder(fn.entry_basic_block)
+        ib.position_at_start(fn.entry_basic_block)
+        return tuple(ib.bitcast(ib.alloca(ir.ArrayType(D, k)), DP) for k in sizes)
+
+    # --- control flow -------------------------------------------------------------------
+    def phis(self, ends: list, values: list) -> list:
+        """Where branches meet: per position of the value lists ``values`` a phi taking
+        ``values[k]`` from the block ``ends[k]``."""
+        out = []
+        for i in range(len(values[0])):
+            phi = self.b.phi(D)
+            for end, vals in zip(ends, values):
+                phi.add_incoming(self.const(vals[i]), end)
+            out.append(phi)
+        return out
+
+    def switch(self, fn, p, cases: list, tag: str, default=None) -> list:
+        """The values of ``emit()`` of the case (key, emit) of ``cases`` whose key the i64 p
+        equals, each case straight-line in its own block; ``default`` (an emit) where none
+        does (None: the first case's block)."""
+        merge = fn.append_basic_block(f"{tag}_merge")
+        blocks = [fn.append_basic_block(f"{tag}_p{k}") for k, _ in cases]
+        other = fn.append_basic_block(f"{tag}_other") if default is not None else blocks[0]
+        sw = self.b.switch(p, other)
+        ends, values = [], []
+        for (k, emit), blk in zip(cases, blocks):
+            sw.add_case(ir.Constant(I64, k), blk)
+            self.b.position_at_end(blk)
+            values.append(emit())
+            ends.append(self.b.block)
+            self.b.branch(merge)
+        if default is not None:
+            self.b.position_at_end(other)
+            values.append(default())
+            ends.append(self.b.block)
+            self.b.branch(merge)
+        self.b.position_at_end(merge)
+        return self.phis(ends, values)

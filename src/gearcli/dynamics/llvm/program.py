@@ -16,6 +16,7 @@ link's axes gets F = that link and its inverse (:func:`_local_frame`), and keeps
 """
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass, field, fields
 
 import numpy as np
@@ -269,15 +270,16 @@ def build_program(an, plans=None) -> Program:
 
 def _hot_maps(an, plans, lowrank: dict) -> dict:
     """{block: (hot pattern indices, their maps)} of the :class:`~..pattern_maps.LowRank`
-    blocks: the patterns the sign search settles on within its first m + 1 trials (every t
-    positive, then the trial's own signs) for 256 random motions of the mechanism (a fixed
-    seed; the block's own d'Alembert loads, without the wrenches of earlier blocks: a hint
-    for speed, not a result; :func:`~..pattern_maps.hot_patterns`)."""
+    blocks: the patterns the sign search settles on within its first m + 1 trials
+    (:class:`~..signs.OwnSigns`, solved by ``LowRank.solve``) for 256 random motions of the
+    mechanism (a fixed seed; the block's own d'Alembert loads, without the wrenches of
+    earlier blocks: a hint for speed, not a result; :func:`~..pattern_maps.hot_patterns`)."""
     if not lowrank:
         return {}
-    from ..blocks import _rotate, _shift            # noqa: PLC0415
+    from ..blocks import block_rhs                 # noqa: PLC0415
     from ..inertia import inertia_load             # noqa: PLC0415
     from ..kinematics import forward               # noqa: PLC0415
+    from ..signs import OwnSigns, pattern_index    # noqa: PLC0415
 
     rng = np.random.default_rng(18)
     n = 256
@@ -289,40 +291,15 @@ def _hot_maps(an, plans, lowrank: dict) -> dict:
     out = {}
     for bi, lr in lowrank.items():
         p = plans[bi]
-        oF = kin.o[p.F]
-        parts = [_shift(b[L], kin.o[L], oF) for L in p.links]
-        r = np.concatenate([w if p.F == an.tree.base else _rotate(kin.R[p.F], w, transpose=True) for w in parts],
-                           axis=1)
-        counts = _settled(lr, r, [int(p.offs[gi]) for gi in p.signed])
+        r = block_rhs(an, p, kin, b)
+        search = OwnSigns(lambda sg, idx, r=r, lr=lr: lr.solve(sg, r[idx]), len(p.signed),
+                          [int(p.offs[gi]) for gi in p.signed], n, 1.0 + np.abs(r).max(axis=1))
+        with np.errstate(all="ignore"):
+            settled = np.setdiff1d(np.arange(n), search.settle())
+        counts = Counter(pattern_index(s) for s in search.used[settled])
         hot = hot_patterns(counts)
         try:
             out[bi] = (hot, np.array([p.Ainv[k] for k in hot]))
         except (np.linalg.LinAlgError, SharingError):
             continue
     return out
-
-
-def _settled(lr, r: np.ndarray, tcols: list) -> dict:
-    """{pattern index: samples} of the rows r (N, 6B) settled by the first m + 1 trials of
-    the sign search (:func:`~..signs.resolve_signs`), solved by ``lr`` (LowRank.solve)."""
-    from ..signs import TOL_SIGN, pattern_index    # noqa: PLC0415
-
-    m = len(tcols)
-    scale = 1.0 + np.abs(r).max(axis=1)
-    todo, signs, counts = np.arange(r.shape[0]), np.ones((r.shape[0], m)), {}
-    for _ in range(m + 1):
-        left = []
-        for k in np.unique([pattern_index(s) for s in signs[todo]]):
-            idx = todo[[pattern_index(s) == k for s in signs[todo]]]
-            sg = signs[idx[0]]
-            with np.errstate(all="ignore"):
-                t = lr.solve(sg, r[idx])[:, tcols]
-            ok = np.all(-sg * t <= TOL_SIGN * scale[idx, None], axis=1)
-            counts[int(k)] = counts.get(int(k), 0) + int(ok.sum())
-            signs[idx[~ok]] = np.where(t[~ok] < 0, -1.0, 1.0)
-            left.append(idx[~ok])
-        todo = np.concatenate(left) if left else todo[:0]
-        if todo.size == 0:
-            break
-    return {k: v for k, v in counts.items() if v}
-

@@ -60,26 +60,9 @@ def _consistent(e: Emitter, t: list, negative: list, tol):
 
 
 def _rows_switch(e: Emitter, fn, p, maps: list, rows: list, r: list, tag: str):
-    """Per pattern k a straight-line case computing rows ``rows`` of maps[k] r; returns
-    (the rows' phi values, the merge block).  The case of the pattern is the caller's
-    ``p`` (i64)."""
-    merge = fn.append_basic_block(f"{tag}_merge")
-    cases = [fn.append_basic_block(f"{tag}_p{k}") for k in range(len(maps))]
-    sw = e.b.switch(p, cases[0])
-    out = []
-    for k, A in enumerate(maps):
-        sw.add_case(ir.Constant(I64, k), cases[k])
-        e.b.position_at_end(cases[k])
-        out.append([e.const(e.dot(floats(A[i]), r)) for i in rows])
-        e.b.branch(merge)
-    e.b.position_at_end(merge)
-    vals = []
-    for i in range(len(rows)):
-        phi = e.b.phi(D)
-        for k in range(len(maps)):
-            phi.add_incoming(out[k][i], cases[k])
-        vals.append(phi)
-    return vals
+    """Per pattern k a straight-line case computing rows ``rows`` of maps[k] r; returns the
+    rows' values (phis).  The case of the pattern is the caller's ``p`` (i64)."""
+    return e.switch(fn, p, [(k, lambda A=A: [e.dot(floats(A[i]), r) for i in rows]) for k, A in enumerate(maps)], tag)
 
 
 def _rows_global(e: Emitter, table, p, n: int, nr: int, rows: list, r: list):

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import llvmlite.ir as ir
 
-from .build import D, DP, I64
+from .build import D, DP, I64, Emitter
 
 FLAGS = ("contract",)
 
@@ -52,9 +52,13 @@ class _Matrix:
         _loop(self.b, self.fn, ir.Constant(I64, 0), self.M, tag, body)
 
     def fabs(self, v):
-        mod = self.fn.module
-        f = mod.globals.get("llvm.fabs.f64") or ir.Function(mod, ir.FunctionType(D, [D]), "llvm.fabs.f64")
-        return self.b.call(f, [v])
+        return Emitter(self.b, self.fn.module).call("fabs", v)
+
+    def exchange(self, a1, a2) -> None:
+        """The values at the pointers a1 and a2 swapped."""
+        v1, v2 = self.b.load(a1), self.b.load(a2)
+        self.b.store(v2, a1)
+        self.b.store(v1, a2)
 
 
 def _column(s: _Matrix, c, singular, best) -> None:
@@ -67,19 +71,8 @@ def _column(s: _Matrix, c, singular, best) -> None:
         b.store(b.select(better, i, b.load(best)), best)
     _loop(b, s.fn, b.add(c, one), s.K, "piv", pick)
     p = b.load(best)
-
-    def swap(j):
-        a1, a2 = s.at(c, j), s.at(p, j)
-        v1, v2 = b.load(a1), b.load(a2)
-        b.store(v2, a1)
-        b.store(v1, a2)
-    _loop(b, s.fn, c, s.K, "swap", swap)
-
-    def swap_x(h):
-        v1, v2 = b.load(s.xi(c, h)), b.load(s.xi(p, h))
-        b.store(v2, s.xi(c, h))
-        b.store(v1, s.xi(p, h))
-    s.each("swapx", swap_x)
+    _loop(b, s.fn, c, s.K, "swap", lambda j: s.exchange(s.at(c, j), s.at(p, j)))
+    s.each("swapx", lambda h: s.exchange(s.xi(c, h), s.xi(p, h)))
     piv = b.load(s.at(c, c))
     b.store(b.or_(b.load(singular), b.fcmp_ordered("==", piv, ir.Constant(D, 0.0))), singular)
 

@@ -67,10 +67,4 @@ def sincos(e: Emitter, q):
             slow, slow_end = (e.call("cos", q), e.call("sin", q)), b.block
         with inline:
             fast, fast_end = _reduced(e, q), b.block
-    out = []
-    for i in range(2):
-        phi = b.phi(D)
-        phi.add_incoming(slow[i], slow_end)
-        phi.add_incoming(fast[i], fast_end)
-        out.append(phi)
-    return tuple(out)
+    return tuple(e.phis([slow_end, fast_end], [slow, fast]))

@@ -166,12 +166,10 @@ class WorldBlock:
         self.n, self.tcols, self.wrench = n, tcols, wrench
         self.fn, self.weights, self.free, self.mem = fn, weights, free, None
 
-    def _stack(self, sizes):
+    def _stack(self, e: Emitter, sizes):
         """Stack arrays of these sizes (doubles), made once in ``run``'s entry block."""
         if self.mem is None:
-            ib = ir.IRBuilder(self.fn.entry_basic_block)
-            ib.position_at_start(self.fn.entry_basic_block)
-            self.mem = tuple(ib.bitcast(ib.alloca(ir.ArrayType(D, k)), D.as_pointer()) for k in sizes)
+            self.mem = e.stack(self.fn, sizes)
         return self.mem
 
     def _by_basis(self, e: Emitter, A: list, r: list) -> list:
@@ -186,13 +184,12 @@ class WorldBlock:
         AB = [[A[i][j] for j in basis] for i in range(k)]
         RHS = [[r[i]] + [A[i][j] for j in free] for i in range(k)]
         fast, bad = static_lu(e, AB, RHS, order, swaps)
-        fast = [[e.const(v) for v in row] for row in fast]
         fn = self.fn
         slow, done = fn.append_basic_block("basis_pivot"), fn.append_basic_block("basis_done")
         pre = e.b.block
         e.b.cbranch(bad, slow, done)
         e.b.position_at_end(slow)
-        M, X = self._stack((k * k, k * m))
+        M, X = self._stack(e, (k * k, k * m))
         for i in range(k):
             for a in range(k):
                 e.store(AB[i][a], M, i * k + a)
@@ -203,15 +200,8 @@ class WorldBlock:
         slow_end = e.b.block
         e.b.branch(done)
         e.b.position_at_end(done)
-        P = []
-        for i in range(k):
-            row = []
-            for h in range(m):
-                phi = e.b.phi(D)
-                phi.add_incoming(fast[i][h], pre)
-                phi.add_incoming(loaded[i][h], slow_end)
-                row.append(phi)
-            P.append(row)
+        merged = e.phis([pre, slow_end], [[v for row in fast for v in row], [v for row in loaded for v in row]])
+        P = [merged[i * m:(i + 1) * m] for i in range(k)]
         wb = [(a, float(w[j])) for a, j in enumerate(basis) if w[j] > 0]
         S = [[e.add(float(w[free[g]]) if g == h else 0.0,
                     e.dot([e.mul(wj, P[a][1 + g]) for a, wj in wb], [P[a][1 + h] for a, _ in wb]))
@@ -246,7 +236,7 @@ class WorldBlock:
         """The minimiser of sum w x^2 subject to A x = r (:func:`..sharing.least_load_solve`)."""
         nr, n = len(A), self.n
         size = n + nr
-        K, x = self._stack((size * size, size))
+        K, x = self._stack(e, (size * size, size))
         scale = 0.0                           # max |A|, NaN-free as numpy's max is not: NaN fails anyway
         for row in A:
             for v in row:
@@ -296,36 +286,14 @@ class LowRankBlock:
 
     def rows(self, e: Emitter, fn, p, rows: list, r: list, tag: str) -> list:
         """Rows ``rows`` of the solution for pattern p (i64)."""
-        merge, cold = fn.append_basic_block(f"{tag}_lr"), fn.append_basic_block(f"{tag}_cold")
-        cases = [fn.append_basic_block(f"{tag}_hot{k}") for k in range(len(self.hot))]
-        sw = e.b.switch(p, cold)
-        ends, vals = [], []
-        for h, case, A in zip(self.hot, cases, self.maps):
-            sw.add_case(ir.Constant(I64, h), case)
-            e.b.position_at_end(case)
-            vals.append([e.const(e.dot(floats(A[i]), r)) for i in rows])
-            ends.append(e.b.block)
-            e.b.branch(merge)
-        e.b.position_at_end(cold)
-        vals.append([e.const(v) for v in self._solved(e, fn, p, rows, r)])
-        ends.append(e.b.block)
-        e.b.branch(merge)
-        e.b.position_at_end(merge)
-        out = []
-        for i in range(len(rows)):
-            phi = e.b.phi(D)
-            for end, v in zip(ends, vals):
-                phi.add_incoming(v[i], end)
-            out.append(phi)
-        return out
+        hot = [(h, lambda A=A: [e.dot(floats(A[i]), r) for i in rows]) for h, A in zip(self.hot, self.maps)]
+        return e.switch(fn, p, hot, tag, default=lambda: self._solved(e, fn, p, rows, r))
 
     def _solved(self, e: Emitter, fn, p, rows: list, r: list) -> list:
         """Rows ``rows`` of the solution for pattern p by the k x k solve."""
         m, k = len(self.tcols), self.lr.k
-        if self.mem is None:                  # in the entry block: one stack slot per block
-            ib = ir.IRBuilder(fn.entry_basic_block)
-            ib.position_at_start(fn.entry_basic_block)
-            self.mem = tuple(ib.bitcast(ib.alloca(ir.ArrayType(D, size)), D.as_pointer()) for size in (k * k, k))
+        if self.mem is None:                  # one stack slot per block
+            self.mem = e.stack(fn, (k * k, k))
         M, c = self.mem
         sig = signs_of(e, p, m)
         W = self.lr.W
