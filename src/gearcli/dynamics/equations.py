@@ -178,20 +178,12 @@ class Columns:
             return self.motor(g.index, L)
         return self.mesh(g.index, L, sigma)
 
-    def balance(self, groups, L: int, signs: dict | None = None, out: np.ndarray | None = None) -> np.ndarray:
-        """Left-hand side of link L's balance (Eqs. 15-16 primary, 19-20 secondary).
-
-        Returns the (N, 6, n) matrix whose columns are the wrenches on L of the unknowns of
-        ``groups`` (n scalars in their order; zero for a group not acting on L); ``signs``
-        maps ``(kind, index)`` of a geared mesh to sign(t), (N,) (default +1).  ``out``, a
-        zeroed (N, 6, n) array (or view) to fill, saves the allocation.
-        """
-        signs = signs or {}
-        if out is None:
-            out = np.zeros((self.kin.n, 6, sum(g.size for g in groups)))
+    def balance(self, groups, L: int, out: np.ndarray) -> None:
+        """Left-hand side of link L's balance (Eqs. 15-16 primary, 19-20 secondary), every t
+        taken positive: into ``out``, a zeroed (N, 6, n) array (or view), the wrenches on L
+        of the unknowns of ``groups`` (n scalars in their order; zero for a group not acting on L)."""
         c0 = 0
         for g in groups:
             if L in g.links:
-                out[:, :, c0:c0 + g.size] = self.group(g, L, signs.get((g.kind, g.index), 1.0))
+                out[:, :, c0:c0 + g.size] = self.group(g, L, 1.0)
             c0 += g.size
-        return out

@@ -29,7 +29,7 @@ def assemble(cols: Columns, groups, links) -> np.ndarray:
     :meth:`~.equations.Columns.balance` per link, stacked), every t taken positive."""
     A = np.zeros((cols.kin.n, 6 * len(links), sum(g.size for g in groups)))
     for r, L in enumerate(links):
-        cols.balance(groups, L, out=A[:, 6 * r:6 * r + 6, :])
+        cols.balance(groups, L, A[:, 6 * r:6 * r + 6, :])
     return A
 
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 
 from ...analysis.schedule import unknown_groups
-from ..blocks import _primary_side, make_plans
+from ..blocks import _primary_side
 from .basis import basis as _basis
 from .output_maps import output_constants
 from ..pattern_maps import hot_patterns, low_rank
@@ -221,10 +221,9 @@ is solved from one base matrix (:class:`..pattern_maps.LowRank`, ``Program.lowra
 k x k solve a pattern, k = m or 2m)."""
 
 
-def build_program(an, plans=None) -> Program:
-    """The :class:`Program` of ``an`` (``plans`` from :func:`..blocks.make_plans`); not
-    ``covered`` when a redundant block has no constant frame."""
-    plans = make_plans(an) if plans is None else plans
+def build_program(an, plans) -> Program:
+    """The :class:`Program` of ``an`` and its block plans (:func:`..blocks.make_plans`); not
+    ``covered`` when a block has more than 16 signed meshes or a singular base matrix."""
     if any(len(p.signed) > MAX_EXHAUSTIVE for p in plans):   # a pattern is an i64 in the code; numpy's search
         return Program(0, {}, [], [], False)
     try:

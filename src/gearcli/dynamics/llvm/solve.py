@@ -43,9 +43,9 @@ class _Matrix:
     def at(self, i, j):
         return self.b.gep(self.A, [self.b.add(self.b.mul(i, self.K), j)])
 
-    def xi(self, i, h=None):
-        """X[i, h] (h: column, 0 if None)."""
-        return self.b.gep(self.x, [self.b.mul(i, self.M) if h is None else self.b.add(self.b.mul(i, self.M), h)])
+    def xi(self, i, h):
+        """X[i, h]."""
+        return self.b.gep(self.x, [self.b.add(self.b.mul(i, self.M), h)])
 
     def each(self, tag: str, body) -> None:
         """body(h) for every column h of X."""
@@ -128,3 +128,17 @@ def solve_function(module: ir.Module, k: int, m: int = 1) -> ir.Function:
     b.position_at_end(ok)
     b.ret_void()
     return fn
+
+
+def loop_solve(e: Emitter, mem: tuple, A: list, B: list) -> list:
+    """X = A^-1 B by ``solve_<k>_<m>``: A (k, k) and B (k, m), lists of rows of values, stored
+    row-major into the stack arrays ``mem`` (k * k and k * m doubles); X as rows of values."""
+    M, X = mem
+    k, m = len(A), len(B[0])
+    for i in range(k):
+        for j in range(k):
+            e.store(A[i][j], M, i * k + j)
+        for h in range(m):
+            e.store(B[i][h], X, i * m + h)
+    e.b.call(solve_function(e.module, k, m), [M, X])
+    return [[e.load(X, i * m + h) for h in range(m)] for i in range(k)]

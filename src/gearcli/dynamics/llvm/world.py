@@ -14,7 +14,7 @@ import llvmlite.ir as ir
 from .build import D, I1, I64, Emitter
 from .links import floats
 from .signs import signs_of
-from .solve import solve_function
+from .solve import loop_solve
 
 
 def _pivot_row(e: Emitter, A, c: int):
@@ -99,7 +99,7 @@ def _swap_rows(e: Emitter, A: list, X: list, c: int, a: int) -> None:
             M[c][j], M[a][j] = e.b.select(sw, v, u), e.b.select(sw, u, v)
 
 
-def static_lu(e: Emitter, A: list, B: list, order: list, swaps: list | None = None):
+def static_lu(e: Emitter, A: list, B: list, order: list, swaps: list):
     """(X, bad): X = A^-1 B (A (k, k), B (k, m), lists of rows of values) by elimination in
     the fixed row order ``order`` (partial pivoting's order at the home pose,
     :func:`.basis._free_columns`), straight-line and without selects, so the zeros
@@ -114,7 +114,7 @@ def static_lu(e: Emitter, A: list, B: list, order: list, swaps: list | None = No
     bad = ir.Constant(I1, 0)
     inv = [1.0] * k                  # 1 / pivot: a product per row, not a division (latency)
     for c in range(k):
-        if swaps is not None and swaps[c] >= 0:
+        if swaps[c] >= 0:
             _swap_rows(e, A, X, c, int(swaps[c]))
         piv = A[c][c]
         below = [A[i][c] for i in range(c + 1, k) if not (isinstance(A[i][c], float) and A[i][c] == 0.0)]
@@ -160,7 +160,7 @@ class WorldBlock:
     full_trial = True
     extra = None        # the block's mesh friction columns, added per trial (losses.world_columns)
 
-    def __init__(self, s, prog, k0: int, nt: int, n: int, tcols: list, wrench, fn=None, weights=None, free=None):
+    def __init__(self, s, prog, k0: int, nt: int, n: int, tcols: list, wrench, fn, weights, free):
         self.s, self.trec, self.tval = s, prog.terms, prog.term_values
         self.terms = [k for k in range(k0, k0 + nt) if self.trec[k].row >= 0]
         self.n, self.tcols, self.wrench = n, tcols, wrench
@@ -189,14 +189,7 @@ class WorldBlock:
         pre = e.b.block
         e.b.cbranch(bad, slow, done)
         e.b.position_at_end(slow)
-        M, X = self._stack(e, (k * k, k * m))
-        for i in range(k):
-            for a in range(k):
-                e.store(AB[i][a], M, i * k + a)
-            for h in range(m):
-                e.store(RHS[i][h], X, i * m + h)
-        e.b.call(solve_function(e.module, k, m), [M, X])
-        loaded = [[e.load(X, i * m + h) for h in range(m)] for i in range(k)]
+        loaded = loop_solve(e, self._stack(e, (k * k, k * m)), AB, RHS)
         slow_end = e.b.block
         e.b.branch(done)
         e.b.position_at_end(done)
@@ -236,7 +229,6 @@ class WorldBlock:
         """The minimiser of sum w x^2 subject to A x = r (:func:`..sharing.least_load_solve`)."""
         nr, n = len(A), self.n
         size = n + nr
-        K, x = self._stack(e, (size * size, size))
         scale = 0.0                           # max |A|, NaN-free as numpy's max is not: NaN fails anyway
         for row in A:
             for v in row:
@@ -248,20 +240,13 @@ class WorldBlock:
                     scale = a
                 else:
                     scale = e.b.select(e.b.fcmp_unordered(">", a, e.const(scale)), a, e.const(scale))
-        for i in range(size):
-            for j in range(size):
-                if i < n and j < n:
-                    v = e.mul(scale, float(self.weights[i])) if i == j else 0.0
-                elif i < n:
-                    v = A[j - n][i]
-                elif j < n:
-                    v = A[i - n][j]
-                else:
-                    v = 0.0
-                e.store(v, K, i * size + j)
-            e.store(0.0 if i < n else r[i - n], x, i)
-        e.b.call(solve_function(e.module, size), [K, x])
-        return [e.load(x, i) for i in range(n)]
+        K = [[0.0] * size for _ in range(size)]       # the KKT matrix of sharing.kkt
+        for i in range(n):
+            K[i][i] = e.mul(scale, float(self.weights[i]))
+            for a in range(nr):
+                K[i][n + a], K[n + a][i] = A[a][i], A[a][i]
+        x = loop_solve(e, self._stack(e, (size * size, size)), K, [[0.0]] * n + [[v] for v in r])
+        return [row[0] for row in x[:n]]
 
     def rows(self, e: Emitter, fn, p, rows: list, r: list, tag: str) -> list:
         """Rows ``rows`` of the solution for pattern p (i64)."""
@@ -294,18 +279,13 @@ class LowRankBlock:
         m, k = len(self.tcols), self.lr.k
         if self.mem is None:                  # one stack slot per block
             self.mem = e.stack(fn, (k * k, k))
-        M, c = self.mem
         sig = signs_of(e, p, m)
-        W = self.lr.W
+        M = [[float(v) for v in row] for row in self.lr.W]       # C_sigma + W
         for i in range(k):
             for j in range(k):
-                v = float(W[i, j])
                 if self.lr.redundant and (j == i + m or i == j + m):
-                    v = e.add(v, sig[min(i, j)])
+                    M[i][j] = e.add(M[i][j], sig[min(i, j)])
                 elif not self.lr.redundant and i == j:
-                    v = e.add(v, sig[i])
-                e.store(v, M, i * k + j)
-            e.store(e.dot(floats(self.lr.G[i]), r), c, i)
-        e.b.call(solve_function(e.module, k), [M, c])
-        cv = [e.load(c, i) for i in range(k)]
+                    M[i][j] = e.add(M[i][j], sig[i])
+        cv = [row[0] for row in loop_solve(e, self.mem, M, [[e.dot(floats(self.lr.G[i]), r)] for i in range(k)])]
         return [e.sub(e.dot(floats(self.lr.Y[i]), r), e.dot(floats(self.lr.Z[i]), cv)) for i in rows]
