@@ -261,11 +261,14 @@ def test_program_key_follows_the_program_and_loads():
     a, b = (solver_for(analyse(parse_mechanism(serial_chain(n)))) for n in (3, 3))
     other = solver_for(analyse(parse_mechanism(serial_chain(4))))
     host = host_identity()
-    key = llvm_cache.program_key(a.kernel_program(), mech_loads(a.an), host, "1")
-    assert key == llvm_cache.program_key(b.kernel_program(), mech_loads(b.an), host, "1")
-    assert key != llvm_cache.program_key(other.kernel_program(), mech_loads(other.an), host, "1")
-    assert key != llvm_cache.program_key(a.kernel_program(), mech_loads(a.an), host + "x", "1")
-    assert key != llvm_cache.program_key(a.kernel_program(), [(1, True, np.zeros(3))], host, "1")
+
+    def key(sol, loads=None, host=host):
+        fingerprint = llvm_cache.program_fingerprint(sol.kernel_program(), mech_loads(sol.an) if loads is None else loads)
+        return llvm_cache.program_key(fingerprint, host, "1")
+    assert key(a) == key(b)
+    assert key(a) != key(other)
+    assert key(a) != key(a, host=host + "x")
+    assert key(a) != key(a, [(1, True, np.zeros(3))])
 
 
 def test_auto_counts_a_cached_kernel_as_cheap(tmp_path, monkeypatch):

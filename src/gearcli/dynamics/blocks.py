@@ -24,7 +24,7 @@ from .kinematics import Kinematics, forward
 from .losses import relative_rate
 from .pattern_maps import PatternMaps
 from .sharing import mesh_weights
-from .signs import MAX_EXHAUSTIVE, SignError, pattern_index, resolve_signs, rows_by_pattern, sign_patterns
+from .signs import SignError, pattern_index, resolve_signs, rows_by_pattern
 
 
 @dataclass(frozen=True, eq=False)
@@ -36,7 +36,6 @@ class BlockPlan:
     F: int | None           # frame link, None -> general solve
     signed: list[int]       # positions in groups of signed mesh unknowns
     offs: np.ndarray        # column offsets of the groups
-    patterns: list          # sign patterns (up to signs.MAX_EXHAUSTIVE signed meshes, else [])
     Ainv: PatternMaps       # solution map per pattern (n, 6*len(links)), a sequence made on
                             # first use; rectangular (n > 6*len(links)) for a redundant gear
                             # set: the least-t^2/k map
@@ -141,15 +140,15 @@ def _friction_columns(an, blk, gs, signed, to_F, cols) -> tuple[np.ndarray | Non
     fric = np.zeros((len(signed), 6 * len(blk)))
     fric_C = {}
     for n, gi in enumerate(signed):
-        g = gs[gi]
-        if cols.mesh_friction(g.index, _primary_side(an, g)) is None:
+        g, P = gs[gi], _primary_side(an, gs[gi])
+        couple = cols.mesh_friction(g.index, P)
+        if couple is None:
             continue
         for L in g.links:
             if L in blk:
                 r0 = 6 * blk.index(L)
                 fric[n, r0:r0 + 6] = to_F(cols.mesh_friction(g.index, L), L)[:, 0]
-        P = _primary_side(an, g)
-        fric_C[gi] = to_F(cols.mesh_friction(g.index, P), P)
+        fric_C[gi] = to_F(couple, P)
     return (fric if fric_C else None), fric_C
 
 
@@ -186,7 +185,7 @@ def make_plans(an) -> tuple[BlockPlan, ...]:
         common = set.intersection(*[_fixed_in(an, g) for g in gs]) if gs else set()
         F, turn = _frame(an, gs, common) if common and offs[-1] >= 6 * len(blk) else (None, {})
         if F is None:
-            plans.append(BlockPlan(tuple(blk), gs, None, signed, offs, [], [], names, {}, {}, later=later))
+            plans.append(BlockPlan(tuple(blk), gs, None, signed, offs, [], names, {}, {}, later=later))
             continue
         RF, oF = home.R[F][0], home.o[F][0]
 
@@ -199,8 +198,7 @@ def make_plans(an) -> tuple[BlockPlan, ...]:
         Ainv = _constant_matrices(an, blk, gs, offs, signed, to_F, cols)
         C, parent_side = _propagation_columns(an, F, gs, signed, to_F, cols)
         fric, fric_C = _friction_columns(an, blk, gs, signed, to_F, cols)
-        pats = sign_patterns(len(signed)) if len(signed) <= MAX_EXHAUSTIVE else []
-        plans.append(BlockPlan(tuple(blk), gs, F, signed, offs, pats, Ainv, names,
+        plans.append(BlockPlan(tuple(blk), gs, F, signed, offs, Ainv, names,
                                C, parent_side, turn, fric, fric_C, later=later))
     return tuple(plans)
 

@@ -26,7 +26,6 @@ import numpy as np
 from threadpoolctl import ThreadpoolController
 
 from ..analysis.schedule import unknown_groups
-from ..model.gears import helical_terms
 from .backends import CALL_SAMPLES, Choice, choose, llvm_refusal
 from .blocks import make_plans, solve_blocks
 from .equations import Columns
@@ -34,6 +33,7 @@ from .general import is_geared, solve_full
 from .external import external_wrenches, load_values, subtract_external
 from .inertia import inertia_load
 from .inputs import motion_arrays
+from .llvm.output_maps import gear_outputs
 from .llvm.program import build_program
 from .kinematics import forward
 from .bearing_friction import solve_with_bearing_friction, subtract_bearing_friction
@@ -357,8 +357,14 @@ def _unknowns(an, res: Result) -> dict:
     x = {("motor", i): res.motor[:, i:i + 1] for i in range(res.motor.shape[1])}
     x.update({("mesh", ci): res.gear_t[:, ci:ci + 1] for ci in range(res.gear_t.shape[1])})
     for ji, jt in enumerate(an.mech.joints):
-        x[("joint", ji)] = res.joint[:, ji, [0, 1, 3, 4, 5] if jt.type == "prismatic" else [0, 1, 2, 3, 4]]
+        x[("joint", ji)] = res.joint[:, ji, _reaction_axes(jt)]
     return x
+
+
+def _reaction_axes(jt) -> list[int]:
+    """The components [fx, fy, fz, mx, my, mz] of a joint's reaction that are unknowns (not
+    along / about its own axis)."""
+    return [0, 1, 3, 4, 5] if jt.type == "prismatic" else [0, 1, 2, 3, 4]
 
 
 def _result(an, groups, x_all) -> Result:
@@ -367,30 +373,18 @@ def _result(an, groups, x_all) -> Result:
     J, G, M = len(mech.joints), len(an.circuits), len(an.motor_links)
     joint = np.zeros((N, J, 6))
     for ji, jt in enumerate(mech.joints):
-        xj = x_all[("joint", ji)]
-        if jt.type == "prismatic":
-            joint[:, ji, [0, 1, 3, 4, 5]] = xj
-        else:
-            joint[:, ji, :5] = xj
+        joint[:, ji, _reaction_axes(jt)] = x_all[("joint", ji)]
     motor = np.column_stack([x_all[("motor", i)][:, 0] for i in range(M)]) if M else np.zeros((N, 0))
-    gt = np.zeros((N, G))
-    sep = np.zeros((N, G))
-    rad = np.zeros((N, G, 2))
-    ax = np.zeros((N, G, 2))
-    for ci, c in enumerate(an.circuits):
-        t = x_all[("mesh", ci)][:, 0]
-        gt[:, ci] = t
-        if c.geometry is None:
-            continue
-        gm, gp = c.geometry, mech.gears[c.gear]
-        tan_t, a = helical_terms(gm, gp.pressure_angle, gp.helix_angle, gp.hand)
-        s = np.abs(t) * tan_t
-        sep[:, ci] = s
-        # g = t (ut + a) + s us (on j); -g on k; ut is perpendicular to both radial directions
-        ua = gm.ut + a
-        rad[:, ci, 0] = t * (ua @ gm.rad_j) + s * (gm.us @ gm.rad_j)
-        ax[:, ci, 0] = t * (ua @ gm.zj) + s * (gm.us @ gm.zj)
-        rad[:, ci, 1] = -(t * (ua @ gm.rad_k) + s * (gm.us @ gm.rad_k))
-        ax[:, ci, 1] = -(t * (ua @ gm.zk) + s * (gm.us @ gm.zk))
+    gt, sep, rad, ax = np.zeros((N, G)), np.zeros((N, G)), np.zeros((N, G, 2)), np.zeros((N, G, 2))
+    for ci in range(G):
+        gt[:, ci] = x_all[("mesh", ci)][:, 0]
+    k = gear_outputs(an)            # g = t (ut + a) + s us on j, -g on k (s = |t| tan phi_t)
+    geo = np.flatnonzero(k.geometry == 1.0)
+    t = gt[:, geo]
+    s = sep[:, geo] = np.abs(t) * k.tan_t[geo]
+    rad[:, geo, 0] = t * k.t_rad_j[geo] + s * k.sep_rad_j[geo]
+    ax[:, geo, 0] = t * k.t_ax_j[geo] + s * k.sep_ax_j[geo]
+    rad[:, geo, 1] = -(t * k.t_rad_k[geo] + s * k.sep_rad_k[geo])
+    ax[:, geo, 1] = -(t * k.t_ax_k[geo] + s * k.sep_ax_k[geo])
     tau = motor @ an.A.T
     return Result(motor, tau, joint, gt, sep, rad, ax)

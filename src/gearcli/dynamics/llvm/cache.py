@@ -89,14 +89,9 @@ def program_fingerprint(prog, loads: list) -> str:
     return _sha(parts)
 
 
-def program_key(prog, loads: list, host: str, version: str) -> str:
-    """A key of what the IR is generated from (:func:`program_fingerprint`), the host and
-    gearcli's version."""
-    return fingerprint_key(program_fingerprint(prog, loads), host, version)
-
-
-def fingerprint_key(fingerprint: str, host: str, version: str) -> str:
-    """:func:`program_key` of the kernel program of ``fingerprint``."""
+def program_key(fingerprint: str, host: str, version: str) -> str:
+    """A key of what the IR is generated from (the :func:`program_fingerprint` of its kernel
+    program), the host and gearcli's version (with its generator's source digest)."""
     return _sha(["program", FORMAT, host, version, fingerprint])
 
 

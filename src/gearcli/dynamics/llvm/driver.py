@@ -318,7 +318,7 @@ def _program_ids(prog: Program, an) -> tuple[str, str]:
 
         version = f"{__version__}|{generator_digest()}"
         fingerprint = llvm_cache.program_fingerprint(prog, mech_loads(an))
-        _PROGRAM_KEYS[prog] = fingerprint, llvm_cache.fingerprint_key(fingerprint, host_identity(), version)
+        _PROGRAM_KEYS[prog] = fingerprint, llvm_cache.program_key(fingerprint, host_identity(), version)
     return _PROGRAM_KEYS[prog]
 
 
@@ -327,4 +327,3 @@ def kernel_on_disk(prog: Program, an) -> bool:
     (its compile would be a load; without building the IR, so a guess should the generator
     have changed since: then it compiles)."""
     return llvm_cache.has_program(_program_ids(prog, an)[1])
-

@@ -171,7 +171,7 @@ class _Builder:
         return True
 
 
-def _block(bd: _Builder, an, bi, p, offsets, sigcol, terms):
+def _block(bd: _Builder, an, bi, p, offsets, sigcol, terms, lowrank):
     """Append block ``bi`` (plan ``p``) to the builder."""
     n = int(p.offs[-1])
     term0, nterm = terms.get(bi, (0, 0))
@@ -184,7 +184,7 @@ def _block(bd: _Builder, an, bi, p, offsets, sigcol, terms):
     for gi in p.signed:
         bd.tcol.append(int(p.offs[gi]))
         bd.scol.append(sigcol[(p.groups[gi].kind, p.groups[gi].index)])
-    if p.F is not None and (1 << len(p.signed)) > MAX_PATTERNS:
+    if bi in lowrank:
         rec["ainv0"] = -1                  # solved from its pattern_maps.LowRank (program.lowrank)
     else:
         for A in p.Ainv:
@@ -241,7 +241,7 @@ def build_program(an, plans) -> Program:
     trec, tflt, terms = general_terms(an, plans)
     bd = _Builder()
     for bi, p in enumerate(plans):
-        _block(bd, an, bi, p, offsets, sigcol, terms)
+        _block(bd, an, bi, p, offsets, sigcol, terms, lowrank)
         if p.F is None and len(p.links) == 1 and not p.signed:
             _local_frame(bd, trec, tflt, p)
     joints, poses = _joints(an)

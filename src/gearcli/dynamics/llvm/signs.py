@@ -48,13 +48,10 @@ def _sign_bit(e: Emitter, p, i: int, m: int):
 
 
 def _consistent(e: Emitter, t: list, negative: list, tol):
-    """All -sig_i t_i <= tol (``negative``: per t a bool, or an i1 when p is at run time)."""
+    """All -sig_i t_i <= tol (``negative``: per t an i1, true for sig_i = -1)."""
     ok = ir.Constant(I1, 1)
     for ti, neg in zip(t, negative):
-        if isinstance(neg, bool):
-            v = e.const(ti) if neg else e.const(e.neg(ti))
-        else:
-            v = e.b.select(neg, e.const(ti), e.const(e.neg(ti)))
+        v = e.b.select(neg, e.const(ti), e.const(e.neg(ti)))
         ok = e.b.and_(ok, e.b.fcmp_ordered("<=", v, tol))
     return ok
 
