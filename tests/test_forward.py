@@ -214,6 +214,19 @@ def test_mass_kernel_passing_abs_t_on_would_be_caught(monkeypatch, tmp_path):
     assert rel_err(wrong, mass_matrix(an, q, backend="numpy")) > 1e-3
 
 
+def test_beyond_max_kernel_dof_the_stacked_llvm_solve(monkeypatch):
+    """More independent joints than MAX_KERNEL_DOF: no mass kernel (its compile grows with
+    dof^2), the stacked solve on the llvm solve kernel, equal to the reference."""
+    from gearcli.dynamics.solve import solver_for
+
+    monkeypatch.setattr(forward, "MAX_KERNEL_DOF", 2)
+    an = analyse(load_mechanism(MECH_DIR / "bendix_wrist.yaml"))
+    q, qd, _ = random_state(an, 20, seed=14)
+    assert max(kernel_error(an, q, qd)) < 1e-12
+    sol = solver_for(an)
+    assert sol not in forward._KERNELS and sol.compiled_llvm()
+
+
 def test_first_call_rule_keeps_a_small_first_call_on_the_reference(monkeypatch, tmp_path):
     """"auto": a first call of fewer than FIRST_CALL_SAMPLES / (dof + 1) samples does not
     compile the mass kernel (nor the solve kernel) when the disk cache does not hold it; a

@@ -31,6 +31,8 @@ of the rotors).  Two implementations, equal to 1e-12 of each sample's largest to
 * the numpy reference (backend "numpy", and "auto"'s first-call rule of :mod:`.backends`,
   a call counting as n (dof + 1) samples, while the kernel is neither compiled nor on
   disk): one numpy solve of the N (dof + 1) stacked samples, dof + 1 inverse dynamics.
+  Beyond :data:`MAX_KERNEL_DOF` independent joints the same stacked solve runs on the
+  solve's own backend (the llvm solve kernel) instead of compiling the mass kernel.
 
 Losses (``gears[].efficiency``/``loss_factor``, ``joints[].friction``, bearing friction):
 the mesh friction couple c |t| rho makes tau(q, qd, qdd) piecewise linear in qdd (linear for
@@ -98,10 +100,10 @@ def _joints(an) -> list[str]:
     return [f"joint '{n}'" for n in an.independent_names]
 
 
-def _stacked_chunks(an, q, qd, loads):
-    """The numpy reference of :func:`_mass_and_h`: yield (slice, tau (m, dof + 1, dof))
-    chunk by chunk, [:, 0] = tau(q, qd, 0) = h, [:, 1 + i] = tau(q, qd, e_i), from one
-    numpy solve of m * (dof + 1) samples per chunk."""
+def _stacked_chunks(an, q, qd, loads, backend, jobs):
+    """The reference of :func:`_mass_and_h`: yield (slice, tau (m, dof + 1, dof)) chunk by
+    chunk, [:, 0] = tau(q, qd, 0) = h, [:, 1 + i] = tau(q, qd, e_i), from one solve of
+    m * (dof + 1) samples per chunk (``backend`` "numpy": the numpy reference)."""
     n, dof = q.shape
     k = dof + 1
     unit = np.zeros((k, dof))
@@ -111,24 +113,34 @@ def _stacked_chunks(an, q, qd, loads):
         m = sl.stop - sl.start
         part = {name: np.repeat(w[sl], k, axis=0) for name, w in loads.items()}
         res = solve(an, np.repeat(q[sl], k, axis=0), np.repeat(qd[sl], k, axis=0), np.tile(unit, (m, 1)),
-                    loads=part, backend="numpy", check_finite=False)
+                    loads=part, backend=backend, jobs=jobs, check_finite=False)
         yield sl, res.tau.reshape(m, k, dof)
 
 
 _KERNELS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
+MAX_KERNEL_DOF = 12
+"""Up to this many independent joints the mass kernel; beyond, the stacked solve on the
+solve's backend: the mass kernel's IR grows with dof^2 and its compile faster (serial
+chains at load 4: 8 joints 2.2 s, 16 10 s, 24 43 s, against 0.7, 1.3 and 2.2 s for the
+solve kernel)."""
+
+
 def _mass_kernel(an, n: int, backend: str):
-    """The mass kernel (:class:`.llvm.mass.MassKernel`) for a call of n samples, or None:
-    the numpy reference then.  ``backend`` as :func:`gearcli.solve`'s: "numpy" None; "llvm"
-    the kernel (or ValueError); "auto" the kernel where the llvm backend can run, by the
-    first-call rule of :mod:`.backends` (a call counting as n (dof + 1) samples, the solve's
-    work it replaces; its own compile and disk cache entries)."""
+    """(the mass kernel (:class:`.llvm.mass.MassKernel`) for a call of n samples, or None
+    and the backend of the stacked solve instead).  ``backend`` as :func:`gearcli.solve`'s:
+    "numpy" the numpy reference; "llvm" the kernel (or ValueError); "auto" the kernel where
+    the llvm backend can run, by the first-call rule of :mod:`.backends` (a call counting as
+    n (dof + 1) samples, the solve's work it replaces; its own compile and disk cache
+    entries), else the numpy reference.  Beyond :data:`MAX_KERNEL_DOF`: the stacked solve."""
     if backend == "numpy":
-        return None
+        return None, "numpy"
     sol = solver_for(an)
     if sol.choice("block", backend, None).path == "numpy":      # ValueError for a bad backend
-        return None
+        return None, "numpy"
+    if an.dof > MAX_KERNEL_DOF:
+        return None, backend
     from .llvm.mass import MassKernel  # noqa: PLC0415  (imports llvmlite)
     kernel, seen = _KERNELS.get(sol, (None, 0))
     if kernel is None:
@@ -136,10 +148,10 @@ def _mass_kernel(an, n: int, backend: str):
         prog = sol.kernel_program()
         if backend == "auto" and seen < FIRST_CALL_SAMPLES and not has_program(MassKernel.ids(prog, an)[1]):
             _KERNELS[sol] = (None, seen)
-            return None
+            return None, "numpy"
         kernel = MassKernel(prog, an)
         _KERNELS[sol] = (kernel, seen)
-    return kernel
+    return kernel, backend
 
 
 def _mass_and_h(an, q, qd, target, loads, backend, jobs):
@@ -148,12 +160,12 @@ def _mass_and_h(an, q, qd, target, loads, backend, jobs):
     the module docstring)."""
     n, dof = q.shape
     values = load_values(an.mech, n, loads)      # checked, (n, 6) each
-    kernel = _mass_kernel(an, n, backend)
+    kernel, stacked = _mass_kernel(an, n, backend)
     got = None if kernel is None else kernel.run(an, q, qd, values, target, jobs)
     if got is not None:
         return got
-    M, h = np.empty((n, dof, dof)), np.empty((n, dof))       # the reference (also a kernel sample not finite:
-    for sl, tau in _stacked_chunks(an, q, qd, values):       # then the solve names it)
+    M, h = np.empty((n, dof, dof)), np.empty((n, dof))       # stacked (also a kernel sample not finite:
+    for sl, tau in _stacked_chunks(an, q, qd, values, stacked, jobs):      # then the solve names it)
         M[sl] = np.swapaxes(tau[:, 1:, :] - tau[:, :1, :], 1, 2)
         M[sl] = 0.5 * (M[sl] + np.swapaxes(M[sl], 1, 2))
         h[sl] = tau[:, 0, :]
