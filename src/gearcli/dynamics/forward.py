@@ -65,8 +65,6 @@ from .solve import solve, solver_for
 
 CHUNK = 2_000
 """Forward samples per batched solve (each becomes dof + 1 inverse-dynamics samples)."""
-SMALL = 16
-"""Up to this many samples :func:`solve_spd` calls LAPACK (its Python loop costs more)."""
 TOLERANCE = 1e-12
 """With losses: the torque residual at which :func:`forward_dynamics` stops, relative to the
 sample's largest torque."""
@@ -169,7 +167,7 @@ def _mass_and_h(an, q, qd, target, loads, backend, jobs):
         M[sl] = np.swapaxes(tau[:, 1:, :] - tau[:, :1, :], 1, 2)
         M[sl] = 0.5 * (M[sl] + np.swapaxes(M[sl], 1, 2))
         h[sl] = tau[:, 0, :]
-    return M, h, solve_spd(np.moveaxis(M, 0, 2).copy(), target - h)
+    return M, h, np.linalg.solve(M, (target - h)[:, :, None])[:, :, 0]
 
 
 def mass_matrix(an, q, backend: str = "auto", jobs: int | None = None) -> np.ndarray:
@@ -245,29 +243,6 @@ def _implicit(an, q, qd, target, M, h, qdd, loads, backend, jobs) -> np.ndarray:
         qdd[todo] -= np.linalg.solve(M[todo], r[:, :, None])[:, :, 0]
     raise ValueError(f"forward dynamics with losses did not settle at sample {todo[0]} in {MAX_STEPS} steps "
                      "(no unique acceleration: a self-locking transmission?)")
-
-
-def solve_spd(M: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """x (N, d) with M[:, :, s] x[s] = b[s] for every sample s: Gaussian elimination without
-    pivoting (stable for a symmetric positive definite M), vectorised over the samples.
-
-    ``M`` (d, d, N), samples last so that every step is an operation on contiguous
-    N-vectors (overwritten); ``b`` (N, d).  Loops over the d rows only: for small d it is
-    ~25 times faster than ``np.linalg.solve`` on (N, d, d), whose cost is ~1 us a matrix
-    (3 x 3: 0.02 against 0.5 us a sample), and as fast for d = 8-12.
-    """
-    d, n = M.shape[0], M.shape[2]
-    if n <= SMALL:                                  # a few samples (an integrator's step): LAPACK
-        return np.linalg.solve(np.moveaxis(M, 2, 0), b[:, :, None])[:, :, 0]
-    y = np.array(b.T, dtype=float)                  # (d, N), a copy
-    for i in range(d - 1):
-        f = M[i + 1:, i] / M[i, i]
-        M[i + 1:, i + 1:] -= f[:, None, :] * M[i, i + 1:][None]
-        y[i + 1:] -= f * y[i]
-    x = np.empty_like(y)
-    for i in range(d - 1, -1, -1):
-        x[i] = (y[i] - np.einsum("jn,jn->n", M[i, i + 1:], x[i + 1:])) / M[i, i]
-    return x.T
 
 
 def motor_inertia(an, q, diagonal: bool = False, backend: str = "auto", jobs: int | None = None) -> np.ndarray:
