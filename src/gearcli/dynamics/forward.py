@@ -24,10 +24,10 @@ of the rotors).  Two implementations, equal to 1e-12 of each sample's largest to
   per sample one h pass and dof column passes (qd = 0, qdd = e_i, no gravity, no loads)
   sharing the pose, every signed block solved with one sign pattern and no search (the
   torques do not depend on it), writing only M, h and qdd = M^-1 (A T - h) (in the same
-  loop).  A forward sample costs about 1 solve sample on Bendix (dof 3) and 3.5 on Panda
-  (dof 8), against dof + 1 (``benchmarks/bench_forward.py``, 2026-11-26 11:19 UTC, load
-  4.2, one thread: Bendix 1.92 M forward samples/s against 1.93 M for solve, 4x the
-  1/(dof + 1) limit; Panda 366,000 against 1.30 M, 2.5x);
+  loop).  A forward sample costs about 1.1 solve samples on Bendix (dof 3) and 3.5 on
+  Panda (dof 8), against dof + 1 (``benchmarks/bench_forward.py --jobs 1``, 2026-11-26
+  11:45 UTC, load 3.2: Bendix 2.24 M forward samples/s against 2.52 M for solve, 3.6x
+  the 1/(dof + 1) limit; Panda 601,000 against 2.08 M, 2.5x);
 * the numpy reference (backend "numpy", and "auto"'s first-call rule of :mod:`.backends`,
   a call counting as n (dof + 1) samples, while the kernel is neither compiled nor on
   disk): one numpy solve of the N (dof + 1) stacked samples, dof + 1 inverse dynamics.
