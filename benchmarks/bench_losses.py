@@ -11,9 +11,10 @@ interleaved round by round so that load drift hits all alike, medians of --round
   of relative-speed signs met); llvm: each block's trial corrected by the rank-ml update of
   its friction columns (:mod:`gearcli.dynamics.llvm.losses`), the joint friction an input;
 * the same with bearing friction on every bearing (mu 0.0015, bore 20 mm), numpy and llvm:
-  a fixed-point iteration per sample (:func:`gearcli.dynamics.bearing_friction.fixed_point`),
-  whose iterations are printed (median and worst); llvm: the kernel rerun per iteration,
-  computing the bearing moments of its own reactions.
+  a fixed-point iteration per sample, whose iterations are printed (median and worst); numpy:
+  :func:`gearcli.dynamics.bearing_friction.fixed_point`, every joint at once; llvm: inside the
+  kernel, block by block (:mod:`gearcli.dynamics.llvm.bearings`), a sample's count the most
+  over its blocks.
 
 The cost of losses in the compiled path (issue 19's target: at most 20 %) is each llvm row
 over the lossless llvm row of the same run.
@@ -77,7 +78,7 @@ def main(argv=None) -> int:
     it = res.bearing_iterations
     print(f"  bearing friction iterations per sample: median {int(np.median(it))}, worst {int(it.max())}")
     fast_it = solve(cases["+ bearing friction, llvm"][0], q, qd, qdd, backend="llvm").bearing_iterations
-    print(f"  (llvm: median {int(np.median(fast_it))}, worst {int(fast_it.max())})")
+    print(f"  (llvm, the most over a sample's blocks: median {int(np.median(fast_it))}, worst {int(fast_it.max())})")
     return 0
 
 

@@ -264,7 +264,10 @@ def test_energy_falls_by_exactly_the_integrated_losses(run_cli, tmp_path):
     hand (pendulum_energy), not from gearcli.  The balance holds to 6e-8 of the largest
     kinetic energy: the trapezoid rule every 0.1 ms, whose error concentrates where the
     mesh force or the rates change sign inside an interval (a kink of |t| v); the
-    integrator's own error (rtol 1e-10) is far below."""
+    integrator's own error (rtol 1e-10) is far below.  A solve that differs by one ulp (a
+    kernel whose arithmetic is ordered otherwise) moves it to 1.1e-7: the implicit
+    acceleration's steps stop at the solve's rounding (forward.STALLED) and DOP853's adaptive
+    steps follow them (20,058 against 17,283 solves, measured), hence 2e-7."""
     mech = write(tmp_path / "pendulum.yaml", LOSSY_PENDULUM)
     inp = write(tmp_path / "in.csv", "t,motor:motor\n0,-0.01\n0.1,-0.01\n0.12,0\n0.4,0\n")
     r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv", "--q0", "0.8", "--dt", "1e-4",
@@ -281,7 +284,7 @@ def test_energy_falls_by_exactly_the_integrated_losses(run_cli, tmp_path):
     assert work[-1] > 0.1 * lost[-1] > 0 and np.ptp(w) > 10     # the motor and every loss matter
     for c, p in losses.items():
         assert running_integral(t, p)[-1] > 0.02 * lost[-1], c
-    assert np.max(np.abs(E - E[0] - work + lost)) < 1e-7 * kinetic.max()
+    assert np.max(np.abs(E - E[0] - work + lost)) < 2e-7 * kinetic.max()
     free = t >= 0.12
     assert np.all(np.diff(E[free]) <= 1e-12 * kinetic.max())
     # a deliberate bug: the bearing friction left out of the losses breaks the balance

@@ -149,16 +149,15 @@ def subtract_bearing_friction(an, kin, b: dict, qd_all: np.ndarray, moments: np.
 
 
 def fixed_point(an, qd_all: np.ndarray, solve_moments):
-    """The fixed point of the bearing friction moments, shared by every solve path.
+    """The fixed point of the bearing friction moments of the numpy path (the llvm kernel
+    converges them per block, :mod:`.llvm.bearings`, with this TOL and MAX_ITERATIONS).
 
     ``solve_moments(Mb, todo)`` solves the samples ``todo`` (indices) with the moments
     Mb[todo] (Mb (N, len(friction_joints)): sum_b M_b >= 0 of each joint with bearing
     friction, on the child -sign(q'_J) Mb about the axis, reversed on the parent) and
     returns the unknowns {(kind, index): (N, size)} of every sample (joint reactions in the
     child's basis; a path may solve the other samples again with their Mb, which no longer
-    changes), or (those unknowns, moments (N, len(friction_joints))): the moments
-    :func:`friction_moments` gives of its own solution (the llvm kernel's twin), then not
-    computed here.  Iterates from zero moments, each sample until its moments change by at most
+    changes).  Iterates from zero moments, each sample until its moments change by at most
     ``TOL`` relative (its Mb is then kept: those of its solution).  Returns (x_all, moments
     (N, J) of every joint, iterations (N,) int: the iteration at which each sample met the
     tolerance).  Raises :class:`BearingFrictionError` naming the first sample that does not
@@ -173,12 +172,8 @@ def fixed_point(an, qd_all: np.ndarray, solve_moments):
     todo = np.arange(N)
     for it in range(1, MAX_ITERATIONS + 1):
         x_all = solve_moments(Mb, todo)
-        x_all, own = x_all if isinstance(x_all, tuple) else (x_all, None)
         every = todo.size == N
-        if own is not None:
-            new = own if every else own[todo]
-        else:
-            new = friction_moments(an.mech, joints, x_all if every else {k: x_all[k][todo] for k in keys})
+        new = friction_moments(an.mech, joints, x_all if every else {k: x_all[k][todo] for k in keys})
         if rest:
             new = np.where(s if every else s[todo], new, 0.0)
         change = np.abs(new - (Mb if every else Mb[todo]))

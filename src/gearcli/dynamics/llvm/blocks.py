@@ -14,6 +14,7 @@ from __future__ import annotations
 import llvmlite.ir as ir
 
 from . import losses as llvm_losses
+from .bearings import converge
 from .build import I64, Emitter
 from .links import Sample, floats
 from .signs import SignedBlock, resolve, signs_of, tolerance
@@ -144,19 +145,25 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row, search: bool
         blk.extra = llvm_losses.world_columns(prog.losses, lossy, s)
     elif lossy is not None:
         blk = llvm_losses.LossyBlock(blk, lossy, s.sv)
-    if m == 0 or not search:
-        sig = [1.0] * m
+
+    def solve(r, tag):              # (x, p) of right-hand side r; p None: pattern 0 without a search
+        if m and search:
+            return resolve(e, fn, blk, r, tolerance(e, r), _on_fail(e, fail, n, b), tag)
         if F < 0:
-            x = blk.solve(e, sig, r)
-        elif b in prog.lowrank:
-            x = blk.rows(e, fn, ir.Constant(I64, 0), list(range(nloc)), r, f"b{b}_x")
-        else:
-            x = [e.dot(floats(maps[0][i]), r) for i in range(nloc)]
+            return blk.solve(e, [1.0] * m, r), None
+        if b in prog.lowrank:
+            return blk.rows(e, fn, ir.Constant(I64, 0), list(range(nloc)), r, f"{tag}_x"), None
+        return [e.dot(floats(maps[0][i]), r) for i in range(nloc)], None
+
+    def rows(p, idx, r, tag):       # rows idx of the solution with pattern p (constant frame)
+        return [e.dot(floats(maps[0][i]), r) for i in idx] if m == 0 else blk.rows(e, fn, p, idx, r, tag)
+    if search and prog.losses is not None and b in prog.losses.bearing_blocks:
+        x, p = converge(e, fn, s, prog, b, F, links, tcols, r, solve, rows, n, fail)
     else:
-        x, p = resolve(e, fn, blk, r, tolerance(e, r), _on_fail(e, fail, n, b), f"b{b}")
-        sig = signs_of(e, p, m)
-        for i in range(m):
-            e.store(sig[i], sg_row, int(scol[t0 + i]))
+        x, p = solve(r, f"b{b}")
+    sig = [1.0] * m if p is None else signs_of(e, p, m)
+    for i in range(m if p is not None else 0):
+        e.store(sig[i], sg_row, int(scol[t0 + i]))
     if nt > 0:
         propagate_terms(e, s, k0, nt, prog, x, sig)
     else:

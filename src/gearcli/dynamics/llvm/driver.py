@@ -25,10 +25,9 @@ from .program import Program, load_arrays
 from .kernel import ARGS, build_module
 from .links import load_groups
 from .outputs import OUTPUTS
-from ..bearing_friction import fixed_point
+from ..bearing_friction import MAX_ITERATIONS, BearingFrictionError
 from ..losses import joint_friction_forces
 from ..result_arrays import one_allocation
-from ..signs import SignError
 
 
 @lru_cache(maxsize=1)
@@ -75,7 +74,7 @@ def mech_loads(an) -> list:
 
 
 GENERATOR = ("kernel", "blocks", "build", "links", "outputs", "signs", "solve", "trig", "world", "driver",
-             "losses", "mass", "../result_arrays", "../signs")
+             "losses", "mass", "bearings", "../result_arrays", "../signs", "../bearing_friction")
 """The modules (paths from :mod:`gearcli.dynamics.llvm`, without .py) whose code makes a kernel program's IR text (a test
 checks that every module they import from the package is listed or makes only hashed input)."""
 
@@ -236,10 +235,10 @@ class LlvmKernel:
 
         A lossy mechanism (``prog.losses``): the joints' friction loads are the kernel's
         input (:func:`..losses.joint_friction_forces` of the joint rates), the bearing
-        friction's fixed point (:func:`..bearing_friction.fixed_point`) runs the kernel again
-        over the samples whose moments have not converged yet; ``losses`` (a dict) receives "rates"
-        {circuit: theta'_{j,c} (N,)}, "bearing" (N, J) moments and "iterations" (N,) (None
-        without bearing friction), "qd" (N, J) the joint rates."""
+        friction converges in the kernel, block by block (:mod:`.bearings`); ``losses`` (a dict)
+        receives "rates" {circuit: theta'_{j,c} (N,)}, "bearing" (N, J) moments and
+        "iterations" (N,): per sample the most iterations over its blocks (None without bearing
+        friction), "qd" (N, J) the joint rates."""
         prog = self.prog
         lp = prog.losses
         if lp is None:
@@ -256,24 +255,13 @@ class LlvmKernel:
             np.take(friction, lp.joints[:, 0], axis=1, out=jq)
         else:
             jq[:] = 0.0
+        self._launch(an, q, qd, qdd, values, jobs, chunk, out, work, jq, rate)
         bearing = iterations = None
-        if lp.bearing_joints:
-            cols = [lp.joints[:, 0].tolist().index(ji) for ji in lp.bearing_joints]
-            base, sign = jq[:, cols].copy(), np.sign(qd_all[:, lp.bearing_joints])
-
-            def solve_moments(Mb, todo):
-                if 4 * todo.size >= q.shape[0]:  # every sample: cheaper than gathering a quarter or more
-                    jq[:, cols] = base - sign * Mb
-                    self._launch(an, q, qd, qdd, values, jobs, chunk, out, work, jq, rate)
-                else:                    # the samples not yet converged only
-                    jq[todo[:, None], cols] = base[todo] - sign[todo] * Mb[todo]
-                    self._rows(an, todo, q, qd, qdd, values, jobs, chunk, out, work, jq, rate)
-                # the kernel's own sum_b M_b of its reactions (the twin of friction_moments)
-                return ({("joint", ji): out["joint"][:, ji, :5] for ji in lp.bearing_joints},
-                        rate[:, len(lp.rate_meshes):])
-            _, bearing, iterations = fixed_point(an, qd_all, solve_moments)
-        else:
-            self._launch(an, q, qd, qdd, values, jobs, chunk, out, work, jq, rate)
+        if lp.bearing_joints:          # the kernel's converged moments and iterations (.bearings)
+            R, K = len(lp.rate_meshes), len(lp.bearing_joints)
+            bearing = np.zeros((N, J))
+            bearing[:, list(lp.bearing_joints)] = rate[:, R:R + K]
+            iterations = rate[:, R + K:R + K + len(lp.bearing_blocks)].max(axis=1).astype(np.int64)
         if losses is not None:
             losses.update(rates={ci: rate[:, k] for k, ci in enumerate(lp.rate_meshes)}, bearing=bearing,
                           iterations=iterations, qd=qd_all, friction=friction,
@@ -281,30 +269,21 @@ class LlvmKernel:
         return {k: work[0][:, i] for i, k in enumerate(prog.signed)}
 
     def _launch(self, an, q, qd, qdd, values, jobs, chunk, out, work, jq, rate) -> None:
-        """One run of the kernel over every sample of q (raises the numpy path's SignError)."""
+        """One run of the kernel over every sample of q (raises the numpy path's SignError or
+        BearingFrictionError)."""
         n = q.shape[0]
         SG, fail = work
         keep = [np.ascontiguousarray(a, float) for a in (q, qd, qdd)] + self.load_args(an, values, n)
         keep += [out[k] if out[k].size else np.empty((1, 1)) for k in OUTPUTS] + [SG, jq, rate, fail]
         ptrs = [a.ctypes.data for a in keep]
         failed = run_parts(lambda s, e, _: self._run(*ptrs, s, e), job_ranges(n, jobs), threads_for(n, jobs))
-        if failed:
-            raise sign_error(self.prog.names, fail, chunk)
-
-    def _rows(self, an, rows, q, qd, qdd, values, jobs, chunk, out, work, jq, rate) -> None:
-        """:meth:`_launch` on the samples ``rows`` only, their results written into their rows."""
-        sub = {k: np.ascontiguousarray(v[rows]) for k, v in out.items()}
-        SG, fail = work
-        sw = (np.empty((rows.size, SG.shape[1])), np.empty(rows.size, np.int64))
-        jr, rr = np.ascontiguousarray(jq[rows]), np.empty((rows.size, rate.shape[1]))
-        try:
-            self._launch(an, q[rows], qd[rows], qdd[rows], {k: v[rows] for k, v in values.items()}, jobs, chunk,
-                         sub, sw, jr, rr)
-        except SignError as exc:
-            raise SignError(int(rows[exc.sample]), exc.meshes) from None
-        for k, v in sub.items():
-            out[k][rows] = v
-        SG[rows], fail[rows], rate[rows] = sw[0], sw[1], rr
+        if failed:                    # a block's sign search, else a bearing fixed point (.bearings)
+            nb = len(self.prog.blocks)
+            if np.any((fail >= 0) & (fail < nb)):
+                raise sign_error(self.prog.names, np.where(fail < nb, fail, -1), chunk)
+            s = int(np.flatnonzero(fail >= nb)[0])
+            joint = an.mech.joints[self.prog.losses.bearing_joints[int(fail[s]) - nb]].name
+            raise BearingFrictionError(s, joint, MAX_ITERATIONS)
 
 
 _PROGRAM_KEYS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()

@@ -12,8 +12,8 @@ the code: joint space, kinematics, inertia and external loads (:mod:`.links`), t
 blocks in schedule order (:mod:`.blocks`, :mod:`.signs`) and the outputs
 (:mod:`.outputs`), straight-line except for the sign search; a lossy mechanism's losses
 (:mod:`.losses`: the joints' friction loads ``jq`` (N, Q) in, each lossy mesh's relative
-rate ``rate`` (N, R) out, followed by the bearing friction moments of the sample's
-reactions, :class:`~.loss_program.LossProgram`).  Only the inputs (the
+rate ``rate`` (N, R) out, followed by the converged bearing friction moments and each
+block's iterations of :mod:`.bearings`, :class:`~.loss_program.LossProgram`).  Only the inputs (the
 independent q, qd, qdd (N, dof), C-ordered), the external loads (their values, points
 ``ldpt``, records ``ldrow`` and per loaded link the range ``ldgrp``, :func:`.links.external`: one loop per loaded link,
 whatever the number of loads) and the output arrays
@@ -68,8 +68,6 @@ def _sample(e: Emitter, fn, prog, loads, n) -> None:
     signs = e.row(a["signs"], n, max(w["signs"], 1))
     for b in range(len(prog.blocks)):
         block(e, fn, s, prog, b, n, a["fail"], signs)
-    if lp is not None and lp.bearing_joints:
-        llvm_losses.friction_moments(e, s, lp, prog.joint_out, rate)
     write_outputs(e, s, prog, ind[1], {k: e.row(a[k], n, max(w[k], 1)) for k in OUTPUTS})
 
 

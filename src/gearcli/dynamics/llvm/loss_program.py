@@ -16,8 +16,10 @@ field (None for a lossless mechanism).  It holds, with the model of :mod:`.losse
   friction force per sample (:func:`..losses.joint_friction_force`, the bearing moments of
   :mod:`..bearing_friction`) the kernel takes as its input ``jq`` (N, Q);
 * ``bearing_flt``, ``bearing_single``: the bearings of the joints with bearing friction
-  (:func:`..bearing_friction.bearing_layout`), whose sum_b M_b of the sample's reactions
-  the kernel writes after the rates in its ``rate`` row (width :attr:`LossProgram.out_width`).
+  (:func:`..bearing_friction.bearing_layout`); ``bearing_blocks``: block index ->
+  :class:`BearingBlock`, the bearing friction joints whose reaction the block solves, which
+  the kernel converges there (:mod:`.bearings`); it writes their converged sum_b M_b and each
+  block's iterations after the rates in its ``rate`` row (width :attr:`LossProgram.out_width`).
 
 Frames and signs as in :mod:`..losses` and :mod:`..blocks`: a constant block's couples are
 in its frame F (``fric`` rows, ``fric_C``), a world-frame block's in base axes per sample.
@@ -30,6 +32,7 @@ import numpy as np
 
 from ..bearing_friction import bearing_layout, friction_joints
 from ..blocks import _primary_side
+from ..kinematics import forward
 from ..losses import mesh_friction_moment
 
 
@@ -56,6 +59,23 @@ class BlockLosses:
 
 
 @dataclass(frozen=True, eq=False)
+class BearingBlock:
+    """The bearing friction joints whose reaction one block solves (its child's or its
+    parent's block, whichever comes first; their friction couple acts on no earlier block).
+
+    ``joints``: each one's index in :attr:`LossProgram.bearing_joints`; ``cols``: the block
+    column of its reaction [fx, fy, fz, mx, my] (the parent's or a coaxial link's basis: a
+    turn about the axis, which leaves the bearing loads' magnitudes as they are); ``wF``
+    (K, 6B): a constant-frame block's unit couple of each, +z on the child and -z on the
+    parent where they are block links, in F's axes (constant: F carries the joint's axis),
+    None for a block solved in world axes."""
+
+    joints: tuple
+    cols: tuple
+    wF: np.ndarray | None
+
+
+@dataclass(frozen=True, eq=False)
 class LossProgram:
     """See the module docstring."""
 
@@ -69,12 +89,14 @@ class LossProgram:
     bearing_joints: tuple = field(default=())     # friction_joints(mech): the fixed point's joints
     bearing_flt: np.ndarray | None = None         # (K, 6) [z1, z2, locating 1, 2, arm 1, 2] (bearing_layout)
     bearing_single: tuple = field(default=())     # (K,) 1: the joint has one bearing
+    bearing_blocks: dict = field(default_factory=dict)   # block -> BearingBlock
 
     @property
     def out_width(self) -> int:
         """Width of the kernel's ``rate`` output row: each lossy mesh's rate, then each bearing
-        friction joint's sum_b M_b of the sample's reactions (:func:`.losses.friction_moments`)."""
-        return max(len(self.rate_meshes) + len(self.bearing_joints), 1)
+        friction joint's converged sum_b M_b, then the iterations of each block of
+        :attr:`bearing_blocks` (:mod:`.bearings`)."""
+        return max(len(self.rate_meshes) + len(self.bearing_joints) + len(self.bearing_blocks), 1)
 
     def parts(self) -> list:
         """What the kernel's code is generated from (hashed into the program fingerprint)."""
@@ -83,6 +105,9 @@ class LossProgram:
                b"" if self.bearing_flt is None else self.bearing_flt.tobytes()]
         for ci in sorted(self.couple):
             out += [ci, self.couple[ci].tobytes()]
+        for b in sorted(self.bearing_blocks):
+            bb = self.bearing_blocks[b]
+            out += [b, bb.joints, bb.cols, b"" if bb.wF is None else bb.wF.tobytes()]
         for b in sorted(self.blocks):
             bl = self.blocks[b]
             out += [b, bl.positions, bl.rates, bl.circuits, bl.later, bl.rows]
@@ -143,4 +168,29 @@ def build_loss_program(an, plans) -> LossProgram | None:
     z1, z2, loc, arm, single = bearing_layout(mech, bj)
     bflt = np.ascontiguousarray(np.column_stack([z1, z2, loc, arm]).reshape(-1, 6), float)
     return LossProgram(rate_meshes, rate_int, rate_flt, couple, blocks, np.array(jrec, np.int64).reshape(-1, 5),
-                       np.array(jflt, float).reshape(-1, 6), tuple(bj), bflt, tuple(int(v) for v in single))
+                       np.array(jflt, float).reshape(-1, 6), tuple(bj), bflt, tuple(int(v) for v in single),
+                       _bearing_blocks(an, plans, bj))
+
+
+def _bearing_blocks(an, plans, bj: list) -> dict:
+    """{block: :class:`BearingBlock`} of the bearing friction joints ``bj``."""
+    out, home = {}, None
+    for bi, p in enumerate(plans):
+        gis = [gi for gi, g in enumerate(p.groups) if g.kind == "joint" and g.index in bj]
+        if not gis:
+            continue
+        wF = None
+        if p.F is not None:
+            if home is None:
+                home = forward(an.mech, an.tree, np.zeros((1, len(an.mech.joints))))
+            wF = np.zeros((len(gis), 6 * len(p.links)))
+            for k, gi in enumerate(gis):
+                jt = an.mech.joints[p.groups[gi].index]
+                c = an.tree.index[jt.child]
+                z = home.R[p.F][0].T @ home.R[c][0] @ np.asarray(jt.R_jc, float)[2, :]
+                for L, sign in ((c, 1.0), (an.tree.index[jt.parent], -1.0)):
+                    if L in p.links:
+                        wF[k, 6 * p.links.index(L) + 3:6 * p.links.index(L) + 6] = sign * z
+        out[bi] = BearingBlock(tuple(bj.index(p.groups[gi].index) for gi in gis),
+                               tuple(int(p.offs[gi]) for gi in gis), wF)
+    return out

@@ -3,10 +3,10 @@
 * :func:`mesh_rates`: each lossy mesh's rate theta'_{j,c} = (w_j - w_c) . R_c z_j (written
   to the ``rate`` output) and s_v = sign of it (0 at rest), known before any block solve;
 * :func:`joint_friction`: rhs[L] -= the joints' friction loads, the generalised force Q per
-  sample from the input ``jq`` (Coulomb, viscous and the bearing moments of the fixed
-  point, computed by the driver with the formulas of :mod:`..losses` and
-  :mod:`..bearing_friction`): about the axis (revolute) or along it through the joint
-  origin (prismatic), on the child, reversed on the parent;
+  sample from the input ``jq`` (Coulomb and viscous, computed by the driver with the
+  formulas of :mod:`..losses`; the bearing friction is :mod:`.bearings`'): about the axis
+  (revolute) or along it through the joint origin (prismatic), on the child, reversed on the
+  parent;
 * :class:`LossyBlock`: a constant-frame block with lossy meshes.  Mesh friction adds
   sigma_i s_v,i phi_i to the column of t_i (phi_i its couples in F per unit of sigma s_v t),
   so the block matrix of sign pattern sigma is A_sigma + Phi D E^T, D = diag(sigma s_v),
@@ -70,29 +70,6 @@ def joint_friction(e: Emitter, s: Sample, lp, row) -> None:
             else:
                 w = (0.0, 0.0, 0.0) + z
             s.rhs[L] = tuple(e.sub(s.rhs[L][h], e.mul(e.mul(sign, Q), w[h])) for h in range(6))
-
-
-def friction_moments(e: Emitter, s: Sample, lp, joint_out, row) -> None:
-    """The twin of :func:`..bearing_friction.friction_moments` (same constants,
-    :func:`..bearing_friction.bearing_layout`, and order of operations): sum_b 1/2 mu_b d_b P_b
-    of each joint with bearing friction from the sample's solved reaction [fx, fy, fz, mx, my]
-    (joint frame), the split of :func:`gearcli.model.shaft.split_components`, stored into
-    ``row`` after the rates (``row``: the sample's ``rate`` row)."""
-    R = len(lp.rate_meshes)
-    for k, ji in enumerate(lp.bearing_joints):
-        z1, z2, loc1, loc2, arm1, arm2 = (float(v) for v in lp.bearing_flt[k])
-        c0 = int(joint_out[ji].col0)
-        fx, fy, fz, mx, my = (s.sol[c0 + h] for h in range(5))
-        if lp.bearing_single[k]:
-            R1x, R1y, R2x, R2y = fx, fy, 0.0, 0.0
-        else:
-            R2x = e.div(e.sub(my, e.mul(z1, fx)), z2 - z1)
-            R2y = e.div(e.sub(e.neg(mx), e.mul(z1, fy)), z2 - z1)
-            R1x, R1y = e.sub(fx, R2x), e.sub(fy, R2y)
-        fz2 = e.mul(fz, fz)
-        P1 = e.call("sqrt", e.add(e.add(e.mul(R1x, R1x), e.mul(R1y, R1y)), e.mul(loc1, fz2)))
-        P2 = e.call("sqrt", e.add(e.add(e.mul(R2x, R2x), e.mul(R2y, R2y)), e.mul(loc2, fz2)))
-        e.store(e.add(e.mul(arm1, P1), e.mul(arm2, P2)), row, R + k)
 
 
 class LossyBlock:

@@ -1,0 +1,199 @@
+"""Generated bearing friction fixed point (the model of :mod:`..bearing_friction`), per block
+and per sample, for :mod:`.blocks`.
+
+Joint J's bearing friction is a couple about its axis, -sign(q'_J) Mb_J on its child (reversed
+on its parent), Mb_J = sum_b 1/2 mu_b d_b P_b from J's reaction [fx fy fz mx my], which the
+first block of J's child and parent solves (:class:`~.loss_program.BearingBlock`): the couple
+reaches no earlier block.  So in schedule order the fixed point is local to each block: only
+its own joints' moments change its solution, and the converged couples on the links of later
+blocks are loads there, as the joints' own friction (:func:`.losses.joint_friction`).
+
+Per block, from Mb = 0 (iteration 1), as :func:`..bearing_friction.fixed_point` with its
+``TOL`` and ``MAX_ITERATIONS``: solve with r + sum_J s_J Mb_J w_J (s_J = sign(q'_J), w_J the
+couple per unit in the block's coordinates), Mb_J' = sum_b 1/2 mu_b d_b P_b of the solved
+reactions (0 at rest), until every |Mb_J' - Mb_J| <= TOL |Mb_J'|; the Mb that solved (not
+Mb') is kept.  A constant-frame block iterates on its 5 reaction rows a joint (and its t):
+with the sign pattern p of the last sign search (at moments Mb0) its solution is affine in
+the moments, x = x0 + sum_J s_J (Mb_J - Mb0_J) g_J, g_J = X_p w_J (w_J constant in F:
+constants per pattern for stored maps, the corrected map of :class:`~.losses.LossyBlock` per
+sample); should the tooth forces no longer fit p (the tolerance of the shifted r), the sign
+search runs again at the current moments (same iteration).  A block without a constant
+couple (world frame) solves the whole block each iteration.
+
+Written per sample after the mesh rates in the ``rate`` row: each joint's converged Mb_J,
+then each block's iteration count.  A block that does not converge records ``fail`` =
+(number of blocks) + k, k the bearing joint of largest relative change (the driver's
+:class:`..bearing_friction.BearingFrictionError`).
+"""
+from __future__ import annotations
+
+import llvmlite.ir as ir
+
+from ..bearing_friction import MAX_ITERATIONS, TOL
+from .build import D, I1, I64, Emitter
+from .links import Sample, floats
+from .losses import _sign
+from .signs import _consistent, _sign_bit, tolerance
+
+
+def split(e: Emitter, lp, k: int, x: list) -> list:
+    """[R1x, R1y, R2x, R2y, fz] of bearing joint k from its reaction x = [fx, fy, fz, mx, my]
+    (joint frame; any basis turned about the axis): the two-bearing split of
+    :func:`gearcli.model.shaft.split_components` (one bearing: R1 = f), linear in x."""
+    z1, z2 = (float(v) for v in lp.bearing_flt[k, :2])
+    fx, fy, fz, mx, my = x
+    if lp.bearing_single[k]:
+        return [fx, fy, 0.0, 0.0, fz]
+    inv = 1.0 / (z2 - z1)
+    R2x = e.mul(e.sub(my, e.mul(z1, fx)), inv)
+    R2y = e.mul(e.sub(e.neg(mx), e.mul(z1, fy)), inv)
+    return [e.sub(fx, R2x), e.sub(fy, R2y), R2x, R2y, fz]
+
+
+def moment(e: Emitter, lp, k: int, R: list):
+    """sum_b 1/2 mu_b d_b P_b of bearing joint k from its :func:`split` R: the twin of
+    :func:`..bearing_friction.friction_moments` (its constants, :func:`..bearing_friction.bearing_layout`)."""
+    loc1, loc2, arm1, arm2 = (float(v) for v in lp.bearing_flt[k, 2:])
+    R1x, R1y, R2x, R2y, fz = R
+    fz2 = e.mul(fz, fz)
+    P1 = e.call("sqrt", e.add(e.add(e.mul(R1x, R1x), e.mul(R1y, R1y)), e.mul(loc1, fz2)))
+    P2 = e.call("sqrt", e.add(e.add(e.mul(R2x, R2x), e.mul(R2y, R2y)), e.mul(loc2, fz2)))
+    return e.add(e.mul(arm1, P1), e.mul(arm2, P2))
+
+
+class _Joints:
+    """The bearing friction joints of one block for one sample: their records, axes z_J (base
+    axes), s_J = sign(q'_J), moving flags and unit couples W (per joint, in the block's r)."""
+
+    def __init__(self, e: Emitter, s: Sample, lp, bb, F: int, links: list, nr: int):
+        jrow = [int(v) for v in lp.joints[:, 0]]
+        self.rec = [lp.joints[jrow.index(lp.bearing_joints[k])] for k in bb.joints]
+        self.zw = [e.mv(s.R[int(rc[1])], floats(lp.joint_flt[jrow.index(int(rc[0]))][:3])) for rc in self.rec]
+        qd = [e.const(s.qd[int(rc[0])]) for rc in self.rec]
+        self.sg = [_sign(e, v) for v in qd]
+        self.moving = [e.b.fcmp_unordered("une", v, ir.Constant(D, 0.0)) for v in qd]
+        if bb.wF is not None:
+            self.W = [floats(w) for w in bb.wF]
+            return
+        self.W = [[0.0] * nr for _ in self.rec]   # per sample: world axes, or F's of a block solved in its link
+        for j, rc in enumerate(self.rec):
+            z = self.zw[j] if F < 0 else e.mtv(s.R[F], self.zw[j])
+            for L, sign in ((int(rc[1]), 1.0), (int(rc[2]), -1.0)):
+                if L in links:
+                    self.W[j][6 * links.index(L) + 3:6 * links.index(L) + 6] = [e.mul(sign, v) for v in z]
+
+    def shifted(self, e: Emitter, r: list, Mb: list) -> list:
+        """r - sum_J Q_J w_J, Q_J = -s_J Mb_J."""
+        sm = [e.mul(sg, M) for sg, M in zip(self.sg, Mb)]
+        return [e.add(r[i], e.dot([w[i] for w in self.W], sm)) for i in range(len(r))]
+
+    def moments(self, e: Emitter, lp, bb, S: list) -> list:
+        """Mb' of each joint from its :func:`split` S (0 at rest)."""
+        return [e.b.select(mv, e.const(moment(e, lp, k, Sj)), ir.Constant(D, 0.0))
+                for mv, k, Sj in zip(self.moving, bb.joints, S)]
+
+
+def _within(e: Emitter, new: list, old: list):
+    """(|new - old| per joint, i1: each <= TOL |new| + 1e-300, bearing_friction's test)."""
+    change = [e.call("fabs", e.sub(v, o)) for v, o in zip(new, old)]
+    ok = ir.Constant(I1, 1)
+    for v, c in zip(new, change):
+        ok = e.b.and_(ok, e.b.fcmp_ordered("<=", c, e.const(e.add(e.mul(TOL, e.call("fabs", v)), 1e-300))))
+    return change, ok
+
+
+def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols: list, r: list, solve, rows,
+             n, fail):
+    """(x, p) of block b with the converged bearing friction of its joints (module
+    docstring).  ``solve(r, tag)``: (x, p) of right-hand side r (the block's own sign search;
+    p None without signed meshes); ``rows(p, idx, r, tag)``: rows idx of the solution with
+    pattern p (constant frame)."""
+    lp = prog.losses
+    bb = lp.bearing_blocks[b]
+    K, m, tag, affine = len(bb.joints), len(tcols), f"b{b}", bb.wF is not None
+    jt = _Joints(e, s, lp, bb, F, links, len(r))
+    pre = e.b.block
+    search, it_bb = fn.append_basic_block(f"{tag}_bsearch"), fn.append_basic_block(f"{tag}_biter")
+    more, failb, done_bb = (fn.append_basic_block(f"{tag}_b{x}") for x in ("more", "fail", "done"))
+    e.b.branch(search)
+    e.b.position_at_end(search)
+    Mb0, it0 = [e.b.phi(D) for _ in range(K)], e.b.phi(I64)
+    x0, p = solve(jt.shifted(e, r, Mb0), tag)
+    # x = x0 + sum_i G_i (Mb_i - Mb0_i), G_i = s_i X_p w_i: the split of each joint likewise
+    G = [[e.mul(jt.sg[i], v) for v in rows(p, list(range(len(x0))), jt.W[i], f"{tag}_g{i}")] for i in range(K)] \
+        if affine else None
+    S0 = [split(e, lp, k, _cols(x0, c0)) for k, c0 in zip(bb.joints, bb.cols)]
+    SG = [[split(e, lp, k, _cols(G[i], c0)) for i in range(K)] for k, c0 in zip(bb.joints, bb.cols)] if affine else None
+    search_end = e.b.block
+    e.b.branch(it_bb)
+    e.b.position_at_end(it_bb)
+    Mb, it, fresh = [e.b.phi(D) for _ in range(K)], e.b.phi(I64), e.b.phi(I1)
+    d = [e.sub(Mb[i], Mb0[i]) for i in range(K)] if affine else None
+    S = S0 if not affine else [[e.add(S0[j][h], e.dot([SG[j][i][h] for i in range(K)], d)) for h in range(5)]
+                               for j in range(K)]
+    new = jt.moments(e, lp, bb, S)
+    change, ok = _within(e, new, Mb)
+
+    def at(i):                # x[i] at the moments Mb
+        return x0[i] if not affine else e.add(x0[i], e.dot([G[j][i] for j in range(K)], d))
+    if affine and m:          # do the tooth forces still fit p? else the sign search again at Mb
+        fits = _consistent(e, [at(c) for c in tcols], [_sign_bit(e, p, i, m) for i in range(m)],
+                           tolerance(e, jt.shifted(e, r, Mb)))
+        fit_bb = fn.append_basic_block(f"{tag}_bfits")
+        e.b.cbranch(e.b.or_(fresh, fits), fit_bb, search)
+        _incoming(Mb0 + [it0], Mb + [it], e.b.block)
+        e.b.position_at_end(fit_bb)
+    e.b.cbranch(ok, done_bb, more)
+    e.b.position_at_end(more)
+    it1 = e.b.add(it, ir.Constant(I64, 1))
+    e.b.cbranch(e.b.icmp_signed("<=", it1, ir.Constant(I64, MAX_ITERATIONS)), it_bb if affine else search, failb)
+    _incoming(Mb + [it, fresh], Mb0 + [it0, ir.Constant(I1, 1)], search_end)
+    _incoming(Mb + [it, fresh] if affine else Mb0 + [it0], new + [it1, ir.Constant(I1, 0)], more)
+    _incoming(Mb0 + [it0], [ir.Constant(D, 0.0)] * K + [ir.Constant(I64, 1)], pre)
+    e.b.position_at_end(failb)
+    _failed(e, prog, bb, new, change, fail, n)
+    e.b.branch(done_bb)
+    e.b.position_at_end(done_bb)
+    _outputs(e, s, lp, b, bb, jt, Mb, it, links, n)
+    return [at(i) for i in range(len(x0))], p
+
+
+def _cols(x: list, c0: int) -> list:
+    return [x[c] for c in range(c0, c0 + 5)]
+
+
+def _incoming(phis: list, values: list, block) -> None:
+    for ph, v in zip(phis, values):
+        ph.add_incoming(v, block)
+
+
+def _failed(e: Emitter, prog, bb, new: list, change: list, fail, n) -> None:
+    """``fail`` of sample n (if none before) = number of blocks + the bearing joint of largest
+    relative change (as bearing_friction names it)."""
+    code, best = ir.Constant(I64, len(prog.blocks) + bb.joints[0]), None
+    for j, (v, c) in enumerate(zip(new, change)):
+        rel = e.div(c, e.add(e.call("fabs", v), 1e-300))
+        if best is None:
+            best = rel
+            continue
+        gt = e.b.fcmp_ordered(">", rel, best)
+        best, code = e.b.select(gt, rel, best), e.b.select(gt, ir.Constant(I64, len(prog.blocks) + bb.joints[j]), code)
+    old = e.load(fail, n)
+    e.b.store(e.b.select(e.b.icmp_signed("<", old, ir.Constant(I64, 0)), code, old), e.b.gep(fail, [n]))
+
+
+def _outputs(e: Emitter, s: Sample, lp, b: int, bb, jt: _Joints, Mb, it, links, n) -> None:
+    """The converged Mb and the block's iterations into the ``rate`` row; the couples
+    -s_J Mb_J z_J on the joints' links of later blocks (rhs[L] -= Q w, reversed on the parent)."""
+    fn = e.b.function
+    row = e.row(next(a for a in fn.args if a.name == "rate"), n, lp.out_width)
+    R, K = len(lp.rate_meshes), len(lp.bearing_joints)
+    for j, k in enumerate(bb.joints):
+        e.store(Mb[j], row, R + k)
+    e.store(e.b.sitofp(it, D), row, R + K + sorted(lp.bearing_blocks).index(b))
+    for j, rc in enumerate(jt.rec):
+        amount = e.mul(jt.sg[j], Mb[j])
+        for L, sign in ((int(rc[1]), 1.0), (int(rc[2]), -1.0)):
+            if L >= 0 and L not in links:
+                s.rhs[L] = s.rhs[L][:3] + tuple(e.add(s.rhs[L][3 + h], e.mul(sign, e.mul(amount, jt.zw[j][h])))
+                                                for h in range(3))
