@@ -65,6 +65,10 @@ class Result:
     positive axis, N.
     ``residual``: with ``verify``, the worst relative Newton-Euler residual of any link and
     sample, and of the sign of every t against the sign pattern used (else None).
+    ``gear_loss``, ``joint_friction``, ``joint_loss``, ``bearing_iterations``: the losses of a
+    lossy mechanism (:func:`.losses.fill_losses`), else None; ``bearing_iterations`` (N,) the
+    bearing friction's fixed-point iterations, on the llvm path the most over the sample's
+    blocks (:mod:`.llvm.bearings`: each block converges its own joints).
     ``backend``: the path that ran, "llvm" or "numpy"; ``backend_note``: why "auto" took numpy.
     """
 
