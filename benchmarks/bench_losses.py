@@ -3,13 +3,16 @@
     python benchmarks/bench_losses.py [--samples 20000] [--rounds 5]
 
 The rated Bendix wrist (5 meshes, 8 joints, 15 bearings), random states, one thread.  Rows,
-interleaved round by round so that load drift hits all alike, medians of --rounds:
+interleaved round by round so that load drift hits all alike, medians of --rounds (an llvm
+row's round: the median of 5 calls, a call of a few ms being at the mercy of one scheduler
+tick on a busy machine):
 
 * lossless, numpy and the compiled llvm kernel (the reference points);
 * mesh + joint friction (every mesh at 3 % loss, every joint with Coulomb + viscous friction),
   numpy: the couples ride in the tooth-force columns (one extra set of block maps per pattern
-  of relative-speed signs met); llvm: each block's trial corrected by the rank-ml update of
-  its friction columns (:mod:`gearcli.dynamics.llvm.losses`), the joint friction an input;
+  of relative-speed signs met); llvm: each block's sign search over the stored maps of the
+  sample's relative-speed signs (:mod:`gearcli.dynamics.llvm.losses`), the joint friction and
+  the loss outputs computed in the kernel;
 * the same with bearing friction on every bearing (mu 0.0015, bore 20 mm), numpy and llvm:
   a fixed-point iteration per sample, whose iterations are printed (median and worst); numpy:
   :func:`gearcli.dynamics.bearing_friction.fixed_point`, every joint at once; llvm: inside the
@@ -63,7 +66,8 @@ def main(argv=None) -> int:
     times = {k: [] for k in cases}
     for _ in range(args.rounds):
         for name, (an, backend) in cases.items():
-            times[name].append(median_time(lambda: solve(an, q, qd, qdd, backend=backend, jobs=1), 1))
+            reps = 5 if backend == "llvm" else 1           # a few ms: the median of 5 calls a round
+            times[name].append(median_time(lambda: solve(an, q, qd, qdd, backend=backend, jobs=1), reps))
     print(f"Bendix wrist (rated), {args.samples:,} random samples, 1 thread, medians of {args.rounds}; {load_line()}")
     base = float(np.median(times["lossless, numpy"]))
     fast = float(np.median(times["lossless, llvm"]))

@@ -3,10 +3,11 @@
 The numpy path (:mod:`gearcli.dynamics.losses`, :mod:`gearcli.dynamics.bearing_friction`,
 the friction maps of :func:`gearcli.dynamics.blocks._constant_block`) is the reference; the
 kernel shares none of its per-sample arithmetic (its own kinematics, relative rates, joint
-friction loads, the rank-ml correction of each block's maps and friction columns of the
-world-frame blocks, :mod:`gearcli.dynamics.llvm.losses`), only the constant couples, the
-friction formulas of the joints' loads and the bearing fixed point's constants.  Every
-output, the loss outputs included, must agree to 1e-12 of the
+friction forces, loss outputs, the rank-ml correction of a block's maps and friction columns
+of the world-frame blocks, :mod:`gearcli.dynamics.llvm.losses`), only constants (the couples,
+the friction coefficients, the stored maps of a block with few (s_v, sign) patterns, made
+as the numpy path makes them) and the bearing fixed point's constants.  Every
+output, the loss outputs and the bearing iterations included, must agree to 1e-12 of the
 sample's largest load on every bundled mechanism with losses switched on and on the hand
 cases of tests/test_losses.py, along random motions in which tooth forces and relative
 rates change sign, with samples at rest (s_v = 0); failures must be the numpy path's.  The
@@ -106,8 +107,9 @@ def test_llvm_equals_numpy_with_losses(key):
 
 
 def test_lossy_blocks_of_every_kind_are_covered():
-    """The mechanisms above hold lossy meshes in a block with stored pattern maps
-    (paper_2dof), one solved from a LowRank base matrix (planetary_5p), a world-frame
+    """The mechanisms above hold lossy meshes in a block whose (s_v, sign pattern) maps are
+    stored (paper_2dof), one with the rank-ml correction of its stored pattern maps
+    (planetary_3p), one solved from a LowRank base matrix (planetary_5p), a world-frame
     square block (geared_arm.urdf has a transmission) and a redundant world-frame one
     (servo_joint_rated)."""
     def lossy_blocks(key):
@@ -115,8 +117,10 @@ def test_lossy_blocks_of_every_kind_are_covered():
         return prog, prog.losses.blocks
     prog, blocks = lossy_blocks("planetary_5p.yaml")
     assert any(b in prog.lowrank for b in blocks)
+    prog, blocks = lossy_blocks("planetary_3p.yaml")
+    assert any(bl.phi is not None and bl.maps is None and b not in prog.lowrank for b, bl in blocks.items())
     prog, blocks = lossy_blocks("paper_2dof.yaml")
-    assert blocks and all(bl.phi is not None for bl in blocks.values())
+    assert blocks and all(bl.maps is not None for bl in blocks.values())
     prog, blocks = lossy_blocks("servo_joint_rated.yaml")
     assert any(bl.phi is None and b in prog.weights for b, bl in blocks.items())
 
@@ -145,7 +149,7 @@ def test_kernel_bearing_moments_are_the_fixed_point_of_its_reactions(key):
     res = solve(an, q, qd, qdd, backend="llvm", jobs=1)
     qd_all = qd @ np.asarray(an.S, float).T
     joints = friction_joints(an.mech)
-    own = joint_friction_forces(an.mech.joints, qd_all, np.empty_like(qd_all), np.empty_like(qd_all))
+    own = joint_friction_forces(an.mech.joints, qd_all)
     applied = -np.sign(qd_all[:, joints]) * (res.joint_friction[:, joints] - own[:, joints])
     of_reactions = friction_moments(an.mech, joints, {("joint", ji): res.joint[:, ji, :5] for ji in joints})
     moving = qd_all[:, joints] != 0.0
@@ -231,14 +235,23 @@ def _reversed_couples(lp):
     return dataclasses.replace(lp, blocks=blocks, couple={ci: -v for ci, v in lp.couple.items()})
 
 
+def _joint_columns(lp, cols, factor):
+    flt = lp.joint_flt.copy()
+    flt[:, cols] *= factor
+    return dataclasses.replace(lp, joint_flt=flt)
+
+
 @pytest.mark.parametrize("key,mutate", [
     ("paper_2dof.yaml", _reversed_couples), ("servo_joint_rated.yaml", _reversed_couples),
-    ("rack", lambda lp: dataclasses.replace(lp, joint_flt=-lp.joint_flt)),     # joint friction reversed
+    ("planetary_3p.yaml", _reversed_couples),
+    ("rack", lambda lp: _joint_columns(lp, slice(0, 6), -1.0)),              # joint friction on the parent
+    ("rack", lambda lp: _joint_columns(lp, [6], -1.0)),                      # Coulomb friction with the rate
     ("spur", lambda lp: dataclasses.replace(lp, rate_flt=-lp.rate_flt)),       # s_v reversed
+    ("paper_2dof.yaml", lambda lp: dataclasses.replace(lp, loss_flt=lp.loss_flt * [1.0, 2.0])),  # gear_loss arm
 ])
 def test_a_wrong_loss_program_is_caught(key, mutate):
-    """A kernel with its friction couples, its joint friction loads or its relative rates
-    reversed must fail the comparison of test_llvm_equals_numpy_with_losses."""
+    """A kernel with its friction couples, its joint friction loads, its relative rates or its
+    mesh loss outputs wrong must fail the comparison of test_llvm_equals_numpy_with_losses."""
     an = analyse(mechanism(key))
     sol = solver_for(an)
     prog = sol.kernel_program()

@@ -58,33 +58,24 @@ def relative_rate(an, kin, ci: int) -> np.ndarray:
     return np.sum((kin.w[c.j] - kin.w[c.carrier]) * zj, axis=1)
 
 
-def mesh_loss(an, kin, ci: int, t: np.ndarray, rate: np.ndarray | None = None) -> np.ndarray:
-    """Mesh power loss P_p = c_p |t_p| |theta'_{j,c}| r_j (N,), W; ``rate`` theta'_{j,c}
-    (N,) when known (the compiled kernel's), else from ``kin``."""
+def mesh_loss(an, kin, ci: int, t: np.ndarray) -> np.ndarray:
+    """Mesh power loss P_p = c_p |t_p| |theta'_{j,c}| r_j (N,), W."""
     c = an.circuits[ci]
     loss = an.mech.gears[c.gear].loss_factor
     if not loss or c.geometry is None:
         return np.zeros_like(t)
-    rate = relative_rate(an, kin, ci) if rate is None else rate
-    return loss * np.abs(t) * np.abs(rate) * c.geometry.r_j
+    return loss * np.abs(t) * np.abs(relative_rate(an, kin, ci)) * c.geometry.r_j
 
 
-def friction_force(coulomb, viscous, qd: np.ndarray, out=None, scratch=None) -> np.ndarray:
+def friction_force(coulomb, viscous, qd: np.ndarray) -> np.ndarray:
     """The joint friction law, -F_c sign(qd) - F_v qd (broadcast: one joint's (N,) rates, or
-    (N, J) with per-joint coefficients (J,)); +0.0: no -0 where both are zero.  Computed in
-    ``out`` (else a new array), ``scratch`` (an array shaped like qd, else a new one) taking
-    F_v qd: the same bits as the expression written out, without its three other arrays."""
-    f = np.sign(qd, out=out)
-    np.multiply(-coulomb, f, out=f)
-    f -= np.multiply(viscous, qd, out=scratch)
-    f += 0.0
-    return f
+    (N, J) with per-joint coefficients (J,)); +0.0: no -0 where both are zero."""
+    return -coulomb * np.sign(qd) - viscous * qd + 0.0
 
 
-def joint_friction_forces(joints, qd_all: np.ndarray, out=None, scratch=None) -> np.ndarray:
-    """(N, J) :func:`friction_force` of every joint (0 without friction) at the rates (N, J)
-    (``out``, ``scratch``: as there)."""
-    return friction_force(*friction_coefficients(joints), qd_all, out, scratch)
+def joint_friction_forces(joints, qd_all: np.ndarray) -> np.ndarray:
+    """(N, J) :func:`friction_force` of every joint (0 without friction) at the rates (N, J)."""
+    return friction_force(*friction_coefficients(joints), qd_all)
 
 
 def friction_coefficients(joints) -> tuple[np.ndarray, np.ndarray]:
@@ -128,47 +119,42 @@ def subtract_joint_friction(an, kin, b: dict, qd_all: np.ndarray) -> None:
                 b[L] -= Q[:, None] * joint_axis_wrench(an, kin, ji, L)
 
 
-def joint_loss(jt, qd: np.ndarray) -> np.ndarray:
-    """Joint friction power loss F_c |qd| + F_v qd^2 (N,), W (= -friction force * qd)."""
-    return -joint_friction_force(jt, qd) * qd
-
-
 LOSS_FIELDS = ("gear_loss", "joint_friction", "joint_loss", "bearing_iterations")   # of a lossy mechanism
 
 
 def fill_losses(an, kin, qd_all: np.ndarray, res, bearing: np.ndarray | None = None,
-                iterations: np.ndarray | None = None, rates: dict | None = None,
-                friction: np.ndarray | None = None, into: dict | None = None) -> None:
+                iterations: np.ndarray | None = None) -> None:
     """Set the loss fields of the :class:`~.solve.Result` ``res`` from its tooth forces and
     the joint rates ``qd_all`` (N, J): ``gear_loss`` (N, G) mesh power loss, W (0 for an
     ideal pair); ``joint_friction`` (N, J) the friction on each joint's child about (along)
     its axis, N*m (N), with the bearing friction moments ``bearing`` (N, J) >= 0
     (:mod:`.bearing_friction`) against the rate; ``joint_loss`` (N, J) its power loss, W;
     ``bearing_iterations`` (N,) the fixed-point iterations of the bearing friction (None
-    without it).  ``rates``: {circuit: theta'_{j,c} (N,)} of the lossy meshes when known
-    (the compiled kernel's; ``kin`` may then be None); ``friction`` (N, J) the joints' own
-    friction forces when known (:func:`joint_friction_forces`; taken as ``joint_friction``,
-    changed in place); ``into``: {"gear_loss": (N, G), "joint_loss": (N, J)} arrays to fill
-    (else new ones).  Nothing for a lossless mechanism
-    (the fields stay None)."""
+    without it).  Nothing for a lossless mechanism (the fields stay None)."""
     if not an.mech.has_losses:
         return
-    N = qd_all.shape[0]
-    res.gear_loss = np.empty((N, len(an.circuits))) if into is None else into["gear_loss"]
+    res.gear_loss = np.empty((qd_all.shape[0], len(an.circuits)))
     for ci in range(len(an.circuits)):
-        res.gear_loss[:, ci] = mesh_loss(an, kin, ci, res.gear_t[:, ci], (rates or {}).get(ci))
-    res.joint_friction = joint_friction_forces(an.mech.joints, qd_all) if friction is None else friction
-    res.joint_loss = np.multiply(res.joint_friction, qd_all, out=None if into is None else into["joint_loss"])
-    np.negative(res.joint_loss, out=res.joint_loss)          # -F q' = F_c |q'| + F_v q'^2, all joints at once
+        res.gear_loss[:, ci] = mesh_loss(an, kin, ci, res.gear_t[:, ci])
+    res.joint_friction = joint_friction_forces(an.mech.joints, qd_all)
+    res.joint_loss = -(res.joint_friction * qd_all)          # -F q' = F_c |q'| + F_v q'^2, all joints at once
+    _add_bearing(res, qd_all, bearing, iterations)
+
+
+def _add_bearing(res, qd_all: np.ndarray, bearing: np.ndarray | None, iterations: np.ndarray | None) -> None:
+    """The bearing friction moments (N, J) into ``res``'s joint friction and loss, in place."""
     if bearing is not None:
         res.joint_friction -= np.sign(qd_all) * bearing
         res.joint_loss += bearing * np.abs(qd_all)
         res.bearing_iterations = iterations
 
 
-def fill_kernel_losses(an, res, losses: dict) -> None:
-    """:func:`fill_losses` from what the llvm kernel's driver put in ``losses`` ("qd" the joint
-    rates, "rates" the lossy meshes' theta'_{j,c}, "bearing", "iterations"; empty: none)."""
-    if losses:
-        fill_losses(an, None, losses["qd"], res, losses["bearing"], losses["iterations"], losses["rates"],
-                    losses["friction"], losses["into"])
+def fill_kernel_losses(res, arrays: dict, losses: dict) -> None:
+    """The loss fields of ``res`` from the llvm kernel's loss outputs in ``arrays`` (gear_loss,
+    joint_friction: the joints' own friction, joint_loss; none for a lossless mechanism) and
+    the bearing friction its driver put in ``losses`` ("bearing", "iterations", "qd"), added
+    as :func:`fill_losses` does."""
+    for k in set(arrays) & {"gear_loss", "joint_friction", "joint_loss"}:
+        setattr(res, k, arrays[k])
+    if losses.get("bearing") is not None:
+        _add_bearing(res, losses["qd"], losses["bearing"], losses["iterations"])

@@ -52,20 +52,30 @@ def _check_apart(named: list, inputs: dict) -> None:
                                  "each other and from the inputs")
 
 
+def loss_shapes(an, n: int) -> dict:
+    """{field: shape} of the loss outputs a compiled kernel writes for n samples of a lossy
+    mechanism ({} for a lossless one)."""
+    if not an.mech.has_losses:
+        return {}
+    J, G = len(an.mech.joints), len(an.circuits)
+    return {"gear_loss": (n, G), "joint_friction": (n, J), "joint_loss": (n, J)}
+
+
 def result_arrays(an, n: int, out=None) -> dict:
-    """{field: array} for n samples: ``out``'s arrays (checked before by :func:`check_out`),
-    or new uninitialised ones, views of one allocation apart from each other: a large one
+    """{field: array} for n samples, the loss outputs of a lossy mechanism (:func:`loss_shapes`)
+    included: ``out``'s arrays (checked before by :func:`check_out`; new loss arrays), or new
+    uninitialised ones, views of one allocation apart from each other: a large one
     is mapped by the operating system in huge pages (numpy asks for them from 4 MB), so
     the kernel's first writes fault a page per 2 MB, not per 4 kB (planetary_5p, 20,000
     samples: page faults were a third of a solve's time)."""
     if out is not None:
-        return {k: getattr(out, k) for k in FIELDS}
-    return one_allocation(shapes(an, n))
+        return {**{k: getattr(out, k) for k in FIELDS}, **one_allocation(loss_shapes(an, n))}
+    return one_allocation({**shapes(an, n), **loss_shapes(an, n)})
 
 
 def one_allocation(shapes: dict) -> dict:
     """{name: new uninitialised float64 array of shapes[name]}, C-ordered views of one
-    allocation apart from each other (large: huge pages, as :func:`result_arrays`)."""
+    allocation apart from each other."""
     sizes = {k: int(np.prod(shape)) for k, shape in shapes.items()}
     buf, arrays, at = np.empty(sum(sizes.values())), {}, 0
     for k, shape in shapes.items():

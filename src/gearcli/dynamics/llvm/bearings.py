@@ -20,7 +20,7 @@ sample); should the tooth forces no longer fit p (the tolerance of the shifted r
 search runs again at the current moments (same iteration).  A block without a constant
 couple (world frame) solves the whole block each iteration.
 
-Written per sample after the mesh rates in the ``rate`` row: each joint's converged Mb_J,
+Written per sample in the ``moments`` row: each joint's converged Mb_J,
 then each block's iteration count.  A block that does not converge records ``fail`` =
 (number of blocks) + k, k the bearing joint of largest relative change (the driver's
 :class:`..bearing_friction.BearingFrictionError`).
@@ -186,11 +186,11 @@ def _outputs(e: Emitter, s: Sample, lp, b: int, bb, jt: _Joints, Mb, it, links, 
     """The converged Mb and the block's iterations into the ``rate`` row; the couples
     -s_J Mb_J z_J on the joints' links of later blocks (rhs[L] -= Q w, reversed on the parent)."""
     fn = e.b.function
-    row = e.row(next(a for a in fn.args if a.name == "rate"), n, lp.out_width)
-    R, K = len(lp.rate_meshes), len(lp.bearing_joints)
+    row = e.row(next(a for a in fn.args if a.name == "moments"), n, lp.out_width)
+    K = len(lp.bearing_joints)
     for j, k in enumerate(bb.joints):
-        e.store(Mb[j], row, R + k)
-    e.store(e.b.sitofp(it, D), row, R + K + sorted(lp.bearing_blocks).index(b))
+        e.store(Mb[j], row, k)
+    e.store(e.b.sitofp(it, D), row, K + sorted(lp.bearing_blocks).index(b))
     for j, rc in enumerate(jt.rec):
         amount = e.mul(jt.sg[j], Mb[j])
         for L, sign in ((int(rc[1]), 1.0), (int(rc[2]), -1.0)):

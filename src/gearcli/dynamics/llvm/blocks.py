@@ -51,12 +51,15 @@ def _subtract(e: Emitter, s: Sample, L: int, w, scale) -> None:
     s.rhs[L] = tuple(e.sub(s.rhs[L][h], e.mul(scale, w[h])) for h in range(6))
 
 
-def propagate(e: Emitter, s: Sample, F: int, recs, prog, x: list, fixed: bool = False) -> None:
-    """rhs[L] -= the solved wrenches of the block's groups on their later links (blocks' propagation)."""
+def propagate(e: Emitter, s: Sample, F: int, recs, prog, x: list, fixed: bool = False, couples=None) -> None:
+    """rhs[L] -= the solved wrenches of the block's groups on their later links (blocks' propagation;
+    ``couples``: {first column of a record: a moment (F axes) added to its wrench})."""
     cmat, later = prog.cmat, prog.later
     RF, oF = s.R[F], s.o[F]
     for rec in recs:
         f, mo = _wrench_in_F(e, rec, cmat, x, fixed)
+        if couples and int(rec.col0) in couples:
+            mo = e.vadd(mo, couples[int(rec.col0)])
         f, mo = e.mv(RF, f), e.mv(RF, mo)                    # world axes, about o_F
         P, l0, nl = int(rec.primary), int(rec.later0), int(rec.nlater)
         for L in (int(v) for v in later[l0:l0 + nl]):
@@ -144,11 +147,12 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row, search: bool
     if lossy is not None and F < 0:
         blk.extra = llvm_losses.world_columns(prog.losses, lossy, s)
     elif lossy is not None:
-        blk = llvm_losses.LossyBlock(blk, lossy, s.sv)
+        blk = llvm_losses.lossy_block(e, blk, lossy, s.sv, f"b{b}")
 
     def solve(r, tag):              # (x, p) of right-hand side r; p None: pattern 0 without a search
         if m and search:
-            return resolve(e, fn, blk, r, tolerance(e, r), _on_fail(e, fail, n, b), tag)
+            args = (r, tolerance(e, r), _on_fail(e, fail, n, b), tag)
+            return blk.search(e, fn, *args) if hasattr(blk, "search") else resolve(e, fn, blk, *args)
         if F < 0:
             return blk.solve(e, [1.0] * m, r), None
         if b in prog.lowrank:
@@ -167,7 +171,8 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row, search: bool
     if nt > 0:
         propagate_terms(e, s, k0, nt, prog, x, sig)
     else:
-        propagate(e, s, F, prog.props[p0:p0 + np_], prog, x, not search)
-    if lossy is not None:
-        llvm_losses.propagate(e, s, prog.losses, lossy, F, x, tcols, sig)
+        couples = llvm_losses.couples_F(e, s, lossy, x, tcols) if lossy is not None and F >= 0 else {}
+        propagate(e, s, F, prog.props[p0:p0 + np_], prog, x, not search, couples)
+    if lossy is not None and F < 0:
+        llvm_losses.propagate(e, s, prog.losses, lossy, x, tcols, sig)
     store(e, s, rec, prog, x)

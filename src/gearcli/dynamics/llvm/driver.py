@@ -22,12 +22,10 @@ import numpy as np
 from . import cache as llvm_cache
 from .jobs import job_ranges, run_parts, sign_error, threads_for
 from .program import Program, load_arrays
-from .kernel import ARGS, build_module
+from .kernel import ARGS, LOSS_OUTPUTS, build_module
 from .links import load_groups
 from .outputs import OUTPUTS
 from ..bearing_friction import MAX_ITERATIONS, BearingFrictionError
-from ..losses import joint_friction_forces
-from ..result_arrays import one_allocation
 
 
 @lru_cache(maxsize=1)
@@ -233,48 +231,37 @@ class LlvmKernel:
               losses: dict | None = None) -> dict:
         """The loads of every sample into ``out``, as the numpy path (:func:`..blocks.solve_blocks`) does.
 
-        A lossy mechanism (``prog.losses``): the joints' friction loads are the kernel's
-        input (:func:`..losses.joint_friction_forces` of the joint rates), the bearing
-        friction converges in the kernel, block by block (:mod:`.bearings`); ``losses`` (a dict)
-        receives "rates" {circuit: theta'_{j,c} (N,)}, "bearing" (N, J) moments and
-        "iterations" (N,): per sample the most iterations over its blocks (None without bearing
-        friction), "qd" (N, J) the joint rates."""
+        A lossy mechanism (``prog.losses``): the kernel computes the joints' own friction and
+        writes the loss outputs (``out``'s gear_loss, joint_friction: the joints' own friction,
+        joint_loss); the bearing friction converges in the kernel, block by block
+        (:mod:`.bearings`); ``losses`` (a dict) then receives "bearing" (N, J) moments,
+        "iterations" (N,): per sample the most iterations over its blocks, and "qd" (N, J) the
+        joint rates."""
         prog = self.prog
         lp = prog.losses
-        if lp is None:
-            self._launch(an, q, qd, qdd, values, jobs, chunk, out, work, np.zeros((1, 1)), np.empty((1, 1)))
+        if lp is None or not lp.bearing_joints:
+            self._launch(an, q, qd, qdd, values, jobs, chunk, out, work, np.empty((1, 1)))
             return {k: work[0][:, i] for i, k in enumerate(prog.signed)}
         N, J = q.shape[0], len(an.mech.joints)
-        A = one_allocation({"qd": (N, J), "friction": (N, J), "joint_loss": (N, J), "gear_loss": (N, len(an.circuits)),
-                            "jq": (N, max(lp.joints.shape[0], 1)), "rate": (N, lp.out_width)})
-        qd_all = np.matmul(qd, np.asarray(an.S, float).T, out=A["qd"])
-        # (N, J), also an output; joint_loss's array as the scratch
-        friction = joint_friction_forces(an.mech.joints, qd_all, A["friction"], A["joint_loss"])
-        jq, rate = A["jq"], A["rate"]
-        if lp.joints.shape[0]:
-            np.take(friction, lp.joints[:, 0], axis=1, out=jq)
-        else:
-            jq[:] = 0.0
-        self._launch(an, q, qd, qdd, values, jobs, chunk, out, work, jq, rate)
-        bearing = iterations = None
-        if lp.bearing_joints:          # the kernel's converged moments and iterations (.bearings)
-            R, K = len(lp.rate_meshes), len(lp.bearing_joints)
-            bearing = np.zeros((N, J))
-            bearing[:, list(lp.bearing_joints)] = rate[:, R:R + K]
-            iterations = rate[:, R + K:R + K + len(lp.bearing_blocks)].max(axis=1).astype(np.int64)
+        moments = np.empty((N, lp.out_width))           # the kernel's converged moments and iterations
+        self._launch(an, q, qd, qdd, values, jobs, chunk, out, work, moments)
+        K = len(lp.bearing_joints)
+        bearing, qd_all = np.zeros((N, J)), qd @ np.asarray(an.S, float).T
+        bearing[:, list(lp.bearing_joints)] = moments[:, :K]
+        iterations = moments[:, K:K + len(lp.bearing_blocks)].max(axis=1).astype(np.int64)
         if losses is not None:
-            losses.update(rates={ci: rate[:, k] for k, ci in enumerate(lp.rate_meshes)}, bearing=bearing,
-                          iterations=iterations, qd=qd_all, friction=friction,
-                          into={"gear_loss": A["gear_loss"], "joint_loss": A["joint_loss"]})
+            losses.update(bearing=bearing, iterations=iterations, qd=qd_all)
         return {k: work[0][:, i] for i, k in enumerate(prog.signed)}
 
-    def _launch(self, an, q, qd, qdd, values, jobs, chunk, out, work, jq, rate) -> None:
+    def _launch(self, an, q, qd, qdd, values, jobs, chunk, out, work, moments) -> None:
         """One run of the kernel over every sample of q (raises the numpy path's SignError or
-        BearingFrictionError)."""
+        BearingFrictionError); ``out`` holds the loss outputs of a lossy mechanism too."""
         n = q.shape[0]
         SG, fail = work
+        none = np.empty((1, 1))
         keep = [np.ascontiguousarray(a, float) for a in (q, qd, qdd)] + self.load_args(an, values, n)
-        keep += [out[k] if out[k].size else np.empty((1, 1)) for k in OUTPUTS] + [SG, jq, rate, fail]
+        keep += [out[k] if out[k].size else none for k in OUTPUTS] + [SG]
+        keep += [out[k] if out.get(k) is not None and out[k].size else none for k in LOSS_OUTPUTS] + [moments, fail]
         ptrs = [a.ctypes.data for a in keep]
         failed = run_parts(lambda s, e, _: self._run(*ptrs, s, e), job_ranges(n, jobs), threads_for(n, jobs))
         if failed:                    # a block's sign search, else a bearing fixed point (.bearings)

@@ -3,7 +3,7 @@
 :func:`build_module` writes, from a :class:`~.program.Program`, one function
 
     run(qi, qdi, qddi, vals, ldpt, ldrow, ldgrp, motor, tau, joint, gear_t, gear_sep, gear_radial,
-        gear_axial, motor_speed, signs, jq, rate, fail, start, stop)
+        gear_axial, motor_speed, signs, gear_loss, joint_friction, joint_loss, moments, fail, start, stop)
 
 whose loop over the samples start..stop-1 does what the numpy path does for all of them,
 with every structural integer and every constant of the program (fixed transforms,
@@ -11,9 +11,10 @@ masses, inertias, inverse block matrices, propagation columns, output coefficien
 the code: joint space, kinematics, inertia and external loads (:mod:`.links`), the
 blocks in schedule order (:mod:`.blocks`, :mod:`.signs`) and the outputs
 (:mod:`.outputs`), straight-line except for the sign search; a lossy mechanism's losses
-(:mod:`.losses`: the joints' friction loads ``jq`` (N, Q) in, each lossy mesh's relative
-rate ``rate`` (N, R) out, followed by the converged bearing friction moments and each
-block's iterations of :mod:`.bearings`, :class:`~.loss_program.LossProgram`).  Only the inputs (the
+(:mod:`.losses`, :class:`~.loss_program.LossProgram`): the joints' own friction from their
+rates, the mesh friction, the loss outputs ``gear_loss`` (N, G), ``joint_friction`` and
+``joint_loss`` (N, J); with bearing friction, the converged bearing friction moments and
+each block's iterations of :mod:`.bearings` in ``moments``).  Only the inputs (the
 independent q, qd, qdd (N, dof), C-ordered), the external loads (their values, points
 ``ldpt``, records ``ldrow`` and per loaded link the range ``ldgrp``, :func:`.links.external`: one loop per loaded link,
 whatever the number of loads) and the output arrays
@@ -31,8 +32,9 @@ from .build import DP, I64, I64P, Emitter
 from .links import at_rest, external, inertia, joint, joint_space, load_groups
 from .outputs import OUTPUTS, widths, write_outputs
 
-ARGS = ("qi", "qdi", "qddi", "vals", "ldpt", "ldrow", "ldgrp") + OUTPUTS + ("signs", "jq", "rate", "fail", "start",
-                                                                          "stop")
+LOSS_OUTPUTS = ("gear_loss", "joint_friction", "joint_loss")
+ARGS = ("qi", "qdi", "qddi", "vals", "ldpt", "ldrow", "ldgrp") + OUTPUTS + ("signs",) + LOSS_OUTPUTS + (
+    "moments", "fail", "start", "stop")
 
 
 def signature(mod: ir.Module, name: str, types: list, names: tuple) -> ir.Function:
@@ -61,13 +63,15 @@ def _sample(e: Emitter, fn, prog, loads, n) -> None:
     external(e, s, fn, [L for L, _, _ in load_groups(loads)[1]], n, a["vals"], a["ldrow"], a["ldpt"], a["ldgrp"])
     lp = prog.losses
     if lp is not None:
-        rate = e.row(a["rate"], n, lp.out_width)
-        s.sv = llvm_losses.mesh_rates(e, s, lp, rate)
-        llvm_losses.joint_friction(e, s, lp, e.row(a["jq"], n, max(lp.joints.shape[0], 1)))
+        rates, s.sv = llvm_losses.mesh_rates(e, s, lp)
+        own = llvm_losses.joint_friction(e, s, lp)
     w = widths(prog)
     signs = e.row(a["signs"], n, max(w["signs"], 1))
     for b in range(len(prog.blocks)):
         block(e, fn, s, prog, b, n, a["fail"], signs)
+    if lp is not None:
+        llvm_losses.write_losses(e, s, lp, prog.gear_col, rates, own,
+                                 {k: e.row(a[k], n, max(w[k], 1)) for k in LOSS_OUTPUTS})
     write_outputs(e, s, prog, ind[1], {k: e.row(a[k], n, max(w[k], 1)) for k in OUTPUTS})
 
 
@@ -75,7 +79,7 @@ def build_module(prog, loads) -> ir.Module:
     """The IR module of ``prog``'s kernel (``loads``: per external load of the mechanism,
     its link id first (:func:`.driver.mech_loads`); only their links shape the code))."""
     mod = ir.Module(name="gearcli_kernel")
-    types = [DP] * 5 + [I64P] * 2 + [DP] * (len(OUTPUTS) + 3) + [I64P, I64, I64]
+    types = [DP] * 5 + [I64P] * 2 + [DP] * (len(OUTPUTS) + len(LOSS_OUTPUTS) + 2) + [I64P, I64, I64]
     fn = signature(mod, "run", types, ARGS)
     fail = fn.args[ARGS.index("fail")]
 

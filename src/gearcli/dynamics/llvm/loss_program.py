@@ -3,23 +3,23 @@
 A :class:`LossProgram` is attached to the kernel's :class:`~.program.Program` as one
 field (None for a lossless mechanism).  It holds, with the model of :mod:`.losses`:
 
-* ``rate_meshes``: the circuits with a loss factor; the kernel writes each one's rate
-  theta'_{j,c} (rad/s) into its ``rate`` output (the mesh power loss and s_v = sign(rate)
-  come from it); ``rate_flt`` (R, 3) their gear j's axis z_j in carrier axes, ``rate_int``
-  (R, 2) [gear j, carrier];
+* ``rate_meshes``: the circuits with a loss factor; the kernel computes each one's rate
+  theta'_{j,c} (rad/s), its s_v = sign(rate) and its mesh power loss c_p |t_p| |rate| r_j
+  (``gear_loss``); ``rate_flt`` (R, 3) their gear j's axis z_j in carrier axes, ``rate_int``
+  (R, 2) [gear j, carrier], ``loss_flt`` (R, 2) [c_p, r_j];
 * ``couple``: circuit -> (3,) the friction couple on gear j per unit of sigma s_v t in
   carrier axes (:func:`..losses.mesh_friction_moment`; gear k receives the opposite);
 * ``blocks``: block index -> :class:`BlockLosses`, the lossy signed meshes of that block;
 * ``joints`` (Q, 5) int [joint index, child, parent (-1: not moving), 1 if prismatic, 0]
-  and ``joint_flt`` (Q, 6): the joint's axis z and origin in its child's axes (from
-  R_jc, p_jc): the joints with friction (Coulomb, viscous or bearings), whose generalised
-  friction force per sample (:func:`..losses.joint_friction_force`, the bearing moments of
-  :mod:`..bearing_friction`) the kernel takes as its input ``jq`` (N, Q);
+  and ``joint_flt`` (Q, 8): the joint's axis z and origin in its child's axes (from R_jc,
+  p_jc), its F_c and F_v: the joints with friction (Coulomb, viscous or bearings), whose own
+  friction -F_c sign(q'_J) - F_v q'_J the kernel computes from its joint rate
+  (:func:`..losses.friction_force`'s law; the bearing friction: :mod:`.bearings`);
 * ``bearing_flt``, ``bearing_single``: the bearings of the joints with bearing friction
   (:func:`..bearing_friction.bearing_layout`); ``bearing_blocks``: block index ->
   :class:`BearingBlock`, the bearing friction joints whose reaction the block solves, which
   the kernel converges there (:mod:`.bearings`); it writes their converged sum_b M_b and each
-  block's iterations after the rates in its ``rate`` row (width :attr:`LossProgram.out_width`).
+  block's iterations in its ``moments`` row (width :attr:`LossProgram.out_width`).
 
 Frames and signs as in :mod:`..losses` and :mod:`..blocks`: a constant block's couples are
 in its frame F (``fric`` rows, ``fric_C``), a world-frame block's in base axes per sample.
@@ -34,6 +34,8 @@ from ..bearing_friction import bearing_layout, friction_joints
 from ..blocks import _primary_side
 from ..kinematics import forward
 from ..losses import mesh_friction_moment
+from ..pattern_maps import PatternMaps
+from ...model.friction import JointFriction
 
 
 @dataclass(frozen=True, eq=False)
@@ -45,9 +47,12 @@ class BlockLosses:
     ``circuits``: each one's circuit.  Constant frame: ``phi`` (ml, 6B) their friction
     couples on the block's rows in F per unit of sigma s_v t (:attr:`..blocks.BlockPlan.fric`),
     ``later`` per mesh [(link, +1 on j / -1 on k)] of the links of later blocks and
-    ``couple_F`` (ml, 3) the couple on j in F.  World frame (``phi`` None): ``rows`` per
-    mesh [(block row of the link, sign)] and ``later`` as above; the couple is
-    :attr:`LossProgram.couple` of the circuit turned by the carrier's R."""
+    ``couple_F`` (ml, 3) the couple on j in F; ``maps`` (a block with stored pattern maps
+    and at most :data:`MAX_TABLE` of them): the changed matrix's map of every pair (s_v of
+    its lossy meshes, sign pattern), index 2^m * sum_i (s_v,i + 1) 3^i + pattern, the maps
+    of the numpy path (:func:`..blocks._constant_block`), else None.  World frame (``phi``
+    None): ``rows`` per mesh [(block row of the link, sign)] and ``later`` as above; the
+    couple is :attr:`LossProgram.couple` of the circuit turned by the carrier's R."""
 
     positions: tuple
     rates: tuple
@@ -56,6 +61,7 @@ class BlockLosses:
     couple_F: np.ndarray | None
     later: tuple
     rows: tuple = ()
+    maps: tuple | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -86,6 +92,7 @@ class LossProgram:
     blocks: dict
     joints: np.ndarray
     joint_flt: np.ndarray
+    loss_flt: np.ndarray
     bearing_joints: tuple = field(default=())     # friction_joints(mech): the fixed point's joints
     bearing_flt: np.ndarray | None = None         # (K, 6) [z1, z2, locating 1, 2, arm 1, 2] (bearing_layout)
     bearing_single: tuple = field(default=())     # (K,) 1: the joint has one bearing
@@ -93,15 +100,14 @@ class LossProgram:
 
     @property
     def out_width(self) -> int:
-        """Width of the kernel's ``rate`` output row: each lossy mesh's rate, then each bearing
-        friction joint's converged sum_b M_b, then the iterations of each block of
-        :attr:`bearing_blocks` (:mod:`.bearings`)."""
-        return max(len(self.rate_meshes) + len(self.bearing_joints) + len(self.bearing_blocks), 1)
+        """Width of the kernel's ``moments`` output row: each bearing friction joint's converged
+        sum_b M_b, then the iterations of each block of :attr:`bearing_blocks` (:mod:`.bearings`)."""
+        return max(len(self.bearing_joints) + len(self.bearing_blocks), 1)
 
     def parts(self) -> list:
         """What the kernel's code is generated from (hashed into the program fingerprint)."""
         out = [self.rate_meshes, self.rate_int.tobytes(), self.rate_flt.tobytes(), self.joints.tobytes(),
-               self.joint_flt.tobytes(), self.bearing_joints, self.bearing_single,
+               self.joint_flt.tobytes(), self.loss_flt.tobytes(), self.bearing_joints, self.bearing_single,
                b"" if self.bearing_flt is None else self.bearing_flt.tobytes()]
         for ci in sorted(self.couple):
             out += [ci, self.couple[ci].tobytes()]
@@ -111,13 +117,33 @@ class LossProgram:
         for b in sorted(self.blocks):
             bl = self.blocks[b]
             out += [b, bl.positions, bl.rates, bl.circuits, bl.later, bl.rows]
-            out += [a.tobytes() for a in (bl.phi, bl.couple_F) if a is not None]
+            out += [a.tobytes() for a in (bl.phi, bl.couple_F) + (bl.maps or ()) if a is not None]
         return out
 
 
+MAX_TABLE = 64
+"""(s_v, sign pattern) pairs, 3^ml 2^m, up to which a constant block with stored pattern maps
+stores the changed matrix's map of each (:attr:`BlockLosses.maps`: a trial then costs what a
+lossless one does); more: the rank-ml correction of :class:`.losses.LossyBlock`."""
+
+
+def _table(p, pos: list) -> tuple | None:
+    """:attr:`BlockLosses.maps` of block plan ``p`` (lossy signed positions ``pos``), or None."""
+    m, ml = len(p.signed), len(pos)
+    if not isinstance(p.Ainv, PatternMaps) or 3 ** ml * (1 << m) > MAX_TABLE:
+        return None
+    maps = []
+    for code in range(3 ** ml):
+        key = np.zeros(m)
+        key[pos] = [code // 3 ** i % 3 - 1 for i in range(ml)]
+        pm = PatternMaps(p.Ainv.A_mid, p.Ainv.halves + key[:, None] * p.fric, p.Ainv.cols, p.Ainv.w)
+        maps += [np.ascontiguousarray(X) for X in pm]
+    return tuple(maps)
+
+
 def friction_joint_list(mech) -> list:
-    """Indices of the joints whose friction is a load of the kernel's input ``jq``: own
-    friction (Coulomb, viscous) or bearing friction, in joint order."""
+    """Indices of the joints with a friction load in the kernel: own friction (Coulomb,
+    viscous) or bearing friction, in joint order."""
     bearing = set(friction_joints(mech))
     return [ji for ji, jt in enumerate(mech.joints)
             if (jt.friction is not None and jt.friction.active) or ji in bearing]
@@ -153,22 +179,24 @@ def build_loss_program(an, plans) -> LossProgram | None:
             assert all(_primary_side(an, p.groups[p.signed[n]]) == an.circuits[ci].j for n, ci in zip(pos, circ))
             couple_F = np.array([p.fric_C[p.signed[n]][3:, 0] for n in pos], float)
             blocks[bi] = BlockLosses(tuple(pos), rates, circ, np.ascontiguousarray(p.fric[pos], float),
-                                     couple_F, later)
-    fj = friction_joint_list(mech)
+                                     couple_F, later, maps=_table(p, pos))
+    bj = friction_joints(mech)
     jrec, jflt = [], []
     moving = set(tree.moving)
-    for ji in fj:
+    for ji in friction_joint_list(mech):
         jt = mech.joints[ji]
         c, par = tree.index[jt.child], tree.index[jt.parent]
         R_jc = np.asarray(jt.R_jc, float)
+        fr = jt.friction if jt.friction is not None else JointFriction()
         # child axes: the joint frame's z is R_jc^T e_z, its origin -R_jc^T p_jc (o_c = o_j + R_j p_jc)
         jrec.append([ji, c if c in moving else -1, par if par in moving else -1, int(jt.type == "prismatic"), 0])
-        jflt.append(np.concatenate([R_jc[2, :], -R_jc.T @ np.asarray(jt.p_jc, float)]))
-    bj = friction_joints(mech)
+        jflt.append(np.concatenate([R_jc[2, :], -R_jc.T @ np.asarray(jt.p_jc, float), [fr.coulomb, fr.viscous]]))
+    loss_flt = np.array([[mech.gears[an.circuits[ci].gear].loss_factor, an.circuits[ci].geometry.r_j]
+                         for ci in rate_meshes], float).reshape(-1, 2)
     z1, z2, loc, arm, single = bearing_layout(mech, bj)
     bflt = np.ascontiguousarray(np.column_stack([z1, z2, loc, arm]).reshape(-1, 6), float)
     return LossProgram(rate_meshes, rate_int, rate_flt, couple, blocks, np.array(jrec, np.int64).reshape(-1, 5),
-                       np.array(jflt, float).reshape(-1, 6), tuple(bj), bflt, tuple(int(v) for v in single),
+                       np.array(jflt, float).reshape(-1, 8), loss_flt, tuple(bj), bflt, tuple(int(v) for v in single),
                        _bearing_blocks(an, plans, bj))
 
 

@@ -1,64 +1,78 @@
 """Generated losses of one sample (:mod:`..losses`, :mod:`.loss_program`), for :mod:`.kernel`.
 
-* :func:`mesh_rates`: each lossy mesh's rate theta'_{j,c} = (w_j - w_c) . R_c z_j (written
-  to the ``rate`` output) and s_v = sign of it (0 at rest), known before any block solve;
-* :func:`joint_friction`: rhs[L] -= the joints' friction loads, the generalised force Q per
-  sample from the input ``jq`` (Coulomb and viscous, computed by the driver with the
-  formulas of :mod:`..losses`; the bearing friction is :mod:`.bearings`'): about the axis
-  (revolute) or along it through the joint origin (prismatic), on the child, reversed on the
-  parent;
-* :class:`LossyBlock`: a constant-frame block with lossy meshes.  Mesh friction adds
-  sigma_i s_v,i phi_i to the column of t_i (phi_i its couples in F per unit of sigma s_v t),
-  so the block matrix of sign pattern sigma is A_sigma + Phi D E^T, D = diag(sigma s_v),
-  a rank-ml change of the matrix whose map X_sigma the block already has (stored maps, or
-  :class:`~.world.LowRankBlock`).  By the Woodbury identity, with t0 = E^T X_sigma r
-  and M = E^T X_sigma Phi (constants per pattern):
+* :func:`mesh_rates`: each lossy mesh's rate theta'_{j,c} = (w_j - w_c) . R_c z_j and
+  s_v = sign of it (0 at rest), known before any block solve;
+* :func:`joint_friction`: each friction joint's own friction -F_c sign(q'_J) - F_v q'_J
+  from the sample's joint rate (the law of :func:`..losses.friction_force`; the bearing
+  friction is :mod:`.bearings`'); rhs[L] -= that generalised force Q times the joint's unit
+  wrench: about the axis (revolute) or along it through the joint origin (prismatic), on
+  the child, reversed on the parent;
+* :func:`write_losses`: the loss outputs of the sample, as :func:`..losses.fill_losses`:
+  ``gear_loss`` c_p |t_p| |theta'_{j,c}| r_j, ``joint_friction`` the own friction (the
+  driver adds the converged bearing moments of :mod:`.bearings`), ``joint_loss`` -friction * q'_J;
+* :func:`lossy_block`: a constant-frame block with lossy meshes.  Mesh friction adds
+  sigma_i s_v,i phi_i to the column of t_i (phi_i its couples in F per unit of sigma s_v t).
+  A block with few patterns (:class:`TabledBlock`) runs the sign search over the changed
+  matrix's stored maps of the sample's s_v pattern (:attr:`.loss_program.BlockLosses.maps`,
+  the numpy path's maps, :func:`..blocks._constant_block`): a trial costs what a lossless
+  one does.  Otherwise
+  (:class:`LossyBlock`) the block matrix of sign pattern sigma is A_sigma + Phi D E^T,
+  D = diag(sigma s_v), a rank-ml change of the matrix whose map X_sigma the block already
+  has (stored maps, or :class:`~.world.LowRankBlock`).  By the Woodbury identity, with
+  t0 = E^T X_sigma r and M = E^T X_sigma Phi (constants per pattern):
 
-      t_l = (I + M D)^-1 t0   (an ml x ml solve),   x = X_sigma r - X_sigma Phi D t_l,
+      t_l = (I + M D)^-1 t0   (an ml x ml solve),   x = X_sigma r - X_sigma Phi D t_l;
 
-  the same sign search as the numpy path, whose maps are those of the changed matrix
-  (:func:`..blocks._constant_block`);
 * :func:`world_columns`: a world-frame block's friction couples added to its matrix per
   sample (sigma s_v (R_c couple) on gear j's rows, minus on k's);
-* :func:`propagate`: the solved couples s_v |t| on the links of later blocks.
+* :func:`couples_F`, :func:`propagate`: the solved couples s_v |t| on the links of later
+  blocks (constant frame: in the mesh's propagation record, :func:`.blocks.propagate`).
 """
 from __future__ import annotations
 
 import llvmlite.ir as ir
 import numpy as np
 
-from .build import D, Emitter
+from .build import D, FLAGS, I64, Emitter
 from .links import Sample, floats
-from .signs import SignedBlock, _rows_switch, signs_of
+from .signs import SignedBlock, _rows_switch, resolve, signs_of
 from .world import eliminate
 
 
+def _signed(e: Emitter, v, pos: float, neg: float):
+    """pos where v > 0, neg where v < 0, else 0.0 (a double; NaN gives 0: no sign pattern
+    accepts a NaN sample anyway)."""
+    zero = ir.Constant(D, 0.0)
+    return e.b.select(e.b.fcmp_ordered(">", v, zero), ir.Constant(D, pos),
+                      e.b.select(e.b.fcmp_ordered("<", v, zero), ir.Constant(D, neg), zero))
+
+
 def _sign(e: Emitter, v):
-    """sign(v) as a double: -1, 0 or 1 (np.sign; NaN gives 0 here, NaN there: no
-    sign pattern accepts a NaN sample anyway)."""
-    pos = e.b.uitofp(e.b.fcmp_ordered(">", v, ir.Constant(D, 0.0)), D)
-    neg = e.b.uitofp(e.b.fcmp_ordered("<", v, ir.Constant(D, 0.0)), D)
-    return e.sub(pos, neg)
+    """sign(v) as a double: -1, 0 or 1 (np.sign; NaN gives 0: as :func:`_signed`)."""
+    return _signed(e, v, 1.0, -1.0)
 
 
-def mesh_rates(e: Emitter, s: Sample, lp, row) -> list:
-    """s_v of every lossy mesh (doubles), its rate stored into ``row`` (double*)."""
-    sv = []
+def mesh_rates(e: Emitter, s: Sample, lp) -> tuple[list, list]:
+    """(theta'_{j,c}, s_v) of every lossy mesh (doubles)."""
+    rates = []
     for k in range(len(lp.rate_meshes)):
         j, c = (int(v) for v in lp.rate_int[k])
         z = e.mv(s.R[c], floats(lp.rate_flt[k]))
-        rate = e.dot(e.vsub(s.w[j], s.w[c]), z)
-        e.store(rate, row, k)
-        sv.append(_sign(e, e.const(rate)))
-    return sv
+        rates.append(e.const(e.dot(e.vsub(s.w[j], s.w[c]), z)))
+    return rates, [_sign(e, r) for r in rates]
 
 
-def joint_friction(e: Emitter, s: Sample, lp, row) -> None:
-    """rhs[L] -= Q * the unit wrench of each friction joint on L (``row``: the sample's Q)."""
+def joint_friction(e: Emitter, s: Sample, lp) -> dict:
+    """rhs[L] -= Q * the unit wrench of each friction joint on L; returns {joint: its own
+    friction Q} (the joints with Coulomb or viscous friction)."""
+    own = {}
     for k in range(lp.joints.shape[0]):
         ji, child, parent, prismatic = (int(v) for v in lp.joints[k, :4])
         f = floats(lp.joint_flt[k])
-        Q = e.load(row, k)
+        if not (f[6] or f[7]):         # bearing friction only (.bearings)
+            continue
+        qd = e.const(s.qd[ji])         # -F_c sign(q') - F_v q' (+0 at rest, as numpy's)
+        Q = own[ji] = e.b.fsub(_signed(e, qd, -f[6], f[6]), e.const(e.mul(f[7], qd)), flags=FLAGS)
         Rc, oc = s.R[child], s.o[child]
         z = e.mv(Rc, f[:3])
         for L, sign in ((child, 1.0), (parent, -1.0)):
@@ -70,6 +84,70 @@ def joint_friction(e: Emitter, s: Sample, lp, row) -> None:
             else:
                 w = (0.0, 0.0, 0.0) + z
             s.rhs[L] = tuple(e.sub(s.rhs[L][h], e.mul(e.mul(sign, Q), w[h])) for h in range(6))
+    return own
+
+
+def write_losses(e: Emitter, s: Sample, lp, gear_col, rates: list, own: dict, rows: dict) -> None:
+    """The sample's ``gear_loss`` (every circuit, 0 for an ideal pair), ``joint_friction`` and
+    ``joint_loss`` (every joint, 0 without own friction) rows (``rows``: name -> double*)."""
+    for k, ci in enumerate(lp.rate_meshes):
+        c, rj = floats(lp.loss_flt[k])
+        t = s.sol[int(gear_col[ci])]
+        e.store(e.mul(e.mul(e.mul(c, e.call("fabs", t)), e.call("fabs", rates[k])), rj), rows["gear_loss"], ci)
+    for ci in set(range(len(gear_col))) - set(lp.rate_meshes):
+        e.store(0.0, rows["gear_loss"], ci)
+    for ji in range(len(s.qd)):
+        f = own.get(ji, 0.0)
+        e.store(f, rows["joint_friction"], ji)
+        e.store(e.neg(e.mul(f, s.qd[ji])), rows["joint_loss"], ji)
+
+
+def lossy_block(e: Emitter, inner, bl, sv: list, name: str):
+    """The solve of a lossy constant-frame block (module docstring): its stored maps per
+    (s_v, sigma) when it has them, else a :class:`LossyBlock` around ``inner``."""
+    if bl.maps is None:
+        return LossyBlock(inner, bl, sv)
+    code = ir.Constant(I64, 0)
+    for i, k in enumerate(bl.rates):       # sum_i (s_v,i + 1) 3^i
+        digit = e.b.add(e.b.fptosi(e.const(sv[k]), I64), ir.Constant(I64, 1))
+        code = e.b.add(code, e.b.mul(digit, ir.Constant(I64, 3 ** i)))
+    return TabledBlock(e, bl.maps, inner.tcols, code, name)
+
+
+class TabledBlock:
+    """The stored maps of every (s_v, sigma) of a block: a ``switch`` on the sample's s_v
+    pattern ``code`` into one sign search each (:func:`~.signs.resolve`), over its 2^m maps;
+    :meth:`rows` of pattern p (the bearing fixed point's, :mod:`.bearings`): the map at
+    2^m code + p."""
+
+    def __init__(self, e: Emitter, maps: tuple, tcols: list, code, name: str):
+        self.maps, self.tcols, self.code = maps, tcols, code
+        self.all = SignedBlock(e, list(maps), tcols, f"{name}_sv")
+        self.n = self.all.n
+
+    def rows(self, e: Emitter, fn, p, rows: list, r: list, tag: str) -> list:
+        off = e.b.mul(self.code, ir.Constant(I64, 1 << len(self.tcols)))
+        return self.all.rows(e, fn, e.b.add(p, off), rows, r, tag)
+
+    def search(self, e: Emitter, fn, r: list, tol, on_fail, tag: str):
+        """(x, p) of :func:`~.signs.resolve` with the maps of the sample's s_v pattern."""
+        k = 1 << len(self.tcols)
+        merge = fn.append_basic_block(f"{tag}_sv")
+        cases = [fn.append_basic_block(f"{tag}_sv{c}") for c in range(len(self.maps) // k)]
+        sw = e.b.switch(self.code, cases[0])
+        done = []
+        for c, case in enumerate(cases):
+            sw.add_case(ir.Constant(I64, c), case)
+            e.b.position_at_end(case)
+            blk = SignedBlock(e, list(self.maps[c * k:(c + 1) * k]), self.tcols, f"{tag}_sv{c}")
+            done.append(resolve(e, fn, blk, r, tol, on_fail, f"{tag}_sv{c}") + (e.b.block,))
+            e.b.branch(merge)
+        e.b.position_at_end(merge)
+        out = [e.b.phi(D) for _ in done[0][0]] + [e.b.phi(I64)]
+        for x, p, blk in done:
+            for phi, v in zip(out, list(x) + [p]):
+                phi.add_incoming(e.const(v), blk)
+        return out[:-1], out[-1]
 
 
 class LossyBlock:
@@ -143,20 +221,22 @@ def _carrier(lp, k: int) -> int:
     return int(lp.rate_int[k, 1])
 
 
-def propagate(e: Emitter, s: Sample, lp, bl, F: int, x: list, tcols: list, sig: list) -> None:
-    """rhs[L] -= the solved friction couples on the later links L: s_v |t| (couple on j)
-    on j, its opposite on k (the couple in F turned by R_F, as :func:`..blocks.solve_blocks`;
-    world blocks: sigma s_v t (R_c couple), as the column of :class:`..equations.Columns`)."""
-    sv = s.sv
+def couples_F(e: Emitter, s: Sample, bl, x: list, tcols: list) -> dict:
+    """A constant-frame block's solved friction couples on the links of later blocks: {t
+    column: s_v |t| (couple on j in F)}, added to the wrench of the mesh's propagation record
+    (+ on j, its primary link, - on k, as :func:`..blocks.solve_blocks`)."""
+    return {tcols[n]: e.scale(floats(bl.couple_F[a]), e.mul(s.sv[k], e.call("fabs", x[tcols[n]])))
+            for a, (n, k) in enumerate(zip(bl.positions, bl.rates)) if bl.later[a]}
+
+
+def propagate(e: Emitter, s: Sample, lp, bl, x: list, tcols: list, sig: list) -> None:
+    """rhs[L] -= a world-frame block's solved friction couples on the later links L:
+    sigma s_v t (R_c couple), as the column of :class:`..equations.Columns` (+ on j, - on k)."""
     for a, (n, k, ci) in enumerate(zip(bl.positions, bl.rates, bl.circuits)):
         if not bl.later[a]:
             continue
-        if bl.phi is not None:
-            m = e.mv(s.R[F], floats(bl.couple_F[a]))
-            amount = e.mul(sv[k], e.call("fabs", x[tcols[n]]))
-        else:
-            m = e.mv(s.R[_carrier(lp, k)], floats(lp.couple[ci]))
-            amount = e.mul(e.mul(sig[n], sv[k]), x[tcols[n]])
+        m = e.mv(s.R[_carrier(lp, k)], floats(lp.couple[ci]))
+        amount = e.mul(e.mul(sig[n], s.sv[k]), x[tcols[n]])
         for L, sign in bl.later[a]:
             s.rhs[L] = s.rhs[L][:3] + tuple(e.sub(s.rhs[L][3 + h], e.mul(float(sign), e.mul(amount, m[h])))
                                             for h in range(3))

@@ -13,11 +13,13 @@ from ..result_arrays import FIELDS as OUTPUTS
 
 
 def widths(prog) -> dict:
-    """Row width of each output (``OUTPUTS`` and "signs") of ``prog``'s mechanism."""
+    """Row width of each output (``OUTPUTS``, "signs" and the loss outputs of :mod:`.kernel`) of
+    ``prog``'s mechanism."""
     J, M, G = len(prog.joint_out), len(prog.motor_col), len(prog.gear_out)
     dof = prog.A.shape[0]
     return {"motor": M, "tau": dof, "joint": 6 * J, "gear_t": G, "gear_sep": G, "gear_radial": 2 * G,
-            "gear_axial": 2 * G, "motor_speed": M, "signs": len(prog.signed)}
+            "gear_axial": 2 * G, "motor_speed": M, "signs": len(prog.signed), "gear_loss": G, "joint_friction": J,
+            "joint_loss": J}
 
 
 def _joints(e: Emitter, s: Sample, jout, row) -> None:
