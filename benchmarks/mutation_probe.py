@@ -209,7 +209,7 @@ MUTATIONS = [
              (("dynamics/llvm/bearings.py", "    e.b.cbranch(ok, done_bb, more)\n",
                "    e.b.cbranch(ir.Constant(I1, 1), done_bb, more)\n"),)),
     Mutation("llvm-bearing-later-couple", "llvm: bearing friction couple passed on to a later block's link with the child's sign on the parent",
-             (("dynamics/llvm/bearings.py", "e.mul(sign, e.mul(amount, zw[j][h]))", "e.mul(amount, zw[j][h])"),)),
+             (("dynamics/llvm/bearings.py", "e.mul(sign, e.mul(amount, jt.zw[j][h]))", "e.mul(amount, jt.zw[j][h])"),)),
     Mutation("llvm-sin-quadrant", "llvm: inline sin with the quadrant's sign flipped",
              (("dynamics/llvm/trig.py", "b.select(sin_neg, e.neg(sin_mag), sin_mag)", "b.select(sin_neg, sin_mag, e.neg(sin_mag))"),)),
 ]
