@@ -113,3 +113,19 @@ def test_callers_on_several_threads_share_the_pool(backend):
     for ref, out in zip(refs, outs):
         for f in FIELDS:
             assert np.array_equal(getattr(out, f), getattr(ref, f)), f
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_out_carries_this_calls_losses(backend):
+    """A lossy mechanism's loss fields (mesh and joint losses, friction, bearing iterations)
+    in ``out`` are this call's, equal to a fresh solve's, never the previous call's (the
+    numpy path once copied only the lossless fields into ``out``)."""
+    an = analyse(mechanism("servo_joint_rated.yaml"))
+    q, qd, qdd = trajectory(an, 500, seed=3)
+    q2, qd2, qdd2 = trajectory(an, 500, seed=4)
+    fresh = solve(an, q, qd, qdd, backend=backend)
+    out = solve(an, q2, qd2, qdd2, backend=backend)
+    got = solve(an, q, qd, qdd, backend=backend, out=out)
+    for f in ("gear_loss", "joint_friction", "joint_loss", "bearing_iterations"):
+        assert getattr(fresh, f) is not None, f
+        np.testing.assert_array_equal(getattr(got, f), getattr(fresh, f), err_msg=f)

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import counted
+from .losses import LOSS_FIELDS
 
 FIELDS = ("motor", "tau", "joint", "gear_t", "gear_sep", "gear_radial", "gear_axial", "motor_speed")
 
@@ -96,7 +97,11 @@ def work_arrays(n: int, signed: int, out=None) -> tuple:
 
 
 def copy_into(out, res) -> None:
-    """The numpy path's result ``res`` copied into ``out``'s arrays (checked before)."""
+    """The numpy path's result ``res`` copied into ``out``'s arrays (checked before); its
+    loss fields (new arrays, or None for a lossless mechanism) replace ``out``'s, as the
+    compiled path's do, never left from ``out``'s earlier call."""
     for k in FIELDS:
         np.copyto(getattr(out, k), getattr(res, k))
+    for k in LOSS_FIELDS:
+        setattr(out, k, getattr(res, k))
     out.residual = res.residual
