@@ -12,6 +12,7 @@ pattern must be named as the numpy path names it; and a wrong program entry must
 from __future__ import annotations
 
 import dataclasses
+import re
 from pathlib import Path
 
 import numpy as np
@@ -70,13 +71,20 @@ def mechanism(key: str):
         "serial_chain": lambda: parse_mechanism(serial_chain(int(arg))),
         "tree": lambda: parse_urdf(binary_tree_urdf(int(arg))),
         "loaded": lambda: parse_mechanism(_with_loads((MECH / arg).read_text())),
+        "planets": lambda: _planets("planetary_5p.yaml", arg),
+        "servo": lambda: _planets("servo_joint.yaml", arg),
     }
     return makers[kind]()
 
 
+def _planets(name: str, n: str):
+    """A bundled mechanism with n planets in its planet set."""
+    return parse_mechanism(re.sub(r"planets: \d+", f"planets: {n}", (MECH / name).read_text()))
+
+
 GENERATED = ["variant:1", "variant:2", "spatial:1", "spatial:0", "planetary", "dh_geared:3", "puma",
              "prismatic:5", "geared_chain:7", "serial_chain:7", "tree:3",
-             "loaded:paper_2dof.yaml", "loaded:bendix_wrist.yaml"]
+             "loaded:paper_2dof.yaml", "loaded:bendix_wrist.yaml", "planets:9"]
 
 
 def trajectory(an, n, seed=0):
@@ -96,11 +104,14 @@ def compiled_backend(an) -> None:
     assert sol.llvm_available() and sol.choice() == backends.Choice("llvm")
 
 
-@pytest.mark.parametrize("key", ALL_BUNDLED + GENERATED)
+@pytest.mark.parametrize("key", ALL_BUNDLED + GENERATED + ["planets:15", "servo:12"])
 def test_auto_backend_of_every_mechanism(key):
     """The path "auto" takes for a large call on every bundled mechanism (servo_joint.yaml,
-    planetary_5p.yaml and the lossy servo_joint_rated.yaml among them) and every
-    test-factory mechanism: llvm.  The robots: test_kernel_equals_numpy_on_robots."""
+    planetary_5p.yaml and the lossy servo_joint_rated.yaml among them), every test-factory
+    mechanism, planetary_5p with 9 and 15 planets (one block of 18 and 30 signed meshes,
+    more than signs.MAX_EXHAUSTIVE: the own-sign trials only) and servo_joint with 12 (a
+    world-frame block of 25): llvm.  The robots:
+    test_kernel_equals_numpy_on_robots."""
     assert solver_for(analyse(mechanism(key))).choice() == backends.Choice("llvm")
 
 
@@ -236,7 +247,7 @@ def _sign_error(an, q, qd, qdd, backend, chunk):
 
 @pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("key", ["paper_2dof.yaml", "bendix_wrist.yaml", "geared_arm.urdf", "planetary_3p.yaml",
-                                 "planetary_5p.yaml", "servo_joint.yaml"])
+                                 "planetary_5p.yaml", "servo_joint.yaml", "planets:9"])
 def test_sign_error_names_the_same_sample(key, backend):
     """Samples with no consistent sign pattern (a NaN acceleration fails the first geared
     block): the error names the sample, and the meshes, that the numpy path names."""

@@ -167,7 +167,7 @@ def test_readme_library_example_runs(monkeypatch):
 
 def test_summary_states_the_backend_and_auto_says_why_numpy(run_cli, mech_dir, tmp_path, monkeypatch):
     """The summary's Backend line names the path that ran; "auto" on a mechanism the kernel
-    refuses (planetary_5p with 9 planets: 18 signed meshes in a block) solves with numpy and
+    refuses (planetary_5p with 18 planets: 36 signed meshes in a block) solves with numpy and
     prints one notice line on stderr; the first-call rule (an empty disk cache, 2,001 rows)
     is stated in the summary only."""
     monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path / "cache"))
@@ -180,10 +180,10 @@ def test_summary_states_the_backend_and_auto_says_why_numpy(run_cli, mech_dir, t
     assert r.exit_code == 0 and r.stderr == ""
     assert ("Backend: numpy (auto: first-call rule: fewer than 5,000 samples, and the kernel is neither "
             "compiled nor in the disk cache)") in r.stdout.splitlines()
-    nine = tmp_path / "planetary_9p.yaml"
-    nine.write_text((mech_dir / "planetary_5p.yaml").read_text().replace("planets: 5", "planets: 9"))
-    r = run_cli("solve", nine, mech_dir / "planetary_3p_traj.csv", "-o", out)
-    reason = "a block has more than 16 signed meshes, or a singular separating-force-free matrix"
+    many = tmp_path / "planetary_18p.yaml"
+    many.write_text((mech_dir / "planetary_5p.yaml").read_text().replace("planets: 5", "planets: 18"))
+    r = run_cli("solve", many, mech_dir / "planetary_3p_traj.csv", "-o", out)
+    reason = "a block has more than 32 signed meshes, or a singular separating-force-free matrix"
     assert r.exit_code == 0 and f"Backend: numpy (auto: {reason})" in r.stdout.splitlines()
     assert r.stderr.splitlines() == [f"notice: solved with numpy, not the llvm kernel: {reason}"]
 

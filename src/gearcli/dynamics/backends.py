@@ -11,7 +11,7 @@ mechanism as LLVM IR (:mod:`.llvm.kernel`: method "block"; its machine code is k
   llvm, except (each a :class:`Choice` with its one-line ``note``)
 
   - llvmlite does not import, or the kernel refuses the mechanism
-    (:attr:`.solve.Solver.kernel_problem`, e.g. a block with more than 16 signed meshes):
+    (:attr:`.solve.Solver.kernel_problem`, e.g. a block with more than 32 signed meshes):
     numpy for every call;
   - the first-call rule: while the kernel is neither compiled in this process nor its
     machine code in the disk cache, a call of fewer than :data:`FIRST_CALL_SAMPLES` samples

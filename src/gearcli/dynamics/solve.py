@@ -34,7 +34,7 @@ from .external import external_wrenches, load_values, subtract_external
 from .inertia import inertia_load
 from .inputs import motion_arrays
 from .llvm.output_maps import gear_outputs
-from .llvm.program import build_program
+from .llvm.program import MAX_SIGNED, build_program
 from .kinematics import forward
 from .bearing_friction import solve_with_bearing_friction, subtract_bearing_friction
 from .losses import LOSS_FIELDS, fill_kernel_losses, fill_losses, subtract_joint_friction
@@ -133,7 +133,7 @@ class Solver:
         if self._program is None and self.kernel_problem is None:
             self._program = build_program(self.an, self.plans)
             if not self._program.covered:
-                self.kernel_problem = ("a block has more than 16 signed meshes, or a singular "
+                self.kernel_problem = (f"a block has more than {MAX_SIGNED} signed meshes, or a singular "
                                        "separating-force-free matrix")
         return self._program if self.kernel_problem is None else None
 
@@ -298,7 +298,7 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
         first use, 0.1-0.3 s for 5-10 links, kept with the analysis and on disk; method
         "block" only); "numpy": the array implementation (the reference); "auto" (default):
         llvm, except numpy for method "full", where llvmlite does not import or the kernel
-        refuses the mechanism (a block with > 16 signed meshes), and by the first-call rule
+        refuses the mechanism (a block with > 32 signed meshes), and by the first-call rule
         of :mod:`.backends` (``Result.backend`` says which ran, ``Result.backend_note`` why numpy).  Both give the
         same results to rounding.  "kernel" (the retired numba kernel) is a ValueError.
     jobs : int, optional
