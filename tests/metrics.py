@@ -40,3 +40,13 @@ def per_sample_loads(an, n, seed=1):
         return None
     rng = np.random.default_rng(seed)
     return {an.mech.loads[0].name: rng.normal(size=(n, 6)) * 5.0}
+
+
+def nan_accelerations(qdd, count: int, seed: int = 9) -> int:
+    """Put NaN into one acceleration of ``count`` random samples of ``qdd`` (N, dof), in
+    place (no sign pattern fits such a sample: the SignError cases); returns the first
+    such sample."""
+    rng = np.random.default_rng(seed)
+    for s in rng.choice(qdd.shape[0], count, replace=False):
+        qdd[s, rng.integers(qdd.shape[1])] = np.nan
+    return int(np.flatnonzero(np.isnan(qdd).any(axis=1))[0])
