@@ -496,3 +496,22 @@ def test_every_truncation_cites_a_line_of_the_file():
         except MechanismError as exc:
             beyond += [(cut, i.line, last, i.message) for i in exc.issues if i.line is not None and i.line > last]
     assert beyond == []
+
+
+def test_alias_of_a_scalar_loads(run_cli, mech_dir, tmp_path):
+    """A designer shares one mesh efficiency between pairs (``efficiency: &eta 0.985``, then
+    ``efficiency: *eta``): an alias of a scalar is not recursive (it was refused as
+    "refers to a node that contains it"), and an alias giving a pair both keys is the
+    loss keys' own error."""
+    text = (mech_dir / "servo_joint_rated.yaml").read_text()
+    assert text.count("efficiency: 0.985") == 2
+    text = text.replace("efficiency: 0.985", "efficiency: &eta 0.985", 1).replace("efficiency: 0.985", "efficiency: *eta")
+    path = tmp_path / "servo.yaml"
+    path.write_text(text)
+    r, before = run_cli("check", path), run_cli("check", mech_dir / "servo_joint_rated.yaml")
+    assert r.exit_code == 0, r.stderr
+    assert r.stdout.splitlines()[1:] == before.stdout.splitlines()[1:]
+    assert sum("efficiency 0.985 (loss factor 0.015)" in ln for ln in r.stdout.splitlines()) == 4   # 1 + 3 planets
+    both = replaced("    ratio: -3.0 ", "    efficiency: &e 0.97\n    loss_factor: *e\n    ratio: -3.0 ")
+    bad(run_cli, tmp_path, both, line_of(both, "loss_factor: *e"), "gears[0].loss_factor",
+        r"^give efficiency or loss_factor \(= 1 - efficiency\), not both$")
