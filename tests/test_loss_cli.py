@@ -124,6 +124,33 @@ def test_solve_summary_spur_pair_by_hand(run_cli, tmp_path):
     assert f"line efficiency of motor motor: {eta:.4f} (lossless power / motor power where the motor drives)" in lines
 
 
+def test_line_efficiency_counts_bearing_friction(run_cli, tmp_path):
+    """Bearing friction alone on the pinion shaft: bearing 'a' (in the gear's plane) carries
+    the whole reaction, P = sqrt((t/cos phi)^2 + (m g)^2) with t = 2 N*m / r_k, and the line
+    efficiency is t r_j / (t r_j + mu d P / 2) = 0.9996 (was 1.0000: the lossless motion
+    the summary compares with kept the bearing friction)."""
+    import math
+    text = _spur_only(SPUR).replace(", efficiency: 0.97", "").replace(
+        "    axis: [0, 0, 1]\n  - {name: Jw",
+        "    axis: [0, 0, 1]\n    bearings:\n"
+        "      - {name: a, position: 0.0, locating: true, friction_coefficient: 0.0015, bore: 0.008}\n"
+        "      - {name: b, position: 0.02, friction_coefficient: 0.0015, bore: 0.008}\n  - {name: Jw", 1)
+    assert "efficiency" not in text and text.count("friction_coefficient") == 2
+    mech, traj = tmp_path / "spur.yaml", tmp_path / "traj.csv"
+    mech.write_text(text)
+    traj.write_text(TRAJ)
+    r = run_cli("solve", mech, traj, "-o", tmp_path / "out.csv")
+    assert r.exit_code == 0, r.stderr
+    rj, rk, t = 0.015, 0.060, 2.0 / 0.060
+    P = math.hypot(t / math.cos(math.radians(20)), 0.1 * 9.81)
+    moment = 0.5 * 0.0015 * 0.008 * P
+    eta = t * rj / (t * rj + moment)
+    assert f"{eta:.4f}" == "0.9996"
+    assert f"line efficiency of motor motor: {eta:.4f} (lossless power / motor power where the motor drives)" \
+        in r.stdout.splitlines()
+    assert f"  joint Jp: {moment * 4.0:.6g} J (100 %)" in r.stdout.splitlines()
+
+
 def test_summary_lists_equal_losses_in_file_order(run_cli, mech_dir, tmp_path):
     """The three copies of a planet lose the same energy (to rounding): the summary lists
     them 1, 2, 3 (was: by their rounding noise, 2, 1, 3)."""

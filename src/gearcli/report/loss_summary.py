@@ -22,9 +22,12 @@ from ..errors import counted
 
 
 def lossless_twin(mech):
-    """The same mechanism with every loss removed (efficiency 1, no joint friction)."""
+    """The same mechanism with every loss removed: efficiency 1, no joint friction, no
+    bearing friction (the bearings' ratings stay)."""
+    def frictionless(bearings):
+        return bearings and tuple(replace(b, friction_coefficient=None) for b in bearings)
     return replace(mech, gears=tuple(replace(g, loss_factor=0.0) for g in mech.gears),
-                   joints=tuple(replace(j, friction=None) for j in mech.joints))
+                   joints=tuple(replace(j, friction=None, bearings=frictionless(j.bearings)) for j in mech.joints))
 
 
 def _trapezoid_parts(t: np.ndarray, y: np.ndarray, t_prev, y_prev) -> np.ndarray:
