@@ -138,14 +138,14 @@ def _subtract(rhs: dict, axis: dict, joints: list, qd_all: np.ndarray, Mb: np.nd
 
 def subtract_bearing_friction(an, kin, b: dict, qd_all: np.ndarray, moments: np.ndarray | None,
                               rows=slice(None)) -> None:
-    """b[L] -= the converged bearing friction moments ``moments[rows]`` (of :func:`fixed_point`,
-    (N, J); None: none) on L, in place (the right-hand side a solution balances)."""
+    """b[L] -= the converged bearing friction moments ``moments[rows]`` ((N, K) of the joints
+    :func:`friction_joints`, the llvm kernel's; None: none) on L, in place (the right-hand
+    side a solution balances)."""
     if moments is None:
         return
-    moments = moments[rows]
     joints = friction_joints(an.mech)
     axis = {ji: {L: joint_axis_wrench(an, kin, ji, L) for L in _links(an, ji)} for ji in joints}
-    _subtract(b, axis, joints, qd_all, moments[:, joints])
+    _subtract(b, axis, joints, qd_all, moments[rows])
 
 
 def fixed_point(an, qd_all: np.ndarray, solve_moments):

@@ -151,10 +151,8 @@ def _add_bearing(res, qd_all: np.ndarray, bearing: np.ndarray | None, iterations
 
 def fill_kernel_losses(res, arrays: dict, losses: dict) -> None:
     """The loss fields of ``res`` from the llvm kernel's loss outputs in ``arrays`` (gear_loss,
-    joint_friction: the joints' own friction, joint_loss; none for a lossless mechanism) and
-    the bearing friction its driver put in ``losses`` ("bearing", "iterations", "qd"), added
-    as :func:`fill_losses` does."""
+    joint_friction, joint_loss, the bearing friction included; none for a lossless
+    mechanism) and the bearing iterations its driver put in ``losses`` ("iterations")."""
     for k in set(arrays) & {"gear_loss", "joint_friction", "joint_loss"}:
         setattr(res, k, arrays[k])
-    if losses.get("bearing") is not None:
-        _add_bearing(res, losses["qd"], losses["bearing"], losses["iterations"])
+    res.bearing_iterations = losses.get("iterations")

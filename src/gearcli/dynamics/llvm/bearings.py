@@ -20,8 +20,8 @@ sample); should the tooth forces no longer fit p (the tolerance of the shifted r
 search runs again at the current moments (same iteration).  A block without a constant
 couple (world frame) solves the whole block each iteration.
 
-Written per sample in the ``moments`` row: each joint's converged Mb_J,
-then each block's iteration count.  A block that does not converge records ``fail`` =
+Written per sample in the ``moments`` row: each joint's converged Mb_J, then the most
+iterations over the sample's blocks; -s_J Mb_J joins J's friction output.  A block that does not converge records ``fail`` =
 (number of blocks) + k, k the bearing joint of largest relative change (the driver's
 :class:`..bearing_friction.BearingFrictionError`).
 """
@@ -183,16 +183,22 @@ def _failed(e: Emitter, prog, bb, new: list, change: list, fail, n) -> None:
 
 
 def _outputs(e: Emitter, s: Sample, lp, b: int, bb, jt: _Joints, Mb, it, links, n) -> None:
-    """The converged Mb and the block's iterations into the ``rate`` row; the couples
-    -s_J Mb_J z_J on the joints' links of later blocks (rhs[L] -= Q w, reversed on the parent)."""
+    """The converged Mb and the most iterations so far over the sample's blocks into its
+    ``moments`` row, s_J Mb_J into ``s.bearing`` (the joint friction outputs,
+    :func:`.losses.write_losses`); the couples -s_J Mb_J z_J on the joints' links of later
+    blocks (rhs[L] -= Q w, reversed on the parent)."""
     fn = e.b.function
     row = e.row(next(a for a in fn.args if a.name == "moments"), n, lp.out_width)
     K = len(lp.bearing_joints)
     for j, k in enumerate(bb.joints):
         e.store(Mb[j], row, k)
-    e.store(e.b.sitofp(it, D), row, K + sorted(lp.bearing_blocks).index(b))
+    it = e.b.sitofp(it, D)
+    if b != min(lp.bearing_blocks):
+        before = e.load(row, K)
+        it = e.b.select(e.b.fcmp_ordered(">", it, before), it, before)
+    e.store(it, row, K)
     for j, rc in enumerate(jt.rec):
-        amount = e.mul(jt.sg[j], Mb[j])
+        amount = s.bearing[int(rc[0])] = e.mul(jt.sg[j], Mb[j])
         for L, sign in ((int(rc[1]), 1.0), (int(rc[2]), -1.0)):
             if L >= 0 and L not in links:
                 s.rhs[L] = s.rhs[L][:3] + tuple(e.add(s.rhs[L][3 + h], e.mul(sign, e.mul(amount, jt.zw[j][h])))

@@ -232,25 +232,21 @@ class LlvmKernel:
         """The loads of every sample into ``out``, as the numpy path (:func:`..blocks.solve_blocks`) does.
 
         A lossy mechanism (``prog.losses``): the kernel computes the joints' own friction and
-        writes the loss outputs (``out``'s gear_loss, joint_friction: the joints' own friction,
-        joint_loss); the bearing friction converges in the kernel, block by block
-        (:mod:`.bearings`); ``losses`` (a dict) then receives "bearing" (N, J) moments,
-        "iterations" (N,): per sample the most iterations over its blocks, and "qd" (N, J) the
-        joint rates."""
+        writes the loss outputs (``out``'s gear_loss, joint_friction, joint_loss); the bearing
+        friction converges in the kernel, block by block (:mod:`.bearings`), and joins the
+        joint friction and loss outputs there; ``losses`` (a dict) then receives "bearing"
+        (N, K) the converged moments of the joints :func:`..bearing_friction.friction_joints`
+        and "iterations" (N,): per sample the most iterations over its blocks."""
         prog = self.prog
         lp = prog.losses
         if lp is None or not lp.bearing_joints:
             self._launch(an, q, qd, qdd, values, jobs, chunk, out, work, np.empty((1, 1)))
             return {k: work[0][:, i] for i, k in enumerate(prog.signed)}
-        N, J = q.shape[0], len(an.mech.joints)
-        moments = np.empty((N, lp.out_width))           # the kernel's converged moments and iterations
+        moments = np.empty((q.shape[0], lp.out_width))           # the kernel's converged moments and iterations
         self._launch(an, q, qd, qdd, values, jobs, chunk, out, work, moments)
-        K = len(lp.bearing_joints)
-        bearing, qd_all = np.zeros((N, J)), qd @ np.asarray(an.S, float).T
-        bearing[:, list(lp.bearing_joints)] = moments[:, :K]
-        iterations = moments[:, K:K + len(lp.bearing_blocks)].max(axis=1).astype(np.int64)
         if losses is not None:
-            losses.update(bearing=bearing, iterations=iterations, qd=qd_all)
+            K = len(lp.bearing_joints)
+            losses.update(bearing=moments[:, :K], iterations=moments[:, K].astype(np.int64))
         return {k: work[0][:, i] for i, k in enumerate(prog.signed)}
 
     def _launch(self, an, q, qd, qdd, values, jobs, chunk, out, work, moments) -> None:

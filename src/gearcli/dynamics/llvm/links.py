@@ -43,6 +43,7 @@ class Sample:
     rhs: dict = field(default_factory=dict)
     sol: dict = field(default_factory=dict)
     sv: list = field(default_factory=list)     # s_v of each lossy mesh (:mod:`.losses`)
+    bearing: dict = field(default_factory=dict)   # joint: s_J Mb_J, its converged bearing friction (:mod:`.bearings`)
     frames: dict = field(default_factory=dict)
 
 

@@ -18,8 +18,8 @@ field (None for a lossless mechanism).  It holds, with the model of :mod:`.losse
 * ``bearing_flt``, ``bearing_single``: the bearings of the joints with bearing friction
   (:func:`..bearing_friction.bearing_layout`); ``bearing_blocks``: block index ->
   :class:`BearingBlock`, the bearing friction joints whose reaction the block solves, which
-  the kernel converges there (:mod:`.bearings`); it writes their converged sum_b M_b and each
-  block's iterations in its ``moments`` row (width :attr:`LossProgram.out_width`).
+  the kernel converges there (:mod:`.bearings`); it writes their converged sum_b M_b and the
+  most iterations over those blocks in its ``moments`` row (width :attr:`LossProgram.out_width`).
 
 Frames and signs as in :mod:`..losses` and :mod:`..blocks`: a constant block's couples are
 in its frame F (``fric`` rows, ``fric_C``), a world-frame block's in base axes per sample.
@@ -101,8 +101,8 @@ class LossProgram:
     @property
     def out_width(self) -> int:
         """Width of the kernel's ``moments`` output row: each bearing friction joint's converged
-        sum_b M_b, then the iterations of each block of :attr:`bearing_blocks` (:mod:`.bearings`)."""
-        return max(len(self.bearing_joints) + len(self.bearing_blocks), 1)
+        sum_b M_b, then the most iterations over the blocks of :attr:`bearing_blocks` (:mod:`.bearings`)."""
+        return len(self.bearing_joints) + 1
 
     def parts(self) -> list:
         """What the kernel's code is generated from (hashed into the program fingerprint)."""

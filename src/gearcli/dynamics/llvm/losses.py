@@ -8,8 +8,8 @@
   wrench: about the axis (revolute) or along it through the joint origin (prismatic), on
   the child, reversed on the parent;
 * :func:`write_losses`: the loss outputs of the sample, as :func:`..losses.fill_losses`:
-  ``gear_loss`` c_p |t_p| |theta'_{j,c}| r_j, ``joint_friction`` the own friction (the
-  driver adds the converged bearing moments of :mod:`.bearings`), ``joint_loss`` -friction * q'_J;
+  ``gear_loss`` c_p |t_p| |theta'_{j,c}| r_j, ``joint_friction`` the own friction less the
+  converged bearing friction s_J Mb_J of :mod:`.bearings`, ``joint_loss`` -friction * q'_J;
 * :func:`lossy_block`: a constant-frame block with lossy meshes.  Mesh friction adds
   sigma_i s_v,i phi_i to the column of t_i (phi_i its couples in F per unit of sigma s_v t).
   A block with few patterns (:class:`TabledBlock`) runs the sign search over the changed
@@ -98,6 +98,8 @@ def write_losses(e: Emitter, s: Sample, lp, gear_col, rates: list, own: dict, ro
         e.store(0.0, rows["gear_loss"], ci)
     for ji in range(len(s.qd)):
         f = own.get(ji, 0.0)
+        if ji in s.bearing:            # (0 - 0 = +0 at rest, as numpy's)
+            f = e.b.fsub(e.const(f), s.bearing[ji], flags=FLAGS)
         e.store(f, rows["joint_friction"], ji)
         e.store(e.neg(e.mul(f, s.qd[ji])), rows["joint_loss"], ji)
 
