@@ -192,7 +192,7 @@ def test_redundant_world_block_by_kkt_and_by_basis():
 
 def test_static_pivots_fall_back_to_pivoting(monkeypatch, tmp_path):
     """With a pivot growth of 1 nearly every sample's basis solve finds a static pivot
-    smaller than an entry below it and takes the pivoting loop code (llvm.world.static_lu):
+    smaller than an entry below it and takes the pivoting loop code (llvm.world.lu_solve):
     that branch too must equal the numpy path."""
     from gearcli.dynamics.llvm import world as llvm_world
     from gearcli.dynamics.external import load_values

@@ -70,7 +70,7 @@ SWAP_POSES = 256
 def _swaps(M: np.ndarray) -> list:
     """Per column c of the matrices M (P, k, k) (rows in the static order): the row below
     c that the generated elimination swaps up where its |entry| is larger than the static
-    pivot's (:func:`.world.static_lu`; -1: none), the row that is largest most often among
+    pivot's (:func:`.world.lu_solve`; -1: none), the row that is largest most often among
     the poses whose static pivot is smaller than an entry below it by more than 10x
     (a pivot row that turns with a gear's angle: its twin row takes over), each pose
     eliminated with the swaps chosen so far."""
@@ -95,7 +95,7 @@ def _swaps(M: np.ndarray) -> list:
 
 def _pivot_order(M: np.ndarray) -> list:
     """The row order partial pivoting takes on the square matrix M (the order the generated
-    kernel eliminates in without pivoting, :func:`.world.static_lu`)."""
+    kernel eliminates in without pivoting, :func:`.world.lu_solve`)."""
     from scipy.linalg import lu_factor                # noqa: PLC0415
 
     order = list(range(M.shape[0]))

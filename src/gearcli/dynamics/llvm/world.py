@@ -4,79 +4,22 @@ As the numpy path (:func:`..blocks.solve_blocks`, a general block): the block's 
 assembled from the column terms of :mod:`.terms` (the pose-dependent wrenches
 :func:`.blocks.term_wrench` emits) for a sign pattern of its t, then solved by
 Gaussian elimination with partial pivoting (the first largest pivot), straight-line: the
-row swaps are selects on the pivot's row.  A zero pivot (a singular matrix) makes the
+row swaps are selects.  A zero pivot (a singular matrix) makes the
 whole solution NaN, which no sign pattern accepts.
 """
 from __future__ import annotations
 
 import llvmlite.ir as ir
 
-from .build import D, I1, I64, Emitter
+from .build import D, I1, Emitter
 from .links import floats
 from .signs import signs_of
 from .solve import loop_solve
 
 
-def _pivot_row(e: Emitter, A, c: int):
-    """The row (i64) of the first largest |A[i][c]|, i >= c (a NaN is never larger)."""
-    best, idx = e.const(e.call("fabs", A[c][c])), ir.Constant(I64, c)
-    for i in range(c + 1, len(A)):
-        if isinstance(A[i][c], float) and A[i][c] == 0.0:
-            continue
-        a = e.const(e.call("fabs", A[i][c]))
-        gt = e.b.fcmp_ordered(">", a, best)
-        best, idx = e.b.select(gt, a, best), e.b.select(gt, ir.Constant(I64, i), idx)
-    return idx
-
-
-def _swap(e: Emitter, A, x, c: int, idx) -> None:
-    """Exchange rows c and idx (i64 >= c) of A (columns >= c) and x, in place."""
-    rows = [i for i in range(c + 1, len(A))]
-    is_row = {i: e.b.icmp_signed("==", idx, ir.Constant(I64, i)) for i in rows}
-    cols = range(c, len(A))
-
-    def pick(values):          # the value of row idx
-        v = e.const(values[c])
-        for i in rows:
-            v = e.b.select(is_row[i], e.const(values[i]), v)
-        return v
-    new_c = [pick([A[i][j] for i in range(len(A))]) for j in cols]
-    new_x = pick(x)
-    for i in rows:
-        for j in cols:
-            A[i][j] = e.b.select(is_row[i], e.const(A[c][j]), e.const(A[i][j]))
-        x[i] = e.b.select(is_row[i], e.const(x[c]), e.const(x[i]))
-    A[c][c:] = new_c
-    x[c] = new_x
-
-
-def eliminate(e: Emitter, A: list, r: list) -> list:
-    """x = A^-1 r (A square, a list of rows of values; partial pivoting), NaN if singular."""
-    n = len(r)
-    A = [list(row) for row in A]
-    x = list(r)
-    singular = ir.Constant(I1, 0)
-    for c in range(n):
-        if any(not (isinstance(A[i][c], float) and A[i][c] == 0.0) for i in range(c + 1, n)):
-            _swap(e, A, x, c, _pivot_row(e, A, c))
-        singular = e.b.or_(singular, e.b.fcmp_ordered("==", e.const(A[c][c]), ir.Constant(D, 0.0)))
-        for i in range(c + 1, n):
-            f = e.div(A[i][c], A[c][c])
-            for j in range(c + 1, n):
-                A[i][j] = e.sub(A[i][j], e.mul(f, A[c][j]))
-            x[i] = e.sub(x[i], e.mul(f, x[c]))
-    for c in range(n - 1, -1, -1):
-        s = x[c]
-        for j in range(c + 1, n):
-            s = e.sub(s, e.mul(A[c][j], x[j]))
-        x[c] = e.div(s, A[c][c])
-    nan = ir.Constant(D, float("nan"))
-    return [e.b.select(singular, nan, e.const(v)) for v in x]
-
-
 PIVOT_GROWTH = 100.0
 """A static pivot smaller than the largest entry below it by more than this factor sends
-the sample's solve to the pivoting loop code (:func:`static_lu`).  Measured on servo_joint
+the sample's solve to the pivoting loop code (:func:`lu_solve` with a fixed ``order``).  Measured on servo_joint
 (60,000 random samples, q to +-50 rad; against the numpy path's KKT solve): 4 gives 1.5e-15
 of the sample's largest load but takes the loop code for most samples (18,000 samples/s),
 32 1.1e-14 (75,000), 100 3.1e-14 (244,000), 1e4 1.6e-12 (305,000): a moment row's entries
@@ -86,9 +29,15 @@ poses had a poor static pivot, one of a planet's pair of rows that turns with it
 with them, 1.1e-15 on the same test and the pivoting loop code is rare."""
 
 
+def _zero(v) -> bool:
+    """True for a constant exact 0.0 (a zero of the matrix's structure)."""
+    return isinstance(v, float) and v == 0.0
+
+
 def _swap_rows(e: Emitter, A: list, X: list, c: int, a: int) -> None:
-    """Rows c and a (> c) exchanged (columns >= c of A, and X) where |A[a][c]| > |A[c][c]|."""
-    if isinstance(A[a][c], float) and A[a][c] == 0.0:
+    """Rows c and a (> c) exchanged (columns >= c of A, and X) where |A[a][c]| > |A[c][c]|
+    (a NaN is never larger)."""
+    if _zero(A[a][c]):
         return
     sw = e.b.fcmp_ordered(">", e.const(e.call("fabs", A[a][c])), e.const(e.call("fabs", A[c][c])))
     for M, lo in ((A, c), (X, 0)):
@@ -99,36 +48,37 @@ def _swap_rows(e: Emitter, A: list, X: list, c: int, a: int) -> None:
             M[c][j], M[a][j] = e.b.select(sw, v, u), e.b.select(sw, u, v)
 
 
-def static_lu(e: Emitter, A: list, B: list, order: list, swaps: list):
-    """(X, bad): X = A^-1 B (A (k, k), B (k, m), lists of rows of values) by elimination in
-    the fixed row order ``order`` (partial pivoting's order at the home pose,
-    :func:`.basis._free_columns`), straight-line and without selects, so the zeros
-    of the matrix's structure fold away; ``bad`` (i1) is true when a pivot is smaller than
-    the largest entry below it by more than :data:`PIVOT_GROWTH` (the caller then solves
-    with pivoting) or zero.  ``swaps``: per column a row (in that order) exchanged with the
-    pivot's where its entry is larger (:func:`.basis._swaps`; -1: none), the one
-    pivoting a turning frame needs."""
-    k = len(A)
-    A = [list(A[i]) for i in order]
-    X = [list(B[i]) for i in order]
+def lu_solve(e: Emitter, A: list, B: list, order: list | None = None, swaps: list | None = None):
+    """(X, bad): X = A^-1 B (A (k, k), B (k, m), lists of rows of values) by straight-line
+    elimination, ``bad`` (i1) true for a zero pivot (a singular matrix).
+
+    Without ``order``: partial pivoting (the first largest pivot), each row below swapped
+    up in turn where its entry is larger (selects, :func:`_swap_rows`).  With ``order``:
+    elimination in that fixed row order (partial pivoting's order at the home pose,
+    :func:`.basis._free_columns`), without selects but the one row per column of ``swaps``
+    (:func:`.basis._swaps`; -1: none), the one pivoting a turning frame needs, so the zeros
+    of the matrix's structure fold away; ``bad`` is then also true when a pivot is smaller
+    than the largest entry below it by more than :data:`PIVOT_GROWTH` (the caller then
+    solves with pivoting)."""
+    k, static = len(A), order is not None
+    A = [list(A[i]) for i in (order if static else range(k))]
+    X = [list(B[i]) for i in (order if static else range(k))]
     bad = ir.Constant(I1, 0)
     inv = [1.0] * k                  # 1 / pivot: a product per row, not a division (latency)
     for c in range(k):
-        if swaps[c] >= 0:
-            _swap_rows(e, A, X, c, int(swaps[c]))
+        for a in ([swaps[c]] if swaps[c] >= 0 else []) if static else range(c + 1, k):
+            _swap_rows(e, A, X, c, a)
         piv = A[c][c]
-        below = [A[i][c] for i in range(c + 1, k) if not (isinstance(A[i][c], float) and A[i][c] == 0.0)]
-        if isinstance(piv, float):
-            if piv == 0.0:
-                return X, ir.Constant(I1, 1)
-        else:
+        if _zero(piv):
+            return X, ir.Constant(I1, 1)
+        if not isinstance(piv, float):
             a = e.call("fabs", piv)
             bad = e.b.or_(bad, e.b.fcmp_ordered("==", a, ir.Constant(D, 0.0)))
-            for v in below:
+            for v in (A[i][c] for i in range(c + 1, k) if static and not _zero(A[i][c])):
                 bad = e.b.or_(bad, e.b.fcmp_ordered(">", e.const(e.call("fabs", v)), e.const(e.mul(PIVOT_GROWTH, a))))
         inv[c] = e.div(1.0, piv)
         for i in range(c + 1, k):
-            if isinstance(A[i][c], float) and A[i][c] == 0.0:
+            if _zero(A[i][c]):
                 continue
             f = e.mul(A[i][c], inv[c])
             for j in range(c + 1, k):
@@ -141,6 +91,13 @@ def static_lu(e: Emitter, A: list, B: list, order: list, swaps: list):
                 v = e.sub(v, e.mul(A[c][j], X[j][h]))
             X[c][h] = e.mul(v, inv[c])
     return X, bad
+
+
+def eliminate(e: Emitter, A: list, r: list) -> list:
+    """x = A^-1 r (A square, a list of rows of values; partial pivoting), NaN if singular."""
+    X, singular = lu_solve(e, A, [[v] for v in r])
+    nan = ir.Constant(D, float("nan"))
+    return [e.b.select(singular, nan, e.const(row[0])) for row in X]
 
 
 class WorldBlock:
@@ -174,7 +131,7 @@ class WorldBlock:
 
     def _by_basis(self, e: Emitter, A: list, r: list) -> list:
         """The least-load solution through the basis A_B (every column but the d ``free``):
-        [p | Q] = A_B^-1 [r | A_free] (:func:`static_lu` in the stored row order, or the
+        [p | Q] = A_B^-1 [r | A_free] (:func:`lu_solve` in the stored row order, or the
         pivoting loop code of :mod:`.solve` when a static pivot is poor), then the free unknowns from
         (Q^T W_B Q + W_free) x_free = Q^T W_B p (d x d, :func:`eliminate`) and x_B = p - Q x_free:
         the minimiser of sum w x^2 over the solutions of A x = r."""
@@ -183,7 +140,7 @@ class WorldBlock:
         m = 1 + len(free)
         AB = [[A[i][j] for j in basis] for i in range(k)]
         RHS = [[r[i]] + [A[i][j] for j in free] for i in range(k)]
-        fast, bad = static_lu(e, AB, RHS, order, swaps)
+        fast, bad = lu_solve(e, AB, RHS, order, swaps)
         fn = self.fn
         slow, done = fn.append_basic_block("basis_pivot"), fn.append_basic_block("basis_done")
         pre = e.b.block
