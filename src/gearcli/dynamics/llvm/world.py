@@ -107,8 +107,8 @@ class WorldBlock:
     set with more unknowns n than its 6B equations, ``weights`` the load-sharing weights of
     :func:`..sharing.mesh_weights`) is solved through a square basis (``free``: the columns
     left out, :func:`.basis._free_columns`; :meth:`_by_basis`), or where none was
-    found from the KKT system of :func:`..sharing.kkt` (the same matrix, D scaled by the
-    sample's largest |A| entry), each with the loop code of :mod:`.solve`, the
+    found from the KKT system of :func:`..sharing.kkt` (:meth:`_least_load`), each with
+    the loop code of :mod:`.solve`, the
     matrices in stack arrays of the ``fn`` ``run``.
 
     ``full_trial``: a trial solves the whole block (:func:`.signs.resolve` keeps
@@ -183,23 +183,15 @@ class WorldBlock:
         return self._least_load(e, A, r)
 
     def _least_load(self, e: Emitter, A: list, r: list) -> list:
-        """The minimiser of sum w x^2 subject to A x = r (:func:`..sharing.least_load_solve`)."""
+        """The minimiser of sum w x^2 subject to A x = r (:func:`..sharing.least_load_solve`)
+        from its KKT system with D unscaled: the minimiser does not depend on D's scale, and
+        the one numpy applies (the largest |A| entry) is of order 1 for unit directions and
+        levers of metres."""
         nr, n = len(A), self.n
         size = n + nr
-        scale = 0.0                           # max |A|, NaN-free as numpy's max is not: NaN fails anyway
-        for row in A:
-            for v in row:
-                a = e.call("fabs", v)
-                if isinstance(a, float):
-                    scale = max(scale, a) if isinstance(scale, float) else e.b.select(
-                        e.b.fcmp_ordered(">", e.const(a), scale), e.const(a), scale)
-                elif isinstance(scale, float) and scale == 0.0:
-                    scale = a
-                else:
-                    scale = e.b.select(e.b.fcmp_unordered(">", a, e.const(scale)), a, e.const(scale))
         K = [[0.0] * size for _ in range(size)]       # the KKT matrix of sharing.kkt
         for i in range(n):
-            K[i][i] = e.mul(scale, float(self.weights[i]))
+            K[i][i] = float(self.weights[i])
             for a in range(nr):
                 K[i][n + a], K[n + a][i] = A[a][i], A[a][i]
         x = loop_solve(e, self._stack(e, (size * size, size)), K, [[0.0]] * n + [[v] for v in r])
