@@ -12,9 +12,9 @@ from gearcli.dynamics.llvm.jobs import job_ranges, run_parts
 
 
 def _recording(log: list):
-    def task(s, e, state):
+    def task(s, e):
         time.sleep(0.002)               # releases the GIL: the other threads take parts meanwhile
-        log.append((s, e, threading.get_ident(), id(state)))
+        log.append((s, e, threading.get_ident()))
         return e - s
     return task
 
@@ -23,12 +23,9 @@ def _recording(log: list):
 def test_every_part_once_and_the_sum(threads):
     log: list = []
     ranges = job_ranges(40_000, threads)
-    assert run_parts(_recording(log), ranges, threads, local=object) == 40_000
-    assert sorted((s, e) for s, e, _, _ in log) == ranges
-    per_thread = {}
-    for _, _, ident, state in log:
-        per_thread.setdefault(ident, set()).add(state)
-    assert all(len(states) == 1 for states in per_thread.values())      # local() once a thread
+    assert run_parts(_recording(log), ranges, threads) == 40_000
+    assert sorted((s, e) for s, e, _ in log) == ranges
+    per_thread = {ident for _, _, ident in log}
     assert threading.get_ident() in per_thread                        # the caller works too
     if threads > 1:
         assert len(per_thread) > 1
@@ -44,26 +41,26 @@ def test_the_pool_threads_persist():
     for _ in range(3):
         log: list = []
         run_parts(_recording(log), job_ranges(40_000, 2), 2)
-        used = {ident for _, _, ident, _ in log} - {threading.get_ident()}
+        used = {ident for _, _, ident in log} - {threading.get_ident()}
         assert used and used <= before
     assert _workers() == before
 
 
 def test_an_error_in_a_part_is_raised():
-    def task(s, e, _):
+    def task(s, e):
         time.sleep(0.001)
         if s >= 20_000:
             raise RuntimeError(f"part {s}")
         return 1
     with pytest.raises(RuntimeError, match="part"):
         run_parts(task, job_ranges(40_000, 2), 2)
-    assert run_parts(lambda s, e, _: 1, job_ranges(40_000, 2), 2) == len(job_ranges(40_000, 2))
+    assert run_parts(lambda s, e: 1, job_ranges(40_000, 2), 2) == len(job_ranges(40_000, 2))
 
 
 def _threads_used(_=None) -> int:
     log: list = []
     run_parts(_recording(log), job_ranges(40_000, 2), 2)
-    return len({ident for _, _, ident, _ in log})
+    return len({ident for _, _, ident in log})
 
 
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="no fork here")

@@ -259,7 +259,7 @@ class LlvmKernel:
         keep += [out[k] if out[k].size else none for k in OUTPUTS] + [SG]
         keep += [out[k] if out.get(k) is not None and out[k].size else none for k in LOSS_OUTPUTS] + [moments, fail]
         ptrs = [a.ctypes.data for a in keep]
-        failed = run_parts(lambda s, e, _: self._run(*ptrs, s, e), job_ranges(n, jobs), threads_for(n, jobs))
+        failed = run_parts(lambda s, e: self._run(*ptrs, s, e), job_ranges(n, jobs), threads_for(n, jobs))
         if failed:                    # a block's sign search, else a bearing fixed point (.bearings)
             nb = len(self.prog.blocks)
             if np.any((fail >= 0) & (fail < nb)):

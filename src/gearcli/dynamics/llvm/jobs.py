@@ -79,27 +79,24 @@ if hasattr(os, "register_at_fork"):
     os.register_at_fork(after_in_child=_forget_pool)
 
 
-def run_parts(task, ranges: list, threads: int, local=lambda: None) -> int:
-    """Run ``task(start, stop, state)`` over every range on ``threads`` threads; the sum
-    of what the calls return.
+def run_parts(task, ranges: list, threads: int) -> int:
+    """Run ``task(start, stop)`` over every range on ``threads`` threads; the sum of what
+    the calls return.
 
     The calling thread and ``threads - 1`` workers of the persistent pool take the next
-    range not yet taken until none is left (a thread slowed by a busy core takes fewer);
-    each calls ``local()`` once for its ``state`` (per-thread work arrays).  ``task`` must
-    release the GIL for the threads to run in parallel (a compiled kernel does).
+    range not yet taken until none is left (a thread slowed by a busy core takes fewer).
+    ``task`` must release the GIL for the threads to run in parallel (a compiled kernel does).
     """
     if threads <= 1 or len(ranges) == 1:
-        state = local()
-        return sum(task(s, e, state) for s, e in ranges)
+        return sum(task(s, e) for s, e in ranges)
     taken = itertools.count()            # next() on it is atomic (the GIL)
 
     def take() -> int:
-        state, total = None, 0
+        total = 0
         for i in taken:
             if i >= len(ranges):
                 return total
-            state = local() if state is None else state
-            total += task(*ranges[i], state)
+            total += task(*ranges[i])
 
     pool = _pool(threads - 1)
     futures = [pool.submit(take) for _ in range(threads - 1)]

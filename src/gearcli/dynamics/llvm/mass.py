@@ -119,5 +119,5 @@ class MassKernel(LlvmKernel):
         out = M, h, qdd = np.empty((n, dof, dof)), np.empty((n, dof)), np.empty((n, dof))
         keep = [np.ascontiguousarray(v, float) for v in (q, qd, rhs)] + self.load_args(an, values, n) + list(out)
         ptrs = [v.ctypes.data for v in keep]
-        bad = run_parts(lambda s, e, _: self._run(*ptrs, s, e), job_ranges(n, jobs), threads_for(n, jobs))
+        bad = run_parts(lambda s, e: self._run(*ptrs, s, e), job_ranges(n, jobs), threads_for(n, jobs))
         return None if bad else out
