@@ -2,6 +2,8 @@
 :func:`analyse`: the graph analysis followed by that check (what every command needs)."""
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 from threadpoolctl import threadpool_limits
 
@@ -45,28 +47,15 @@ def block_unknowns(an) -> list[list]:
     return owned
 
 
-def _block_matrix(cols: Columns, blk: tuple, groups: list) -> np.ndarray:
-    """(6 len(blk), n) matrix of a block's equations in its own unknowns (world frame)."""
-    return assemble(cols, groups, blk)[0]
-
-
-class _Configurations:
+def _configurations(an):
     """The equation columns at the home configuration and at a random one (seed 0), in that
-    order, each computed when first asked for: most mechanisms are checked at home alone
-    (and then numpy.random is not even imported)."""
-
-    def __init__(self, an):
-        self.an, self._cols = an, {}
-
-    def __getitem__(self, i: int) -> Columns:
-        if i not in self._cols:
-            an = self.an
-            q = np.zeros((1, an.dof)) if i == 0 else np.random.default_rng(0).uniform(-np.pi, np.pi, (1, an.dof))
-            self._cols[i] = Columns(an, forward(an.mech, an.tree, (q @ an.S.T).reshape(1, len(an.mech.joints))))
-        return self._cols[i]
-
-    def __iter__(self):
-        return (self[i] for i in range(2))
+    order, each computed when first asked for (iterate ``map(cols, range(2))``): most
+    mechanisms are checked at home alone (and then numpy.random is not even imported)."""
+    @lru_cache(maxsize=None)
+    def cols(i: int) -> Columns:
+        q = np.zeros((1, an.dof)) if i == 0 else np.random.default_rng(0).uniform(-np.pi, np.pi, (1, an.dof))
+        return Columns(an, forward(an.mech, an.tree, (q @ an.S.T).reshape(1, len(an.mech.joints))))
+    return cols
 
 
 def check_determinate(an, col: Collector) -> None:
@@ -79,7 +68,7 @@ def check_determinate(an, col: Collector) -> None:
     a zero lever arm or a motor whose axis carries no load; this can.
     """
     owned = block_unknowns(an)
-    cols = _Configurations(an)
+    cols = _configurations(an)
     rank, total = 0, 0
     for blk, groups in zip(an.schedule, owned):
         n = sum(g.size for g in groups)
@@ -88,8 +77,8 @@ def check_determinate(an, col: Collector) -> None:
             rank, total = rank + 6 * len(blk), total + 6 * len(blk)
             continue
         best = 0
-        for c in cols:
-            A = _block_matrix(c, blk, groups)
+        for c in map(cols, range(2)):
+            A = assemble(c, groups, blk)[0]                 # (6B, n), world frame
             best = max(best, numerical_rank(np.linalg.svd(A, compute_uv=False)) if A.shape[0] == n else min(A.shape))
             if best == n == A.shape[0]:
                 break
@@ -99,12 +88,12 @@ def check_determinate(an, col: Collector) -> None:
                 f"singular (rank {rank} of {total}); check the gear geometry and the motors")
 
 
-def _check_sharing(an, cols: _Configurations, blk: tuple, groups: list, col: Collector) -> None:
+def _check_sharing(an, cols, blk: tuple, groups: list, col: Collector) -> None:
     """A redundant block: its equations must be independent (full row rank) and every
     redundancy must change some tooth force, else the mesh-stiffness model cannot share it."""
     w = mesh_weights(an, groups)
     names = ", ".join(f"'{an.tree.links[x]}'" for x in blk)
-    found = [null_directions_without_t(_block_matrix(c, blk, groups), w) for c in cols]
+    found = [null_directions_without_t(assemble(c, groups, blk)[0], w) for c in map(cols, range(2))]
     if all(r < 6 * len(blk) for r, _ in found):
         col.add("", f"the loads are statically indeterminate: the equations of links {names} are "
                 "singular; check the gear geometry and the motors")
