@@ -108,13 +108,14 @@ class Columns:
             cols = [_force_at(E[:, :, i], oj, o) for i in range(3)] + [_moment(E[:, :, 0]), _moment(E[:, :, 1])]
         return sign * np.stack(cols, axis=2)
 
-    def axial(self, ji: int, L: int) -> np.ndarray:
+    def axial(self, ji: int, L: int, sign: float | None = None) -> np.ndarray:
         """(N, 6) wrench on link L of a unit generalised force of joint ``ji``: about its axis
         (revolute) or along it through the joint origin (prismatic), on the child, reversed
-        on the parent; zero on any other link."""
+        on the parent, zero on any other link (``sign``: +-1 on L instead, a motor's)."""
         an, kin = self.an, self.kin
         jt = an.mech.joints[ji]
-        sign = float(an.tree.index[jt.child] == L) - float(an.tree.index[jt.parent] == L)
+        if sign is None:
+            sign = float(an.tree.index[jt.child] == L) - float(an.tree.index[jt.parent] == L)
         z = kin.Rj[ji][:, :, 2]
         if jt.type == "prismatic":
             return sign * _force_at(z, kin.oj[ji], kin.o[L])
@@ -122,18 +123,11 @@ class Columns:
 
     def motor(self, mi: int, L: int) -> np.ndarray:
         """(N, 6, 1) column of motor ``mi``'s torque on link L: about the input link's joint axis on the input link, reversed on the stator (a transmission motor: its joints' generalised forces)."""
-        an, kin = self.an, self.kin
+        an = self.an
         if an.motor_joints and an.motor_joints[mi] is not None:
             return sum(coef * self.axial(ji, L) for ji, coef in an.motor_joints[mi])[:, :, None]
         x = an.motor_links[mi]
-        ji = an.tree.parent_joint[x]
-        z = kin.Rj[ji][:, :, 2]
-        sign = 1.0 if L == x else -1.0
-        if an.mech.joints[ji].type == "prismatic":
-            col = _force_at(z, kin.oj[ji], kin.o[L])
-        else:
-            col = _moment(z)
-        return sign * col[:, :, None]
+        return self.axial(an.tree.parent_joint[x], L, 1.0 if L == x else -1.0)[:, :, None]
 
     def mesh_friction(self, ci: int, L: int) -> np.ndarray | None:
         """(N, 6, 1) friction couple of geared mesh ``ci`` on link L per unit of sigma s_v t

@@ -32,11 +32,12 @@ def _joint_frame(jt):
     return E, -E @ np.asarray(jt.p_jc, float)
 
 
-def _axial(an, ji, L, coef):
+def _axial(an, ji, L, coef, sign=None):
     """Terms of a unit generalised force of joint ji on link L (see Columns.axial)."""
     jt = an.mech.joints[ji]
     idx = an.tree.index
-    sign = float(idx[jt.child] == L) - float(idx[jt.parent] == L)
+    if sign is None:
+        sign = float(idx[jt.child] == L) - float(idx[jt.parent] == L)
     if not sign:
         return []
     E, p = _joint_frame(jt)
@@ -61,11 +62,7 @@ def _motor(an, mi, L):
     if an.motor_joints and an.motor_joints[mi] is not None:
         return [[t for ji, coef in an.motor_joints[mi] for t in _axial(an, ji, L, coef)]]
     x = an.motor_links[mi]
-    ji = an.tree.parent_joint[x]
-    jt = an.mech.joints[ji]
-    E, p = _joint_frame(jt)
-    kind = 0 if jt.type == "prismatic" else 1
-    return [[(kind, x, -1, 1.0 if L == x else -1.0, E[:, 2], p)]]
+    return [_axial(an, an.tree.parent_joint[x], L, 1.0, 1.0 if L == x else -1.0)]
 
 
 def _mesh(an, ci, L, t_pos):
