@@ -220,12 +220,7 @@ class LlvmKernel:
 
     def load_args(self, an, values: dict, n: int) -> list:
         """The external loads' arguments of the code (vals, ldpt, ldrow, ldgrp), contiguous."""
-        ld, ldpt, vals = load_arrays(an, values, n)
-        order = self._load_order      # ldrow, as the code reads it: [row0, per_sample, in_link] a load
-        ldrow = np.ascontiguousarray(np.column_stack([ld.row0, ld.per_sample, ld.in_link])[order] if order
-                                     else np.zeros((1, 3), np.int64))
-        ldpt = np.ascontiguousarray(ldpt[order] if order else np.zeros((1, 3)))
-        return [np.ascontiguousarray(vals, float), ldpt, ldrow, self._load_groups]
+        return load_arrays(an, values, n, self._load_order) + [self._load_groups]
 
     def solve(self, an, q, qd, qdd, values: dict, jobs: int | None, chunk: int, out: dict, work: tuple,
               losses: dict | None = None) -> dict:

@@ -27,7 +27,7 @@ from .basis import basis as _basis
 from .output_maps import output_constants
 from ..pattern_maps import hot_patterns, low_rank
 from ..sharing import SharingError, mesh_weights
-from .records import BLOCK, BODY, CHILD_BASIS, JOINT, LOAD, POSE, PROPAGATION, records
+from .records import BLOCK, BODY, CHILD_BASIS, JOINT, POSE, PROPAGATION, records
 from .terms import general_terms, local_inverse
 from .loss_program import build_loss_program
 
@@ -108,21 +108,22 @@ def _bodies(an):
     return out
 
 
-def load_arrays(an, values: dict, n: int):
-    """The loads of ``an`` for n samples: LOAD records, the load points (nloads, 3; link
-    frame, m) and the stacked values: one row (constant) or n rows per load."""
-    rec, pts, rows = [], [], []
-    off = 0
+def load_arrays(an, values: dict, n: int, order: list) -> list:
+    """The external loads' arguments of the kernel for n samples (vals, ldpt, ldrow),
+    contiguous: the stacked values (one row (constant) or n rows per load) and, per load in
+    ``order`` (:func:`.links.load_groups`), its point (link frame, m) and [its first row in
+    the values, 1 if one row a sample, 1 if in link axes] (a row of zeros without loads)."""
+    rows, rec, pts, off = [], [], [], 0
     for ld in an.mech.loads:
         w = values[ld.name]
         per = int(w.strides[0] != 0 and n > 1)
-        w = np.ascontiguousarray(w if per else w[:1], float)
-        rec.append((an.tree.index[ld.link], int(ld.frame == "link"), off, per))
+        rows.append(np.ascontiguousarray(w if per else w[:1], float))
+        rec.append((off, per, int(ld.frame == "link")))
         pts.append(np.asarray(ld.point, float))
-        rows.append(w)
-        off += w.shape[0]
+        off += rows[-1].shape[0]
     vals = (rows[0] if len(rows) == 1 else np.concatenate(rows)) if rows else np.zeros((1, 6))  # no copy of one
-    return records(rec, LOAD), np.array(pts, float).reshape(-1, 3), vals
+    return [vals, np.array([pts[k] for k in order] or [np.zeros(3)], float),
+            np.array([rec[k] for k in order] or [(0, 0, 0)], np.int64)]
 
 
 class _Builder:
@@ -131,23 +132,21 @@ class _Builder:
     def __init__(self):
         self.brec, self.blinks, self.gcol, self.tcol, self.scol = [], [], [], [], []
         self.ainv, self.prec, self.cmat, self.later, self.cbrec, self.turns = [], [], [], [], [], []
-        self.ainv_len = self.cmat_len = 0
 
-    def add_floats(self, attr: str, arr) -> int:
-        arr = np.ascontiguousarray(arr, float).ravel()
-        off = getattr(self, attr + "_len")
-        getattr(self, attr).append(arr)
-        setattr(self, attr + "_len", off + arr.size)
-        return off
+    @staticmethod
+    def add_floats(parts: list, arr) -> int:
+        """Append ``arr`` (flat floats) to ``parts``; its offset in their concatenation."""
+        parts.append(np.ascontiguousarray(arr, float).ravel())
+        return sum(a.size for a in parts[:-1])
 
     def propagation(self, an, p, gi, g, later, first: int) -> bool:
         """Append group gi's propagation record (False: merged into the previous one)."""
         Cp, Cs = p.C[gi]
         if Cs is None and self._merge(int(p.offs[gi]), g.size, _primary_side(an, g), later, Cp, first):
             return False
-        off = self.add_floats("cmat", Cp)
+        off = self.add_floats(self.cmat, Cp)
         if Cs is not None:
-            self.add_floats("cmat", Cs)
+            self.add_floats(self.cmat, Cs)
         self.prec.append(dict(col0=int(p.offs[gi]), ncols=g.size, signed=int(Cs is not None), cmat0=off,
                               primary=_primary_side(an, g), later0=len(self.later), nlater=len(later)))
         self.later += later
@@ -164,8 +163,7 @@ class _Builder:
                 or self.later[last["later0"]:last["later0"] + last["nlater"]] != later):
             return False
         prev = self.cmat.pop().reshape(6, last["ncols"])
-        self.cmat_len -= prev.size
-        last["cmat0"] = self.add_floats("cmat", np.hstack([prev, np.asarray(Cp, float).reshape(6, size)]))
+        last["cmat0"] = self.add_floats(self.cmat, np.hstack([prev, np.asarray(Cp, float).reshape(6, size)]))
         last["ncols"] += size
         return True
 
@@ -175,7 +173,7 @@ def _block(bd: _Builder, an, bi, p, offsets, sigcol, terms, lowrank):
     n = int(p.offs[-1])
     term0, nterm = terms.get(bi, (0, 0))
     rec = dict(F=-1 if p.F is None else p.F, link0=len(bd.blinks), nlinks=len(p.links), n=n, col0=len(bd.gcol),
-               m=len(p.signed), t0=len(bd.tcol), ainv0=bd.ainv_len, prop0=len(bd.prec), nprop=0,
+               m=len(p.signed), t0=len(bd.tcol), ainv0=sum(a.size for a in bd.ainv), prop0=len(bd.prec), nprop=0,
                cb0=len(bd.cbrec), ncb=0, term0=term0, nterm=nterm)
     bd.blinks += list(p.links)
     for g in p.groups:
@@ -187,7 +185,7 @@ def _block(bd: _Builder, an, bi, p, offsets, sigcol, terms, lowrank):
         rec["ainv0"] = -1                  # solved from its pattern_maps.LowRank (program.lowrank)
     else:
         for A in p.Ainv:
-            bd.add_floats("ainv", A)
+            bd.add_floats(bd.ainv, A)
     for gi, g in enumerate(p.groups):
         later = p.later[gi]
         if later and p.F is not None and bd.propagation(an, p, gi, g, later, rec["prop0"]):
@@ -209,7 +207,7 @@ def _local_frame(bd: _Builder, terms, values, p) -> None:
     rec = bd.brec[-1]
     Ainv = local_inverse(terms, values, rec["term0"], rec["nterm"], p.links[0], rec["n"])
     if Ainv is not None:
-        rec["F"], rec["ainv0"] = p.links[0], bd.add_floats("ainv", Ainv)
+        rec["F"], rec["ainv0"] = p.links[0], bd.add_floats(bd.ainv, Ainv)
 
 
 MAX_PATTERNS = 256

@@ -40,9 +40,6 @@ block (-1: a later link, the term propagates), block column, 1 for a moment (0 a
 link X, signed-mesh position in the block (-1: unsigned)."""
 TERM_VALUE = np.dtype([("coef", F), ("d", F, (3,)), ("p", F, (3,))])
 """A term's coefficient, direction d_X and point p_X in its frame link's axes."""
-LOAD = _ints("link", "in_link", "row0", "per_sample")
-"""An external load at run time: its link, 1 if given in link axes, its first row in the
-values array, 1 if one row a sample (else one constant row)."""
 JOINT_OUT = _ints("col0", "prismatic")
 """Where a joint's reaction starts in the solution row, 1 if prismatic."""
 GEAR_OUT = np.dtype([(n, F) for n in ("geometry", "tan_t", "t_rad_j", "sep_rad_j", "t_ax_j", "sep_ax_j",
