@@ -404,6 +404,31 @@ def test_urdf_bad_loss_input(run_cli, tmp_path):
         assert len(lines) == 1 and lines[0].startswith(f"{bad}:") and message in lines[0], lines
 
 
+
+def test_urdf_numbers_with_digit_separators_are_refused(run_cli, mech_dir, tmp_path):
+    """Python's float() reads "0_002" as 2: a URDF's coulomb="0_002" gave 2 N*m of friction,
+    bore="0_01" a 1 m bore and <mass value="0_15"> 15 kg, silently.  They are refused like
+    any other malformed number (file:line, exit 2); ordinary forms (+2.e-3, 1E-2) still read."""
+    good = tmp_path / "servo.urdf"
+    assert run_cli("export", mech_dir / "servo_joint_rated.yaml", "-o", good).exit_code == 0
+    text = good.read_text()
+    for old, new, message in [('coulomb="0.002"', 'coulomb="0_002"', 'coulomb="0_002" is not a finite number'),
+                              ('bore="0.01"', 'bore="0_01"', "bore must be a finite number, got '0_01'"),
+                              ('<mass value="0.15"/>', '<mass value="0_15"/>', 'mass "0_15" is not a finite number')]:
+        assert old in text
+        bad = tmp_path / "bad.urdf"
+        bad.write_text(text.replace(old, new, 1))
+        line = next(i for i, ln in enumerate(bad.read_text().splitlines(), 1) if new in ln)
+        res = run_cli("check", bad)
+        assert res.exit_code == 2 and res.stdout == "", new
+        lines = res.stderr.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith(f"{bad}:{line}: ") and message in lines[0], lines
+    ok = tmp_path / "ok.urdf"
+    ok.write_text(text.replace('coulomb="0.002"', 'coulomb="+2.e-3"', 1).replace('bore="0.01"', 'bore="1E-2"', 1))
+    a, b = load_mechanism(good), load_mechanism(ok)
+    assert [(j.friction, j.bearings) for j in a.joints] == [(j.friction, j.bearings) for j in b.joints]
+
+
 SHAFT = """
 name: shaft_hand
 gravity: [0, 0, 0]

@@ -190,6 +190,8 @@ def _urdf_spec(el, keys, required, path: str, add) -> dict | None:
     kept as strings, ``locating`` as a boolean; None (with issues) when one is bad."""
     from lxml import etree  # noqa: PLC0415  (URDF only: YAML mechanisms do not import lxml)
 
+    from .urdf_xml import decimal_numbers  # noqa: PLC0415  (likewise)
+
     spec: dict = {}
     ok = True
     for attr, text in el.attrib.items():
@@ -211,7 +213,7 @@ def _urdf_spec(el, keys, required, path: str, add) -> dict | None:
             spec[key] = text == "true"
         else:
             try:
-                spec[key] = float(text)
+                (spec[key],) = decimal_numbers(text)   # not float(): "0_02" is not 2
             except ValueError:
                 spec[key] = math.nan
             if not math.isfinite(spec[key]):
@@ -233,7 +235,7 @@ def _urdf_limit(el, path: str, warn, add) -> JointLimit | None:
     lim = el.find("limit")
     if lim is None:
         return None
-    from .urdf_xml import placeholders  # noqa: PLC0415  (URDF only: YAML mechanisms do not import lxml)
+    from .urdf_xml import decimal_numbers, placeholders  # noqa: PLC0415  (URDF only: YAML mechanisms do not import lxml)
 
     vals = {}
     stand_in = placeholders(lim)
@@ -241,7 +243,7 @@ def _urdf_limit(el, path: str, warn, add) -> JointLimit | None:
         text, v = (None if key in stand_in else lim.get(key)), None
         if text is not None:
             try:
-                v = float(text)
+                (v,) = decimal_numbers(text)
             except ValueError:
                 v = None
             why = None if v is None else number_problem(v)

@@ -78,13 +78,27 @@ def parse_xml(data: bytes, file: str):
     return root
 
 
+# A number as XML Schema's xs:double writes it (ASCII digits, no digit separators; inf and nan
+# are read, for the callers to refuse as not finite): float() would also take "0_05" (as 5).
+_DECIMAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|[+-]?(?:inf|infinity|nan)", re.I)
+
+
+def decimal_numbers(text: str) -> list[float]:
+    """The whitespace-separated numbers of ``text`` (decimal, inf, nan); ValueError for any other token."""
+    words = text.split()
+    if not all(_DECIMAL.fullmatch(w) for w in words):
+        raise ValueError(text)
+    return [float(w) for w in words]
+
+
 def floats(text: str | None, n: int | None = None) -> np.ndarray | None:
-    """Whitespace-separated numbers, or None if malformed, the wrong count, not finite or
-    beyond :data:`~gearcli.model.validate.MAX_ABS` (:func:`range_problem` tells)."""
+    """Whitespace-separated decimal numbers, or None if malformed (``0_05``, ``0,5``), the
+    wrong count, not finite or beyond :data:`~gearcli.model.validate.MAX_ABS`
+    (:func:`range_problem` tells)."""
     if text is None:
         return None
     try:
-        v = np.array([float(x) for x in text.split()], float)
+        v = np.array(decimal_numbers(text), float)
     except ValueError:
         return None
     if (n is not None and v.size != n) or not np.all(np.isfinite(v)) or np.any(np.abs(v) > MAX_ABS):
@@ -95,7 +109,7 @@ def floats(text: str | None, n: int | None = None) -> np.ndarray | None:
 def range_problem(text: str | None) -> str | None:
     """Why a finite number in ``text`` is out of range, or None."""
     try:
-        values = [float(x) for x in (text or "").split()]
+        values = decimal_numbers(text or "")
     except ValueError:
         return None
     return next((number_problem(v) for v in values if np.isfinite(v) and number_problem(v)), None)
