@@ -186,6 +186,17 @@ def test_help_names_the_losses_and_their_units(run_cli):
     check = " ".join(run_cli("check", "--help").stdout.split())
     assert "losses (mesh efficiency in (0, 1], friction >= 0)" in check
     assert "lossy gear pair (efficiency, friction arm in m)" in check
+    simulate = " ".join(run_cli("simulate", "--help").stdout.split())
+    for text in ("losses included (its energy falls by them;", "gear:<pair>:loss, joint:<joint>:loss in W",
+                 "joint:<joint>:friction)"):
+        assert text in simulate, text
+    export = " ".join(run_cli("export", "--help").stdout.split())
+    for text in ("gearcli:gear efficiency or loss_factor", "gearcli:friction coulomb viscous",
+                 "gearcli:bearing friction_coefficient bore in m"):
+        assert text in export, text
+    verify = " ".join(run_cli("verify", "--help").stdout.split())
+    assert "with the motor torques of 'gearcli solve' (losses included: mesh efficiency, joint and bearing friction)" \
+        in verify
 
 
 def test_bearing_friction_on_a_slide_points_to_joint_friction(run_cli, mech_dir, tmp_path):

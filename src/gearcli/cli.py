@@ -50,10 +50,7 @@ app = _App(
     name="gearcli",
     help="Dynamics of geared robotic mechanisms: canonical graph, structure matrix, motor "
          "torques, bearing loads and gear tooth forces.  SI units: m, kg, kg*m^2, rad, N, N*m.",
-    no_args_is_help=True,
-    add_completion=False,
-    rich_markup_mode=None,
-    pretty_exceptions_show_locals=False,
+    no_args_is_help=True, add_completion=False, rich_markup_mode=None, pretty_exceptions_show_locals=False,
 )
 
 MECH_HELP = ("Mechanism file: YAML (schemas/mechanism.schema.json) or URDF (.urdf, .xml).  Lengths in m, "
@@ -276,7 +273,8 @@ def simulate(
     method: str = typer.Option("RK45", "--method", metavar="NAME", help="solve_ivp: RK45, DOP853, RK23, Radau, BDF, LSODA."),
     loads: str = typer.Option(None, "--loads", metavar="LOADS.csv", help="Also write the loads, as 'gearcli solve'."),
 ) -> None:
-    """Integrate the exact geared dynamics under motor torques or voltages; a joint limit stops it (exit 1)."""
+    """Integrate the exact geared dynamics under motor torques or voltages, losses included (its energy falls by them;
+    --loads has gear:<pair>:loss, joint:<joint>:loss in W, joint:<joint>:friction); a joint limit stops it (exit 1)."""
     from .simulation import simulate_with_progress  # noqa: PLC0415
     report = simulate_with_progress(mech, drive, output, stderr_console(), load_analysis(mech), t_end, q0, qd0, dt, rtol, atol, method, loads)
     if report.simulation.stop:
@@ -296,9 +294,9 @@ def export(
                                     "'-' for stdout)."),
     strict: bool = STRICT_OPTION,
 ) -> None:
-    """Write a URDF of the mechanism: links with inertials, the joint tree, geared joints as
-    <mimic> where a single leader exists, motors as <transmission>, and the full gear
-    geometry in gearcli extension elements (namespace https://gearcli.dev/urdf/1)."""
+    """Write a URDF of the mechanism: links with inertials, the joint tree, geared joints as <mimic> where a single
+    leader exists, motors as <transmission>, the gear geometry and losses (gearcli:gear efficiency or loss_factor,
+    gearcli:friction coulomb viscous, gearcli:bearing friction_coefficient bore in m) in gearcli extension elements."""
     from .report.urdf_writer import export_urdf, urdf_target  # noqa: PLC0415
 
     urdf_target(output, (mech,))   # refuse a bad -o (also one not named .urdf/.xml) before any work
@@ -332,10 +330,10 @@ def verify(
                              "cluster (scheduler address, e.g. tcp://host:8786)."),
     strict: bool = STRICT_OPTION,
 ) -> None:
-    """Check motors (peak/RMS torque, speed, power; servo sizing: inertia ratio, torque-speed
-    envelope, regenerative energy per cycle), bearings (ISO 281 life, static safety,
-    tilting moment), gear teeth (bending and contact stress) and column limits along every
-    trajectory of each case.  Exit 0 when every check passes, 1 when any fails, 2 on bad input."""
+    """Check motors (peak/RMS torque, speed, power; servo sizing: inertia ratio, torque-speed envelope, regenerative
+    energy per cycle), bearings (ISO 281 life, static safety, tilting moment), gear teeth (bending and contact stress)
+    and column limits along every trajectory of each case, with the motor torques of 'gearcli solve' (losses included:
+    mesh efficiency, joint and bearing friction).  Exit 0 when every check passes, 1 when any fails, 2 on bad input."""
     from rich.progress import BarColumn, Progress, TextColumn  # noqa: PLC0415
 
     from .batch.manifest import load_manifest  # noqa: PLC0415
