@@ -411,6 +411,24 @@ def test_urdf_number_out_of_range(run_cli, tmp_path, old, new, place, reason):
     bad(run_cli, tmp_path, text, line_of(text, needle[place]), place, reason, name="n.urdf")
 
 
+@pytest.mark.parametrize("old,new,place,reason", [
+    ('<limit lower="-2.6" upper="2.6"', '<limit lower="-2_6" upper="2.6"', "joint 'elbow'.limit",
+     r'^lower="-2_6" is not a finite number$'),
+    ('<limit lower="-2.6" upper="2.6"', '<limit lower="-2.6" upper="nan"', "joint 'elbow'.limit",
+     r'^upper="nan" is not a finite number$'),
+    ("<mechanicalReduction>50</mechanicalReduction>", "<mechanicalReduction>5_0</mechanicalReduction>",
+     "transmission 'elbow_trans'", r"mechanicalReduction '5_0' is not a number"),
+])
+def test_urdf_numbers_float_would_misread(run_cli, tmp_path, old, new, place, reason):
+    """Python's float() takes "-2_6" as -26 and "5_0" as 50, and a NaN position limit: a
+    joint limit of -26 rad, a reduction of 50 instead of 5, a limit that never stops
+    simulate, all silently (exit 0).  Each is now a located error."""
+    assert ARM.count(old) == 1, old
+    text = ARM.replace(old, new)
+    needle = new.split(">")[0] if "limit" in place else '<transmission name="elbow_trans"'
+    bad(run_cli, tmp_path, text, line_of(text, needle), place, reason, name="n.urdf")
+
+
 def test_urdf_mass_out_of_range(run_cli, tmp_path):
     text = ARM.replace('<mass value=', '<mass value="1e300" was=', 1)
     bad(run_cli, tmp_path, text, line_of(text, 'value="1e300"'), "link 'upper_arm'.inertial",

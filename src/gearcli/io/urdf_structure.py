@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from .urdf_xml import floats as _floats
-from .urdf_xml import range_problem
+from .urdf_xml import placeholders, range_problem
 
 JOINT_TYPES = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic"}
 INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
@@ -71,6 +71,12 @@ class StructureChecks:
         if mimic is not None:
             for attr in ("multiplier", "offset"):
                 self.vector(mimic, attr, f"{path}.mimic", n=1)
+        limit = el.find("limit")
+        if limit is not None:
+            stand_in = placeholders(limit)
+            for attr in ("lower", "upper"):
+                if attr not in stand_in:
+                    self.vector(limit, attr, f"{path}.limit", n=1)
 
     def check_joint_ends(self, el, path: str) -> None:
         """The joint's <parent> and <child> links: known, distinct, one parent joint a link."""

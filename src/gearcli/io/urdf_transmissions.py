@@ -31,6 +31,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..model.validate import number_problem
+from .urdf_xml import decimal_numbers
 
 KINDS = ("SimpleTransmission", "DifferentialTransmission", "WristTransmission")
 
@@ -64,7 +65,7 @@ def _number(text: str | None, what: str, problems: list[str], default: float = 1
     if text is None or not text.strip():
         return default
     try:
-        value = float(text)
+        (value,) = decimal_numbers(text)   # not float(): "1_0" is not 10
     except ValueError:
         problems.append(f"{what} '{text.strip()}' is not a number")
         return default
