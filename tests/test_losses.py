@@ -405,6 +405,27 @@ def test_urdf_bad_loss_input(run_cli, tmp_path):
 
 
 
+@pytest.mark.parametrize("joint, element, message", [
+    ('<joint name="elbow" type="revolute">',
+     '<gearcli:friction coulomb="0.05"/><gearcli:friction coulomb="0.5" viscous="0.01"/>',
+     "joint 'elbow': a second gearcli:friction element: give a joint's coulomb and viscous friction in one"),
+    ('<joint name="tool_mount" type="fixed">', '<gearcli:friction coulomb="0.5"/>',
+     "joint 'tool_mount': gearcli:friction on a fixed joint (its links are merged into one body: nothing turns there)"),
+])
+def test_urdf_friction_element_read_once_on_a_moving_joint(run_cli, mech_dir, tmp_path, joint, element, message):
+    """Two gearcli:friction elements in one joint: the last one was taken, silently; one in a
+    fixed joint was dropped, silently.  Each is a located error."""
+    text = (mech_dir / "geared_arm.urdf").read_text()
+    assert text.count(joint) == 1
+    text = text.replace(joint, f"{joint}\n    {element}")
+    bad = tmp_path / "arm.urdf"
+    bad.write_text(text)
+    line = next(i for i, ln in enumerate(text.splitlines(), 1) if element in ln)
+    res = run_cli("check", bad)
+    assert res.exit_code == 2 and res.stdout == ""
+    assert res.stderr == f"{bad}:{line}: {message}\n"
+
+
 def test_urdf_numbers_with_digit_separators_are_refused(run_cli, mech_dir, tmp_path):
     """Python's float() reads "0_002" as 2: a URDF's coulomb="0_002" gave 2 N*m of friction,
     bore="0_01" a 1 m bore and <mass value="0_15"> 15 kg, silently.  They are refused like

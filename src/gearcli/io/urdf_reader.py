@@ -215,33 +215,19 @@ class _Reader(StructureChecks, Mimics, Extension, UrdfLoads):
         dyn = []
         for name in self.joint_order:
             yj = self.yjoints[name]
-            if yj.type == "fixed":
-                continue
             el = self.joint_el[name]
+            if yj.type == "fixed":
+                for sub in el.iterfind(f"{{{NS}}}friction"):
+                    self.add(f"joint '{name}'", "gearcli:friction on a fixed joint (its links are merged into one "
+                             "body: nothing turns there)", sub)
+                continue
             path = f"joint '{name}'"
             parent, Tp = self.body_of[yj.parent]
             T = Tp @ _transform(yj.origin)
             axis = np.asarray(yj.axis, float)
             axis = axis / np.linalg.norm(axis)
             A = align_z(axis)
-            label = friction = None
-            for sub in el:
-                if not isinstance(sub.tag, str) or etree.QName(sub).namespace != NS:
-                    continue
-                local = etree.QName(sub).localname
-                if local == "joint":
-                    label = sub.get("label")
-                    self.unknown_attrs(sub, ("label",), path)
-                elif local == "bearing":
-                    continue  # read by io.ratings_reader
-                elif local == "friction":
-                    friction = self.joint_friction(sub, path, JOINT_TYPES[yj.type] == "prismatic")
-                elif local != "gear":
-                    self.add(path, f"unknown element gearcli:{local} in a joint (expected gearcli:joint, "
-                             "gearcli:friction or gearcli:gear)", sub)
-                elif el.find("mimic") is None:
-                    self.add(path, "gearcli:gear inside a joint gives the geometry of its <mimic> "
-                             "coupling, but the joint has no <mimic>", sub)
+            label, friction = self.joint_extensions(el, path, JOINT_TYPES[yj.type] == "prismatic")
             source = {"origin": {"xyz": T[:3, 3].tolist(), "rpy": matrix_rpy(T[:3, :3]).tolist()},
                       "axis": axis.tolist(), "urdf_type": yj.type}
             lim, bounds = yj.limit, None
@@ -267,6 +253,32 @@ class _Reader(StructureChecks, Mimics, Extension, UrdfLoads):
             self.add("", "the robot has no movable joints: nothing to analyse", self.root)
         self.movable = {j.name: j for j in joints}
         return joints
+
+    def joint_extensions(self, el, path: str, prismatic: bool):
+        """The (label, friction) of a movable joint's gearcli elements: gearcli:joint and one
+        gearcli:friction; gearcli:bearing is read by io.ratings_reader, gearcli:gear by the gears."""
+        label = friction = None
+        for sub in el:
+            if not isinstance(sub.tag, str) or etree.QName(sub).namespace != NS:
+                continue
+            local = etree.QName(sub).localname
+            if local == "joint":
+                label = sub.get("label")
+                self.unknown_attrs(sub, ("label",), path)
+            elif local == "bearing":
+                continue  # read by io.ratings_reader
+            elif local == "friction" and friction is not None:
+                self.add(path, "a second gearcli:friction element: give a joint's coulomb and viscous "
+                         "friction in one", sub)
+            elif local == "friction":
+                friction = self.joint_friction(sub, path, prismatic)
+            elif local != "gear":
+                self.add(path, f"unknown element gearcli:{local} in a joint (expected gearcli:joint, "
+                         "gearcli:friction or gearcli:gear)", sub)
+            elif el.find("mimic") is None:
+                self.add(path, "gearcli:gear inside a joint gives the geometry of its <mimic> "
+                         "coupling, but the joint has no <mimic>", sub)
+        return label, friction
 
     # -- end effector ------------------------------------------------------------------------------
     def end_effector(self, mech_el) -> tuple[str, str]:
