@@ -528,6 +528,18 @@ def test_bad_bearing_friction_input(run_cli, tmp_path, old, new, place, message)
     assert lines[0].startswith(f"{path}:{_line_of(text, new)}:")
 
 
+def test_three_bearings_are_refused_in_gearclis_words(run_cli, tmp_path):
+    """A third bearing was refused in jsonschema's words, "[{'name': 'near', ...… is too long"."""
+    text = SHAFT.format(z1=0.02, z2=0.06, mu=0.05, d=0.03, ML=-4.0)
+    far = next(ln for ln in text.splitlines() if "{name: far" in ln)
+    text = text.replace(far, far + "\n" + far.replace("far", "third"))
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    res = run_cli("check", path)
+    assert res.exit_code == 2 and res.stdout == ""
+    assert res.stderr == f"{path}:{_line_of(text, 'bearings:')}: joints[1].bearings: a joint has one or two bearings, got 3\n"
+
+
 def _line_of(text: str, fragment: str) -> int:
     return next(i for i, ln in enumerate(text.splitlines(), 1) if fragment in ln)
 

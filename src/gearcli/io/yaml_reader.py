@@ -81,6 +81,8 @@ def schema_messages(err) -> list[tuple[list, str]]:
     if err.validator == "required" and isinstance(err.instance, dict):
         missing = [r for r in err.validator_value if r not in err.instance and repr(r) in err.message]
         return [(path, f"missing required key '{r}'") for r in missing[:1]] or [(path, err.message)]
+    if err.validator == "maxItems" and path and path[-1] == "bearings" and isinstance(err.instance, list):
+        return [(path, f"a joint has one or two bearings, got {len(err.instance)}")]   # as in URDF files
     if err.validator == "oneOf" and err.context:
         branches: dict = {}
         for e in err.context:
