@@ -13,6 +13,8 @@
 """
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -319,6 +321,24 @@ def test_unsettled_forward_dynamics_is_one_line(run_cli, tmp_path, monkeypatch):
     assert r.exit_code == 2
     assert "in.csv: simulation failed: t = 0 s: forward dynamics with losses did not settle" in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and not (tmp_path / "traj.csv").exists()
+
+
+def test_coulomb_friction_that_holds_the_mechanism_stalls_with_one_line(run_cli, tmp_path, monkeypatch):
+    """The pendulum held horizontal by 0.5 N*m of Coulomb friction on its wheel (gravity
+    pulls with 9.81 * 0.03 = 0.294 N*m): with no stiction model the wheel's rate reverses at
+    0 at every step and the integrator's step collapses (0.2 s had not finished after 2
+    minutes).  simulate stops with gearcli's one line naming the time, exit 2, nothing
+    written; the threshold is lowered here to keep the test short."""
+    from gearcli import simulation
+    monkeypatch.setattr(simulation, "STALL_EVALUATIONS", 300)
+    mech = write(tmp_path / "pendulum.yaml", LOSSY_PENDULUM.replace("friction: {viscous: 2.0e-4}",
+                                                                    "friction: {coulomb: 0.5}"))
+    inp = write(tmp_path / "in.csv", "t,motor:motor\n0,0\n0.2,0\n")
+    r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv")
+    assert r.exit_code == 2 and not (tmp_path / "traj.csv").exists()
+    assert re.fullmatch(rf"{re.escape(str(inp))}: simulation stalled at t = [0-9.e-]+ s: 300 evaluations of the "
+                        r"dynamics without advancing 2e-05 s: a joint's rate reverses at 0 where its friction holds "
+                        r"the mechanism \(gearcli models no stiction: README, Losses\) \(nothing written\)\n", r.stderr), r.stderr
 
 
 # --- position limits in YAML ---------------------------------------------------------------------

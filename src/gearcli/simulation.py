@@ -21,6 +21,32 @@ from .io.output import OutputError, atomic_output, output_target
 from .pipeline import SolveReport, _output_format, solve_file
 
 MAX_SIMULATE_SAMPLES = 10_000_000
+STALL_EVALUATIONS = 5_000    # evaluations of the dynamics without advancing STALL_FRACTION of the span
+STALL_FRACTION = 1e-4
+
+
+class StallWatch:
+    """Called with the time of every evaluation of the dynamics: raises GearcliError when
+    :data:`STALL_EVALUATIONS` of them pass without the time reached advancing by
+    :data:`STALL_FRACTION` of the span (the integrator's step collapsed: a smooth motion
+    needs a few hundred evaluations a second).  Coulomb friction that holds a mechanism at
+    rest does this: with no stiction model the joint's rate reverses at 0 at every step."""
+
+    def __init__(self, an: Analysis, input_path, t0: float, t1: float, progress=None):
+        self.an, self.input_path, self.progress = an, input_path, progress
+        self.step, self.mark, self.n, self.n_mark = STALL_FRACTION * (t1 - t0), t0, 0, 0
+
+    def __call__(self, t: float) -> None:
+        self.n += 1
+        if t >= self.mark + self.step:
+            self.mark, self.n_mark = t, self.n
+        elif self.n - self.n_mark > STALL_EVALUATIONS:
+            hint = (": a joint's rate reverses at 0 where its friction holds the mechanism (gearcli models no "
+                    "stiction: README, Losses)" if self.an.mech.has_losses else "")
+            raise GearcliError(f"{self.input_path}: simulation stalled at t = {self.mark:.6g} s: {STALL_EVALUATIONS:,} "
+                               f"evaluations of the dynamics without advancing {self.step:.3g} s{hint} (nothing written)")
+        if self.progress is not None:
+            self.progress(t)
 
 
 @dataclass
@@ -102,8 +128,8 @@ def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None
     if progress is not None:
         progress(total=t1 - t0)
     try:
-        sim = simulate(an, drive, t_eval, x0, v0, rtol=rtol, atol=atol, method=method,
-                       progress=None if progress is None else (lambda t: progress(t=t - t0)))
+        sim = simulate(an, drive, t_eval, x0, v0, rtol=rtol, atol=atol, method=method, progress=StallWatch(
+            an, input_path, t0, t1, None if progress is None else (lambda t: progress(t=t - t0))))
     except SimulationError as exc:
         raise GearcliError(f"{input_path}: simulation failed: {exc} (nothing written)") from None
     names = an.independent_names
