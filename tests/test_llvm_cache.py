@@ -35,7 +35,7 @@ from gearcli.dynamics.llvm import cache as llvm_cache
 from gearcli.dynamics.llvm import driver as llvm_driver
 if sys.argv[2] == "off":
     jit = llvm_driver.Jit
-    llvm_driver.Jit = lambda module: jit(module, cache=False)
+    llvm_driver.Jit = lambda module, **kw: jit(module, cache=False, **kw)
 if sys.argv[2] == "other generator":   # as if the IR generator's source had changed
     llvm_driver.generator_digest = lambda: "0" * 64
 an = analyse(load_mechanism(sys.argv[1]))
