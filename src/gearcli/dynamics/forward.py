@@ -60,6 +60,7 @@ import numpy as np
 
 from .backends import CALL_SAMPLES, FIRST_CALL_SAMPLES
 from .external import load_values
+from .inputs import joint_names, sample_arrays
 from .llvm.cache import has_program
 from .solve import solve, solver_for
 
@@ -73,29 +74,6 @@ STALLED = 1e-10
 step no longer reduces it (the solve's rounding reached before :data:`TOLERANCE`)."""
 MAX_STEPS = 60
 """With losses: the most correction steps of :func:`forward_dynamics`."""
-
-
-def _arrays(an, named: dict) -> list[np.ndarray]:
-    """The named arrays as float (N, width) (a 1-D array is one sample); ValueError for a
-    bad shape, different sample counts or a value that is not finite (first one named)."""
-    out = []
-    for name, (given, width, cols) in named.items():
-        x = np.asarray(given, float)
-        if x.ndim == 1:
-            x = x[None, :]
-        if x.ndim != 2 or x.shape[1] != width:
-            raise ValueError(f"expected {name} with shape (N, {width}) or ({width},), got {np.shape(given)}")
-        if not np.isfinite(x).all():
-            i, j = np.argwhere(~np.isfinite(x))[0]
-            raise ValueError(f"{name} is not finite at sample {i}, {cols[j]}: {x[i, j]}")
-        out.append(x)
-    if len({x.shape[0] for x in out}) != 1:
-        raise ValueError(f"{', '.join(named)} must have the same number of samples, got {[x.shape[0] for x in out]}")
-    return out
-
-
-def _joints(an) -> list[str]:
-    return [f"joint '{n}'" for n in an.independent_names]
 
 
 def _stacked_chunks(an, q, qd, loads, backend, jobs):
@@ -182,7 +160,7 @@ def mass_matrix(an, q, backend: str = "auto", jobs: int | None = None) -> np.nda
     ``jobs`` as in :func:`gearcli.solve`.  Raises ValueError for a bad shape or a value
     that is not finite.
     """
-    (q,) = _arrays(an, {"q": (q, an.dof, _joints(an))})
+    (q,) = sample_arrays({"q": (q, an.dof, joint_names(an))})
     return _mass_and_h(an, q, np.zeros_like(q), np.zeros_like(q), None, backend, jobs)[0]
 
 
@@ -205,8 +183,8 @@ def forward_dynamics(an, q, qd, motor_torques, loads: dict | None = None, backen
     a sample without a settled acceleration.
     """
     motors = [f"motor '{m.name}'" for m in an.mech.motors]
-    q, qd, T = _arrays(an, {"q": (q, an.dof, _joints(an)), "qd": (qd, an.dof, _joints(an)),
-                            "motor_torques": (motor_torques, len(motors), motors)})
+    q, qd, T = sample_arrays({"q": (q, an.dof, joint_names(an)), "qd": (qd, an.dof, joint_names(an)),
+                              "motor_torques": (motor_torques, len(motors), motors)})
     target = np.einsum("nm,dm->nd", T, an.A)    # A T per sample; not matmul: BLAS threads would
     # start, then spin on the second core through the kernel calls below (up to 2x slower)
     M, h, qdd = _mass_and_h(an, q, qd, target, loads, backend, jobs)
