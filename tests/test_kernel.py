@@ -222,7 +222,7 @@ def test_general_blocks_are_exercised():
     assert any(p.F is None for p in solver_for(an).plans)
     servo = solver_for(analyse(mechanism("servo_joint.yaml")))
     assert any(p.F is None and p.offs[-1] > 6 * len(p.links) for p in servo.plans)
-    assert servo.kernel_program().weights and servo.backend() == "llvm"
+    assert servo.kernel_program().weights and servo.choice().path == "llvm"
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
@@ -318,7 +318,7 @@ def test_backend_choice_and_errors():
     sol = solver_for(an)
     kept, sol.llvm_problem = sol.llvm_problem, "a stand-in reason"   # as for a mechanism with losses
     try:
-        assert sol.backend() == "numpy"
+        assert sol.choice().path == "numpy"
         with pytest.raises(ValueError, match="unavailable: a stand-in reason"):
             solve(an, q, q, q, backend="llvm")
     finally:

@@ -50,7 +50,7 @@ def test_first_call_rule(monkeypatch, tmp_path):
     C = backends.CALL_SAMPLES                                                  # what the 10-sample call counted
     assert sol.choice(n=K - C - 1).path == "numpy" and sol.choice(n=K - C).path == "llvm"
     assert sol.choice(n=None).path == "llvm"                                               # a large call
-    assert sol.backend(backend="llvm", n=1) == "llvm" and not sol.compiled_llvm()         # choosing compiles nothing
+    assert sol.choice(backend="llvm", n=1).path == "llvm" and not sol.compiled_llvm()         # choosing compiles nothing
     big = np.zeros((K, an.dof))
     res = solve(an, big, big, big)
     assert res.backend == "llvm" and res.backend_note is None and sol.compiled_llvm()
@@ -58,9 +58,9 @@ def test_first_call_rule(monkeypatch, tmp_path):
     assert res.backend == "llvm" and res.backend_note is None                            # compiled: always
     other = solver_for(analyse(load_mechanism(MECH / "helical_reduction.yaml")))          # its code on disk now
     assert other.choice(n=1).path == "llvm" and not other.compiled_llvm()
-    assert sol.backend("full", "auto", 10) == "numpy" and sol.choice("full", "auto", 10).note is None
+    assert sol.choice("full", "auto", 10).path == "numpy" and sol.choice("full", "auto", 10).note is None
     with pytest.raises(ValueError, match="backend 'llvm' solves method 'block' only"):
-        sol.backend("full", "llvm")
+        sol.choice("full", "llvm")
 
 
 def test_many_small_calls_compile_once_they_add_up(monkeypatch, tmp_path):

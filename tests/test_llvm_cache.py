@@ -278,12 +278,12 @@ def test_auto_counts_a_cached_kernel_as_cheap(tmp_path, monkeypatch):
     monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path))
     first = solver_for(analyse(parse_mechanism(serial_chain(15))))
     assert not backends.llvm_on_disk(first)
-    assert first.backend(n=10) == "numpy"
+    assert first.choice(n=10).path == "numpy"
     q = np.zeros((2, first.an.dof))
     solve(first.an, q, q, q, backend="llvm")
     second = solver_for(analyse(parse_mechanism(serial_chain(15))))
     assert backends.llvm_on_disk(second)
-    assert second.backend(n=10) == "llvm"
+    assert second.choice(n=10).path == "llvm"
     assert second.llvm_kernel().jit.from_cache
     assert "run:" in second.llvm_kernel().jit.assembly()    # optimised again on demand
 

@@ -85,7 +85,7 @@ def iterations_agree(prog, qd_all, got, ref) -> None:
 def test_llvm_equals_numpy_with_losses(key):
     an = analyse(mechanism(key))
     sol = solver_for(an)
-    assert sol.llvm_available() and sol.backend() == "llvm"       # auto: the compiled path
+    assert sol.llvm_available() and sol.choice().path == "llvm"       # auto: the compiled path
     q, qd, qdd = motion(an, 500)
     loads = per_sample_loads(an, 500)
     ref = solve(an, q, qd, qdd, backend="numpy", loads=loads)
@@ -271,4 +271,4 @@ def test_bundled_design_with_losses_takes_the_llvm_path():
     doc = yaml.safe_load((DESIGNS / "servo_joint_losses.yaml").read_text())
     rel = doc["cases"][0]["mechanism"]
     an = analyse(load_mechanism((DESIGNS / rel).resolve()))
-    assert an.mech.has_losses and solver_for(an).backend() == "llvm"
+    assert an.mech.has_losses and solver_for(an).choice().path == "llvm"

@@ -80,7 +80,7 @@ def check_solve_options(an: Analysis, method: str, backend: str) -> Analysis:
     if backend not in BACKENDS and backend != "kernel":   # "kernel": the solver's own answer (retired)
         raise GearcliError(f"--backend: expected one of {', '.join(BACKENDS)}, got '{backend}'")
     try:
-        solver_for(an).backend(method, backend)
+        solver_for(an).choice(method, backend)
     except ValueError as exc:
         raise GearcliError(f"--backend: {exc}") from None
     return an

@@ -156,12 +156,9 @@ class Solver:
         """True once the llvm kernel of this mechanism is compiled."""
         return self._llvm is not None
 
-    def backend(self, method: str = "block", backend: str = "auto", n: int | None = None) -> str:
-        """The path a solve of n samples (None: a large call) takes: "llvm" or "numpy"."""
-        return choose(self, method, backend, n).path
-
     def choice(self, method: str = "block", backend: str = "auto", n: int | None = None) -> Choice:
-        """:meth:`backend` with the note of why "auto" took numpy (:class:`.backends.Choice`)."""
+        """The path a solve of n samples (None: a large call) takes (``.path``: "llvm" or
+        "numpy") and the note of why "auto" took numpy (:class:`.backends.Choice`)."""
         return choose(self, method, backend, n)
 
     def solve(self, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK,
