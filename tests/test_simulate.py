@@ -341,6 +341,21 @@ def test_coulomb_friction_that_holds_the_mechanism_stalls_with_one_line(run_cli,
                         r"the mechanism \(gearcli models no stiction: README, Losses\) \(nothing written\)\n", r.stderr), r.stderr
 
 
+def test_a_stiff_motor_under_an_explicit_method_stalls_with_one_line(run_cli, tmp_path):
+    """L/R = 5e-10 s under RK45: its stable step is ~1e-9 s, 0.3 s would take ~1e9
+    evaluations.  simulate stops after STALL_EVALUATIONS, naming L/R and the way out; Radau
+    runs it (472 evaluations)."""
+    mech = write(tmp_path / "stage.yaml", dc_stage(inductance=1e-9))
+    inp = write(tmp_path / "in.csv", "t,voltage:servo\n0,12\n0.3,12\n")
+    r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv")
+    assert r.exit_code == 2 and not (tmp_path / "traj.csv").exists()
+    assert r.stderr == (f"{inp}: simulation stalled at t = 0 s: 5,000 evaluations of the dynamics without advancing "
+                        "3e-05 s: a motor's L/R of 5e-10 s makes the system stiff: give --method Radau or BDF "
+                        "(nothing written)\n")
+    r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv", "--method", "Radau")
+    assert r.exit_code == 0, r.stderr
+
+
 # --- position limits in YAML ---------------------------------------------------------------------
 
 PENDULUM_YAML = """

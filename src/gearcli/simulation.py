@@ -30,10 +30,12 @@ class StallWatch:
     :data:`STALL_EVALUATIONS` of them pass without the time reached advancing by
     :data:`STALL_FRACTION` of the span (the integrator's step collapsed: a smooth motion
     needs a few hundred evaluations a second).  Coulomb friction that holds a mechanism at
-    rest does this: with no stiction model the joint's rate reverses at 0 at every step."""
+    rest does this (with no stiction model the joint's rate reverses at 0 at every step), and
+    so does a stiff system (a motor's L/R far below the motion's time scale) under an
+    explicit method; the message says which applies."""
 
-    def __init__(self, an: Analysis, input_path, t0: float, t1: float, progress=None):
-        self.an, self.input_path, self.progress = an, input_path, progress
+    def __init__(self, an: Analysis, input_path, t0: float, t1: float, method: str, progress=None):
+        self.an, self.input_path, self.method, self.progress = an, input_path, method, progress
         self.step, self.mark, self.n, self.n_mark = STALL_FRACTION * (t1 - t0), t0, 0, 0
 
     def __call__(self, t: float) -> None:
@@ -41,12 +43,21 @@ class StallWatch:
         if t >= self.mark + self.step:
             self.mark, self.n_mark = t, self.n
         elif self.n - self.n_mark > STALL_EVALUATIONS:
-            hint = (": a joint's rate reverses at 0 where its friction holds the mechanism (gearcli models no "
-                    "stiction: README, Losses)" if self.an.mech.has_losses else "")
             raise GearcliError(f"{self.input_path}: simulation stalled at t = {self.mark:.6g} s: {STALL_EVALUATIONS:,} "
-                               f"evaluations of the dynamics without advancing {self.step:.3g} s{hint} (nothing written)")
+                               f"evaluations of the dynamics without advancing {self.step:.3g} s{self.hint()} "
+                               "(nothing written)")
         if self.progress is not None:
             self.progress(t)
+
+    def hint(self) -> str:
+        hints = ["a joint's rate reverses at 0 where its friction holds the mechanism (gearcli models no stiction: "
+                 "README, Losses)"] if self.an.mech.has_losses else []
+        tau = [m.model.inductance / m.model.resistance for m in self.an.mech.motors
+               if m.model is not None and m.model.inductance]
+        if self.method in ("RK45", "RK23", "DOP853") and (tau or not hints):
+            hints.append(f"a motor's L/R of {min(tau):.3g} s makes the system stiff: give --method Radau or BDF"
+                         if tau else "if the system is stiff, give --method Radau or BDF")
+        return ": " + "; ".join(hints) if hints else ""
 
 
 @dataclass
@@ -129,7 +140,7 @@ def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None
         progress(total=t1 - t0)
     try:
         sim = simulate(an, drive, t_eval, x0, v0, rtol=rtol, atol=atol, method=method, progress=StallWatch(
-            an, input_path, t0, t1, None if progress is None else (lambda t: progress(t=t - t0))))
+            an, input_path, t0, t1, method, None if progress is None else (lambda t: progress(t=t - t0))))
     except SimulationError as exc:
         raise GearcliError(f"{input_path}: simulation failed: {exc} (nothing written)") from None
     names = an.independent_names
