@@ -150,7 +150,8 @@ def subtract_bearing_friction(an, kin, b: dict, qd_all: np.ndarray, moments: np.
 
 def fixed_point(an, qd_all: np.ndarray, solve_moments):
     """The fixed point of the bearing friction moments of the numpy path (the llvm kernel
-    converges them per block, :mod:`.llvm.bearings`, with this TOL and MAX_ITERATIONS).
+    converges them per block, :mod:`.llvm.bearings`, with this TOL and MAX_ITERATIONS, in a
+    smooth stretch from the moments of the samples before).
 
     ``solve_moments(Mb, todo)`` solves the samples ``todo`` (indices) with the moments
     Mb[todo] (Mb (N, len(friction_joints)): sum_b M_b >= 0 of each joint with bearing

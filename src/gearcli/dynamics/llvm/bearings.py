@@ -8,21 +8,23 @@ reaches no earlier block.  So in schedule order the fixed point is local to each
 its own joints' moments change its solution, and the converged couples on the links of later
 blocks are loads there, as the joints' own friction (:func:`.losses.joint_friction`).
 
-Per block, from Mb = 0 (iteration 1), as :func:`..bearing_friction.fixed_point` with its
-``TOL`` and ``MAX_ITERATIONS``: solve with r + sum_J s_J Mb_J w_J (s_J = sign(q'_J), w_J the
+Per block, from Mb = 0 (iteration 1; in a smooth stretch of the motion the extrapolated
+moments of the two samples before, :func:`_warm`), as :func:`..bearing_friction.fixed_point`
+with its ``TOL`` and ``MAX_ITERATIONS``: solve with r + sum_J s_J Mb_J w_J (s_J = sign(q'_J), w_J the
 couple per unit in the block's coordinates), Mb_J' = sum_b 1/2 mu_b d_b P_b of the solved
 reactions (0 at rest), until every |Mb_J' - Mb_J| <= TOL |Mb_J'|; the Mb that solved (not
 Mb') is kept.  A constant-frame block iterates on its 5 reaction rows a joint (and its t):
 with the sign pattern p of the last sign search (at moments Mb0) its solution is affine in
 the moments, x = x0 + sum_J s_J (Mb_J - Mb0_J) g_J, g_J = X_p w_J (w_J constant in F:
 constants per pattern for stored maps, the corrected map of :class:`~.losses.LossyBlock` per
-sample); should the tooth forces no longer fit p (the tolerance of the shifted r), the sign
-search runs again at the current moments (same iteration).  A block without a constant
+sample; its first sign search at Mb0 = 0, the warm start then its first iterate, off the
+search's chain); should the tooth forces no longer fit p (the tolerance of the shifted r),
+the sign search runs again at the current moments (same iteration).  A block without a constant
 couple (world frame) solves the whole block each iteration.
 
 Written per sample in the ``moments`` row: each joint's converged Mb_J, then the most
-iterations over the sample's blocks; -s_J Mb_J joins J's friction output.  A block that does not converge records ``fail`` =
-(number of blocks) + k, k the bearing joint of largest relative change (the driver's
+iterations over the sample's blocks; -s_J Mb_J joins J's friction output.  A block that does
+not converge records ``fail`` = (number of blocks) + k, k the bearing joint of largest relative change (the driver's
 :class:`..bearing_friction.BearingFrictionError`).
 """
 from __future__ import annotations
@@ -112,12 +114,15 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
     bb = lp.bearing_blocks[b]
     K, m, tag, affine = len(bb.joints), len(tcols), f"b{b}", bb.wF is not None
     jt = _Joints(e, s, lp, bb, F, links, len(r))
+    warm = _warm(e, lp, bb, jt, n)
     pre = e.b.block
     search, it_bb = fn.append_basic_block(f"{tag}_bsearch"), fn.append_basic_block(f"{tag}_biter")
     more, failb, done_bb = (fn.append_basic_block(f"{tag}_b{x}") for x in ("more", "fail", "done"))
     e.b.branch(search)
     e.b.position_at_end(search)
     Mb0, it0 = [e.b.phi(D) for _ in range(K)], e.b.phi(I64)
+    # the moments and fresh flag the iterations start from (affine: the warm start at the first search)
+    first, fr = ([e.b.phi(D) for _ in range(K)], e.b.phi(I1)) if affine else (Mb0, ir.Constant(I1, 1))
     x0, p = solve(jt.shifted(e, r, Mb0), tag)
     # x = x0 + sum_i G_i (Mb_i - Mb0_i), G_i = s_i X_p w_i: the split of each joint likewise
     G = [[e.mul(jt.sg[i], v) for v in rows(p, list(range(len(x0))), jt.W[i], f"{tag}_g{i}")] for i in range(K)] \
@@ -141,21 +146,52 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
                            tolerance(e, jt.shifted(e, r, Mb)))
         fit_bb = fn.append_basic_block(f"{tag}_bfits")
         e.b.cbranch(e.b.or_(fresh, fits), fit_bb, search)
-        _incoming(Mb0 + [it0], Mb + [it], e.b.block)
+        _incoming(Mb0 + [it0] + first + [fr], Mb + [it] + Mb + [ir.Constant(I1, 1)], e.b.block)
         e.b.position_at_end(fit_bb)
     e.b.cbranch(ok, done_bb, more)
     e.b.position_at_end(more)
     it1 = e.b.add(it, ir.Constant(I64, 1))
     e.b.cbranch(e.b.icmp_signed("<=", it1, ir.Constant(I64, MAX_ITERATIONS)), it_bb if affine else search, failb)
-    _incoming(Mb + [it, fresh], Mb0 + [it0, ir.Constant(I1, 1)], search_end)
+    _incoming(Mb + [it, fresh], first + [it0, fr], search_end)
     _incoming(Mb + [it, fresh] if affine else Mb0 + [it0], new + [it1, ir.Constant(I1, 0)], more)
-    _incoming(Mb0 + [it0], [ir.Constant(D, 0.0)] * K + [ir.Constant(I64, 1)], pre)
+    if affine:                # searched at zero moments (the sign search off the warm start's chain)
+        _incoming(Mb0 + [it0] + first + [fr], [ir.Constant(D, 0.0)] * K + [ir.Constant(I64, 1)] + warm
+                  + [ir.Constant(I1, 0)], pre)
+    else:
+        _incoming(Mb0 + [it0], warm + [ir.Constant(I64, 1)], pre)
     e.b.position_at_end(failb)
     _failed(e, prog, bb, new, change, fail, n)
     e.b.branch(done_bb)
     e.b.position_at_end(done_bb)
     _outputs(e, s, lp, b, bb, jt, Mb, it, links, n)
     return [at(i) for i in range(len(x0))], p
+
+
+WARM, SMOOTH = 256, 0.03125
+"""Samples n = k WARM .. (k + 1) WARM - 1 of a call form a run: the fixed point of a sample
+of a smooth stretch starts from the moments of the two samples before in the run (the
+driver's thread ranges start at multiples of WARM, so no result depends on the threads);
+smooth: a moment changed by at most SMOOTH of itself from the one to the other."""
+
+
+def _warm(e: Emitter, lp, bb, jt: _Joints, n) -> list:
+    """Per joint of the block the moments its fixed point starts from: where it moves and
+    samples n-1 and n-2 are in the run with 0 < Mb(n-2) and |Mb(n-1) - Mb(n-2)| <= SMOOTH
+    Mb(n-1), their extrapolation 2 Mb(n-1) - Mb(n-2); else 0, the fixed point's own start
+    (:func:`..bearing_friction.fixed_point`: so a random motion's samples iterate as there)."""
+    fn = e.b.function
+    mom, start = (next(a for a in fn.args if a.name == k) for k in ("moments", "start"))
+    m2 = e.b.sub(n, ir.Constant(I64, 2))
+    ok = e.b.and_(e.b.icmp_signed(">=", e.b.srem(n, ir.Constant(I64, WARM)), ir.Constant(I64, 2)),
+                  e.b.icmp_signed(">=", m2, start))
+    rows = [e.row(mom, e.b.select(ok, e.b.sub(n, ir.Constant(I64, h)), n), lp.out_width) for h in (1, 2)]
+    out, zero = [], ir.Constant(D, 0.0)
+    for mv, k in zip(jt.moving, bb.joints):     # (row n when not ok: loaded, never used)
+        M1, M2 = (e.load(row, k) for row in rows)
+        smooth = e.b.fcmp_ordered("<=", e.call("fabs", e.sub(M1, M2)), e.mul(SMOOTH, M1))
+        use = e.b.and_(e.b.and_(ok, mv), e.b.and_(e.b.fcmp_ordered(">", M2, zero), smooth))
+        out.append(e.b.select(use, e.sub(e.mul(2.0, M1), M2), zero))
+    return out
 
 
 def _cols(x: list, c0: int) -> list:

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from . import cache as llvm_cache
+from .bearings import WARM
 from .jobs import job_ranges, run_parts, sign_error, threads_for
 from .program import Program, load_arrays
 from .kernel import ARGS, LOSS_OUTPUTS, build_module
@@ -235,7 +236,10 @@ class LlvmKernel:
         keep += [out[k] if out[k].size else none for k in OUTPUTS] + [SG]
         keep += [out[k] if out.get(k) is not None and out[k].size else none for k in LOSS_OUTPUTS] + [moments, fail]
         ptrs = [a.ctypes.data for a in keep]
-        failed = run_parts(lambda s, e: self._run(*ptrs, s, e), job_ranges(n, jobs), threads_for(n, jobs))
+        # the threads' ranges cut at multiples of WARM: a bearing fixed point's warm start (.bearings) stays in its range
+        cuts = sorted({min(n, WARM * round(a / WARM)) for a, _ in job_ranges(n, jobs)} | {n})
+        ranges = [(a, b) for a, b in zip(cuts, cuts[1:]) if b > a]
+        failed = run_parts(lambda s, e: self._run(*ptrs, s, e), ranges, threads_for(n, jobs))
         if failed:                    # a block's sign search, else a bearing fixed point (.bearings)
             nb = len(self.prog.blocks)
             if np.any((fail >= 0) & (fail < nb)):
