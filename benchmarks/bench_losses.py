@@ -17,7 +17,10 @@ tick on a busy machine):
   a fixed-point iteration per sample, whose iterations are printed (median and worst); numpy:
   :func:`gearcli.dynamics.bearing_friction.fixed_point`, every joint at once; llvm: inside the
   kernel, block by block (:mod:`gearcli.dynamics.llvm.bearings`), a sample's count the most
-  over its blocks.
+  over its blocks;
+* llvm lossless and with bearing friction along a smooth motion (the analytic motion of
+  mechanisms/bendix_wrist_traj.csv, continued to --samples at 1 kHz): random states give the
+  kernel's warm start (a block's fixed point from the samples before) nothing to start from.
 
 The cost of losses in the compiled path (issue 19's target: at most 20 %) is each llvm row
 over the lossless llvm row of the same run.
@@ -61,20 +64,25 @@ def main(argv=None) -> int:
     rng = np.random.default_rng(0)
     dof = cases["lossless, numpy"][0].dof
     q, qd, qdd = (rng.uniform(-3, 3, (args.samples, dof)) for _ in range(3))
+    states = {k: (q, qd, qdd) for k in cases}
+    cases["lossless, llvm, smooth motion"] = cases["lossless, llvm"]
+    cases["+ bearing friction, llvm, smooth motion"] = cases["+ bearing friction, llvm"]
+    states["lossless, llvm, smooth motion"] = states["+ bearing friction, llvm, smooth motion"] = smooth(args.samples)
     for an, backend in cases.values():                 # warm up: compile, plans, caches
         solve(an, q[:100], qd[:100], qdd[:100], backend=backend, jobs=1)
     times = {k: [] for k in cases}
     for _ in range(args.rounds):
         for name, (an, backend) in cases.items():
             reps = 5 if backend == "llvm" else 1           # a few ms: the median of 5 calls a round
-            times[name].append(median_time(lambda: solve(an, q, qd, qdd, backend=backend, jobs=1), reps))
+            times[name].append(median_time(lambda: solve(an, *states[name], backend=backend, jobs=1), reps))
     print(f"Bendix wrist (rated), {args.samples:,} random samples, 1 thread, medians of {args.rounds}; {load_line()}")
     base = float(np.median(times["lossless, numpy"]))
     fast = float(np.median(times["lossless, llvm"]))
     for name, ts in times.items():
         t = float(np.median(ts))
-        print(f"  {name:32s} {t * 1e3:9.1f} ms  {args.samples / t:12,.0f} samples/s  {t / base:6.3f}x numpy lossless"
-              f"  {t / fast:6.2f}x llvm lossless")
+        ref = float(np.median(times["lossless, llvm, smooth motion"])) if "smooth" in name else fast
+        print(f"  {name:40s} {t * 1e3:9.1f} ms  {args.samples / t:12,.0f} samples/s  {t / base:6.3f}x numpy lossless"
+              f"  {t / ref:6.2f}x llvm lossless{' (smooth)' if 'smooth' in name else ''}")
     for name in ("mesh + joint friction, llvm", "+ bearing friction, llvm"):
         print(f"  cost of losses in the compiled path, {name.split(',')[0]}: "
               f"{100 * (float(np.median(times[name])) / fast - 1):+.0f} % (target: at most +20 %)")
@@ -83,7 +91,16 @@ def main(argv=None) -> int:
     print(f"  bearing friction iterations per sample: median {int(np.median(it))}, worst {int(it.max())}")
     fast_it = solve(cases["+ bearing friction, llvm"][0], q, qd, qdd, backend="llvm").bearing_iterations
     print(f"  (llvm, the most over a sample's blocks: median {int(np.median(fast_it))}, worst {int(fast_it.max())})")
+    it = solve(cases["+ bearing friction, llvm"][0], *smooth(args.samples), backend="llvm").bearing_iterations
+    print(f"  (llvm, smooth motion: median {int(np.median(it))}, worst {int(it.max())}, mean {it.mean():.2f})")
     return 0
+
+
+def smooth(n: int):
+    """q, qd, qdd (n, 3) of mechanisms/make_trajectories.py's Bendix wrist motion at 1 kHz."""
+    t = np.arange(n)[:, None] * 1e-3
+    A, f, ph = np.array([1.0, 0.7, 2.0]), np.array([1.0, 1.5, 0.75]) * np.pi, np.array([0.0, 0.5, 1.0])
+    return A * np.sin(f * t + ph), A * f * np.cos(f * t + ph), -A * f**2 * np.sin(f * t + ph)
 
 
 if __name__ == "__main__":
