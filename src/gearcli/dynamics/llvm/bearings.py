@@ -10,22 +10,24 @@ blocks are loads there, as the joints' own friction (:func:`.losses.joint_fricti
 
 Per block, from Mb = 0 (iteration 1; in a smooth stretch of the motion the extrapolated
 moments of the two samples before, :func:`_warm`), as :func:`..bearing_friction.fixed_point`
-with its ``TOL`` and ``MAX_ITERATIONS``: solve with r + sum_J s_J Mb_J w_J (s_J = sign(q'_J), w_J the
-couple per unit in the block's coordinates), Mb_J' = sum_b 1/2 mu_b d_b P_b of the solved
-reactions (0 at rest), until every |Mb_J' - Mb_J| <= TOL |Mb_J'|; the Mb that solved (not
-Mb') is kept.  A constant-frame block iterates on its 5 reaction rows a joint (and its t):
-with the sign pattern p of the last sign search (at moments Mb0) its solution is affine in
-the moments, x = x0 + sum_J s_J (Mb_J - Mb0_J) g_J, g_J = X_p w_J (w_J constant in F:
-constants per pattern for stored maps, the corrected map of :class:`~.losses.LossyBlock` per
-sample; its first sign search at Mb0 = 0, the warm start then its first iterate, off the
-search's chain); should the tooth forces no longer fit p (the tolerance of the shifted r),
-the sign search runs again at the current moments (same iteration).  A block without a constant
-couple (world frame) solves the whole block each iteration.
+with its ``TOL`` and ``MAX_ITERATIONS`` (:func:`_loop`): solve with r + sum_J s_J Mb_J w_J
+(s_J = sign(q'_J), w_J the couple per unit in the block's coordinates), Mb_J' = sum_b 1/2
+mu_b d_b P_b of the solved reactions (0 at rest), until every |Mb_J' - Mb_J| <= TOL |Mb_J'|;
+the Mb that solved (not Mb') is kept.  A constant-frame block searches its sign pattern p
+once, at zero moments; with p fixed its solution is affine in the moments, x = x0 + sum_J
+s_J Mb_J g_J, g_J = X_p w_J (w_J constant in F: constants per pattern for stored maps, the
+corrected map of :class:`~.losses.LossyBlock` per sample), so an iteration updates the 5
+reaction rows of each joint and two square roots, and no branch leads back to the search
+(a short loop on the moments alone).  The tooth forces must fit p (the tolerance of the
+shifted r) at iteration 2 (where the moments have moved from zero) and at the converged
+moments; where they do not, the block goes on from those moments and that iteration as a
+block without a constant couple (world frame) does from the start: the whole block solved,
+its sign search included, each iteration (the numpy path's loop).
 
 Written per sample in the ``moments`` row: each joint's converged Mb_J, then the most
 iterations over the sample's blocks; -s_J Mb_J joins J's friction output.  A block that does
-not converge records ``fail`` = (number of blocks) + k, k the bearing joint of largest relative change (the driver's
-:class:`..bearing_friction.BearingFrictionError`).
+not converge records ``fail`` = (number of blocks) + k, k the bearing joint of largest
+relative change (the driver's :class:`..bearing_friction.BearingFrictionError`).
 """
 from __future__ import annotations
 
@@ -112,59 +114,100 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
     pattern p (constant frame)."""
     lp = prog.losses
     bb = lp.bearing_blocks[b]
-    K, m, tag, affine = len(bb.joints), len(tcols), f"b{b}", bb.wF is not None
+    K, m, tag = len(bb.joints), len(tcols), f"b{b}"
     jt = _Joints(e, s, lp, bb, F, links, len(r))
     warm = _warm(e, lp, bb, jt, n)
-    pre = e.b.block
-    search, it_bb = fn.append_basic_block(f"{tag}_bsearch"), fn.append_basic_block(f"{tag}_biter")
-    more, failb, done_bb = (fn.append_basic_block(f"{tag}_b{x}") for x in ("more", "fail", "done"))
-    e.b.branch(search)
-    e.b.position_at_end(search)
-    Mb0, it0 = [e.b.phi(D) for _ in range(K)], e.b.phi(I64)
-    # the moments and fresh flag the iterations start from (affine: the warm start at the first search)
-    first, fr = ([e.b.phi(D) for _ in range(K)], e.b.phi(I1)) if affine else (Mb0, ir.Constant(I1, 1))
-    x0, p = solve(jt.shifted(e, r, Mb0), tag)
-    # x = x0 + sum_i G_i (Mb_i - Mb0_i), G_i = s_i X_p w_i: the split of each joint likewise
-    G = [[e.mul(jt.sg[i], v) for v in rows(p, list(range(len(x0))), jt.W[i], f"{tag}_g{i}")] for i in range(K)] \
-        if affine else None
-    S0 = [split(e, lp, k, _cols(x0, c0)) for k, c0 in zip(bb.joints, bb.cols)]
-    SG = [[split(e, lp, k, _cols(G[i], c0)) for i in range(K)] for k, c0 in zip(bb.joints, bb.cols)] if affine else None
-    search_end = e.b.block
-    e.b.branch(it_bb)
-    e.b.position_at_end(it_bb)
-    Mb, it, fresh = [e.b.phi(D) for _ in range(K)], e.b.phi(I64), e.b.phi(I1)
-    d = [e.sub(Mb[i], Mb0[i]) for i in range(K)] if affine else None
-    S = S0 if not affine else [[e.add(S0[j][h], e.dot([SG[j][i][h] for i in range(K)], d)) for h in range(5)]
-                               for j in range(K)]
-    new = jt.moments(e, lp, bb, S)
-    change, ok = _within(e, new, Mb)
+    done_bb = fn.append_basic_block(f"{tag}_bdone")
+    ends = []                 # (block, Mb, it, x, p) of each way into done_bb
+    start = (warm, ir.Constant(I64, 1))
+    if bb.wF is not None:     # affine in the moments, from the sign search at zero moments
+        x0, p = solve(r, tag)
+        G = [[e.mul(jt.sg[i], v) for v in rows(p, list(range(len(x0))), jt.W[i], f"{tag}_g{i}")] for i in range(K)]
+        S0 = [split(e, lp, k, _cols(x0, c0)) for k, c0 in zip(bb.joints, bb.cols)]
+        SG = [[split(e, lp, k, _cols(G[i], c0)) for i in range(K)] for k, c0 in zip(bb.joints, bb.cols)]
 
-    def at(i):                # x[i] at the moments Mb
-        return x0[i] if not affine else e.add(x0[i], e.dot([G[j][i] for j in range(K)], d))
-    if affine and m:          # do the tooth forces still fit p? else the sign search again at Mb
-        fits = _consistent(e, [at(c) for c in tcols], [_sign_bit(e, p, i, m) for i in range(m)],
-                           tolerance(e, jt.shifted(e, r, Mb)))
-        fit_bb = fn.append_basic_block(f"{tag}_bfits")
-        e.b.cbranch(e.b.or_(fresh, fits), fit_bb, search)
-        _incoming(Mb0 + [it0] + first + [fr], Mb + [it] + Mb + [ir.Constant(I1, 1)], e.b.block)
-        e.b.position_at_end(fit_bb)
-    e.b.cbranch(ok, done_bb, more)
+        def at(Mb):            # x at the moments Mb
+            return [e.add(x0[i], e.dot([G[j][i] for j in range(K)], Mb)) for i in range(len(x0))]
+
+        def fits(Mb):          # do the tooth forces at Mb fit p (the tolerance of the shifted r)?
+            return _consistent(e, [e.add(x0[c], e.dot([G[j][c] for j in range(K)], Mb)) for c in tcols],
+                               [_sign_bit(e, p, i, m) for i in range(m)], tolerance(e, jt.shifted(e, r, Mb)))
+        again = fn.append_basic_block(f"{tag}_bagain") if m else None
+        Mb, it, failb = _loop(e, fn, f"{tag}_ba", start, lambda Mb: jt.moments(e, lp, bb, [
+            [e.add(S0[j][h], e.dot([SG[j][i][h] for i in range(K)], Mb)) for h in range(5)] for j in range(K)]),
+            prog, bb, fail, n, fits if m else None, again)
+        x, start = at(Mb), None
+        if m:                  # converged: do the tooth forces fit p? else the whole block's loop from Mb
+            fit_bb = fn.append_basic_block(f"{tag}_bfit")
+            e.b.cbranch(fits(Mb), fit_bb, again)
+            start = (Mb, it)
+            e.b.position_at_end(fit_bb)
+        ends.append((e.b.block, Mb, it, x, p))
+        e.b.branch(done_bb)
+        e.b.position_at_end(failb)
+        ends.append((failb, Mb, it, at(Mb), p))
+        e.b.branch(done_bb)
+        if start is not None:
+            e.b.position_at_end(again)
+    if start is not None:     # the whole block solved each iteration (a world-frame block, or a changed pattern)
+        sol = {}
+
+        def solved(Mb):
+            sol["x"], sol["p"] = solve(jt.shifted(e, r, Mb), f"{tag}_s")
+            return jt.moments(e, lp, bb, [split(e, lp, k, _cols(sol["x"], c0)) for k, c0 in zip(bb.joints, bb.cols)])
+        Mb, it, failb = _loop(e, fn, f"{tag}_bs", start, solved, prog, bb, fail, n)
+        ends += [(e.b.block, Mb, it, sol["x"], sol["p"]), (failb, Mb, it, sol["x"], sol["p"])]
+        e.b.branch(done_bb)
+        e.b.position_at_end(failb)
+        e.b.branch(done_bb)
+    e.b.position_at_end(done_bb)
+    Mb, it, x, p = (_phis(e, ends, k) for k in (1, 2, 3, 4))
+    _outputs(e, s, lp, b, bb, jt, Mb, it[0], links, n)
+    return x, (None if p is None else p[0])
+
+
+def _loop(e: Emitter, fn, tag: str, start: tuple, step, prog, bb, fail, n, check=None, bail=None):
+    """Iterate Mb <- step(Mb) from ``start`` (Mb, its iteration number) until every
+    |Mb' - Mb| <= TOL |Mb'| (:func:`_within`): returns (the Mb that solved, its iteration, the
+    block reached after MAX_ITERATIONS, which records ``fail``), the builder at the converged exit.
+    ``check(Mb)`` (i1), tested at iteration 2 only: false goes to ``bail`` with (Mb, it)."""
+    pre = e.b.block
+    body, more, out, failb = (fn.append_basic_block(f"{tag}_{x}") for x in ("it", "more", "out", "fail"))
+    e.b.branch(body)
+    e.b.position_at_end(body)
+    Mb, it = [e.b.phi(D) for _ in start[0]], e.b.phi(I64)
+    new = step(Mb)
+    change, ok = _within(e, new, Mb)
+    if check is not None:
+        chk, cont = fn.append_basic_block(f"{tag}_chk"), fn.append_basic_block(f"{tag}_cont")
+        e.b.cbranch(e.b.icmp_signed("==", it, ir.Constant(I64, 2)), chk, cont)
+        e.b.position_at_end(chk)
+        e.b.cbranch(check(Mb), cont, bail)
+        e.b.position_at_end(cont)
+    e.b.cbranch(ok, out, more)
     e.b.position_at_end(more)
     it1 = e.b.add(it, ir.Constant(I64, 1))
-    e.b.cbranch(e.b.icmp_signed("<=", it1, ir.Constant(I64, MAX_ITERATIONS)), it_bb if affine else search, failb)
-    _incoming(Mb + [it, fresh], first + [it0, fr], search_end)
-    _incoming(Mb + [it, fresh] if affine else Mb0 + [it0], new + [it1, ir.Constant(I1, 0)], more)
-    if affine:                # searched at zero moments (the sign search off the warm start's chain)
-        _incoming(Mb0 + [it0] + first + [fr], [ir.Constant(D, 0.0)] * K + [ir.Constant(I64, 1)] + warm
-                  + [ir.Constant(I1, 0)], pre)
-    else:
-        _incoming(Mb0 + [it0], warm + [ir.Constant(I64, 1)], pre)
+    e.b.cbranch(e.b.icmp_signed("<=", it1, ir.Constant(I64, MAX_ITERATIONS)), body, failb)
+    _incoming(Mb + [it], list(start[0]) + [start[1]], pre)
+    _incoming(Mb + [it], new + [it1], more)
     e.b.position_at_end(failb)
     _failed(e, prog, bb, new, change, fail, n)
-    e.b.branch(done_bb)
-    e.b.position_at_end(done_bb)
-    _outputs(e, s, lp, b, bb, jt, Mb, it, links, n)
-    return [at(i) for i in range(len(x0))], p
+    e.b.position_at_end(out)
+    return Mb, it, failb
+
+
+def _phis(e: Emitter, ends: list, k: int):
+    """Per position of item k of ``ends`` (block, Mb, it, x, p) a phi of its values (None: p without signs)."""
+    if ends[0][k] is None:
+        return None
+    vals = [en[k] if isinstance(en[k], list) else [en[k]] for en in ends]
+    out = []
+    for i, v in enumerate(vals[0]):
+        phi = e.b.phi(v.type if hasattr(v, "type") else D)
+        for en, vs in zip(ends, vals):
+            phi.add_incoming(e.const(vs[i]) if not hasattr(vs[i], "type") else vs[i], en[0])
+        out.append(phi)
+    return out
 
 
 WARM, SMOOTH = 256, 0.03125
