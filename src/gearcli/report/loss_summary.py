@@ -10,7 +10,9 @@ fixed-point iterations of bearing friction (median and worst over the samples).
   flows forward (both positive): sum P_lossless / sum P_lossy.  It is the measured ratio,
   not the per-mesh efficiency eta (a 15/60 mm spur pair at eta = 0.97 driven by its pinion
   gives 0.9707; a rack driven by its pinion at eta = 0.9 gives 1 / (1 + 0.1) = 0.909).
-  ``nan`` when the power never flows forward.
+  ``nan`` when the power never flows forward.  Above 1 where motors share the work of coupled
+  links: the reaction of one line's friction couple can help another motor (the paper's arm
+  with its bevel pair at eta = 0.98: motor3 0.9805, motor5 1.0009).
 """
 from __future__ import annotations
 
@@ -109,7 +111,8 @@ class LossSummary:
             out.append(f"bearing friction: converged in {counted(median, 'iteration')} per sample (median), "
                        f"{self.iterations.size - 1} at worst")
         for m, eta in zip(self.motors, self.efficiency):
+            above = "; above 1: losses elsewhere do part of this motor's work (coupled lines)" if eta > 1 else ""
             out.append(f"line efficiency of motor {m}: " + ("- (its power never flows forward)" if np.isnan(eta)
                                                              else f"{eta:.4f} (lossless power / motor power where "
-                                                                  "the motor drives)"))
+                                                                  f"the motor drives{above})"))
         return out
