@@ -126,12 +126,12 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
         S0 = [split(e, lp, k, _cols(x0, c0)) for k, c0 in zip(bb.joints, bb.cols)]
         SG = [[split(e, lp, k, _cols(G[i], c0)) for i in range(K)] for k, c0 in zip(bb.joints, bb.cols)]
 
-        def at(Mb):            # x at the moments Mb
-            return [e.add(x0[i], e.dot([G[j][i] for j in range(K)], Mb)) for i in range(len(x0))]
+        def at(Mb, rows=range(len(x0))):     # x[rows] at the moments Mb
+            return [e.add(x0[i], e.dot([G[j][i] for j in range(K)], Mb)) for i in rows]
 
         def fits(Mb):          # do the tooth forces at Mb fit p (the tolerance of the shifted r)?
-            return _consistent(e, [e.add(x0[c], e.dot([G[j][c] for j in range(K)], Mb)) for c in tcols],
-                               [_sign_bit(e, p, i, m) for i in range(m)], tolerance(e, jt.shifted(e, r, Mb)))
+            return _consistent(e, at(Mb, tcols), [_sign_bit(e, p, i, m) for i in range(m)],
+                               tolerance(e, jt.shifted(e, r, Mb)))
         again = fn.append_basic_block(f"{tag}_bagain") if m else None
         Mb, it, failb = _loop(e, fn, f"{tag}_ba", start, lambda Mb: jt.moments(e, lp, bb, [
             [e.add(S0[j][h], e.dot([SG[j][i][h] for i in range(K)], Mb)) for h in range(5)] for j in range(K)]),
@@ -201,13 +201,10 @@ def _phis(e: Emitter, ends: list, k: int):
     if ends[0][k] is None:
         return None
     vals = [en[k] if isinstance(en[k], list) else [en[k]] for en in ends]
-    out = []
-    for i, v in enumerate(vals[0]):
-        phi = e.b.phi(v.type if hasattr(v, "type") else D)
-        for en, vs in zip(ends, vals):
-            phi.add_incoming(e.const(vs[i]) if not hasattr(vs[i], "type") else vs[i], en[0])
-        out.append(phi)
-    return out
+    phis = [e.b.phi(getattr(v, "type", D)) for v in vals[0]]
+    for en, vs in zip(ends, vals):
+        _incoming(phis, [e.const(v) for v in vs], en[0])
+    return phis
 
 
 WARM, SMOOTH = 256, 0.03125
@@ -222,11 +219,9 @@ def _warm(e: Emitter, lp, bb, jt: _Joints, n) -> list:
     samples n-1 and n-2 are in the run with 0 < Mb(n-2) and |Mb(n-1) - Mb(n-2)| <= SMOOTH
     Mb(n-1), their extrapolation 2 Mb(n-1) - Mb(n-2); else 0, the fixed point's own start
     (:func:`..bearing_friction.fixed_point`: so a random motion's samples iterate as there)."""
-    fn = e.b.function
-    mom, start = (next(a for a in fn.args if a.name == k) for k in ("moments", "start"))
-    m2 = e.b.sub(n, ir.Constant(I64, 2))
+    mom, start = (next(a for a in e.b.function.args if a.name == k) for k in ("moments", "start"))
     ok = e.b.and_(e.b.icmp_signed(">=", e.b.srem(n, ir.Constant(I64, WARM)), ir.Constant(I64, 2)),
-                  e.b.icmp_signed(">=", m2, start))
+                  e.b.icmp_signed(">=", e.b.sub(n, ir.Constant(I64, 2)), start))
     rows = [e.row(mom, e.b.select(ok, e.b.sub(n, ir.Constant(I64, h)), n), lp.out_width) for h in (1, 2)]
     out, zero = [], ir.Constant(D, 0.0)
     for mv, k in zip(jt.moving, bb.joints):     # (row n when not ok: loaded, never used)
