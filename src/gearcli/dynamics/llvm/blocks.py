@@ -152,7 +152,7 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row, search: bool
     def solve(r, tag):              # (x, p) of right-hand side r; p None: pattern 0 without a search
         if m and search:
             args = (r, tolerance(e, r), _on_fail(e, fail, n, b), tag)
-            return blk.search(e, fn, *args) if hasattr(blk, "search") else resolve(e, fn, blk, *args)
+            return resolve(e, fn, blk, *args)
         if F < 0:
             return blk.solve(e, [1.0] * m, r), None
         if b in prog.lowrank:
