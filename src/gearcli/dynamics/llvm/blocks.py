@@ -129,7 +129,7 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row, search: bool
     rec = prog.blocks[b]
     F, lk0, B, nloc, m, t0, a0 = (int(v) for v in (rec.F, rec.link0, rec.nlinks, rec.n, rec.m, rec.t0, rec.ainv0))
     p0, np_, k0, nt = int(rec.prop0), int(rec.nprop), int(rec.term0), int(rec.nterm)
-    blinks, tcol, scol, ainv = prog.block_links, prog.t_col, prog.sign_col, prog.ainv
+    blinks, tcol, ainv = prog.block_links, prog.t_col, prog.ainv
     nr = 6 * B
     links = [int(v) for v in blinks[lk0:lk0 + B]]
     tcols = [int(c) for c in tcol[t0:t0 + m]]
@@ -167,7 +167,7 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row, search: bool
         x, p = solve(r, f"b{b}")
     sig = [1.0] * m if p is None else signs_of(e, p, m)
     for i in range(m if p is not None else 0):
-        e.store(sig[i], sg_row, int(scol[t0 + i]))
+        e.store(sig[i], sg_row, t0 + i)              # the signs row holds Program.signed in order
     if nt > 0:
         propagate_terms(e, s, k0, nt, prog, x, sig)
     else:

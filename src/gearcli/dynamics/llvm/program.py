@@ -61,8 +61,7 @@ class Program:
     blocks: np.ndarray = _arr()           # BLOCK records, schedule order
     block_links: np.ndarray = _arr()      # the blocks' links
     group_col: np.ndarray = _arr()        # each block column's position in the solution row
-    t_col: np.ndarray = _arr()            # the block columns of the signed t
-    sign_col: np.ndarray = _arr()         # their position in the signs row
+    t_col: np.ndarray = _arr()            # the block columns of the signed t (in the order of ``signed``)
     ainv: np.ndarray = _arr()             # every pattern's (n, 6B) inverse, row-major, patterns in sign_patterns order
     props: np.ndarray = _arr()            # PROPAGATION records
     cmat: np.ndarray = _arr()             # their C_plus (6, size), then C_sep, row-major
@@ -130,7 +129,7 @@ class _Builder:
     """Accumulates the per-block arrays."""
 
     def __init__(self):
-        self.brec, self.blinks, self.gcol, self.tcol, self.scol = [], [], [], [], []
+        self.brec, self.blinks, self.gcol, self.tcol = [], [], [], []
         self.ainv, self.prec, self.cmat, self.later, self.cbrec, self.turns = [], [], [], [], [], []
 
     @staticmethod
@@ -168,7 +167,7 @@ class _Builder:
         return True
 
 
-def _block(bd: _Builder, an, bi, p, offsets, sigcol, terms, lowrank):
+def _block(bd: _Builder, an, bi, p, offsets, terms, lowrank):
     """Append block ``bi`` (plan ``p``) to the builder."""
     n = int(p.offs[-1])
     term0, nterm = terms.get(bi, (0, 0))
@@ -178,9 +177,7 @@ def _block(bd: _Builder, an, bi, p, offsets, sigcol, terms, lowrank):
     bd.blinks += list(p.links)
     for g in p.groups:
         bd.gcol += range(offsets[(g.kind, g.index)][0], offsets[(g.kind, g.index)][0] + g.size)
-    for gi in p.signed:
-        bd.tcol.append(int(p.offs[gi]))
-        bd.scol.append(sigcol[(p.groups[gi].kind, p.groups[gi].index)])
+    bd.tcol += [int(p.offs[gi]) for gi in p.signed]
     if bi in lowrank:
         rec["ainv0"] = -1                  # solved from its pattern_maps.LowRank (program.lowrank)
     else:
@@ -242,11 +239,10 @@ def build_program(an, plans) -> Program:
         offsets[(g.kind, g.index)] = (c, g.size)
         c += g.size
     signed = [(p.groups[gi].kind, p.groups[gi].index) for p in plans for gi in p.signed]
-    sigcol = {k: i for i, k in enumerate(signed)}
     trec, tflt, terms = general_terms(an, plans)
     bd = _Builder()
     for bi, p in enumerate(plans):
-        _block(bd, an, bi, p, offsets, sigcol, terms, lowrank)
+        _block(bd, an, bi, p, offsets, terms, lowrank)
         if p.F is None and len(p.links) == 1 and not p.signed:
             _local_frame(bd, trec, tflt, p)
     joints, poses = _joints(an)
@@ -264,7 +260,7 @@ def build_program(an, plans) -> Program:
                    bodies=_bodies(an), moving=ints(an.tree.moving), base=int(an.tree.base),
                    gravity=np.asarray(an.mech.gravity, float), S=np.ascontiguousarray(an.S, float),
                    A=np.ascontiguousarray(an.A, float), blocks=records(bd.brec, BLOCK), block_links=ints(bd.blinks),
-                   group_col=ints(bd.gcol), t_col=ints(bd.tcol), sign_col=ints(bd.scol), ainv=cat(bd.ainv),
+                   group_col=ints(bd.gcol), t_col=ints(bd.tcol), ainv=cat(bd.ainv),
                    props=records(bd.prec, PROPAGATION), cmat=cat(bd.cmat), later=ints(bd.later),
                    child_basis=records(bd.cbrec, CHILD_BASIS), turns=np.array(bd.turns, float), terms=trec,
                    term_values=tflt, joint_out=jout, motor_col=mcol, gear_col=gcol, gear_out=gout, hashed=hashed,

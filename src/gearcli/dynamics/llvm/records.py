@@ -25,7 +25,7 @@ BODY = np.dtype([("mass", F), ("inertia", F, (9,)), ("com", F, (3,))])
 """A link: mass (kg), inertia about its centre of mass (link axes, kg m^2), centre of mass (link frame, m)."""
 BLOCK = _ints("F", "link0", "nlinks", "n", "col0", "m", "t0", "ainv0", "prop0", "nprop", "cb0", "ncb", "term0", "nterm")
 """A block of the schedule: frame link F (-1: world axes), its links (``block_links[link0:]``),
-n unknowns (columns ``group_col[col0:]``), m signed meshes (``t_col``/``sign_col[t0:]``),
+n unknowns (columns ``group_col[col0:]``), m signed meshes (``t_col[t0:]``, at ``t0`` in the signs row),
 its pattern maps at ``ainv[ainv0:]`` (-1: a :class:`..pattern_maps.LowRank`), propagation
 records ``props[prop0:]``, child-basis records ``child_basis[cb0:]``, column terms ``terms[term0:]``."""
 PROPAGATION = _ints("col0", "ncols", "signed", "cmat0", "primary", "later0", "nlater")
