@@ -245,6 +245,9 @@ def test_bearing_friction_on_a_slide_points_to_joint_friction(run_cli, mech_dir,
     ("efficiency: 0.97", "loss_factor: 0.97", "gears[0].loss_factor",
      "gear pair 'mesh': mesh efficiency 0.03 (loss factor 0.97) is below 0.5; a gear mesh loses 0.5 to 3 % at the "
      "pitch point: efficiency and loss_factor swapped? (loss_factor = 1 - efficiency)"),
+    ("efficiency: 0.97", "loss_factor: 0.999999", "gears[0].loss_factor",     # was "(loss factor 1)": not allowed
+     "gear pair 'mesh': mesh efficiency 1e-06 (loss factor 0.999999) is below 0.5; a gear mesh loses 0.5 to 3 % at "
+     "the pitch point: efficiency and loss_factor swapped? (loss_factor = 1 - efficiency)"),
     ("bore: 0.008}\n      - {name: b", "bore: 8}\n      - {name: b", "joints[0].bearings[0].bore",
      "joint 'Jp': bearing 'a': bore 8 m is above 2 m: in mm? (gearcli reads m)"),
 ])

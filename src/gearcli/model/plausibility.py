@@ -189,7 +189,7 @@ def mesh_losses(mech) -> list[Finding]:
         eta = 1.0 - g.loss_factor
         if eta < MIN_EFFICIENCY:
             found.append(Finding(_key_path(mech, g.path, ("efficiency", "loss_factor")),
-                                 f"gear pair '{g.name}': mesh efficiency {_g(eta)} (loss factor {_g(g.loss_factor)}) "
+                                 f"gear pair '{g.name}': mesh efficiency {eta:.6g} (loss factor {g.loss_factor:.6g}) "
                                  f"is below {_g(MIN_EFFICIENCY)}; a gear mesh loses 0.5 to 3 % at the pitch point: "
                                  "efficiency and loss_factor swapped? (loss_factor = 1 - efficiency)"))
     return found
