@@ -1,6 +1,6 @@
 """What losses cost in the solve (issue 19); prints figures, not a test.
 
-    python benchmarks/bench_losses.py [--samples 20000] [--rounds 5]
+    python benchmarks/bench_losses.py [--samples 20000] [--rounds 5] [--cpu]
 
 The rated Bendix wrist (5 meshes, 8 joints, 15 bearings), random states, one thread.  Rows,
 interleaved round by round so that load drift hits all alike, medians of --rounds (an llvm
@@ -23,13 +23,17 @@ tick on a busy machine):
   kernel's warm start (a block's fixed point from the samples before) nothing to start from.
 
 The cost of losses in the compiled path (issue 19's target: at most 20 %) is each llvm row
-over the lossless llvm row of the same run.
+over the lossless llvm row of the same run.  ``--cpu``: each call timed by this thread's CPU
+time instead of the wall clock (every row runs in this thread: one thread, one BLAS thread);
+on a busy machine the wall clock also counts the other processes' turns (load 5: the
+lossless llvm row 4.4 to 8.1 ms from run to run, its CPU time 4.2 to 4.5 ms at load 6).
 """
 from __future__ import annotations
 
 import argparse
 import dataclasses
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -54,6 +58,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--samples", type=int, default=20_000)
     ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--cpu", action="store_true", help="time by this thread's CPU time, not the wall clock")
     args = ap.parse_args(argv)
     mech = load_mechanism(ROOT / "mechanisms" / "bendix_wrist_rated.yaml")
     cases = {"lossless, llvm": (analyse(mech), "llvm"), "lossless, numpy": (analyse(mech), "numpy"),
@@ -74,8 +79,10 @@ def main(argv=None) -> int:
     for _ in range(args.rounds):
         for name, (an, backend) in cases.items():
             reps = 5 if backend == "llvm" else 1           # a few ms: the median of 5 calls a round
-            times[name].append(median_time(lambda: solve(an, *states[name], backend=backend, jobs=1), reps))
-    print(f"Bendix wrist (rated), {args.samples:,} random samples, 1 thread, medians of {args.rounds}; {load_line()}")
+            times[name].append(median_time(lambda: solve(an, *states[name], backend=backend, jobs=1), reps,
+                                           time.thread_time if args.cpu else time.perf_counter))
+    print(f"Bendix wrist (rated), {args.samples:,} random samples, 1 thread, medians of {args.rounds}"
+          f"{', thread CPU time' if args.cpu else ''}; {load_line()}")
     base = float(np.median(times["lossless, numpy"]))
     fast = float(np.median(times["lossless, llvm"]))
     for name, ts in times.items():
