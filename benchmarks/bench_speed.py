@@ -191,7 +191,10 @@ def library_section(n: int, repeat: int) -> None:
     head = ["mechanism", "gearcli llvm", "llvm x2", "gearcli kernel", "kernel x2", "gearcli numpy", "gearcli full",
             "pin rnea loop", "rneaInParallel 1", "rneaInParallel 2", "llvm / rIP 1", "llvm x2 / rIP 2",
             "kernel / rIP 1", "kernel x2 / rIP 2"]
-    print("| " + " | ".join(head) + " |\n|" + "---|" * len(head))
+    # the numba kernel's columns only where the code measured has one (it was retired in issue 18)
+    keep = [i for i, h in enumerate(head)
+            if "kernel" not in h or "kernel" in BACKENDS or "backend" not in SOLVE_PARAMS]
+    print("| " + " | ".join(head[i] for i in keep) + " |\n|" + "---|" * len(keep))
     with tempfile.TemporaryDirectory() as d:
         for name, path, urdf in subjects(Path(d)):
             mech = load_mechanism(path)
@@ -212,7 +215,7 @@ def library_section(n: int, repeat: int) -> None:
                    fmt_rate(p["rnea loop"]), fmt_rate(p["rneaInParallel 1"]), fmt_rate(p["rneaInParallel 2"]),
                    ratio(l1, p["rneaInParallel 1"]), ratio(l2, p["rneaInParallel 2"]),
                    ratio(k1, p["rneaInParallel 1"]), ratio(k2, p["rneaInParallel 2"])]
-            print("| " + " | ".join(row) + " |", flush=True)
+            print("| " + " | ".join(row[i] for i in keep) + " |", flush=True)
     print("\nEvery row: gearcli's equivalent joint torques equal Pinocchio's (S^T tau) to 1e-8 relative or a "
           "WARNING line says otherwise.")
     if "backend" not in SOLVE_PARAMS:
