@@ -76,7 +76,7 @@ def test_helical_export_round_trip(tmp_path):
     (("helix_angle_deg: 20, hand: HAND", "hand: right"), "hand", "hand given without a"),
     (("helix_angle_deg: 20, hand: HAND", "helix_angle_deg: 20"), "hand", "needs the hand of gear j"),
     (("kind: external", "kind: bevel"), "helix_angle_deg", "only for external and internal"),
-    (("hand: HAND", "hand: up"), "hand", "'up' is not one of"),
+    (("hand: HAND", "hand: up"), "hand", "expected one of: right, left; got 'up'"),
 ])
 def test_bad_helical(run_cli, tmp_path, edit, field, pattern):
     text = HELICAL.replace(*edit).replace("HAND", "right")

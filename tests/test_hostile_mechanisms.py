@@ -193,7 +193,7 @@ def test_long_value_not_echoed(run_cli, tmp_path):
     text = PAPER + "description: [" + ", ".join(["xxxxxxxxxx"] * 20000) + "]\n"
     text = replaced("description: Two-dof geared manipulator of Fig. 1 in the paper\n", "", text)
     line = bad(run_cli, tmp_path, text, line_of(text, "description: ["), "description",
-               r"^\['xxxxxxxxxx', .{0,80}… is not of type 'string'$")
+               r"^expected a string, got a list of 20000 items$")
     assert len(line) < 200 + len(str(tmp_path))
 
 

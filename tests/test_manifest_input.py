@@ -171,17 +171,17 @@ def test_schema_and_semantic_problems_come_in_one_round(run_cli, tmp_path):
     r = run_cli("verify", man)
     assert r.exit_code == 2
     assert lines_of(r) == [
-        f"{man}:3: cases[0].trajectories[1]: 3 is not of type 'string'",
+        f"{man}:3: cases[0].trajectories[1]: expected a string, got a number (3)",
         f"{man}:3: cases[0].trajectories[2]: no trajectory file matches 'nope_*.csv' (relative to {tmp_path})",
         f"{man}:4: cases[0].min_static_safty: unknown key 'min_static_safty' (did you mean 'min_static_safety'?)",
         f"{man}:5: cases[0].min_bending_safety: nan is not a finite number",
         f"{man}:6: cases[0].bearing_life_h: a bearing life in hours needs the duty's cycles_per_hour",
         f"{man}:8: cases[0].limits[0].column: unknown output column 'gear:4-1:tt' (did you mean 'gear:4-1:t'?)",
         f"{man}:9: cases[0].limits[1]: give max_abs or max_rms (or both)",
-        f"{man}:10: cases[0].limits[2].column: 5 is not of type 'string'",
+        f"{man}:10: cases[0].limits[2].column: expected a string, got a number (5)",
         f"{man}:10: cases[0].limits[2].max_abs: 1e-300 is out of range (1e-12 <= x <= 1e12 in SI units)",
-        f"{man}:13: cases[1].degrees: 3 is not of type 'boolean'",
-        f"{man}:14: cases[2]: 7 is not of type 'object'",
+        f"{man}:13: cases[1].degrees: expected true or false, got a number (3)",
+        f"{man}:14: cases[2]: expected a mapping, got a number (7)",
         f"{tmp_path / 'bad.yaml'}:1: missing required key 'base'",
         f"{tmp_path / 'bad.yaml'}:1: missing required key 'end_effector'",
         f"{tmp_path / 'bad.yaml'}:1: missing required key 'links'",

@@ -107,7 +107,7 @@ def test_urdf_rating_errors(run_cli, tmp_path, edit, message):
 
 @pytest.mark.parametrize("edit, message", [
     ("{name: xrb, position: 0.0, C: 2900, C0: 3300, type: roller, M: 15}",
-     "joints[2].bearings[0].type: 'rolling' is not one of ['ball', 'cylindrical_roller', 'tapered_roller', 'roller']"),
+     "joints[2].bearings[0].type: expected one of: ball, cylindrical_roller, tapered_roller, roller; got 'rolling'"),
     ("rating: {peak_torque: 0.5, rms_torque: 0.3, max_speed: 15, max_power: 5}}",
      "motors[0].rating.rms_torque: rms_torque 0.9 exceeds peak_torque 0.5"),
 ])

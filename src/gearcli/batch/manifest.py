@@ -20,7 +20,8 @@ from ..errors import Collector, GearcliError
 from ..io import load_mechanism
 from ..io.limits import input_problem
 from ..io.trajectory import TrajectoryReader, forget_rows
-from ..io.yaml_reader import json_path, number_issues, schema_messages
+from ..io.schema_words import schema_messages
+from ..io.yaml_reader import json_path, number_issues
 from ..io.yaml_safe import read_text, yaml_lines
 from ..model.validate import MAX_ABS
 from ..pipeline import analyse, prismatic_independent
@@ -96,7 +97,7 @@ def _range_message(x) -> str:
 
 def _schema_issues(data, col: Collector, skip: set) -> None:
     """Schema violations (except at the paths in ``skip``, already reported), in the words
-    of mechanism files (:func:`gearcli.io.yaml_reader.schema_messages`)."""
+    of mechanism files (:func:`gearcli.io.schema_words.schema_messages`)."""
     validator = jsonschema.Draft202012Validator(design_schema())
     for err in sorted(validator.iter_errors(data), key=lambda e: list(map(str, e.absolute_path))):
         if json_path(err.absolute_path) in skip:    # a non-finite or huge number, reported already
@@ -105,7 +106,7 @@ def _schema_issues(data, col: Collector, skip: set) -> None:
             found = [(list(err.absolute_path), "give max_abs or max_rms (or both)")]
         elif err.validator in ("minimum", "maximum") and isinstance(err.instance, (int, float)):
             found = [(list(err.absolute_path), _range_message(err.instance))]
-        elif err.validator == "pattern" and err.absolute_path and err.absolute_path[-1] == "name":
+        elif err.validator == "pattern" and err.absolute_path and err.absolute_path[-1] == "name" and err.instance:
             found = [(list(err.absolute_path), f"{err.instance!r}: a name without control characters"
                       + (" or spaces (one word)" if len(err.absolute_path) > 1 else ""))]
         else:

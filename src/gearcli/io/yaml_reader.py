@@ -2,14 +2,13 @@
 
 Parsing keeps each node's line (``yaml.compose``) under its YAML path, e.g.
 ``gears[2].mesh_point``, so that every later check can say where a problem is.  The file is
-validated against ``schemas/mechanism.schema.json`` (jsonschema), then checked for names,
-masses and inertias.  Problems are collected and raised together as a
+validated against ``schemas/mechanism.schema.json`` (jsonschema; its errors worded by
+:mod:`.schema_words`), then checked for names, masses and inertias.  Problems are collected and raised together as a
 :class:`~gearcli.errors.MechanismError`.  Degrees (``*_deg`` fields) are converted here;
 nothing below this module knows about them.
 """
 from __future__ import annotations
 
-import difflib
 from pathlib import Path
 
 from functools import lru_cache
@@ -25,6 +24,7 @@ from .planets import expand_planets, item_path
 from .ratings_reader import attach_yaml_ratings
 from ..model.geometry import dh_transform, origin_axis_transform
 from ..model.validate import check_inertia, gear_pair_problems, inertia_matrix, number_problem
+from .schema_words import schema_messages
 from .yaml_safe import read_text, yaml_lines
 from .schemas import packaged_schema
 
@@ -63,48 +63,6 @@ def json_path(parts) -> str:
     for p in parts:
         out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))
     return out
-
-
-def schema_messages(err) -> list[tuple[list, str]]:
-    """(path parts, message) pairs for one jsonschema error, made precise for the common
-    cases: an unknown key is reported at its own path (with a close match), a missing key
-    by name, and a oneOf by the branch whose type fits the value."""
-    path = list(err.absolute_path)
-    if err.validator == "additionalProperties" and isinstance(err.instance, dict):
-        allowed = list(err.schema.get("properties", {}))
-        out = []
-        for key in (k for k in err.instance if k not in allowed):
-            close = difflib.get_close_matches(str(key), allowed, n=1)
-            hint = f"did you mean '{close[0]}'?" if close else f"allowed: {', '.join(allowed)}"
-            out.append((path + [key], f"unknown key '{key}' ({hint})"))
-        return out
-    if err.validator == "required" and isinstance(err.instance, dict):
-        missing = [r for r in err.validator_value if r not in err.instance and repr(r) in err.message]
-        return [(path, f"missing required key '{r}'") for r in missing[:1]] or [(path, err.message)]
-    if err.validator == "maxItems" and path and path[-1] == "bearings" and isinstance(err.instance, list):
-        return [(path, f"a joint has one or two bearings, got {len(err.instance)}")]   # as in URDF files
-    if err.validator == "oneOf" and err.context:
-        branches: dict = {}
-        for e in err.context:
-            branches.setdefault(e.relative_schema_path[0], []).append(e)
-        fitting = [b for b in branches.values()
-                   if not any(e.validator == "type" and list(e.absolute_path) == path for e in b)]
-        if len(fitting) == 1:
-            return [m for e in fitting[0] for m in schema_messages(e)]
-        types = [s.get("type") for s in err.validator_value if isinstance(s, dict) and "type" in s]
-        if types:
-            return [(path, f"{err.instance!r} is not valid: expected {' or '.join(map(str, types))}")]
-    return [(path, _short_message(err))]
-
-
-def _short_message(err) -> str:
-    """jsonschema's message with a long echoed value shortened (``[...] is not of type``)."""
-    message = err.message
-    if len(message) > 200:
-        whole = repr(err.instance)
-        if whole in message:
-            message = message.replace(whole, whole[:60] + "…")
-    return message
 
 
 def _schema_issues(data, col: Collector, skip: set) -> None:
