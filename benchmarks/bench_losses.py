@@ -16,8 +16,9 @@ tick on a busy machine):
 * the same with bearing friction on every bearing (mu 0.0015, bore 20 mm), numpy and llvm:
   a fixed-point iteration per sample, whose iterations are printed (median and worst); numpy:
   :func:`gearcli.dynamics.bearing_friction.fixed_point`, every joint at once; llvm: inside the
-  kernel, block by block (:mod:`gearcli.dynamics.llvm.bearings`), a sample's count the most
-  over its blocks;
+  kernel, block by block (:mod:`gearcli.dynamics.llvm.bearings`), by Newton's method on each
+  constant-frame block's moments (:mod:`gearcli.dynamics.llvm.bearing_newton`), a sample's
+  count the most levels over its blocks;
 * llvm lossless and with bearing friction along a smooth motion (the analytic motion of
   mechanisms/bendix_wrist_traj.csv, continued to --samples at 1 kHz): random states give the
   kernel's warm start (a block's fixed point from the samples before) nothing to start from.

@@ -16,13 +16,14 @@ mu_b d_b P_b of the solved reactions (0 at rest), until every |Mb_J' - Mb_J| <= 
 the Mb that solved (not Mb') is kept.  A constant-frame block searches its sign pattern p
 once, at zero moments; with p fixed its solution is affine in the moments, x = x0 + sum_J
 s_J Mb_J g_J, g_J = X_p w_J (w_J constant in F: constants per pattern for stored maps, the
-corrected map of :class:`~.losses.LossyBlock` per sample), so an iteration updates the 5
-reaction rows of each joint and two square roots, and no branch leads back to the search
-(a short loop on the moments alone).  The tooth forces must fit p (the tolerance of the
-shifted r) at iteration 2 (where the moments have moved from zero) and at the converged
-moments; where they do not, the block goes on from those moments and that iteration as a
-block without a constant couple (world frame) does from the start: the whole block solved,
-its sign search included, each iteration (the numpy path's loop).
+corrected map of :class:`~.losses.LossyBlock` per sample), so are its bearings' load vectors,
+and the moments converge by Newton's method on them alone (:mod:`.bearing_newton`: two
+levels from zero where the fixed point takes five or six, one in a smooth stretch; each a
+square root per bearing and one division, stopped by the fixed point's own test or by
+Newton's proven error bound).  The tooth forces must fit p (the tolerance of the shifted
+r) at the converged moments; where they do not, the block goes on from those moments and
+that iteration as a block without a constant couple (world frame) does from the start: the
+whole block solved, its sign search included, each iteration (the numpy path's loop).
 
 Written per sample in the ``moments`` row: each joint's converged Mb_J, then the most
 iterations over the sample's blocks; -s_J Mb_J joins J's friction output.  A block that does
@@ -34,6 +35,7 @@ from __future__ import annotations
 import llvmlite.ir as ir
 
 from ..bearing_friction import MAX_ITERATIONS, TOL
+from .bearing_newton import loads, newton
 from .build import D, I1, I64, Emitter
 from .links import Sample, floats
 from .losses import _sign
@@ -133,9 +135,9 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
             return _consistent(e, at(Mb, tcols), [_sign_bit(e, p, i, m) for i in range(m)],
                                tolerance(e, jt.shifted(e, r, Mb)))
         again = fn.append_basic_block(f"{tag}_bagain") if m else None
-        Mb, it, failb = _loop(e, fn, f"{tag}_ba", start, lambda Mb: jt.moments(e, lp, bb, [
-            [e.add(S0[j][h], e.dot([SG[j][i][h] for i in range(K)], Mb)) for h in range(5)] for j in range(K)]),
-            prog, bb, fail, n, fits if m else None, again)
+        quad = [loads(e, lp, k, S0[j], SG[j]) for j, k in enumerate(bb.joints)]
+        Mb, it, failb, Mf = newton(e, fn, f"{tag}_ba", start, quad, jt.moving,
+                                   lambda g, change: _failed(e, prog, bb, g, change, fail, n))
         x, start = at(Mb), None
         if m:                  # converged: do the tooth forces fit p? else the whole block's loop from Mb
             fit_bb = fn.append_basic_block(f"{tag}_bfit")
@@ -145,7 +147,7 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
         ends.append((e.b.block, Mb, it, x, p))
         e.b.branch(done_bb)
         e.b.position_at_end(failb)
-        ends.append((failb, Mb, it, at(Mb), p))
+        ends.append((failb, Mf, it, at(Mf), p))
         e.b.branch(done_bb)
         if start is not None:
             e.b.position_at_end(again)
@@ -166,11 +168,10 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
     return x, (None if p is None else p[0])
 
 
-def _loop(e: Emitter, fn, tag: str, start: tuple, step, prog, bb, fail, n, check=None, bail=None):
+def _loop(e: Emitter, fn, tag: str, start: tuple, step, prog, bb, fail, n):
     """Iterate Mb <- step(Mb) from ``start`` (Mb, its iteration number) until every
     |Mb' - Mb| <= TOL |Mb'| (:func:`_within`): returns (the Mb that solved, its iteration, the
-    block reached after MAX_ITERATIONS, which records ``fail``), the builder at the converged exit.
-    ``check(Mb)`` (i1), tested at iteration 2 only: false goes to ``bail`` with (Mb, it)."""
+    block reached after MAX_ITERATIONS, which records ``fail``), the builder at the converged exit."""
     pre = e.b.block
     body, more, out, failb = (fn.append_basic_block(f"{tag}_{x}") for x in ("it", "more", "out", "fail"))
     e.b.branch(body)
@@ -178,12 +179,6 @@ def _loop(e: Emitter, fn, tag: str, start: tuple, step, prog, bb, fail, n, check
     Mb, it = [e.b.phi(D) for _ in start[0]], e.b.phi(I64)
     new = step(Mb)
     change, ok = _within(e, new, Mb)
-    if check is not None:
-        chk, cont = fn.append_basic_block(f"{tag}_chk"), fn.append_basic_block(f"{tag}_cont")
-        e.b.cbranch(e.b.icmp_signed("==", it, ir.Constant(I64, 2)), chk, cont)
-        e.b.position_at_end(chk)
-        e.b.cbranch(check(Mb), cont, bail)
-        e.b.position_at_end(cont)
     e.b.cbranch(ok, out, more)
     e.b.position_at_end(more)
     it1 = e.b.add(it, ir.Constant(I64, 1))
