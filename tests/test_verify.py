@@ -469,6 +469,24 @@ def test_mission_profile_hours_need_the_service_life(run_cli, tmp_path):
         in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
 
 
+@pytest.mark.parametrize("share,message", [
+    ("hours: 0", "hours: must be positive, got 0"),
+    ("cycles_per_hour: -3", "cycles_per_hour: must be positive, got -3"),
+    ("hours: 1.0e-13", "hours: 1e-13 is out of range (1e-12 <= x <= 1e12 in SI units)"),
+    ("fraction: 1.5", "fraction: expected at most 1, got 1.5"),
+])
+def test_mission_profile_share_out_of_range_worded_as_the_case_numbers(run_cli, tmp_path, share, message):
+    """A share's number is worded as the case's own numbers (``cases[0].cycles_per_hour: must be
+    positive, got 0``), not in the schema's words of a bound; a fraction keeps its own range."""
+    write_rotor_case(tmp_path, "[{name: x, position: 0, C: 3000, C0: 3000, type: ball}]")
+    man = tmp_path / "design.yaml"
+    man.write_text("cases:\n  - {mechanism: rotor.yaml, service_life_h: 100, bearing_life_h: 10,\n"
+                   f"     trajectories: [{{file: rotor.csv, {share}}}]}}\n")
+    r = run_cli("verify", man, "-j", "1")
+    lines = r.stderr.strip().splitlines()
+    assert r.exit_code == 2 and r.stdout == "" and lines == [f"{man}:3: cases[0].trajectories[0].{message}"], r.stderr
+
+
 def test_load_spectra_sum_to_the_duty_and_its_revolutions(run_cli, tmp_path):
     # The rotor at constant rate W for 2 s, 1800 times an hour: every spectrum holds 3600 s
     # per hour, and the bearing's turns W T / 2 pi x 1800 per hour, all in the one bin of its

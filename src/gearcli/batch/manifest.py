@@ -102,10 +102,12 @@ def _schema_issues(data, col: Collector, skip: set) -> None:
     for err in sorted(validator.iter_errors(data), key=lambda e: list(map(str, e.absolute_path))):
         if json_path(err.absolute_path) in skip:    # a non-finite or huge number, reported already
             continue
+        leaf = _leaf(err)
         if err.validator == "anyOf":
             found = [(list(err.absolute_path), "give max_abs or max_rms (or both)")]
-        elif err.validator in ("minimum", "maximum") and isinstance(err.instance, (int, float)):
-            found = [(list(err.absolute_path), _range_message(err.instance))]
+        elif leaf.validator in ("minimum", "maximum") and isinstance(leaf.instance, (int, float)) \
+                and leaf.schema.get("minimum") == MIN_POSITIVE:        # the schema's "positive"
+            found = [(list(leaf.absolute_path), _range_message(leaf.instance))]
         elif err.validator == "pattern" and err.absolute_path and err.absolute_path[-1] == "name" and err.instance:
             found = [(list(err.absolute_path), f"{err.instance!r}: a name without control characters"
                       + (" or spaces (one word)" if len(err.absolute_path) > 1 else ""))]
@@ -114,6 +116,16 @@ def _schema_issues(data, col: Collector, skip: set) -> None:
         for parts, message in found:
             if json_path(parts) not in skip:
                 col.add(json_path(parts), message)
+
+
+def _leaf(err):
+    """The error itself, or inside a oneOf (trajectories given as a file name or as a list,
+    one with its share) the deepest of its branches' errors, the one in the branch the value
+    took: a share's number out of range is then worded as every other manifest number's
+    (:func:`_range_message`)."""
+    while err.validator == "oneOf" and err.context:
+        err = max(err.context, key=lambda e: len(e.absolute_path))
+    return err
 
 
 def _with_enclosing(paths) -> set:
