@@ -506,6 +506,23 @@ def test_overhung_shaft_bearing_friction_by_hand():
     assert rest.bearing_iterations[0] == 1
 
 
+@pytest.mark.parametrize("mu,d", [(0.3, 0.06), (0.5, 0.08)])
+def test_large_bearing_friction_converges_on_both_paths(mu, d):
+    """The overhung shaft with friction that is a third and then 70 % of the load it changes
+    (contraction mu d k / (2 cos phi r_k) = 0.32 and 0.71 an iteration): the numpy fixed point
+    (~25 and ~80 iterations) and the kernel's Newton levels both reach the closed form; with
+    the old limit of 50 iterations the numpy path raised at 0.71 where the kernel converged."""
+    z1, z2, ML, rk = 0.02, 0.06, -4.0, 0.06
+    an = analyse(parse_mechanism(SHAFT.format(z1=z1, z2=z2, mu=mu, d=d, ML=ML)))
+    k = (z2 + z1) / (z2 - z1)
+    t = abs(ML) / (rk - mu * d * k / (2 * np.cos(np.deg2rad(20))))
+    n = 300
+    for backend in ("numpy", "llvm"):
+        res = solve(an, np.zeros((n, 1)), np.full((n, 1), 2.0), np.zeros((n, 1)), backend=backend)
+        assert np.allclose(np.abs(res.gear_t[:, 0]), t, rtol=1e-11, atol=0.0), backend
+        assert res.bearing_iterations.max() <= (100 if backend == "numpy" else 4)
+
+
 @pytest.mark.parametrize("old,new,place,message", [
     ("friction_coefficient: 0.05, bore: 0.03, locating: true", "friction_coefficient: 0.05, locating: true",
      "joints[1].bearings[0].friction_coefficient", "bearing friction needs both friction_coefficient and bore"),

@@ -27,7 +27,13 @@ from ..errors import GearcliError
 from .losses import joint_axis_wrench
 
 TOL = 1e-12
-MAX_ITERATIONS = 50
+MAX_ITERATIONS = 500
+"""The most iterations (numpy's fixed point) or Newton levels (the kernel, :mod:`.llvm.
+bearing_newton`) a sample may take.  The fixed point contracts by Lambda an iteration (the
+friction moment's rate per unit of itself through the loads it changes) and so needs ~log(1e-12)
+/ log(Lambda) of them: 500 reach the tolerance up to Lambda ~0.945 (50 did up to 0.57, where
+Newton's levels converge in two or three: both paths then gave different answers, one an
+error); at Lambda >= 1 the friction locks the mechanism and no path converges."""
 
 
 class BearingFrictionError(GearcliError):
