@@ -64,15 +64,15 @@ def loads(e: Emitter, lp, k: int, S0: list, SG: list) -> list:
     return out
 
 
-def level(e: Emitter, quad: list, moving: list, Mb: list):
-    """(g, N, D, P) at the moments Mb: g (K), the Jacobian J_ki = N_ki / D_k (K x K; D_k the
+def level(e: Emitter, lv: list, moving: list, Mb: list):
+    """(g, N, D, P) at the moments Mb (``lv``: per joint its bearings' :func:`loads`): g (K), the Jacobian J_ki = N_ki / D_k (K x K; D_k the
     product of joint k's bearing loads, 1 where one is 0: J_k = 0 there, a fixed-point step)
     and each joint's bearings' loads P (P_b = |u_b| from the vector, not from its square's
     expanded form, which cancels where a bearing's load nearly vanishes)."""
     K = len(Mb)
     g, N, D, P = [], [], [], []
     zero, one = ir.Constant(D_, 0.0), ir.Constant(D_, 1.0)
-    for k, bearings in enumerate(quad):
+    for k, bearings in enumerate(lv):
         gk, Nk, Dk, Pk = 0.0, [0.0] * K, 1.0, []
         for h, u0, ug, _ in bearings:
             u = [e.add(u0[c], e.dot([v[c] for v in ug], Mb)) for c in range(3)]
@@ -114,7 +114,7 @@ def step(e: Emitter, N: list, D: list, r: list) -> list:
     return x
 
 
-def proven(e: Emitter, quad: list, moving: list, P: list, r: list, new: list):
+def proven(e: Emitter, lv: list, moving: list, P: list, r: list, new: list):
     """i1: Newton's error bound after the step to ``new`` is within TOL of every moving
     joint's moment (module docstring), without a division: with room = 1 - Lambda, e =
     ||r|| / room, Pmin_b = slack_b / room, slack_b = P_b room - sigma_b ||r||, and S = max_k
@@ -127,7 +127,7 @@ def proven(e: Emitter, quad: list, moving: list, P: list, r: list, new: list):
         return e.b.select(e.b.fcmp_ordered("<", e.const(x), e.const(y)), e.const(x), e.const(y))
     zero, inf = ir.Constant(D_, 0.0), ir.Constant(D_, float("inf"))
     lam, S, rn, small = zero, zero, zero, inf
-    for k, bearings in enumerate(quad):
+    for k, bearings in enumerate(lv):
         mv = moving[k]
         lam = fmax(lam, e.b.select(mv, e.const(e.dot([h for h, *_ in bearings], [s for *_, s in bearings])), zero))
         S = fmax(S, e.b.select(mv, e.const(e.dot([h for h, *_ in bearings], [e.mul(s, s) for *_, s in bearings])), zero))
@@ -135,7 +135,7 @@ def proven(e: Emitter, quad: list, moving: list, P: list, r: list, new: list):
         small = fmin(small, e.b.select(mv, e.const(e.call("fabs", new[k])), inf))
     room = e.sub(1.0, lam)
     slack = inf
-    for k, bearings in enumerate(quad):
+    for k, bearings in enumerate(lv):
         for (*_, sigma), p in zip(bearings, P[k]):
             slack = fmin(slack, e.b.select(moving[k], e.const(e.sub(e.mul(p, room), e.mul(sigma, rn))), inf))
     lhs = e.mul(0.5, e.mul(S, e.mul(rn, rn)))
@@ -144,7 +144,7 @@ def proven(e: Emitter, quad: list, moving: list, P: list, r: list, new: list):
     return e.b.and_(ok, e.b.fcmp_ordered("<=", e.const(lhs), e.const(rhs)))
 
 
-def newton(e: Emitter, fn, tag: str, start: tuple, quad: list, moving: list, failed):
+def newton(e: Emitter, fn, tag: str, start: tuple, lv: list, moving: list, failed):
     """Levels from ``start`` (Mb, its iteration number) until the fixed point's test holds
     or Newton's step is proven (module docstring): returns (the Mb kept, its iteration, the
     block reached after MAX_ITERATIONS levels, where ``failed(g, |r|)`` records the
@@ -154,7 +154,7 @@ def newton(e: Emitter, fn, tag: str, start: tuple, quad: list, moving: list, fai
     e.b.branch(body)
     e.b.position_at_end(body)
     Mb, it = [e.b.phi(D_) for _ in start[0]], e.b.phi(I64)
-    g, N, Dn, P = level(e, quad, moving, Mb)
+    g, N, Dn, P = level(e, lv, moving, Mb)
     r = [e.sub(gk, m) for gk, m in zip(g, Mb)]
     change = [e.call("fabs", v) for v in r]
     ok = ir.Constant(I1, 1)
@@ -165,7 +165,7 @@ def newton(e: Emitter, fn, tag: str, start: tuple, quad: list, moving: list, fai
     e.b.position_at_end(tried)
     new = [e.add(m, d) for m, d in zip(Mb, step(e, N, Dn, r))]
     there = e.b.block
-    e.b.cbranch(proven(e, quad, moving, P, r, new), out, more)
+    e.b.cbranch(proven(e, lv, moving, P, r, new), out, more)
     e.b.position_at_end(more)
     it1 = e.b.add(it, ir.Constant(I64, 1))
     e.b.cbranch(e.b.icmp_signed("<=", it1, ir.Constant(I64, MAX_ITERATIONS)), body, failb)

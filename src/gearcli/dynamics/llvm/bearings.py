@@ -135,8 +135,8 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
             return _consistent(e, at(Mb, tcols), [_sign_bit(e, p, i, m) for i in range(m)],
                                tolerance(e, jt.shifted(e, r, Mb)))
         again = fn.append_basic_block(f"{tag}_bagain") if m else None
-        quad = [loads(e, lp, k, S0[j], SG[j]) for j, k in enumerate(bb.joints)]
-        Mb, it, failb, Mf = newton(e, fn, f"{tag}_ba", start, quad, jt.moving,
+        lv = [loads(e, lp, k, S0[j], SG[j]) for j, k in enumerate(bb.joints)]
+        Mb, it, failb, Mf = newton(e, fn, f"{tag}_ba", start, lv, jt.moving,
                                    lambda g, change: _failed(e, prog, bb, g, change, fail, n))
         x, start = at(Mb), None
         if m:                  # converged: do the tooth forces fit p? else the whole block's loop from Mb
