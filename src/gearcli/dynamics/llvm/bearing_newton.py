@@ -36,6 +36,7 @@ import llvmlite.ir as ir
 
 from ..bearing_friction import MAX_ITERATIONS, TOL
 from .build import D as D_, I1, I64, Emitter
+from .world import lu_solve
 
 
 def _vectors(lp, k: int, R: list) -> list:
@@ -91,27 +92,20 @@ def level(e: Emitter, lv: list, moving: list, Mb: list):
 
 def step(e: Emitter, N: list, D: list, r: list) -> list:
     """Delta solving (1 - J) Delta = r, J_ki = N_ki / D_k: rows scaled by D_k, (D - N) Delta =
-    D r, by Cramer's rule for K <= 2 (one division), else Gaussian elimination without
-    pivoting (1 - J is diagonally dominant, ||J|| <= Lambda < 1)."""
+    D r; one division for one joint, Cramer's rule's one for two, else
+    :func:`.world.lu_solve` in row order (1 - J is diagonally dominant, ||J|| <= Lambda < 1:
+    no pivoting)."""
     K = len(r)
-    A = [[e.sub(D[i] if i == j else 0.0, N[i][j]) for j in range(K)] + [e.mul(D[i], r[i])] for i in range(K)]
+    A = [[e.sub(D[i] if i == j else 0.0, N[i][j]) for j in range(K)] for i in range(K)]
+    b = [e.mul(D[i], r[i]) for i in range(K)]
     if K == 1:
-        return [e.div(A[0][1], A[0][0])]
+        return [e.div(b[0], A[0][0])]
     if K == 2:
         inv = e.div(1.0, e.sub(e.mul(A[0][0], A[1][1]), e.mul(A[0][1], A[1][0])))
-        return [e.mul(inv, e.sub(e.mul(A[0][2], A[1][1]), e.mul(A[0][1], A[1][2]))),
-                e.mul(inv, e.sub(e.mul(A[0][0], A[1][2]), e.mul(A[1][0], A[0][2])))]
-    for c in range(K):
-        for i in range(c + 1, K):
-            f = e.div(A[i][c], A[c][c])
-            A[i] = [e.sub(A[i][j], e.mul(f, A[c][j])) for j in range(K + 1)]
-    x = [0.0] * K
-    for i in reversed(range(K)):
-        acc = A[i][K]
-        for j in range(i + 1, K):
-            acc = e.sub(acc, e.mul(A[i][j], x[j]))
-        x[i] = e.div(acc, A[i][i])
-    return x
+        return [e.mul(inv, e.sub(e.mul(b[0], A[1][1]), e.mul(A[0][1], b[1]))),
+                e.mul(inv, e.sub(e.mul(A[0][0], b[1]), e.mul(A[1][0], b[0])))]
+    X, _ = lu_solve(e, A, [[v] for v in b], list(range(K)), [-1] * K)
+    return [row[0] for row in X]
 
 
 def proven(e: Emitter, lv: list, moving: list, P: list, r: list, new: list):
@@ -144,6 +138,16 @@ def proven(e: Emitter, lv: list, moving: list, P: list, r: list, new: list):
     return e.b.and_(ok, e.b.fcmp_ordered("<=", e.const(lhs), e.const(rhs)))
 
 
+def within(e: Emitter, new: list, old: list):
+    """(|new - old| per joint, i1: each <= TOL |new| + 1e-300): the fixed point's test
+    (:func:`..bearing_friction.fixed_point`), of a Newton level and of :func:`.bearings._loop`."""
+    change = [e.call("fabs", e.sub(v, o)) for v, o in zip(new, old)]
+    ok = ir.Constant(I1, 1)
+    for v, c in zip(new, change):
+        ok = e.b.and_(ok, e.b.fcmp_ordered("<=", c, e.const(e.add(e.mul(TOL, e.call("fabs", v)), 1e-300))))
+    return change, ok
+
+
 def newton(e: Emitter, fn, tag: str, start: tuple, lv: list, moving: list, failed):
     """Levels from ``start`` (Mb, its iteration number) until the fixed point's test holds
     or Newton's step is proven (module docstring): returns (the Mb kept, its iteration, the
@@ -156,10 +160,7 @@ def newton(e: Emitter, fn, tag: str, start: tuple, lv: list, moving: list, faile
     Mb, it = [e.b.phi(D_) for _ in start[0]], e.b.phi(I64)
     g, N, Dn, P = level(e, lv, moving, Mb)
     r = [e.sub(gk, m) for gk, m in zip(g, Mb)]
-    change = [e.call("fabs", v) for v in r]
-    ok = ir.Constant(I1, 1)
-    for gk, c in zip(g, change):
-        ok = e.b.and_(ok, e.b.fcmp_ordered("<=", c, e.const(e.add(e.mul(TOL, e.call("fabs", gk)), 1e-300))))
+    change, ok = within(e, g, Mb)
     here = e.b.block
     e.b.cbranch(ok, out, tried)
     e.b.position_at_end(tried)

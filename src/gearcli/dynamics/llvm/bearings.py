@@ -35,7 +35,7 @@ from __future__ import annotations
 import llvmlite.ir as ir
 
 from ..bearing_friction import MAX_ITERATIONS, TOL
-from .bearing_newton import loads, newton
+from .bearing_newton import loads, newton, within
 from .build import D, I1, I64, Emitter
 from .links import Sample, floats
 from .losses import _sign
@@ -97,15 +97,6 @@ class _Joints:
         """Mb' of each joint from its :func:`split` S (0 at rest)."""
         return [e.b.select(mv, e.const(moment(e, lp, k, Sj)), ir.Constant(D, 0.0))
                 for mv, k, Sj in zip(self.moving, bb.joints, S)]
-
-
-def _within(e: Emitter, new: list, old: list):
-    """(|new - old| per joint, i1: each <= TOL |new| + 1e-300, bearing_friction's test)."""
-    change = [e.call("fabs", e.sub(v, o)) for v, o in zip(new, old)]
-    ok = ir.Constant(I1, 1)
-    for v, c in zip(new, change):
-        ok = e.b.and_(ok, e.b.fcmp_ordered("<=", c, e.const(e.add(e.mul(TOL, e.call("fabs", v)), 1e-300))))
-    return change, ok
 
 
 def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols: list, r: list, solve, rows,
@@ -170,7 +161,7 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
 
 def _loop(e: Emitter, fn, tag: str, start: tuple, step, prog, bb, fail, n):
     """Iterate Mb <- step(Mb) from ``start`` (Mb, its iteration number) until every
-    |Mb' - Mb| <= TOL |Mb'| (:func:`_within`): returns (the Mb that solved, its iteration, the
+    |Mb' - Mb| <= TOL |Mb'| (:func:`.bearing_newton.within`): returns (the Mb that solved, its iteration, the
     block reached after MAX_ITERATIONS, which records ``fail``), the builder at the converged exit."""
     pre = e.b.block
     body, more, out, failb = (fn.append_basic_block(f"{tag}_{x}") for x in ("it", "more", "out", "fail"))
@@ -178,7 +169,7 @@ def _loop(e: Emitter, fn, tag: str, start: tuple, step, prog, bb, fail, n):
     e.b.position_at_end(body)
     Mb, it = [e.b.phi(D) for _ in start[0]], e.b.phi(I64)
     new = step(Mb)
-    change, ok = _within(e, new, Mb)
+    change, ok = within(e, new, Mb)
     e.b.cbranch(ok, out, more)
     e.b.position_at_end(more)
     it1 = e.b.add(it, ir.Constant(I64, 1))
