@@ -65,6 +65,15 @@ def loads(e: Emitter, lp, k: int, S0: list, SG: list) -> list:
     return out
 
 
+def unaffected(lv: list) -> bool:
+    """True when no bearing load of the block depends on its joints' moments: every ug_bi is
+    the constant 0 (known when the code is generated: the block's stored map sends the
+    couples only to unknowns the splits do not read, e.g. a link whose other unknown is its
+    motor torque about the same axis).  Then g is constant, Mb* = g(0) exactly, in one
+    iteration and without a Newton level (the fixed point's second iteration only confirms it)."""
+    return all(isinstance(c, float) and c == 0.0 for bearings in lv for *_, ug, _ in bearings for u in ug for c in u)
+
+
 def level(e: Emitter, lv: list, moving: list, Mb: list):
     """(g, N, D, P) at the moments Mb (``lv``: per joint its bearings' :func:`loads`): g (K), the Jacobian J_ki = N_ki / D_k (K x K; D_k the
     product of joint k's bearing loads, 1 where one is 0: J_k = 0 there, a fixed-point step)

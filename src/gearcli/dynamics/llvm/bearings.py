@@ -20,7 +20,9 @@ corrected map of :class:`~.losses.LossyBlock` per sample), so are its bearings' 
 and the moments converge by Newton's method on them alone (:mod:`.bearing_newton`: two
 levels from zero where the fixed point takes five or six, one in a smooth stretch; each a
 square root per bearing and one division, stopped by the fixed point's own test or by
-Newton's proven error bound).  The tooth forces must fit p (the tolerance of the shifted
+Newton's proven error bound).  Where no bearing load of the block depends on the moments
+(:func:`.bearing_newton.unaffected`: a link whose other unknown is its motor torque about
+the same axis takes the couple there) Mb = g(0) exactly, one iteration and no level.  The tooth forces must fit p (the tolerance of the shifted
 r) at the converged moments; where they do not, the block goes on from those moments and
 that iteration as a block without a constant couple (world frame) does from the start: the
 whole block solved, its sign search included, each iteration (the numpy path's loop).
@@ -35,7 +37,7 @@ from __future__ import annotations
 import llvmlite.ir as ir
 
 from ..bearing_friction import MAX_ITERATIONS, TOL
-from .bearing_newton import loads, newton, within
+from .bearing_newton import level, loads, newton, unaffected, within
 from .build import D, I1, I64, Emitter
 from .links import Sample, floats
 from .losses import _sign
@@ -127,8 +129,11 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
                                tolerance(e, jt.shifted(e, r, Mb)))
         again = fn.append_basic_block(f"{tag}_bagain") if m else None
         lv = [loads(e, lp, k, S0[j], SG[j]) for j, k in enumerate(bb.joints)]
-        Mb, it, failb, Mf = newton(e, fn, f"{tag}_ba", start, lv, jt.moving,
-                                   lambda g, change: _failed(e, prog, bb, g, change, fail, n))
+        if unaffected(lv):     # the loads do not see the moments: Mb* = g(0), one iteration, nothing to fail
+            Mb, it, failb = level(e, lv, jt.moving, [0.0] * K)[0], ir.Constant(I64, 1), None
+        else:
+            Mb, it, failb, Mf = newton(e, fn, f"{tag}_ba", start, lv, jt.moving,
+                                       lambda g, change: _failed(e, prog, bb, g, change, fail, n))
         x, start = at(Mb), None
         if m:                  # converged: do the tooth forces fit p? else the whole block's loop from Mb
             fit_bb = fn.append_basic_block(f"{tag}_bfit")
@@ -137,9 +142,10 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
             e.b.position_at_end(fit_bb)
         ends.append((e.b.block, Mb, it, x, p))
         e.b.branch(done_bb)
-        e.b.position_at_end(failb)
-        ends.append((failb, Mf, it, at(Mf), p))
-        e.b.branch(done_bb)
+        if failb is not None:
+            e.b.position_at_end(failb)
+            ends.append((failb, Mf, it, at(Mf), p))
+            e.b.branch(done_bb)
         if start is not None:
             e.b.position_at_end(again)
     if start is not None:     # the whole block solved each iteration (a world-frame block, or a changed pattern)
