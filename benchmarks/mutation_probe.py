@@ -216,7 +216,7 @@ MUTATIONS = [
     Mutation("llvm-bearing-bound", "llvm: bearing friction Newton step accepted without its error bound",
              (("dynamics/llvm/bearing_newton.py", "lhs = e.mul(0.5, e.mul(S, e.mul(rn, rn)))", "lhs = 0.0"),)),
     Mutation("llvm-bearing-unaffected", "llvm: bearing friction taken as g(0) in one iteration where the loads do depend on the moments",
-             (("dynamics/llvm/bearing_newton.py", "isinstance(c, float) and c == 0.0 for bearings", "True or c == 0.0 for bearings"),)),
+             (("dynamics/llvm/bearing_newton.py", "return all(_constant(sigma) for bearings", "return True or all(_constant(sigma) for bearings"),)),
     Mutation("llvm-bearing-later-couple", "llvm: bearing friction couple passed on to a later block's link with the child's sign on the parent",
              (("dynamics/llvm/bearings.py", "e.mul(sign, e.mul(amount, jt.zw[j][h]))", "e.mul(amount, jt.zw[j][h])"),)),
     Mutation("llvm-sin-quadrant", "llvm: inline sin with the quadrant's sign flipped",

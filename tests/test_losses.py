@@ -523,6 +523,23 @@ def test_large_bearing_friction_converges_on_both_paths(mu, d):
         assert res.bearing_iterations.max() <= (100 if backend == "numpy" else 4)
 
 
+def test_gear_in_the_plane_of_its_bearing():
+    """The overhung shaft with its near bearing in the mesh plane (z1 = 0): it takes the whole
+    tooth force, the far bearing nothing (R2 = -|g| z1 / (z2 - z1) = 0 at every moment), k = 1
+    in the closed form.  Both paths reach it; the kernel's Newton levels keep the near
+    bearing's Jacobian and their proof (the unloaded bearing's term is 0: it bends nothing),
+    so they stop in two levels, not in the ~16 of the fixed point they fell back to while a
+    zero load zeroed the joint's Jacobian."""
+    z1, z2, mu, d, ML, rk = 0.0, 0.06, 0.3, 0.06, -4.0, 0.06
+    an = analyse(parse_mechanism(SHAFT.format(z1=z1, z2=z2, mu=mu, d=d, ML=ML)))
+    t = abs(ML) / (rk - mu * d / (2 * np.cos(np.deg2rad(20))))
+    for backend, most in (("numpy", 30), ("llvm", 3)):
+        res = solve(an, np.zeros((50, 1)), np.full((50, 1), 2.0), np.zeros((50, 1)), backend=backend)
+        assert np.allclose(np.abs(res.gear_t[:, 0]), t, rtol=1e-11, atol=0.0), backend
+        assert np.allclose(res.joint_friction[:, 1], -0.5 * mu * d * t / np.cos(np.deg2rad(20)), rtol=1e-11, atol=0.0)
+        assert res.bearing_iterations.max() <= most, backend
+
+
 @pytest.mark.parametrize("old,new,place,message", [
     ("friction_coefficient: 0.05, bore: 0.03, locating: true", "friction_coefficient: 0.05, locating: true",
      "joints[1].bearings[0].friction_coefficient", "bearing friction needs both friction_coefficient and bore"),

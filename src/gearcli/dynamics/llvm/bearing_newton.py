@@ -20,7 +20,8 @@ A level stops the iteration (:func:`newton`) where either
   with sigma_b = sum_i |ug_bi|_1 (>= the rate of P_b per unit Mb in the max norm) and
   Lambda = max_k sum_b h_b sigma_b (g's Lipschitz constant, max norm, < 1), e = ||r|| /
   (1 - Lambda) bounds ||Mb* - Mb||; along the segment to Mb* P_b >= Pmin_b = P_b - sigma_b e
-  and g's second derivative is at most H = max_k sum_b h_b sigma_b^2 / min_b Pmin_b, so
+  and g's second derivative is at most H = max_k sum_b h_b sigma_b^2 / min_b Pmin_b (b with
+  sigma_b > 0: a load the moments do not move bends nothing, even at 0), so
   ||Mb* - (Mb + Delta)|| <= 1/2 H e^2 / (1 - Lambda) (Taylor's remainder, ||(1 - J)^-1|| <=
   1 / (1 - Lambda)), which must be <= TOL |Mb_k + Delta_k| for every moving joint (any
   Pmin_b <= 0 or Lambda >= 1: no proof, the next level).
@@ -65,18 +66,25 @@ def loads(e: Emitter, lp, k: int, S0: list, SG: list) -> list:
     return out
 
 
+def _constant(sigma) -> bool:
+    """sigma_b is the constant 0: bearing b's load does not depend on the moments (ug_b = 0)."""
+    return isinstance(sigma, float) and sigma == 0.0
+
+
 def unaffected(lv: list) -> bool:
     """True when no bearing load of the block depends on its joints' moments: every ug_bi is
     the constant 0 (known when the code is generated: the block's stored map sends the
     couples only to unknowns the splits do not read, e.g. a link whose other unknown is its
     motor torque about the same axis).  Then g is constant, Mb* = g(0) exactly, in one
     iteration and without a Newton level (the fixed point's second iteration only confirms it)."""
-    return all(isinstance(c, float) and c == 0.0 for bearings in lv for *_, ug, _ in bearings for u in ug for c in u)
+    return all(_constant(sigma) for bearings in lv for *_, sigma in bearings)
 
 
 def level(e: Emitter, lv: list, moving: list, Mb: list):
     """(g, N, D, P) at the moments Mb (``lv``: per joint its bearings' :func:`loads`): g (K), the Jacobian J_ki = N_ki / D_k (K x K; D_k the
-    product of joint k's bearing loads, 1 where one is 0: J_k = 0 there, a fixed-point step)
+    product of joint k's nonzero bearing loads: a load P_b = 0 has u_b = 0, so its term of
+    J is 0 (the subgradient 0 of |u| at 0: a gear in the plane of one bearing leaves the other
+    unloaded); 1 for a joint at rest)
     and each joint's bearings' loads P (P_b = |u_b| from the vector, not from its square's
     expanded form, which cancels where a bearing's load nearly vanishes)."""
     K = len(Mb)
@@ -84,12 +92,14 @@ def level(e: Emitter, lv: list, moving: list, Mb: list):
     zero, one = ir.Constant(D_, 0.0), ir.Constant(D_, 1.0)
     for k, bearings in enumerate(lv):
         gk, Nk, Dk, Pk = 0.0, [0.0] * K, 1.0, []
-        for h, u0, ug, _ in bearings:
+        for h, u0, ug, sigma in bearings:
             u = [e.add(u0[c], e.dot([v[c] for v in ug], Mb)) for c in range(3)]
             p = e.call("sqrt", e.dot(u, u))
             gk = e.add(gk, e.mul(h, p))        # N/D + h d / p = (N p + h d D) / (D p)
-            Nk = [e.add(e.mul(Nk[i], p), e.mul(e.mul(h, Dk), e.dot(u, ug[i]))) for i in range(K)]
-            Dk = e.mul(Dk, p)
+            if not _constant(sigma):           # p = 0: u = 0, u . ug = 0, the term 0 with p read as 1
+                q = e.b.select(e.b.fcmp_ordered(">", e.const(p), zero), e.const(p), one)
+                Nk = [e.add(e.mul(Nk[i], q), e.mul(e.mul(h, Dk), e.dot(u, ug[i]))) for i in range(K)]
+                Dk = e.mul(Dk, q)
             Pk.append(p)
         use = e.b.and_(moving[k], e.b.fcmp_ordered(">", e.const(Dk), zero))
         g.append(e.b.select(moving[k], e.const(gk), zero))
@@ -122,7 +132,7 @@ def proven(e: Emitter, lv: list, moving: list, P: list, r: list, new: list):
     joint's moment (module docstring), without a division: with room = 1 - Lambda, e =
     ||r|| / room, Pmin_b = slack_b / room, slack_b = P_b room - sigma_b ||r||, and S = max_k
     sum_b h_b sigma_b^2, the bound 1/2 S e^2 / (min_b Pmin_b room) <= TOL min_k |new_k| reads
-    1/2 S ||r||^2 <= TOL min_k |new_k| min_b slack_b room^2 (with room > 0, every slack_b > 0)."""
+    1/2 S ||r||^2 <= TOL min_k |new_k| min_b slack_b room^2 (with room > 0, every slack_b > 0 of a bearing with sigma_b > 0)."""
     def fmax(x, y):
         return e.b.select(e.b.fcmp_ordered(">", e.const(x), e.const(y)), e.const(x), e.const(y))
 
@@ -140,7 +150,10 @@ def proven(e: Emitter, lv: list, moving: list, P: list, r: list, new: list):
     slack = inf
     for k, bearings in enumerate(lv):
         for (*_, sigma), p in zip(bearings, P[k]):
-            slack = fmin(slack, e.b.select(moving[k], e.const(e.sub(e.mul(p, room), e.mul(sigma, rn))), inf))
+            if _constant(sigma):               # sigma_b = 0: no curvature, whatever P_b
+                continue
+            counts = e.b.and_(moving[k], e.b.fcmp_ordered(">", e.const(sigma), zero))
+            slack = fmin(slack, e.b.select(counts, e.const(e.sub(e.mul(p, room), e.mul(sigma, rn))), inf))
     lhs = e.mul(0.5, e.mul(S, e.mul(rn, rn)))
     rhs = e.mul(e.mul(TOL, small), e.mul(slack, e.mul(room, room)))
     ok = e.b.and_(e.b.fcmp_ordered(">", e.const(room), zero), e.b.fcmp_ordered(">", e.const(slack), zero))
