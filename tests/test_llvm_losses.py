@@ -27,7 +27,7 @@ from gearcli.dynamics.llvm.bearings import WARM
 from gearcli.dynamics.signs import SignError
 from gearcli.dynamics.solve import solve, solver_for
 from metrics import nan_accelerations, per_sample_loads, sample_err
-from test_losses import PLANETARY, RACK, SHAFT, SPUR, with_losses
+from test_losses import MOTOR_SHAFT, PLANETARY, RACK, SHAFT, SPUR, with_losses
 
 pytest.importorskip("llvmlite")
 
@@ -42,6 +42,7 @@ HAND = {
     "rack": lambda: RACK.format(Fc=12.0, Fv=30.0, eta=0.9, F=-50.0),
     "planetary": lambda: PLANETARY.format(a=0.03, rs=0.012, rr=0.048, eta=0.98, Tc=-3.0),
     "shaft": lambda: SHAFT.format(z1=0.02, z2=0.06, mu=0.05, d=0.03, ML=-4.0),
+    "motor_shaft": lambda: MOTOR_SHAFT.format(z1=0.02, z2=0.06, mu=0.05, d=0.03, ML=-4.0),
 }
 
 

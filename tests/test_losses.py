@@ -478,6 +478,56 @@ loads:
 """
 
 
+MOTOR_SHAFT = """
+name: motor_shaft_hand
+gravity: [0, 0, 0]
+base: base
+end_effector: gear
+links:
+  - {{name: base}}
+  - {{name: pinion, mass: 0.1, inertia: [1.0e-5, 1.0e-5, 1.0e-5]}}
+  - {{name: gear, mass: 1.0, inertia: [1.0e-3, 1.0e-3, 1.0e-3]}}
+joints:
+  - name: JP
+    parent: base
+    child: pinion
+    origin: {{xyz: [0, 0, 0]}}
+    axis: [0, 0, 1]
+    bearings:
+      - {{name: near, position: {z1}, friction_coefficient: {mu}, bore: {d}, locating: true}}
+      - {{name: far, position: {z2}, friction_coefficient: {mu}, bore: {d}}}
+  - {{name: JG, parent: base, child: gear, origin: {{xyz: [0.075, 0, 0]}}, axis: [0, 0, 1]}}
+gears:
+  - {{name: stage, links: [pinion, gear], teeth: [15, 60], mesh_point: [0.015, 0, 0]}}
+motors:
+  - {{name: m, link: pinion}}
+loads:
+  - {{name: out, link: gear, frame: base, moment: [0, 0, {ML}]}}
+"""
+
+
+def test_bearing_friction_on_the_motor_shaft_by_hand():
+    """The overhung shaft's bearings moved to the motor's pinion shaft: the pinion's own
+    balance about its axis holds the motor torque, so the friction couple changes only that
+    torque, never the tooth force |t| = |M_L| / r_k nor the bearing loads it causes.  The
+    lever rule on |g| = |t| / cos(phi) then gives the moment once, Mb = 1/2 mu d |g| (z2 +
+    z1) / (z2 - z1), and |motor| = |t| r_j + Mb.  The fixed point meets it in its second
+    iteration (the first only finds it); the kernel knows when the code is generated that
+    the loads do not depend on the moment and takes it in one."""
+    z1, z2, mu, d, ML, rj, rk = 0.02, 0.06, 0.05, 0.03, -4.0, 0.015, 0.06
+    an = analyse(parse_mechanism(MOTOR_SHAFT.format(z1=z1, z2=z2, mu=mu, d=d, ML=ML)))
+    t = abs(ML) / rk
+    Mb = 0.5 * mu * d * t / np.cos(np.deg2rad(20)) * (z2 + z1) / (z2 - z1)
+    for backend, iterations in (("numpy", 2), ("llvm", 1)):
+        res = solve(an, [[0.0]], [[2.0]], [[0.0]], backend=backend)
+        assert abs(res.gear_t[0, 0]) == pytest.approx(t, rel=1e-12)
+        assert abs(res.motor[0, 0]) == pytest.approx(t * rj + Mb, rel=1e-12)
+        assert abs(res.joint_friction[0, 0]) == pytest.approx(Mb, rel=1e-12)
+        assert res.joint_friction[0, 0] * res.motor_speed[0, 0] < 0.0        # against the pinion's rate
+        assert res.joint_loss[0, 0] == pytest.approx(Mb * abs(res.motor_speed[0, 0]), rel=1e-12)
+        assert res.bearing_iterations[0] == iterations, backend
+
+
 def test_overhung_shaft_bearing_friction_by_hand():
     """A gear overhung on a shaft with two bearings at z1, z2 beyond the mesh plane (z = 0),
     driven at constant speed against a load moment M_L, no gravity.  The tooth force
