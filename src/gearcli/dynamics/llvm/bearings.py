@@ -13,19 +13,22 @@ moments of the two samples before, :func:`_warm`), as :func:`..bearing_friction.
 with its ``TOL`` and ``MAX_ITERATIONS`` (:func:`_loop`): solve with r + sum_J s_J Mb_J w_J
 (s_J = sign(q'_J), w_J the couple per unit in the block's coordinates), Mb_J' = sum_b 1/2
 mu_b d_b P_b of the solved reactions (0 at rest), until every |Mb_J' - Mb_J| <= TOL |Mb_J'|;
-the Mb that solved (not Mb') is kept.  A constant-frame block searches its sign pattern p
-once, at zero moments; with p fixed its solution is affine in the moments, x = x0 + sum_J
-s_J Mb_J g_J, g_J = X_p w_J (w_J constant in F: constants per pattern for stored maps, the
-corrected map of :class:`~.losses.LossyBlock` per sample), so are its bearings' load vectors,
+the Mb that solved (not Mb') is kept.  A block solved in a constant frame or in world
+axes searches its sign pattern p once, at zero moments; with p fixed its solution is affine
+in the moments, x = x0 + sum_J s_J Mb_J g_J, g_J = X_p w_J (w_J constant in F: constants
+per pattern for stored maps, the corrected map of :class:`~.losses.LossyBlock` per sample;
+in world axes w_J per sample, solved with r by each trial of the search, the block's matrix
+factored once, :meth:`~.world.WorldBlock.solve`), so are its bearings' load vectors,
 and the moments converge by Newton's method on them alone (:mod:`.bearing_newton`: two
 levels from zero where the fixed point takes five or six, one in a smooth stretch; each a
 square root per bearing and one division, stopped by the fixed point's own test or by
 Newton's proven error bound).  Where no bearing load of the block depends on the moments
 (:func:`.bearing_newton.unaffected`: a link whose other unknown is its motor torque about
-the same axis takes the couple there) Mb = g(0) exactly, one iteration and no level.  The tooth forces must fit p (the tolerance of the shifted
-r) at the converged moments; where they do not, the block goes on from those moments and
-that iteration as a block without a constant couple (world frame) does from the start: the
-whole block solved, its sign search included, each iteration (the numpy path's loop).
+the same axis takes the couple there) Mb = g(0) exactly, one iteration and no level.  The
+tooth forces must fit p (the tolerance of the shifted r) at the converged moments; where
+they do not, and in a block solved in its link's axes (no constant couple), the block goes
+on from those moments and that iteration by the numpy path's loop: the whole block solved,
+its sign search included, each iteration.
 
 Written per sample in the ``moments`` row: each joint's converged Mb_J, then the most
 iterations over the sample's blocks; -s_J Mb_J joins J's friction output.  A block that does
@@ -102,11 +105,13 @@ class _Joints:
 
 
 def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols: list, r: list, solve, rows,
-             n, fail):
+             n, fail, world=None):
     """(x, p) of block b with the converged bearing friction of its joints (module
     docstring).  ``solve(r, tag)``: (x, p) of right-hand side r (the block's own sign search;
     p None without signed meshes); ``rows(p, idx, r, tag)``: rows idx of the solution with
-    pattern p (constant frame)."""
+    pattern p (constant frame); ``world``: a world-frame block's
+    :class:`~.world.WorldBlock` (None: a constant frame), whose solve at zero moments (each
+    trial of its sign search) also solves the unit couples (its ``more``)."""
     lp = prog.losses
     bb = lp.bearing_blocks[b]
     K, m, tag = len(bb.joints), len(tcols), f"b{b}"
@@ -115,9 +120,15 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
     done_bb = fn.append_basic_block(f"{tag}_bdone")
     ends = []                 # (block, Mb, it, x, p) of each way into done_bb
     start = (warm, ir.Constant(I64, 1))
-    if bb.wF is not None:     # affine in the moments, from the sign search at zero moments
+    if bb.wF is not None or world is not None:     # affine in the moments, from the sign search at zero moments
+        if world is not None:
+            world.more = jt.W
         x0, p = solve(r, tag)
-        G = [[e.mul(jt.sg[i], v) for v in rows(p, list(range(len(x0))), jt.W[i], f"{tag}_g{i}")] for i in range(K)]
+        if world is None:
+            X = [rows(p, list(range(len(x0))), jt.W[i], f"{tag}_g{i}") for i in range(K)]
+        else:
+            X, world.more = world.more_x, ()
+        G = [[e.mul(jt.sg[i], v) for v in X[i]] for i in range(K)]
         S0 = [split(e, lp, k, _cols(x0, c0)) for k, c0 in zip(bb.joints, bb.cols)]
         SG = [[split(e, lp, k, _cols(G[i], c0)) for i in range(K)] for k, c0 in zip(bb.joints, bb.cols)]
 

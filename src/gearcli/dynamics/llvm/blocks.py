@@ -162,7 +162,7 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row, search: bool
     def rows(p, idx, r, tag):       # rows idx of the solution with pattern p (constant frame)
         return [e.dot(floats(maps[0][i]), r) for i in idx] if m == 0 else blk.rows(e, fn, p, idx, r, tag)
     if search and prog.losses is not None and b in prog.losses.bearing_blocks:
-        x, p = converge(e, fn, s, prog, b, F, links, tcols, r, solve, rows, n, fail)
+        x, p = converge(e, fn, s, prog, b, F, links, tcols, r, solve, rows, n, fail, blk if F < 0 else None)
     else:
         x, p = solve(r, f"b{b}")
     sig = [1.0] * m if p is None else signs_of(e, p, m)

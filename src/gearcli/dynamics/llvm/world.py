@@ -116,6 +116,8 @@ class WorldBlock:
 
     full_trial = True
     extra = None        # the block's mesh friction columns, added per trial (losses.world_columns)
+    more = ()           # right-hand sides each solve also solves (:meth:`solve`)
+    more_x = ()
 
     def __init__(self, s, prog, k0: int, nt: int, n: int, tcols: list, wrench, fn, weights, free):
         self.s, self.trec, self.tval = s, prog.terms, prog.term_values
@@ -124,22 +126,25 @@ class WorldBlock:
         self.fn, self.weights, self.free, self.mem = fn, weights, free, None
 
     def _stack(self, e: Emitter, sizes):
-        """Stack arrays of these sizes (doubles), made once in ``run``'s entry block."""
+        """Stack arrays of these sizes (doubles), made once per sizes in ``run``'s entry block."""
         if self.mem is None:
-            self.mem = e.stack(self.fn, sizes)
-        return self.mem
+            self.mem = {}
+        if sizes not in self.mem:
+            self.mem[sizes] = e.stack(self.fn, sizes)
+        return self.mem[sizes]
 
-    def _by_basis(self, e: Emitter, A: list, r: list) -> list:
+    def _by_basis(self, e: Emitter, A: list, R: list) -> list:
         """The least-load solution through the basis A_B (every column but the d ``free``):
         [p | Q] = A_B^-1 [r | A_free] (:func:`lu_solve` in the stored row order, or the
         pivoting loop code of :mod:`.solve` when a static pivot is poor), then the free unknowns from
         (Q^T W_B Q + W_free) x_free = Q^T W_B p (d x d, :func:`eliminate`) and x_B = p - Q x_free:
-        the minimiser of sum w x^2 over the solutions of A x = r."""
-        k, (free, order, swaps), w = len(r), self.free, self.weights
+        the minimiser of sum w x^2 over the solutions of A x = r, for each r of ``R``."""
+        k, (free, order, swaps), w = len(R[0]), self.free, self.weights
         basis = [j for j in range(self.n) if j not in free]
-        m = 1 + len(free)
+        nR = len(R)
+        m = nR + len(free)
         AB = [[A[i][j] for j in basis] for i in range(k)]
-        RHS = [[r[i]] + [A[i][j] for j in free] for i in range(k)]
+        RHS = [[r[i] for r in R] + [A[i][j] for j in free] for i in range(k)]
         fast, bad = lu_solve(e, AB, RHS, order, swaps)
         fn = self.fn
         slow, done = fn.append_basic_block("basis_pivot"), fn.append_basic_block("basis_done")
@@ -154,20 +159,33 @@ class WorldBlock:
         P = [merged[i * m:(i + 1) * m] for i in range(k)]
         wb = [(a, float(w[j])) for a, j in enumerate(basis) if w[j] > 0]
         S = [[e.add(float(w[free[g]]) if g == h else 0.0,
-                    e.dot([e.mul(wj, P[a][1 + g]) for a, wj in wb], [P[a][1 + h] for a, _ in wb]))
+                    e.dot([e.mul(wj, P[a][nR + g]) for a, wj in wb], [P[a][nR + h] for a, _ in wb]))
               for h in range(len(free))] for g in range(len(free))]
-        rhs = [e.dot([e.mul(wj, P[a][1 + g]) for a, wj in wb], [P[a][0] for a, _ in wb]) for g in range(len(free))]
-        xf = eliminate(e, S, rhs)
-        x = [0.0] * self.n
-        for g, j in enumerate(free):
-            x[j] = xf[g]
-        for a, j in enumerate(basis):
-            x[j] = e.const(e.sub(P[a][0], e.dot([P[a][1 + h] for h in range(len(free))], xf)))
-        return x
+        out = []
+        for c in range(nR):
+            rhs = [e.dot([e.mul(wj, P[a][nR + g]) for a, wj in wb], [P[a][c] for a, _ in wb]) for g in range(len(free))]
+            xf = eliminate(e, S, rhs)
+            x = [0.0] * self.n
+            for g, j in enumerate(free):
+                x[j] = xf[g]
+            for a, j in enumerate(basis):
+                x[j] = e.const(e.sub(P[a][c], e.dot([P[a][nR + h] for h in range(len(free))], xf)))
+            out.append(x)
+        return out
 
     def solve(self, e: Emitter, sig: list, r: list) -> list:
-        """x of the block for the signs ``sig`` (values) of its t."""
-        A = [[0.0] * self.n for _ in range(len(r))]
+        """x of the block for the signs ``sig`` (values) of its t; the solutions of ``more``
+        (further right-hand sides, bearing friction's unit couples, :func:`.bearings.converge`)
+        with the same matrix, factored once, into ``more_x``."""
+        X = self.solve_columns(e, sig, [r] + list(self.more))
+        self.more_x = X[1:]
+        return X[0]
+
+    def solve_columns(self, e: Emitter, sig: list, R: list) -> list:
+        """[x of the block for the signs ``sig`` and right-hand side r, for each r of ``R``]:
+        the block's matrix built and factored once."""
+        nr = len(R[0])
+        A = [[0.0] * self.n for _ in range(nr)]
         for k in self.terms:
             term = self.trec[k]
             row, col = int(term.row), int(term.col)
@@ -176,13 +194,15 @@ class WorldBlock:
                 A[6 * row + h][col] = e.add(A[6 * row + h][col], w[h])
         if self.extra is not None:
             self.extra(e, A, self.tcols, sig)
-        if len(r) == self.n:
-            return eliminate(e, A, r)
+        if nr == self.n:
+            X, singular = lu_solve(e, A, [[r[i] for r in R] for i in range(nr)])
+            nan = ir.Constant(D, float("nan"))
+            return [[e.b.select(singular, nan, e.const(row[c])) for row in X] for c in range(len(R))]
         if self.free is not None:
-            return self._by_basis(e, A, r)
-        return self._least_load(e, A, r)
+            return self._by_basis(e, A, R)
+        return self._least_load(e, A, R)
 
-    def _least_load(self, e: Emitter, A: list, r: list) -> list:
+    def _least_load(self, e: Emitter, A: list, R: list) -> list:
         """The minimiser of sum w x^2 subject to A x = r (:func:`..sharing.least_load_solve`)
         from its KKT system with D unscaled: the minimiser does not depend on D's scale, and
         the one numpy applies (the largest |A| entry) is of order 1 for unit directions and
@@ -194,8 +214,9 @@ class WorldBlock:
             K[i][i] = float(self.weights[i])
             for a in range(nr):
                 K[i][n + a], K[n + a][i] = A[a][i], A[a][i]
-        x = loop_solve(e, self._stack(e, (size * size, size)), K, [[0.0]] * n + [[v] for v in r])
-        return [row[0] for row in x[:n]]
+        m = len(R)
+        x = loop_solve(e, self._stack(e, (size * size, size * m)), K, [[0.0] * m] * n + [[r[a] for r in R] for a in range(nr)])
+        return [[row[c] for row in x[:n]] for c in range(m)]
 
     def rows(self, e: Emitter, fn, p, rows: list, r: list, tag: str) -> list:
         """Rows ``rows`` of the solution for pattern p (i64)."""
