@@ -121,14 +121,7 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
     ends = []                 # (block, Mb, it, x, p) of each way into done_bb
     start = (warm, ir.Constant(I64, 1))
     if bb.wF is not None or world is not None:     # affine in the moments, from the sign search at zero moments
-        if world is not None:
-            world.more = jt.W
-        x0, p = solve(r, tag)
-        if world is None:
-            X = [rows(p, list(range(len(x0))), jt.W[i], f"{tag}_g{i}") for i in range(K)]
-        else:
-            X, world.more = world.more_x, ()
-        G = [[e.mul(jt.sg[i], v) for v in X[i]] for i in range(K)]
+        x0, p, G = _affine(e, jt, r, solve, rows, world, tag)
         S0 = [split(e, lp, k, _cols(x0, c0)) for k, c0 in zip(bb.joints, bb.cols)]
         SG = [[split(e, lp, k, _cols(G[i], c0)) for i in range(K)] for k, c0 in zip(bb.joints, bb.cols)]
 
@@ -174,6 +167,20 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
     Mb, it, x, p = (_phis(e, ends, k) for k in (1, 2, 3, 4))
     _outputs(e, s, lp, b, bb, jt, Mb, it[0], links, n)
     return x, (None if p is None else p[0])
+
+
+def _affine(e: Emitter, jt: _Joints, r: list, solve, rows, world, tag: str):
+    """(x0, p, G) of a block solved in a constant frame or world axes: its solution x0 and
+    sign pattern p at zero moments, and G[J] = s_J X_p w_J, the solution's change per unit
+    Mb_J (a world-frame block's unit couples solved by each trial with r, its ``more``)."""
+    if world is not None:
+        world.more = jt.W
+    x0, p = solve(r, tag)
+    if world is None:
+        X = [rows(p, list(range(len(x0))), w, f"{tag}_g{i}") for i, w in enumerate(jt.W)]
+    else:
+        X, world.more = world.more_x, ()
+    return x0, p, [[e.mul(sg, v) for v in col] for sg, col in zip(jt.sg, X)]
 
 
 def _loop(e: Emitter, fn, tag: str, start: tuple, step, prog, bb, fail, n):
