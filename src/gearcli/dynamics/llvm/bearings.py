@@ -108,8 +108,8 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
              n, fail, world=None):
     """(x, p) of block b with the converged bearing friction of its joints (module
     docstring).  ``solve(r, tag)``: (x, p) of right-hand side r (the block's own sign search;
-    p None without signed meshes); ``rows(p, idx, r, tag)``: rows idx of the solution with
-    pattern p (constant frame); ``world``: a world-frame block's
+    p None without signed meshes); ``rows(p, idx, R, tag)``: rows idx of the solution with
+    pattern p of each right-hand side of R (constant frame); ``world``: a world-frame block's
     :class:`~.world.WorldBlock` (None: a constant frame), whose solve at zero moments (each
     trial of its sign search) also solves the unit couples (its ``more``)."""
     lp = prog.losses
@@ -177,7 +177,7 @@ def _affine(e: Emitter, jt: _Joints, r: list, solve, rows, world, tag: str):
         world.more = jt.W
     x0, p = solve(r, tag)
     if world is None:
-        X = [rows(p, list(range(len(x0))), w, f"{tag}_g{i}") for i, w in enumerate(jt.W)]
+        X = rows(p, list(range(len(x0))), jt.W, f"{tag}_g")
     else:
         X, world.more = world.more_x, ()
     return x0, p, [[e.mul(sg, v) for v in col] for sg, col in zip(jt.sg, X)]

@@ -159,8 +159,13 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row, search: bool
             return blk.rows(e, fn, ir.Constant(I64, 0), list(range(nloc)), r, f"{tag}_x"), None
         return [e.dot(floats(maps[0][i]), r) for i in range(nloc)], None
 
-    def rows(p, idx, r, tag):       # rows idx of the solution with pattern p (constant frame)
-        return [e.dot(floats(maps[0][i]), r) for i in idx] if m == 0 else blk.rows(e, fn, p, idx, r, tag)
+    def rows(p, idx, R, tag):       # rows idx of the solution with pattern p of each r of R (constant frame)
+        if m == 0:
+            return [[e.dot(floats(maps[0][i]), r) for i in idx] for r in R]
+        X = blk.products(e, p, R) if hasattr(blk, "products") and all(isinstance(v, float) for r in R for v in r) else None
+        if X is not None:
+            return [[x[i] for i in idx] for x in X]
+        return [blk.rows(e, fn, p, idx, r, f"{tag}{j}") for j, r in enumerate(R)]
     if search and prog.losses is not None and b in prog.losses.bearing_blocks:
         x, p = converge(e, fn, s, prog, b, F, links, tcols, r, solve, rows, n, fail, blk if F < 0 else None)
     else:

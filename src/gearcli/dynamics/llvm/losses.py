@@ -36,7 +36,7 @@ import numpy as np
 from .build import D, FLAGS, I64, Emitter
 from .links import Sample, floats
 from .signs import SignedBlock, _rows_switch, signs_of
-from .world import eliminate
+from .world import lu_solve
 
 
 def _signed(e: Emitter, v, pos: float, neg: float):
@@ -104,11 +104,35 @@ def write_losses(e: Emitter, s: Sample, lp, gear_col, rates: list, own: dict, ro
         e.store(e.neg(e.mul(f, s.qd[ji])), rows["joint_loss"], ji)
 
 
+def _product_table(e: Emitter, tables: dict, name: str, products: list, index, W: list):
+    """get(i, c): entry (i, c) of the constant matrix products[index] (all of one shape),
+    stored in one constant global array made once per W (``tables``); an entry 0 in every
+    matrix is the constant 0."""
+    key = tuple(tuple(w) for w in W)
+    if key not in tables:
+        P = np.array(products)
+        g = ir.GlobalVariable(e.module, ir.ArrayType(D, P.size), f"ainv_{name}{len(tables)}")
+        g.global_constant, g.linkage = True, "internal"
+        g.initializer = ir.Constant(g.type.pointee, [float(v) for v in P.ravel()])
+        tables[key] = (_address(e, g), np.all(P == 0.0, axis=0))
+    table, zero = tables[key]
+    width = zero.shape[1]
+    base = e.b.mul(index, ir.Constant(I64, zero.size))
+    return lambda i, c: 0.0 if zero[i, c] else e.load(table, e.b.add(base, ir.Constant(I64, i * width + c)))
+
+
+def _address(e: Emitter, g):
+    """The address of the constant table ``g`` through an empty asm: a register LLVM cannot
+    fold into each load's offset (the JIT's large code model would load every entry's
+    address by movabs)."""
+    return e.b.asm(ir.FunctionType(D.as_pointer(), [D.as_pointer()]), "", "=r,0", [g.bitcast(D.as_pointer())], False)
+
+
 def lossy_block(e: Emitter, inner, bl, sv: list, name: str):
     """The solve of a lossy constant-frame block (module docstring): its stored maps per
     (s_v, sigma) when it has them, else a :class:`LossyBlock` around ``inner``."""
     if bl.maps is None:
-        return LossyBlock(inner, bl, sv)
+        return LossyBlock(inner, bl, sv, name)
     code = ir.Constant(I64, 0)
     for i, k in enumerate(bl.rates):       # sum_i (s_v,i + 1) 3^i
         digit = e.b.add(e.b.fptosi(e.const(sv[k]), I64), ir.Constant(I64, 1))
@@ -125,15 +149,22 @@ class TabledBlock:
 
     def __init__(self, e: Emitter, maps: tuple, tcols: list, code, name: str):
         self.tcols, self.n = tcols, maps[0].shape[0]
+        self.maps, self.name, self.tables = maps, name, {}
         used = np.any(np.array(maps) != 0.0, axis=0)
         self.nz, self.at = [np.flatnonzero(u) for u in used], np.cumsum([0] + list(used.sum(axis=1)))
         flat = [float(v) for A in maps for v in A[used]]
         g = ir.GlobalVariable(e.module, ir.ArrayType(D, len(flat)), f"ainv_{name}_sv")
         g.global_constant, g.linkage, g.initializer = True, "internal", ir.Constant(g.type.pointee, flat)
-        # its address through an empty asm: a register LLVM cannot fold into each load's
-        # offset (the JIT's large code model would load every entry's address by movabs)
-        self.table = e.b.asm(ir.FunctionType(D.as_pointer(), [D.as_pointer()]), "", "=r,0", [g.bitcast(D.as_pointer())], False)
+        self.table = _address(e, g)
         self.code = e.b.mul(code, ir.Constant(I64, 1 << len(tcols)))
+
+    def products(self, e: Emitter, p, W: list) -> list:
+        """[X W_j (n values) for each constant W_j of W] of pattern p: the products stored per
+        map in a second constant table (made once per W), read without a product; an entry 0
+        in every map is the constant 0 (bearing friction's unit couples, :func:`.bearings.converge`)."""
+        cols = np.array(W, float).T
+        get = _product_table(e, self.tables, f"{self.name}_w", [A @ cols for A in self.maps], e.b.add(p, self.code), W)
+        return [[get(i, j) for i in range(self.n)] for j in range(len(W))]
 
     def rows(self, e: Emitter, fn, p, rows: list, r: list, tag: str) -> list:
         base = e.b.mul(e.b.add(p, self.code), ir.Constant(I64, int(self.at[-1])))
@@ -146,8 +177,8 @@ class LossyBlock:
     :class:`~.signs.SignedBlock` or :class:`~.world.LowRankBlock`): the
     module docstring's rank-ml correction of each trial and of the accepted solution."""
 
-    def __init__(self, inner, bl, sv: list):
-        self.inner, self.bl = inner, bl
+    def __init__(self, inner, bl, sv: list, name: str = ""):
+        self.inner, self.bl, self.name, self.tables = inner, bl, name, {}
         self.tcols, self.n = inner.tcols, inner.n
         self.d_sv = [sv[k] for k in bl.rates]
         self.aug = None
@@ -178,17 +209,43 @@ class LossyBlock:
 
     def rows(self, e: Emitter, fn, p, rows: list, r: list, tag: str) -> list:
         """Rows ``rows`` of the solution of the changed matrix for pattern p (i64)."""
-        bl, m = self.bl, len(self.tcols)
-        lt = [self.tcols[i] for i in bl.positions]
+        lt = [self.tcols[i] for i in self.bl.positions]
         need = sorted(set(rows) | set(lt))
         xr, xf = self._products(e, fn, p, need, r, tag)
+        return self._corrected(e, p, [xr], xf, rows)[0]
+
+    def _corrected(self, e: Emitter, p, xrs: list, xf: list, rows: list) -> list:
+        """Rows ``rows`` of the changed matrix's solution for each X r of ``xrs`` (row -> value)
+        with pattern p's X Phi^T ``xf``: x = X r - X Phi^T D y, (1 + Phi X D) y = (X r)[lt],
+        that matrix factored once."""
+        bl, m = self.bl, len(self.tcols)
+        lt = [self.tcols[i] for i in bl.positions]
         sig = signs_of(e, p, m)
         d = [e.mul(sig[i], sv) for i, sv in zip(bl.positions, self.d_sv)]
         K = [[e.add(1.0 if a == b else 0.0, e.mul(xf[b][lt[a]], d[b])) for b in range(len(lt))]
              for a in range(len(lt))]
-        y = eliminate(e, K, [xr[c] for c in lt])
-        dy = [e.mul(db, yb) for db, yb in zip(d, y)]
-        return [e.const(e.sub(xr[i], e.dot([xf[b][i] for b in range(len(lt))], dy))) for i in rows]
+        Y, singular = lu_solve(e, K, [[xr[c] for xr in xrs] for c in lt])
+        nan, out = ir.Constant(D, float("nan")), []
+        for j, xr in enumerate(xrs):
+            dy = [e.mul(db, e.b.select(singular, nan, e.const(Y[b][j]))) for b, db in enumerate(d)]
+            out.append([e.const(e.sub(xr[i], e.dot([xf[b][i] for b in range(len(lt))], dy))) for i in rows])
+        return out
+
+    def products(self, e: Emitter, p, W: list):
+        """[the changed matrix's solution (n values) for each constant W_j of W] of pattern p:
+        X W_j and X Phi^T stored per pattern in one constant table (made once per W, read
+        without a switch), then :meth:`_corrected` (bearing friction's unit couples,
+        :func:`.bearings.converge`); None where the inner maps are not stored per pattern."""
+        if not isinstance(self.inner, SignedBlock):
+            return None
+        phi = self.bl.phi.T
+        ml, n = phi.shape[1], self.n
+        cols = np.array(W, float).T
+        get = _product_table(e, self.tables, f"{self.name}_w", [np.hstack([X @ cols, X @ phi]) for X in self.inner.maps],
+                             p, W)
+        xrs = [{i: get(i, j) for i in range(n)} for j in range(len(W))]
+        xf = [{i: get(i, len(W) + b) for i in range(n)} for b in range(ml)]
+        return self._corrected(e, p, xrs, xf, list(range(n)))
 
 
 def world_columns(lp, bl, s: Sample):
