@@ -478,32 +478,16 @@ loads:
 """
 
 
-MOTOR_SHAFT = """
-name: motor_shaft_hand
-gravity: [0, 0, 0]
-base: base
-end_effector: gear
-links:
-  - {{name: base}}
-  - {{name: pinion, mass: 0.1, inertia: [1.0e-5, 1.0e-5, 1.0e-5]}}
-  - {{name: gear, mass: 1.0, inertia: [1.0e-3, 1.0e-3, 1.0e-3]}}
-joints:
-  - name: JP
-    parent: base
-    child: pinion
-    origin: {{xyz: [0, 0, 0]}}
-    axis: [0, 0, 1]
-    bearings:
+_SHAFT_BEARINGS = """    bearings:
       - {{name: near, position: {z1}, friction_coefficient: {mu}, bore: {d}, locating: true}}
       - {{name: far, position: {z2}, friction_coefficient: {mu}, bore: {d}}}
-  - {{name: JG, parent: base, child: gear, origin: {{xyz: [0.075, 0, 0]}}, axis: [0, 0, 1]}}
-gears:
-  - {{name: stage, links: [pinion, gear], teeth: [15, 60], mesh_point: [0.015, 0, 0]}}
-motors:
-  - {{name: m, link: pinion}}
-loads:
-  - {{name: out, link: gear, frame: base, moment: [0, 0, {ML}]}}
 """
+_JP = "  - {{name: JP, parent: base, child: pinion, origin: {{xyz: [0, 0, 0]}}, axis: [0, 0, 1]}}\n"
+assert SHAFT.count(_SHAFT_BEARINGS) == 1 and SHAFT.count(_JP) == 1
+MOTOR_SHAFT = (SHAFT.replace("name: shaft_hand", "name: motor_shaft_hand").replace(_SHAFT_BEARINGS, "")
+               .replace(_JP, "  - name: JP\n    parent: base\n    child: pinion\n    origin: {{xyz: [0, 0, 0]}}\n"
+                             "    axis: [0, 0, 1]\n" + _SHAFT_BEARINGS))
+"""SHAFT with its two bearings on the motor's pinion shaft JP instead of the gear's JG."""
 
 
 def test_bearing_friction_on_the_motor_shaft_by_hand():
