@@ -111,20 +111,20 @@ def _product_table(e: Emitter, tables: dict, name: str, products: list, index, W
     key = tuple(tuple(w) for w in W)
     if key not in tables:
         P = np.array(products)
-        g = ir.GlobalVariable(e.module, ir.ArrayType(D, P.size), f"ainv_{name}{len(tables)}")
-        g.global_constant, g.linkage = True, "internal"
-        g.initializer = ir.Constant(g.type.pointee, [float(v) for v in P.ravel()])
-        tables[key] = (_address(e, g), np.all(P == 0.0, axis=0))
+        tables[key] = (_table(e, f"ainv_{name}{len(tables)}", P.ravel()), np.all(P == 0.0, axis=0))
     table, zero = tables[key]
     width = zero.shape[1]
     base = e.b.mul(index, ir.Constant(I64, zero.size))
     return lambda i, c: 0.0 if zero[i, c] else e.load(table, e.b.add(base, ir.Constant(I64, i * width + c)))
 
 
-def _address(e: Emitter, g):
-    """The address of the constant table ``g`` through an empty asm: a register LLVM cannot
-    fold into each load's offset (the JIT's large code model would load every entry's
-    address by movabs)."""
+def _table(e: Emitter, name: str, values) -> ir.Value:
+    """A constant global array of ``values`` (doubles), its address through an empty asm: a
+    register LLVM cannot fold into each load's offset (the JIT's large code model would load
+    every entry's address by movabs)."""
+    flat = [float(v) for v in values]
+    g = ir.GlobalVariable(e.module, ir.ArrayType(D, len(flat)), name)
+    g.global_constant, g.linkage, g.initializer = True, "internal", ir.Constant(g.type.pointee, flat)
     return e.b.asm(ir.FunctionType(D.as_pointer(), [D.as_pointer()]), "", "=r,0", [g.bitcast(D.as_pointer())], False)
 
 
@@ -152,10 +152,7 @@ class TabledBlock:
         self.maps, self.name, self.tables = maps, name, {}
         used = np.any(np.array(maps) != 0.0, axis=0)
         self.nz, self.at = [np.flatnonzero(u) for u in used], np.cumsum([0] + list(used.sum(axis=1)))
-        flat = [float(v) for A in maps for v in A[used]]
-        g = ir.GlobalVariable(e.module, ir.ArrayType(D, len(flat)), f"ainv_{name}_sv")
-        g.global_constant, g.linkage, g.initializer = True, "internal", ir.Constant(g.type.pointee, flat)
-        self.table = _address(e, g)
+        self.table = _table(e, f"ainv_{name}_sv", [v for A in maps for v in A[used]])
         self.code = e.b.mul(code, ir.Constant(I64, 1 << len(tcols)))
 
     def products(self, e: Emitter, p, W: list) -> list:
