@@ -1,6 +1,6 @@
 """What losses cost in the solve (issue 19); prints figures, not a test.
 
-    python benchmarks/bench_losses.py [--samples 20000] [--rounds 5] [--cpu]
+    python benchmarks/bench_losses.py [--samples 20000] [--rounds 5] [--cpu] [--bendix-only]
 
 The rated Bendix wrist (5 meshes, 8 joints, 15 bearings), random states, one thread.  Rows,
 interleaved round by round so that load drift hits all alike, medians of --rounds (an llvm
@@ -22,6 +22,9 @@ tick on a busy machine):
 * llvm lossless and with bearing friction along a smooth motion (the analytic motion of
   mechanisms/bendix_wrist_traj.csv, continued to --samples at 1 kHz): random states give the
   kernel's warm start (a block's fixed point from the samples before) nothing to start from.
+
+Then (unless --bendix-only) the same losses on the many-mesh blocks of :data:`OTHERS`, each
+llvm over its own lossless kernel.
 
 The cost of losses in the compiled path (issue 19's target: at most 20 %) is each llvm row
 over the lossless llvm row of the same run.  ``--cpu``: each call timed by this thread's CPU
@@ -55,11 +58,49 @@ def lossy(mech, bearings: bool):
     return dataclasses.replace(mech, gears=gears, joints=joints)
 
 
+def lossless(mech):
+    """``mech`` without any loss (its own efficiencies and frictions removed)."""
+    joints = tuple(dataclasses.replace(j, friction=None, bearings=tuple(
+        dataclasses.replace(b, friction_coefficient=None) for b in j.bearings) if j.bearings else j.bearings)
+        for j in mech.joints)
+    return dataclasses.replace(mech, gears=tuple(dataclasses.replace(g, loss_factor=0.0) for g in mech.gears),
+                               joints=joints)
+
+
+OTHERS = ("planetary_3p_rated.yaml", "planetary_5p.yaml", "servo_joint_rated.yaml")
+"""Many-mesh blocks: a 32-unknown constant-frame block with stored maps (3 planets), one from
+a low-rank base matrix (5 planets: 1,024 sign patterns), a redundant world-frame one (the
+servo joint)."""
+
+
+def others(args) -> None:
+    """llvm, lossless against :func:`lossy` (mesh + joint, then + bearing friction) on each
+    of :data:`OTHERS` (their own losses removed first), interleaved, random states."""
+    rng = np.random.default_rng(0)
+    for name in OTHERS:
+        mech = lossless(load_mechanism(ROOT / "mechanisms" / name))
+        rows = {"lossless": analyse(mech), "mesh + joint": analyse(lossy(mech, False)),
+                "+ bearing": analyse(lossy(mech, True))}
+        q, qd, qdd = (rng.uniform(-3, 3, (args.samples, rows["lossless"].dof)) for _ in range(3))
+        for an in rows.values():
+            solve(an, q[:100], qd[:100], qdd[:100], backend="llvm", jobs=1)
+        times = {k: [] for k in rows}
+        for _ in range(args.rounds):
+            for k, an in rows.items():
+                times[k].append(median_time(lambda: solve(an, q, qd, qdd, backend="llvm", jobs=1), 5,
+                                            time.thread_time if args.cpu else time.perf_counter))
+        med = {k: float(np.median(v)) for k, v in times.items()}
+        print(f"  {name:26s} llvm lossless {med['lossless'] * 1e3:6.1f} ms, mesh + joint friction "
+              f"{100 * (med['mesh + joint'] / med['lossless'] - 1):+4.0f} %, + bearing friction "
+              f"{med['+ bearing'] / med['lossless']:.2f}x")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--samples", type=int, default=20_000)
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--cpu", action="store_true", help="time by this thread's CPU time, not the wall clock")
+    ap.add_argument("--bendix-only", action="store_true", help="leave out the many-mesh blocks (planetaries, servo joint)")
     args = ap.parse_args(argv)
     mech = load_mechanism(ROOT / "mechanisms" / "bendix_wrist_rated.yaml")
     cases = {"lossless, llvm": (analyse(mech), "llvm"), "lossless, numpy": (analyse(mech), "numpy"),
@@ -101,6 +142,9 @@ def main(argv=None) -> int:
     print(f"  (llvm, the most over a sample's blocks: median {int(np.median(fast_it))}, worst {int(fast_it.max())})")
     it = solve(cases["+ bearing friction, llvm"][0], *smooth(args.samples), backend="llvm").bearing_iterations
     print(f"  (llvm, smooth motion: median {int(np.median(it))}, worst {int(it.max())}, mean {it.mean():.2f})")
+    if not args.bendix_only:
+        print(f"Many-mesh blocks, the same losses, {args.samples:,} random samples, llvm over its lossless kernel:")
+        others(args)
     return 0
 
 

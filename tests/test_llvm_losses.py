@@ -115,6 +115,25 @@ def test_warm_start_along_a_smooth_motion():
     assert np.mean(res.bearing_iterations) < np.mean(shuffled) - 0.5
 
 
+@pytest.mark.parametrize("key", ["planetary_3p.yaml", "planetary_5p.yaml"])
+def test_screened_trials_where_friction_reverses_a_tooth_force(key):
+    """A lossy block of many meshes decides its sign trials on the lossless map's tooth
+    forces t0 where a bound proves the friction cannot change a sign (``LossyBlock.trial``).
+    Sweeping the acceleration through the planet-ring forces' reversal, both ways of turning:
+    in a band around it t0 and the lossy t differ in sign (the friction shifts the
+    reversal), and there the trials must take the exact solve.  llvm equals numpy on 8,001
+    samples a way; with the bound halved the llvm path fails this test."""
+    an = analyse(mechanism(key))
+    n = 8001
+    for rate in (1.0, -1.0):
+        q, qd, qdd = np.zeros((n, 1)), np.full((n, 1), rate), np.linspace(-2000.0, 2000.0, n)[:, None]
+        ref = solve(an, q, qd, qdd, backend="numpy")
+        lossless = solve(analyse(load_mechanism(MECH / key)), q, qd, qdd, backend="numpy")
+        assert (np.sign(ref.gear_t) != np.sign(lossless.gear_t)).any(axis=1).sum() > 20   # the band is met
+        res = solve(an, q, qd, qdd, backend="llvm", jobs=1)
+        assert worst(res, ref) < TOL
+
+
 @pytest.mark.parametrize("key", LOSSY + list(HAND))
 def test_llvm_equals_numpy_with_losses(key):
     an = analyse(mechanism(key))

@@ -115,7 +115,9 @@ def resolve(e: Emitter, fn, blk: SignedBlock, r: list, tol, on_fail, tag: str):
     (i64) of the search order (module docstring); ``on_fail()`` emits what a sample with
     no consistent pattern does (its x is then that of the last pattern tried).  ``blk``:
     a :class:`SignedBlock`, or a :class:`~.world.WorldBlock` whose trials solve the
-    whole block (kept for the pattern accepted)."""
+    whole block (kept for the pattern accepted), or a block with ``trial(e, fn, p, r, tol,
+    tag) -> (t, kept)`` and ``full(e, fn, p, r, kept, tag)`` (:class:`~.losses.LossyBlock`: the
+    accepted solution reuses its trial's kept values)."""
     m = len(blk.tcols)
     steps = 1 + m + ((1 << m) if m <= MAX_EXHAUSTIVE else 0)
     pre = e.b.block
@@ -131,7 +133,11 @@ def resolve(e: Emitter, fn, blk: SignedBlock, r: list, tol, on_fail, tag: str):
                    e.b.select(e.b.icmp_signed("<=", step, ir.Constant(I64, m)), own, late))
     full = getattr(blk, "full_trial", False)     # a trial solves the whole block
     xs = blk.rows(e, fn, p, list(range(blk.n)), r, f"{tag}_x") if full else None
-    t = [xs[c] for c in blk.tcols] if full else blk.rows(e, fn, p, blk.tcols, r, f"{tag}_t")
+    kept = None                                  # what a block's trial passes to its full solution
+    if hasattr(blk, "trial"):
+        t, kept = blk.trial(e, fn, p, r, tol, f"{tag}_t")
+    else:
+        t = [xs[c] for c in blk.tcols] if full else blk.rows(e, fn, p, blk.tcols, r, f"{tag}_t")
     ok = _consistent(e, t, [_sign_bit(e, p, i, m) for i in range(m)], tol)
     e.b.cbranch(ok, accept, nxt)
     e.b.position_at_end(nxt)
@@ -146,6 +152,8 @@ def resolve(e: Emitter, fn, blk: SignedBlock, r: list, tol, on_fail, tag: str):
     on_fail()
     e.b.branch(accept)
     e.b.position_at_end(accept)
+    if kept is not None:                         # (the loop body dominates accept: its last trial's values)
+        return blk.full(e, fn, p, r, kept, f"{tag}_x"), p
     return (xs if full else blk.rows(e, fn, p, list(range(blk.n)), r, f"{tag}_x")), p
 
 

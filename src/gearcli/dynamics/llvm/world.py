@@ -48,7 +48,8 @@ def _swap_rows(e: Emitter, A: list, X: list, c: int, a: int) -> None:
             M[c][j], M[a][j] = e.b.select(sw, v, u), e.b.select(sw, u, v)
 
 
-def lu_solve(e: Emitter, A: list, B: list, order: list | None = None, swaps: list | None = None):
+def lu_solve(e: Emitter, A: list, B: list, order: list | None = None, swaps: list | None = None,
+             dominant: bool = False):
     """(X, bad): X = A^-1 B (A (k, k), B (k, m), lists of rows of values) by straight-line
     elimination, ``bad`` (i1) true for a zero pivot (a singular matrix).
 
@@ -59,7 +60,11 @@ def lu_solve(e: Emitter, A: list, B: list, order: list | None = None, swaps: lis
     (:func:`.basis._swaps`; -1: none), the one pivoting a turning frame needs, so the zeros
     of the matrix's structure fold away; ``bad`` is then also true when a pivot is smaller
     than the largest entry below it by more than :data:`PIVOT_GROWTH` (the caller then
-    solves with pivoting)."""
+    solves with pivoting).  ``dominant``: A is known strictly diagonally dominant (every row's
+    off-diagonal entries smaller in sum than its diagonal one, whatever the sample), so
+    elimination in row order needs no pivoting and no test: ``bad`` is the constant false."""
+    if dominant:
+        order, swaps = list(range(len(A))), [-1] * len(A)
     k, static = len(A), order is not None
     A = [list(A[i]) for i in (order if static else range(k))]
     X = [list(B[i]) for i in (order if static else range(k))]
@@ -71,7 +76,7 @@ def lu_solve(e: Emitter, A: list, B: list, order: list | None = None, swaps: lis
         piv = A[c][c]
         if _zero(piv):
             return X, ir.Constant(I1, 1)
-        if not isinstance(piv, float):
+        if not isinstance(piv, float) and not dominant:
             a = e.call("fabs", piv)
             bad = e.b.or_(bad, e.b.fcmp_ordered("==", a, ir.Constant(D, 0.0)))
             for v in (A[i][c] for i in range(c + 1, k) if static and not _zero(A[i][c])):
