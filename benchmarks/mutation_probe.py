@@ -152,7 +152,7 @@ MUTATIONS = [
     Mutation("inertia-world-axes", "inertia tensor (link axes) applied to world-frame w",
              (("dynamics/inertia.py", "wb = mtv(R_0i, omega_i)", "wb = omega_i"),)),
     Mutation("no-stator-reaction", "motor torque not reacted on the stator",
-             (("dynamics/equations.py", "sign = 1.0 if L == x else -1.0", "sign = 1.0 if L == x else 0.0"),)),
+             (("dynamics/equations.py", "L, 1.0 if L == x else -1.0)", "L, 1.0 if L == x else 0.0)"),)),
     Mutation("ring-as-gear-j", "ring gear j of an internal pair pushed inwards",
              (("model/gears.py", "return ut, (-us if ring == 0 else us), e", "return ut, us, e"),)),
     Mutation("bevel-sep-radial", "bevel separating force along the radius, not normal to the pitch element",
@@ -190,7 +190,7 @@ MUTATIONS = [
              (("dynamics/llvm/blocks.py", "arm = e.vsub(e.vadd(s.o[X], P), s.o[L])", "arm = P"),)),
     # issue 19: losses in the generated kernel
     Mutation("llvm-loss-couple-sign", "llvm: constant-frame block, mesh friction couple with the rate instead of against it",
-             (("dynamics/llvm/losses.py", "d = [e.mul(sig[i], sv) for", "d = [e.mul(e.neg(sig[i]), sv) for"),)),
+             (("dynamics/llvm/losses.py", "return [e.mul(sig[i], sv) for", "return [e.mul(e.neg(sig[i]), sv) for"),)),
     Mutation("llvm-world-couple-sign", "llvm: world-frame block, mesh friction couple with the rate instead of against it",
              (("dynamics/llvm/losses.py", "coef = e.mul(sig[n], sv[k])", "coef = e.neg(e.mul(sig[n], sv[k]))"),)),
     Mutation("llvm-joint-friction-sign", "llvm: joint friction applied to the parent instead of the child",

@@ -240,13 +240,17 @@ class LossyBlock:
         cols = [self.inner.rows(e, fn, p, self.tcols, floats(phi[b]), f"{tag}_phi{b}") for b in range(phi.shape[0])]
         return [[col[i] for col in cols] for i in range(m)]
 
+    def _d(self, e: Emitter, p) -> list:
+        """D = diag(sigma s_v) of pattern p (i64), per lossy t (-1, 0 or 1)."""
+        sig = signs_of(e, p, len(self.tcols))
+        return [e.mul(sig[i], sv) for i, sv in zip(self.bl.positions, self.d_sv)]
+
     def _exact(self, e: Emitter, fn, p, t0: list, tag: str):
         """(t, y) of pattern p (i64) from the inner map's tooth rows t0: the changed matrix's
         m tooth forces t = t0 - M y and y = D t_l, (1 + M_l D) t_l = t0_l (M = (X
         Phi^T)[tcols], l the lossy ones; NaN where that matrix is singular)."""
         M = self._tooth_map(e, fn, p, tag)
-        sig = signs_of(e, p, len(self.tcols))
-        d = [e.mul(sig[i], sv) for i, sv in zip(self.bl.positions, self.d_sv)]
+        d = self._d(e, p)
         lt = self.bl.positions
         K = [[e.add(1.0 if a == b else 0.0, e.mul(M[lt[a]][b], d[b])) for b in range(len(lt))] for a in range(len(lt))]
         Y, singular = lu_solve(e, K, [[t0[i]] for i in lt], dominant=self.screen is not None)
@@ -316,8 +320,7 @@ class LossyBlock:
         that matrix factored once."""
         bl, m = self.bl, len(self.tcols)
         lt = [self.tcols[i] for i in bl.positions]
-        sig = signs_of(e, p, m)
-        d = [e.mul(sig[i], sv) for i, sv in zip(bl.positions, self.d_sv)]
+        d = self._d(e, p)
         K = [[e.add(1.0 if a == b else 0.0, e.mul(xf[b][lt[a]], d[b])) for b in range(len(lt))]
              for a in range(len(lt))]
         Y, singular = lu_solve(e, K, [[xr[c] for xr in xrs] for c in lt], dominant=self.screen is not None)
