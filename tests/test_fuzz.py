@@ -181,8 +181,32 @@ def problems(result, hung: bool, work: Path, inputs: dict, allowed_outputs=()) -
             if result.exit_code == 2:
                 out.append(f"output {p.name} written although the exit status is 2")
             else:
-                out += non_finite_in(p)
+                out += non_finite_in(p, input_names(inputs))
     return out
+
+
+def input_names(inputs: dict) -> set[str]:
+    """Every string under a ``name`` key of the YAML inputs (a design, case, gear, joint,
+    bearing or motor name a Markdown report echoes; unreadable inputs give none)."""
+    import yaml
+    names: set[str] = set()
+
+    def walk(node):
+        if isinstance(node, dict):
+            for k, v in node.items():
+                if k == "name" and isinstance(v, str):
+                    names.add(v)
+                walk(v)
+        elif isinstance(node, list):
+            for v in node:
+                walk(v)
+    for fname, data in inputs.items():
+        if fname.endswith((".yaml", ".yml")):
+            try:
+                walk(yaml.safe_load(data))
+            except Exception:   # noqa: BLE001 (a hostile input: no names from it)
+                pass
+    return names
 
 
 def table_of(path: Path) -> dict:
@@ -203,8 +227,9 @@ def table_of(path: Path) -> dict:
     return {h: data[:, i] for i, h in enumerate(head)}
 
 
-def non_finite_in(path: Path) -> list[str]:
-    """A problem when an output file holds a NaN or an infinity (or cannot be read back)."""
+def non_finite_in(path: Path, names: set[str] = frozenset()) -> list[str]:
+    """A problem when an output file holds a NaN or an infinity (or cannot be read back);
+    ``names``: the inputs' names, taken out of a Markdown report first (it echoes them)."""
     import numpy as np
     if path.suffix.lower() == ".json":     # strings may say 'inf' (a case named so): parse, look at numbers
         return _non_finite_json(path)
@@ -214,6 +239,9 @@ def non_finite_in(path: Path) -> list[str]:
             text = text.partition(b"\n")[2]
         elif path.suffix.lower() == ".xml":     # JUnit: a design or case may be named '-inf'
             text = _without_xml_names(text)
+        elif path.suffix.lower() == ".md":      # a case named 'NaN' (a long run's only finding)
+            for name in sorted(names, key=len, reverse=True):
+                text = text.replace(name.encode(), b"")
         return [f"non-finite number written to {path.name}"] if NON_FINITE.search(text) else []
     try:
         cols = table_of(path)
@@ -286,6 +314,18 @@ def test_non_finite_oracle_reads_csv_data_not_names(tmp_path):
     bad.write_text("t,gear:5-1:t\n0,1.5\n0.1,-inf\n")
     assert non_finite_in(ok) == []
     assert non_finite_in(bad) == ["non-finite number written to bad.csv"]
+
+
+def test_non_finite_oracle_reads_markdown_numbers_not_names(tmp_path):
+    """The oracle flags a NaN/inf among a Markdown report's numbers, not a name the inputs
+    give (a long run's only finding was a case named 'NaN': ``name: NaN`` is a string)."""
+    ok, bad = tmp_path / "ok.md", tmp_path / "bad.md"
+    ok.write_text("| ok | NaN | gear 5-inf | 1.5 | 2 |\n")
+    bad.write_text("| ok | NaN | gear 5-1 | nan | 2 |\n")
+    names = input_names({"design.yaml": b"cases:\n  - name: NaN\n", "mech.yaml": b"gears: [{name: 5-inf}]\n"})
+    assert names == {"NaN", "5-inf"}
+    assert non_finite_in(ok, names) == []
+    assert non_finite_in(bad, names) == ["non-finite number written to bad.md"]
 
 
 def test_non_finite_oracle_reads_junit_numbers_not_names(tmp_path):
