@@ -198,10 +198,11 @@ SCREEN_ROUNDING = 1e-12
 class LossyBlock:
     """A constant-frame block with lossy meshes around its lossless solve ``inner`` (a
     :class:`~.signs.SignedBlock` or :class:`~.world.LowRankBlock`): the module docstring's
-    rank-ml correction.  A trial (:meth:`trial`) solves the ml x ml system for t_l from the
-    inner map's tooth rows; the accepted pattern's solution (:meth:`full`) is the inner map
-    times r - Phi D t_l (the friction couples moved to the right-hand side), reusing that
-    trial's t_l: no second solve and no X Phi^T beyond the tooth rows."""
+    rank-ml correction.  A trial (:meth:`trial`) decides on the inner map's tooth rows where
+    a screen proves the friction cannot change the decision, else solves the ml x ml system
+    for t_l; the accepted pattern's solution (:meth:`full`) solves it once and corrects the
+    inner map's X r by the stored (X Phi^T) D t_l (X (r - Phi^T D t_l) around a low-rank
+    block)."""
 
     def __init__(self, inner, bl, sv: list, name: str = ""):
         self.inner, self.bl, self.name, self.tables = inner, bl, name, {}
@@ -286,13 +287,7 @@ class LossyBlock:
         done = e.b.block
         e.b.branch(merge)
         e.b.position_at_end(merge)
-        t = []
-        for a, b in zip(t0, t_ex):
-            ph = e.b.phi(D)
-            ph.add_incoming(e.const(a), pre)
-            ph.add_incoming(e.const(b), done)
-            t.append(ph)
-        return t, t0
+        return e.phis([pre, done], [[e.const(v) for v in t0], [e.const(v) for v in t_ex]]), t0
 
     def full(self, e: Emitter, fn, p, r: list, kept: list, tag: str) -> list:
         """The changed matrix's solution (n values) of pattern p from what its :meth:`trial`
@@ -318,8 +313,7 @@ class LossyBlock:
         """Rows ``rows`` of the changed matrix's solution for each X r of ``xrs`` (row -> value)
         with pattern p's X Phi^T ``xf``: x = X r - X Phi^T D y, (1 + Phi X D) y = (X r)[lt],
         that matrix factored once."""
-        bl, m = self.bl, len(self.tcols)
-        lt = [self.tcols[i] for i in bl.positions]
+        lt = [self.tcols[i] for i in self.bl.positions]
         d = self._d(e, p)
         K = [[e.add(1.0 if a == b else 0.0, e.mul(xf[b][lt[a]], d[b])) for b in range(len(lt))]
              for a in range(len(lt))]
