@@ -79,8 +79,9 @@ def others(args) -> None:
     rng = np.random.default_rng(0)
     for name in OTHERS:
         mech = lossless(load_mechanism(ROOT / "mechanisms" / name))
-        rows = {"lossless": analyse(mech), "mesh + joint": analyse(lossy(mech, False)),
-                "+ bearing": analyse(lossy(mech, True))}
+        rows = {"lossless": analyse(mech), "mesh + joint": analyse(lossy(mech, False))}
+        if any(j.bearings for j in mech.joints):
+            rows["+ bearing"] = analyse(lossy(mech, True))
         q, qd, qdd = (rng.uniform(-3, 3, (args.samples, rows["lossless"].dof)) for _ in range(3))
         for an in rows.values():
             solve(an, q[:100], qd[:100], qdd[:100], backend="llvm", jobs=1)
@@ -90,9 +91,9 @@ def others(args) -> None:
                 times[k].append(median_time(lambda: solve(an, q, qd, qdd, backend="llvm", jobs=1), 5,
                                             time.thread_time if args.cpu else time.perf_counter))
         med = {k: float(np.median(v)) for k, v in times.items()}
+        bearing = f"{med['+ bearing'] / med['lossless']:.2f}x" if "+ bearing" in med else "(no bearings)"
         print(f"  {name:26s} llvm lossless {med['lossless'] * 1e3:6.1f} ms, mesh + joint friction "
-              f"{100 * (med['mesh + joint'] / med['lossless'] - 1):+4.0f} %, + bearing friction "
-              f"{med['+ bearing'] / med['lossless']:.2f}x")
+              f"{100 * (med['mesh + joint'] / med['lossless'] - 1):+4.0f} %, + bearing friction {bearing}")
 
 
 def main(argv=None) -> int:
