@@ -16,20 +16,23 @@ A level stops the iteration (:func:`newton`) where either
 
 * the fixed point's own test holds at Mb, |r_k| <= TOL |g_k| for every joint (Mb is kept,
   as :func:`..bearing_friction.fixed_point` keeps it), or
-* Newton's error after the step is proven within TOL (Mb + Delta is kept, :func:`proven`):
-  with sigma_b = sum_i |ug_bi|_1 (>= the rate of P_b per unit Mb in the max norm) and
-  Lambda = max_k sum_b h_b sigma_b (g's Lipschitz constant, max norm, < 1), e = ||r|| /
-  (1 - Lambda) bounds ||Mb* - Mb||; along the segment to Mb* P_b >= Pmin_b = P_b - sigma_b e
-  and g's second derivative is at most H = max_k sum_b h_b sigma_b^2 / min_b Pmin_b (b with
-  sigma_b > 0: a load the moments do not move bends nothing, even at 0), so
-  ||Mb* - (Mb + Delta)|| <= 1/2 H e^2 / (1 - Lambda) (Taylor's remainder, ||(1 - J)^-1|| <=
-  1 / (1 - Lambda)), which must be <= TOL |Mb_k + Delta_k| for every moving joint (any
-  Pmin_b <= 0 or Lambda >= 1: no proof, the next level).
+* Newton's error after the step is proven within TOL / (1 + Lambda) (Mb + Delta is kept,
+  :func:`proven`), so that its residual |g - Mb| is within TOL too, as the fixed point's
+  test would have it: with sigma_b = sum_i |ug_bi|_1 (>= the rate of P_b per unit Mb in
+  the max norm) and Lambda = max_k sum_b h_b sigma_b (g's Lipschitz constant, max norm,
+  < 1), e = ||r|| / (1 - Lambda) bounds ||Mb* - Mb||; along the segment to Mb* P_b >= Pmin_b
+  = P_b - sigma_b e and g's second derivative is at most H = max_k sum_b h_b sigma_b^2 /
+  min_b Pmin_b (b with sigma_b > 0: a load the moments do not move bends nothing, even at
+  0), so ||Mb* - (Mb + Delta)|| <= 1/2 H e^2 / (1 - Lambda) (Taylor's remainder, ||(1 -
+  J)^-1|| <= 1 / (1 - Lambda)), which must be <= TOL |Mb_k + Delta_k| / (1 + Lambda) for
+  every moving joint (any Pmin_b <= 0 or Lambda >= 1: no proof, the next level).
 
-From zero moments the first step lands within ~Lambda^2 / 2 (relative), the second within
-~Lambda^6: two levels on random states where the fixed point takes five or six (Lambda ~
-1e-3), one in a smooth stretch from the warm start.  The numpy path keeps the fixed point
-(:func:`..bearing_friction.fixed_point`): both stop within TOL of the same Mb*.
+A level from Mb lands within ~1/2 Lambda^2 (|Mb* - Mb| / |Mb*|)^2 of Mb*: from zero moments
+~Lambda^2 / 2 (relative), so a second level; from g(0), the fixed point's first iteration
+(within ~Lambda, :func:`.bearings._cold`), ~Lambda^4 / 2, proven at the first level where
+Lambda ~ 1e-3 (random states: g(0) and one level, where the fixed point takes five or six
+iterations); from the warm start in a smooth stretch one level.  The numpy path keeps the
+fixed point (:func:`..bearing_friction.fixed_point`): both stop within TOL of the same Mb*.
 """
 from __future__ import annotations
 
@@ -128,11 +131,11 @@ def step(e: Emitter, N: list, D: list, r: list) -> list:
 
 
 def proven(e: Emitter, lv: list, moving: list, P: list, r: list, new: list):
-    """i1: Newton's error bound after the step to ``new`` is within TOL of every moving
-    joint's moment (module docstring), without a division: with room = 1 - Lambda, e =
+    """i1: Newton's error bound after the step to ``new`` is within TOL / (1 + Lambda) of every
+    moving joint's moment (module docstring), without a division: with room = 1 - Lambda, e =
     ||r|| / room, Pmin_b = slack_b / room, slack_b = P_b room - sigma_b ||r||, and S = max_k
-    sum_b h_b sigma_b^2, the bound 1/2 S e^2 / (min_b Pmin_b room) <= TOL min_k |new_k| reads
-    1/2 S ||r||^2 <= TOL min_k |new_k| min_b slack_b room^2 (with room > 0, every slack_b > 0 of a bearing with sigma_b > 0)."""
+    sum_b h_b sigma_b^2, the bound 1/2 S e^2 / (min_b Pmin_b room) <= TOL min_k |new_k| / (1 +
+    Lambda) reads 1/2 (1 + Lambda) S ||r||^2 <= TOL min_k |new_k| min_b slack_b room^2 (with room > 0, every slack_b > 0 of a bearing with sigma_b > 0)."""
     def fmax(x, y):
         return e.b.select(e.b.fcmp_ordered(">", e.const(x), e.const(y)), e.const(x), e.const(y))
 
@@ -154,7 +157,7 @@ def proven(e: Emitter, lv: list, moving: list, P: list, r: list, new: list):
                 continue
             counts = e.b.and_(moving[k], e.b.fcmp_ordered(">", e.const(sigma), zero))
             slack = fmin(slack, e.b.select(counts, e.const(e.sub(e.mul(p, room), e.mul(sigma, rn))), inf))
-    lhs = e.mul(0.5, e.mul(S, e.mul(rn, rn)))
+    lhs = e.mul(e.mul(0.5, e.add(1.0, lam)), e.mul(S, e.mul(rn, rn)))
     rhs = e.mul(e.mul(TOL, small), e.mul(slack, e.mul(room, room)))
     ok = e.b.and_(e.b.fcmp_ordered(">", e.const(room), zero), e.b.fcmp_ordered(">", e.const(slack), zero))
     return e.b.and_(ok, e.b.fcmp_ordered("<=", e.const(lhs), e.const(rhs)))

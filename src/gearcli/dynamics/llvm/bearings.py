@@ -19,13 +19,15 @@ in the moments, x = x0 + sum_J s_J Mb_J g_J, g_J = X_p w_J (w_J constant in F: c
 per pattern for stored maps, the corrected map of :class:`~.losses.LossyBlock` per sample;
 in world axes w_J per sample, solved with r by each trial of the search, the block's matrix
 factored once, :meth:`~.world.WorldBlock.solve`), so are its bearings' load vectors,
-and the moments converge by Newton's method on them alone (:mod:`.bearing_newton`: two
-levels from zero where the fixed point takes five or six, one in a smooth stretch; each a
-square root per bearing and one division, stopped by the fixed point's own test or by
-Newton's proven error bound).  Where no bearing load of the block depends on the moments
+and the moments converge by Newton's method on them alone (:mod:`.bearing_newton`: from
+g(0), the fixed point's first iteration, one level where the fixed point takes five or six
+iterations, :func:`_cold`; one from the warm start in a smooth stretch; each a square root
+per bearing and one division, stopped by the fixed point's own test or by Newton's proven
+error bound).  Where no bearing load of the block depends on the moments
 (:func:`.bearing_newton.unaffected`: a link whose other unknown is its motor torque about
 the same axis takes the couple there) Mb = g(0) exactly, one iteration and no level.  The
-tooth forces must fit p (the tolerance of the shifted r) at the converged moments; where
+tooth forces must fit p (the tolerance of the shifted r; no tolerance needed where each is
+strictly on p's side of zero) at the converged moments; where
 they do not, and in a block solved in its link's axes (no constant couple), the block goes
 on from those moments and that iteration by the numpy path's loop: the whole block solved,
 its sign search included, each iteration.
@@ -131,16 +133,23 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
         def fits(Mb):          # do the tooth forces at Mb fit p (the tolerance of the shifted r)?
             return _consistent(e, at(Mb, tcols), [_sign_bit(e, p, i, m) for i in range(m)],
                                tolerance(e, jt.shifted(e, r, Mb)))
+        def strict(Mb):        # every t_i on p's side of 0 (and Mb a number): fits whatever the tolerance
+            ok = _consistent(e, at(Mb, tcols), [_sign_bit(e, p, i, m) for i in range(m)], ir.Constant(D, 0.0))
+            for v in Mb:
+                ok = e.b.and_(ok, e.b.fcmp_ordered("ord", v, v))
+            return ok
         again = fn.append_basic_block(f"{tag}_bagain") if m else None
         lv = [loads(e, lp, k, S0[j], SG[j]) for j, k in enumerate(bb.joints)]
         if unaffected(lv):     # the loads do not see the moments: Mb* = g(0), one iteration, nothing to fail
             Mb, it, failb = level(e, lv, jt.moving, [0.0] * K)[0], ir.Constant(I64, 1), None
         else:
-            Mb, it, failb, Mf = newton(e, fn, f"{tag}_ba", start, lv, jt.moving,
+            Mb, it, failb, Mf = newton(e, fn, f"{tag}_ba", _cold(e, fn, f"{tag}_bc", lv, jt, start), lv, jt.moving,
                                        lambda g, change: _failed(e, prog, bb, g, change, fail, n))
         x, start = at(Mb), None
         if m:                  # converged: do the tooth forces fit p? else the whole block's loop from Mb
-            fit_bb = fn.append_basic_block(f"{tag}_bfit")
+            fit_bb, exact = (fn.append_basic_block(f"{tag}_{x}") for x in ("bfit", "bexact"))
+            e.b.cbranch(strict(Mb), fit_bb, exact)
+            e.b.position_at_end(exact)
             e.b.cbranch(fits(Mb), fit_bb, again)
             start = (Mb, it)
             e.b.position_at_end(fit_bb)
@@ -167,6 +176,33 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
     Mb, it, x, p = (_phis(e, ends, k) for k in (1, 2, 3, 4))
     _outputs(e, s, lp, b, bb, jt, Mb, it[0], links, n)
     return x, (None if p is None else p[0])
+
+
+def _cold(e: Emitter, fn, tag: str, lv: list, jt: _Joints, start: tuple) -> tuple:
+    """``start`` (Mb, 1) with each moving joint not warm-started (Mb_J = 0) started from g_J(0)
+    instead, the fixed point's first iteration (the count then 2 where one g_J(0) is nonzero):
+    within ~Lambda of Mb*, so that the first Newton level's step lands within ~Lambda^4 / 2
+    and is proven there (:func:`.bearing_newton.proven`), where from zero it lands ~Lambda^2
+    / 2 off and takes a second level.  g(0) costs a square root per bearing, not a level,
+    and nothing where every joint is warm-started (a smooth stretch)."""
+    pre, cold_bb, join = e.b.block, fn.append_basic_block(f"{tag}_cold"), fn.append_basic_block(f"{tag}_join")
+    zero, any_cold = ir.Constant(D, 0.0), ir.Constant(I1, 0)
+    colds = [e.b.and_(mv, e.b.fcmp_ordered("==", e.const(w), zero)) for w, mv in zip(start[0], jt.moving)]
+    for c in colds:
+        any_cold = e.b.or_(any_cold, c)
+    e.b.cbranch(any_cold, cold_bb, join)
+    e.b.position_at_end(cold_bb)
+    g0, first, Mc = level(e, lv, jt.moving, [0.0] * len(jt.moving))[0], ir.Constant(I1, 0), []
+    for w, g, c in zip(start[0], g0, colds):
+        Mc.append(e.b.select(c, e.const(g), e.const(w)))
+        first = e.b.or_(first, e.b.and_(c, e.b.fcmp_ordered("!=", e.const(g), zero)))
+    itc = e.b.add(ir.Constant(I64, 1), e.b.zext(first, I64))
+    e.b.branch(join)
+    e.b.position_at_end(join)
+    Mb, it = [e.b.phi(D) for _ in Mc], e.b.phi(I64)
+    _incoming(Mb + [it], [e.const(w) for w in start[0]] + [start[1]], pre)
+    _incoming(Mb + [it], Mc + [itc], cold_bb)
+    return Mb, it
 
 
 def _affine(e: Emitter, jt: _Joints, r: list, solve, rows, world, tag: str):
