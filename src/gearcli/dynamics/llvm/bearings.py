@@ -130,14 +130,6 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
         def at(Mb, rows=range(len(x0))):     # x[rows] at the moments Mb
             return [e.add(x0[i], e.dot([G[j][i] for j in range(K)], Mb)) for i in rows]
 
-        def fits(Mb):          # do the tooth forces at Mb fit p (the tolerance of the shifted r)?
-            return _consistent(e, at(Mb, tcols), [_sign_bit(e, p, i, m) for i in range(m)],
-                               tolerance(e, jt.shifted(e, r, Mb)))
-        def strict(Mb):        # every t_i on p's side of 0 (and Mb a number): fits whatever the tolerance
-            ok = _consistent(e, at(Mb, tcols), [_sign_bit(e, p, i, m) for i in range(m)], ir.Constant(D, 0.0))
-            for v in Mb:
-                ok = e.b.and_(ok, e.b.fcmp_ordered("ord", v, v))
-            return ok
         again = fn.append_basic_block(f"{tag}_bagain") if m else None
         lv = [loads(e, lp, k, S0[j], SG[j]) for j, k in enumerate(bb.joints)]
         if unaffected(lv):     # the loads do not see the moments: Mb* = g(0), one iteration, nothing to fail
@@ -147,10 +139,8 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
                                        lambda g, change: _failed(e, prog, bb, g, change, fail, n))
         x, start = at(Mb), None
         if m:                  # converged: do the tooth forces fit p? else the whole block's loop from Mb
-            fit_bb, exact = (fn.append_basic_block(f"{tag}_{x}") for x in ("bfit", "bexact"))
-            e.b.cbranch(strict(Mb), fit_bb, exact)
-            e.b.position_at_end(exact)
-            e.b.cbranch(fits(Mb), fit_bb, again)
+            fit_bb = fn.append_basic_block(f"{tag}_bfit")
+            _fits(e, fn, tag, jt, r, p, at(Mb, tcols), Mb, (fit_bb, again))
             start = (Mb, it)
             e.b.position_at_end(fit_bb)
         ends.append((e.b.block, Mb, it, x, p))
@@ -176,6 +166,20 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
     Mb, it, x, p = (_phis(e, ends, k) for k in (1, 2, 3, 4))
     _outputs(e, s, lp, b, bb, jt, Mb, it[0], links, n)
     return x, (None if p is None else p[0])
+
+
+def _fits(e: Emitter, fn, tag: str, jt: _Joints, r: list, p, t: list, Mb: list, to: tuple) -> None:
+    """Branch to to[0] where the tooth forces t at the converged moments Mb fit the pattern p
+    (the tolerance of the shifted r), else to to[1]: first without the tolerance (every t_i
+    strictly on p's side of zero, and Mb numbers: the common case), then with it."""
+    neg = [_sign_bit(e, p, i, len(t)) for i in range(len(t))]
+    ok = _consistent(e, t, neg, ir.Constant(D, 0.0))
+    for v in Mb:
+        ok = e.b.and_(ok, e.b.fcmp_ordered("ord", v, v))
+    exact = fn.append_basic_block(f"{tag}_bexact")
+    e.b.cbranch(ok, to[0], exact)
+    e.b.position_at_end(exact)
+    e.b.cbranch(_consistent(e, t, neg, tolerance(e, jt.shifted(e, r, Mb))), *to)
 
 
 def _cold(e: Emitter, fn, tag: str, lv: list, jt: _Joints, start: tuple) -> tuple:
