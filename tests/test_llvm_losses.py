@@ -134,6 +134,30 @@ def test_screened_trials_where_friction_reverses_a_tooth_force(key):
         assert worst(res, ref) < TOL
 
 
+@pytest.mark.parametrize("key", ["planetary_3p.yaml", "planetary_5p.yaml"])
+def test_factor_cache_changes_no_bit(key):
+    """A lossy block of many meshes keeps the factors of 1 + M_l D of the last two (p, D)
+    met in a kernel call (``llvm.factor_cache``): every sample's results must be bit for bit
+    those of the same sample in another order, and alone (an empty cache), whatever came
+    before.  Both ways of turning and a sweep through the planet-ring forces' reversal give
+    four (p, D), more than the cache holds; with a key that leaves out D's digits the llvm
+    path fails this test."""
+    mech = load_mechanism(MECH / key)
+    an = analyse(dataclasses.replace(mech, gears=tuple(dataclasses.replace(g, loss_factor=0.03) for g in mech.gears)))
+    n = 2001
+    qdd = np.tile(np.linspace(-2000.0, 2000.0, n // 2 + 1), 2)[:n, None]
+    q, qd = np.zeros((n, 1)), np.where(np.arange(n) % 3 == 0, -1.0, 1.0)[:, None]
+    res = solve(an, q, qd, qdd, backend="llvm", jobs=1)
+    keys = {(tuple(np.sign(t)), float(v)) for t, v in zip(res.gear_t, qd[:, 0])}
+    assert len(keys) >= 3
+    order = np.random.default_rng(2).permutation(n)
+    shuffled = solve(an, q[order], qd[order], qdd[order], backend="llvm", jobs=1)
+    alone = [solve(an, q[i:i + 1], qd[i:i + 1], qdd[i:i + 1], backend="llvm", jobs=1) for i in order[:40]]
+    for f in FIELDS:
+        assert np.array_equal(getattr(shuffled, f), getattr(res, f)[order]), f
+        assert all(np.array_equal(getattr(a, f)[0], getattr(res, f)[i]) for a, i in zip(alone, order)), f
+
+
 @pytest.mark.parametrize("key", LOSSY + list(HAND))
 def test_llvm_equals_numpy_with_losses(key):
     an = analyse(mechanism(key))

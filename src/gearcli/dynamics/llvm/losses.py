@@ -34,6 +34,7 @@ import llvmlite.ir as ir
 import numpy as np
 
 from .build import D, FLAGS, I1, I64, Emitter
+from .factor_cache import FactorCache
 from .links import Sample, floats
 from .signs import SignedBlock, signs_of
 from .world import lu_solve
@@ -205,7 +206,7 @@ class LossyBlock:
     block)."""
 
     def __init__(self, inner, bl, sv: list, name: str = ""):
-        self.inner, self.bl, self.name, self.tables = inner, bl, name, {}
+        self.inner, self.bl, self.name, self.tables, self._caches = inner, bl, name, {}, {}
         self.tcols, self.n = inner.tcols, inner.n
         self.d_sv = [sv[k] for k in bl.rates]
         self.screen = None
@@ -259,6 +260,21 @@ class LossyBlock:
         y = [e.mul(db, e.b.select(singular, nan, e.const(Y[b][0]))) for b, db in enumerate(d)]
         return [e.const(e.sub(t0[i], e.dot(M[i], y))) for i in range(len(self.tcols))], y
 
+    def _cached(self, e: Emitter, fn, p, t0: list, tag: str) -> list:
+        """:meth:`_exact`'s y, 1 + M_l D factored once per call and (p, D) (:mod:`.factor_cache`)."""
+        d, lt = self._d(e, p), self.bl.positions
+        key = e.b.sitofp(p, D)
+        for db in d:                   # (p, D's digits) in base 3, exact in a double (p < 2^12)
+            key = e.add(e.mul(3.0, key), e.add(db, 1.0))
+        cache = self._caches.get(fn) or self._caches.setdefault(fn, FactorCache(e, fn, len(lt)))
+
+        def make():
+            M = self._tooth_map(e, fn, p, f"{tag}_m")
+            return [[e.add(1.0 if a == b else 0.0, e.mul(M[lt[a]][b], d[b])) for b in range(len(lt))]
+                    for a in range(len(lt))]
+        Y = cache.solve(e, fn, key, make, [t0[i] for i in lt], tag)
+        return [e.mul(db, y) for db, y in zip(d, Y)]
+
     def trial(self, e: Emitter, fn, p, r: list, tol, tag: str):
         """(t, kept) of a trial of pattern p (i64) with sign tolerance ``tol``: tooth forces
         t whose signs and consistency (:func:`~.signs.resolve`) are those of the changed
@@ -295,7 +311,7 @@ class LossyBlock:
         the inner maps stored per pattern (X r does not wait for y: the solve's divisions
         run beside it; 1.56x -> 1.26x the lossless kernel on the 3-planet stage against X (r
         - Phi^T y)), else X (r - Phi^T y)."""
-        y = kept if self.screen is None else self._exact(e, fn, p, kept, f"{tag}_y")[1]
+        y = kept if self.screen is None else self._cached(e, fn, p, kept, f"{tag}_y")
         phi, rows = self.bl.phi, list(range(self.n))
         if isinstance(self.inner, SignedBlock):
             xr, get = self.inner.rows(e, fn, p, rows, r, tag), self._couple_map(e, p)
