@@ -262,16 +262,16 @@ class LossyBlock:
 
     def _cached(self, e: Emitter, fn, p, t0: list, tag: str) -> list:
         """:meth:`_exact`'s y, 1 + M_l D factored once per call and (p, D) (:mod:`.factor_cache`)."""
-        d, lt = self._d(e, p), self.bl.positions
-        key = e.b.sitofp(p, D)
-        for db in d:                   # (p, D's digits) in base 3, exact in a double (p < 2^12)
+        d, lt, key = self._d(e, p), self.bl.positions, e.b.sitofp(p, D)
+        if (1 << len(self.tcols)) * 3 ** len(lt) > 1 << 53:      # no exact key: no cache
+            return self._exact(e, fn, p, t0, tag)[1]
+        for db in d:                   # (p, D's digits) in base 3, exact in a double
             key = e.add(e.mul(3.0, key), e.add(db, 1.0))
         cache = self._caches.get(fn) or self._caches.setdefault(fn, FactorCache(e, fn, len(lt)))
 
         def make():
-            M = self._tooth_map(e, fn, p, f"{tag}_m")
-            return [[e.add(1.0 if a == b else 0.0, e.mul(M[lt[a]][b], d[b])) for b in range(len(lt))]
-                    for a in range(len(lt))]
+            M, ks = self._tooth_map(e, fn, p, f"{tag}_m"), range(len(lt))
+            return [[e.add(1.0 if a == b else 0.0, e.mul(M[lt[a]][b], d[b])) for b in ks] for a in ks]
         Y = cache.solve(e, fn, key, make, [t0[i] for i in lt], tag)
         return [e.mul(db, y) for db, y in zip(d, Y)]
 
