@@ -135,9 +135,9 @@ def test_screened_trials_where_friction_reverses_a_tooth_force(key):
 
 
 @pytest.mark.parametrize("key", ["planetary_3p.yaml", "planetary_5p.yaml"])
-def test_factor_cache_changes_no_bit(key):
+def test_inverse_cache_changes_no_bit(key):
     """A lossy block of many meshes keeps the factors of 1 + M_l D of the last two (p, D)
-    met in a kernel call (``llvm.factor_cache``): every sample's results must be bit for bit
+    met in a kernel call (``llvm.inverse_cache``): every sample's results must be bit for bit
     those of the same sample in another order, and alone (an empty cache), whatever came
     before.  Both ways of turning and a sweep through the planet-ring forces' reversal give
     four (p, D), more than the cache holds; with a key that leaves out D's digits the llvm

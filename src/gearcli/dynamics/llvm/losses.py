@@ -34,7 +34,7 @@ import llvmlite.ir as ir
 import numpy as np
 
 from .build import D, FLAGS, I1, I64, Emitter
-from .factor_cache import FactorCache
+from .inverse_cache import InverseCache
 from .links import Sample, floats
 from .signs import SignedBlock, signs_of
 from .world import lu_solve
@@ -261,13 +261,13 @@ class LossyBlock:
         return [e.const(e.sub(t0[i], e.dot(M[i], y))) for i in range(len(self.tcols))], y
 
     def _cached(self, e: Emitter, fn, p, t0: list, tag: str) -> list:
-        """:meth:`_exact`'s y, 1 + M_l D factored once per call and (p, D) (:mod:`.factor_cache`)."""
+        """:meth:`_exact`'s y, 1 + M_l D inverted once per call and (p, D) (:mod:`.inverse_cache`)."""
         d, lt, key = self._d(e, p), self.bl.positions, e.b.sitofp(p, D)
         if (1 << len(self.tcols)) * 3 ** len(lt) > 1 << 53:      # no exact key: no cache
             return self._exact(e, fn, p, t0, tag)[1]
         for db in d:                   # (p, D's digits) in base 3, exact in a double
             key = e.add(e.mul(3.0, key), e.add(db, 1.0))
-        cache = self._caches.get(fn) or self._caches.setdefault(fn, FactorCache(e, fn, len(lt)))
+        cache = self._caches.get(fn) or self._caches.setdefault(fn, InverseCache(e, fn, len(lt)))
 
         def make():
             M, ks = self._tooth_map(e, fn, p, f"{tag}_m"), range(len(lt))

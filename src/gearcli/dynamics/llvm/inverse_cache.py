@@ -12,10 +12,10 @@ states, the same few (p, D) recur: every sample of 20,000 random states of the 5
 stage has one p, and D takes two values with the sign of its rate.
 
 So each call of the kernel keeps the inverses of the last two matrices met, keyed by (p,
-D), in stack arrays (:meth:`FactorCache.solve`): a sample whose key is there reads its
-inverse back; another forms and factors its matrix (elimination in row order: the matrix
-is strictly diagonally dominant for every pattern, no pivoting, as :func:`.world.lu_solve`'s
-``dominant``), inverts it column by column, stores the inverse over the older entry and
+D), in stack arrays (:meth:`InverseCache.solve`): a sample whose key is there reads its
+inverse back; another forms its matrix and inverts it (:func:`.world.lu_solve` of the
+identity, ``dominant``: the matrix is strictly diagonally dominant for every pattern, so
+elimination in row order without pivoting), stores the inverse over the older entry and
 reads it back the same way.  The inverse is the same numbers either way (a deterministic
 function of (p, D)), so no result depends on the cache, on the samples before or on the
 threads.  The solution is then one k x k product, k independent dot products, where a
@@ -27,41 +27,10 @@ from __future__ import annotations
 import llvmlite.ir as ir
 
 from .build import D, DP, I64, Emitter
+from .world import lu_solve
 
 
-def factor(e: Emitter, A: list) -> tuple:
-    """(LU, inv) of A (k x k rows of values, strictly diagonally dominant): LU[i][c] the
-    multiplier of row c for row i (i > c), LU[c][j] U's entry (j > c), inv[c] = 1 / U[c][c];
-    the elimination of :func:`.world.lu_solve` in row order."""
-    k = len(A)
-    A = [list(row) for row in A]
-    inv = [1.0] * k
-    for c in range(k):
-        inv[c] = e.div(1.0, A[c][c])
-        for i in range(c + 1, k):
-            f = A[i][c] = e.mul(A[i][c], inv[c])
-            for j in range(c + 1, k):
-                A[i][j] = e.sub(A[i][j], e.mul(f, A[c][j]))
-    return A, inv
-
-
-def apply(e: Emitter, LU: list, inv: list, b: list) -> list:
-    """A^-1 b from :func:`factor`'s (LU, inv): forward then back substitution, in the order
-    of :func:`.world.lu_solve` (so the same values)."""
-    k = len(b)
-    x = list(b)
-    for c in range(k):
-        for i in range(c + 1, k):
-            x[i] = e.sub(x[i], e.mul(LU[i][c], x[c]))
-    for c in range(k - 1, -1, -1):
-        v = x[c]
-        for j in range(c + 1, k):
-            v = e.sub(v, e.mul(LU[c][j], x[j]))
-        x[c] = e.mul(v, inv[c])
-    return x
-
-
-class FactorCache:
+class InverseCache:
     """Two entries of (key, a k x k inverse, row-major) on the stack of the kernel function
     ``fn``, keys -1 (none) at its entry."""
 
@@ -89,13 +58,12 @@ class FactorCache:
         slot_new = b_.load(self.older)
         b_.store(b_.sub(ir.Constant(I64, 1), slot_new), self.older)
         b_.store(key, b_.gep(self.keys, [slot_new]))
-        LU, inv = factor(e, make())
         k = self.k
-        cols = [apply(e, LU, inv, [1.0 if i == j else 0.0 for i in range(k)]) for j in range(k)]
+        inverse = lu_solve(e, make(), [[1.0 if i == j else 0.0 for j in range(k)] for i in range(k)], dominant=True)[0]
         base = b_.mul(slot_new, ir.Constant(I64, self.size))
         for i in range(k):
             for j in range(k):
-                e.store(cols[j][i], b_.gep(self.data, [base]), i * k + j)
+                e.store(inverse[i][j], b_.gep(self.data, [base]), i * k + j)
         miss_end = b_.block
         b_.branch(done)
         b_.position_at_end(done)
