@@ -15,6 +15,7 @@ A 3-vector is a 3-tuple of values, a 3x3 matrix a row-major 9-tuple.
 from __future__ import annotations
 
 import math
+import struct
 
 import llvmlite.ir as ir
 
@@ -26,12 +27,52 @@ I64P = I64.as_pointer()
 FLAGS = ("contract",)
 
 
-class Emitter:
-    """Folding double arithmetic on an :class:`llvmlite.ir.IRBuilder` (see module docstring)."""
+class ConstantPool:
+    """The constants of one function's arithmetic in one internal constant array, each read
+    at its use as base + offset from one register, the base loaded once in the function's
+    entry (``finish`` writes the array).  As immediates of the JIT's large code model each
+    use cost a 10-byte ``movabs`` of its address besides the instruction: the code of a
+    many-mesh lossy kernel then overflowed the instruction cache (planetary_5p with mesh
+    friction: ~350 L1i misses a sample, valgrind)."""
 
-    def __init__(self, builder: ir.IRBuilder, module: ir.Module):
+    def __init__(self, fn: ir.Function):
+        self.fn, self.index = fn, {}
+        self.ptr = ir.GlobalVariable(fn.module, DP, f"{fn.name}_pool_at")
+        self.ptr.global_constant, self.ptr.linkage = True, "internal"
+        ib = ir.IRBuilder(fn.entry_basic_block)
+        ib.position_at_start(fn.entry_basic_block)
+        # the base through an empty asm: a register LLVM cannot fold into each load's offset
+        self.base = ib.asm(ir.FunctionType(DP, [DP]), "", "=r,0", [ib.load(self.ptr)], False)
+        self.invariant = fn.module.add_metadata([])
+
+    def load(self, b: ir.IRBuilder, a: float) -> ir.Value:
+        """The constant ``a`` (a double), read from the pool at the builder's position."""
+        i = self.index.setdefault(struct.pack("<d", a), len(self.index))
+        v = b.load(b.gep(self.base, [ir.Constant(I64, i)]))
+        v.set_metadata("invariant.load", self.invariant)
+        return v
+
+    def finish(self) -> None:
+        values = [struct.unpack("<d", k)[0] for k in self.index] or [0.0]
+        g = ir.GlobalVariable(self.fn.module, ir.ArrayType(D, len(values)), f"{self.fn.name}_pool")
+        g.global_constant, g.linkage, g.initializer = True, "internal", ir.Constant(g.value_type, values)
+        self.ptr.initializer = g.bitcast(DP)
+
+
+class Emitter:
+    """Folding double arithmetic on an :class:`llvmlite.ir.IRBuilder` (see module docstring);
+    with a :class:`ConstantPool` the constants of its arithmetic come from the pool."""
+
+    def __init__(self, builder: ir.IRBuilder, module: ir.Module, pool: ConstantPool | None = None):
         self.b = builder
         self.module = module
+        self.pool = pool
+
+    def _operand(self, a) -> ir.Value:
+        """``a`` as an operand of an arithmetic instruction (a pool read for a constant)."""
+        if isinstance(a, float) and self.pool is not None:
+            return self.pool.load(self.b, a)
+        return self.const(a)
 
     @staticmethod
     def const(a) -> ir.Value:
@@ -52,7 +93,7 @@ class Emitter:
             return b
         if isinstance(b, float) and b == 0.0:
             return a
-        return self.b.fadd(self.const(a), self.const(b), flags=FLAGS)
+        return self.b.fadd(self._operand(a), self._operand(b), flags=FLAGS)
 
     def neg(self, a):
         return -a if isinstance(a, float) else self.b.fneg(a, flags=FLAGS)
@@ -64,7 +105,7 @@ class Emitter:
             return a
         if isinstance(a, float) and a == 0.0:
             return self.neg(b)
-        return self.b.fsub(self.const(a), self.const(b), flags=FLAGS)
+        return self.b.fsub(self._operand(a), self._operand(b), flags=FLAGS)
 
     def mul(self, a, b):
         if isinstance(a, float) and isinstance(b, float):
@@ -78,14 +119,14 @@ class Emitter:
                 return b
             if a == -1.0:
                 return self.neg(b)
-        return self.b.fmul(self.const(a), self.const(b), flags=FLAGS)
+        return self.b.fmul(self._operand(a), self._operand(b), flags=FLAGS)
 
     def div(self, a, b):
         if isinstance(a, float) and isinstance(b, float):
             return a / b
         if isinstance(b, float) and b == 1.0:
             return a
-        return self.b.fdiv(self.const(a), self.const(b), flags=FLAGS)
+        return self.b.fdiv(self._operand(a), self._operand(b), flags=FLAGS)
 
     def dot(self, xs, ys):
         """sum_i xs[i] ys[i], left to right."""

@@ -28,7 +28,7 @@ import llvmlite.ir as ir
 
 from . import losses as llvm_losses
 from .blocks import block
-from .build import DP, I64, I64P, Emitter
+from .build import DP, I64, I64P, ConstantPool, Emitter
 from .links import at_rest, external, inertia, joint, joint_space, load_groups
 from .outputs import OUTPUTS, widths, write_outputs
 
@@ -102,7 +102,9 @@ def sample_loop(fn: ir.Function, body) -> None:
     n, bad = b.phi(I64, "n"), b.phi(I64, "bad")
     n.add_incoming(start, entry)
     bad.add_incoming(ir.Constant(I64, 0), entry)
-    failed = body(Emitter(b, fn.module), n)
+    pool = ConstantPool(fn)
+    failed = body(Emitter(b, fn.module, pool), n)
+    pool.finish()
     n1, bad1 = b.add(n, ir.Constant(I64, 1)), b.add(bad, b.zext(failed, I64))
     latch = b.block
     n.add_incoming(n1, latch)
