@@ -243,6 +243,11 @@ MUTATIONS = [
     Mutation("llvm-mesh-couple-map", "llvm: a lossy block's accepted solution corrected by the couples' map of pattern 0",
              (("dynamics/llvm/losses.py", "xr, get = self.inner.rows(e, fn, p, rows, r, tag), self._couple_map(e, p)",
                "xr, get = self.inner.rows(e, fn, p, rows, r, tag), self._couple_map(e, ir.Constant(I64, 0))"),)),
+    Mutation("llvm-constant-pool-key", "llvm: the kernels' constant pool keyed by each constant in single precision (nearby constants share one entry)",
+             (("dynamics/llvm/build.py", 'i = self.index.setdefault(struct.pack("<d", a), len(self.index))',
+               'i = self.index.setdefault(struct.pack("<f", a), len(self.index))'),
+              ("dynamics/llvm/build.py", 'values = [struct.unpack("<d", k)[0] for k in self.index] or [0.0]',
+               'values = [struct.unpack("<f", k)[0] for k in self.index] or [0.0]'))),
     Mutation("llvm-sin-quadrant", "llvm: inline sin with the quadrant's sign flipped",
              (("dynamics/llvm/trig.py", "b.select(sin_neg, e.neg(sin_mag), sin_mag)", "b.select(sin_neg, sin_mag, e.neg(sin_mag))"),)),
 ]
