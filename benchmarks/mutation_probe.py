@@ -248,6 +248,11 @@ MUTATIONS = [
                'i = self.index.setdefault(struct.pack("<f", a), len(self.index))'),
               ("dynamics/llvm/build.py", 'values = [struct.unpack("<d", k)[0] for k in self.index] or [0.0]',
                'values = [struct.unpack("<f", k)[0] for k in self.index] or [0.0]'))),
+    Mutation("llvm-hot-lossy-map", "llvm: a hot (pattern, s_v) pair's stored lossy map made with D's signs reversed",
+             (("dynamics/llvm/lossy_maps.py", "for i in bl.positions]) * sv)", "for i in bl.positions]) * -sv)"),)),
+    Mutation("llvm-hot-tabled-pattern", "llvm: a tabled signed block's hot pattern cases each computing the next hot pattern's map",
+             (("dynamics/llvm/signs.py", "lambda A=self.maps[k]: [e.dot(floats(A[i]), r) for i in rows]) for k in self.hot]",
+               "lambda A=self.maps[self.hot[(j + 1) % len(self.hot)]]: [e.dot(floats(A[i]), r) for i in rows]) for j, k in enumerate(self.hot)]"),)),
     Mutation("llvm-sin-quadrant", "llvm: inline sin with the quadrant's sign flipped",
              (("dynamics/llvm/trig.py", "b.select(sin_neg, e.neg(sin_mag), sin_mag)", "b.select(sin_neg, sin_mag, e.neg(sin_mag))"),)),
 ]

@@ -308,11 +308,21 @@ def test_bearing_friction_that_does_not_converge_is_the_same_error():
 # --- the comparison catches a wrong kernel ---------------------------------------------------
 def _reversed_couples(lp):
     """The LossProgram with every friction couple of the kernel reversed (block maps' phi,
-    propagated couples in F, the world-frame blocks' couples)."""
-    blocks = {b: dataclasses.replace(bl, phi=None if bl.phi is None else -bl.phi,
+    propagated couples in F, the world-frame blocks' couples; the hot pairs' maps, made
+    from phi with the program, dropped: every pair then takes the reversed correction)."""
+    blocks = {b: dataclasses.replace(bl, phi=None if bl.phi is None else -bl.phi, hot=(),
                                      couple_F=None if bl.couple_F is None else -bl.couple_F)
               for b, bl in lp.blocks.items()}
     return dataclasses.replace(lp, blocks=blocks, couple={ci: -v for ci, v in lp.couple.items()})
+
+
+def _hot_maps_rotated(lp):
+    """The LossProgram with each hot pair's stored map (:mod:`gearcli.dynamics.llvm.lossy_maps`)
+    under the next pair's key."""
+    def rotated(hot):
+        return tuple(zip([k for k, _ in hot], [L for _, L in hot][1:] + [L for _, L in hot][:1]))
+    assert any(len(bl.hot) > 1 for bl in lp.blocks.values())
+    return dataclasses.replace(lp, blocks={b: dataclasses.replace(bl, hot=rotated(bl.hot)) for b, bl in lp.blocks.items()})
 
 
 def _joint_columns(lp, cols, factor):
@@ -323,7 +333,7 @@ def _joint_columns(lp, cols, factor):
 
 @pytest.mark.parametrize("key,mutate", [
     ("paper_2dof.yaml", _reversed_couples), ("servo_joint_rated.yaml", _reversed_couples),
-    ("planetary_3p.yaml", _reversed_couples),
+    ("planetary_3p.yaml", _reversed_couples), ("planetary_3p.yaml", _hot_maps_rotated),
     ("rack", lambda lp: _joint_columns(lp, slice(0, 6), -1.0)),              # joint friction on the parent
     ("rack", lambda lp: _joint_columns(lp, [6], -1.0)),                      # Coulomb friction with the rate
     ("spur", lambda lp: dataclasses.replace(lp, rate_flt=-lp.rate_flt)),       # s_v reversed

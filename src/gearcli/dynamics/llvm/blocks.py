@@ -15,6 +15,7 @@ import llvmlite.ir as ir
 
 from . import losses as llvm_losses
 from .bearings import converge
+from .hot_pairs import HotLossyBlock
 from .build import I64, Emitter
 from .links import Sample, floats
 from .signs import SignedBlock, resolve, signs_of, tolerance
@@ -142,12 +143,14 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row, search: bool
     else:
         r = gather(e, s, F, links)
         maps = [ainv[a0 + k * nloc * nr:a0 + (k + 1) * nloc * nr].reshape(nloc, nr) for k in range(1 << m)]
-        blk = SignedBlock(e, maps, tcols, f"b{b}") if m and search else None
+        blk = SignedBlock(e, maps, tcols, f"b{b}", prog.hot.get(b, ((),))[0]) if m and search else None
     lossy = prog.losses.blocks.get(b) if prog.losses is not None and search else None
     if lossy is not None and F < 0:
         blk.extra = llvm_losses.world_columns(prog.losses, lossy, s)
     elif lossy is not None:
         blk = llvm_losses.lossy_block(e, blk, lossy, s.sv, f"b{b}")
+        if lossy.hot:                # (a LossyBlock) its hot pairs from their stored maps
+            blk = HotLossyBlock(e, blk, lossy, s.sv)
 
     def solve(r, tag):              # (x, p) of right-hand side r; p None: pattern 0 without a search
         if m and search:

@@ -52,7 +52,9 @@ class BlockLosses:
     its lossy meshes, sign pattern), index 2^m * sum_i (s_v,i + 1) 3^i + pattern, the maps
     of the numpy path (:func:`..blocks._constant_block`), else None.  World frame (``phi``
     None): ``rows`` per mesh [(block row of the link, sign)] and ``later`` as above; the
-    couple is :attr:`LossProgram.couple` of the circuit turned by the carrier's R."""
+    couple is :attr:`LossProgram.couple` of the circuit turned by the carrier's R.  ``hot``
+    (a constant frame without ``maps``): ((key, map), ...) the changed matrix's maps of the
+    pairs random motions meet most (:func:`.lossy_maps.hot_lossy_maps`)."""
 
     positions: tuple
     rates: tuple
@@ -62,6 +64,7 @@ class BlockLosses:
     later: tuple
     rows: tuple = ()
     maps: tuple | None = None
+    hot: tuple = ()
 
 
 @dataclass(frozen=True, eq=False)
@@ -118,6 +121,7 @@ class LossProgram:
             bl = self.blocks[b]
             out += [b, bl.positions, bl.rates, bl.circuits, bl.later, bl.rows]
             out += [a.tobytes() for a in (bl.phi, bl.couple_F) + (bl.maps or ()) if a is not None]
+            out += [v for key, L in bl.hot for v in (key, L.tobytes())]
         return out
 
 

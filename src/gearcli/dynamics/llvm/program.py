@@ -17,13 +17,14 @@ link's axes gets F = that link and its inverse (:func:`_local_frame`), and keeps
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
 from ...analysis.schedule import unknown_groups
 from ..blocks import _primary_side
 from .basis import basis as _basis
+from .lossy_maps import hot_lossy_maps
 from .output_maps import output_constants
 from ..pattern_maps import hot_patterns, low_rank
 from ..sharing import SharingError, mesh_weights
@@ -248,7 +249,8 @@ def build_program(an, plans) -> Program:
     joints, poses = _joints(an)
     cat = (lambda xs: np.concatenate(xs) if xs else np.zeros(0))
     jout, mcol, gcol, gout = output_constants(an, offsets)
-    hot = _hot_maps(an, plans, lowrank)
+    study = _Study(an, plans, lowrank)
+    hot = _hot_maps(an, plans, lowrank, study)
     weights = {bi: mesh_weights(an, p.groups) for bi, p in enumerate(plans)
                if p.F is None and int(p.offs[-1]) > 6 * len(p.links)}
     free = {bi: f for bi in weights if (f := _basis(an, plans[bi], weights[bi])) is not None}
@@ -265,41 +267,86 @@ def build_program(an, plans) -> Program:
                    child_basis=records(bd.cbrec, CHILD_BASIS), turns=np.array(bd.turns, float), terms=trec,
                    term_values=tflt, joint_out=jout, motor_col=mcol, gear_col=gcol, gear_out=gout, hashed=hashed,
                    lowrank=lowrank, hot=hot, weights=weights, free=free,
-                   losses=build_loss_program(an, plans))
+                   losses=_hot_lossy(an, plans, build_loss_program(an, plans), study))
 
 
-def _hot_maps(an, plans, lowrank: dict) -> dict:
+STUDIED_PATTERNS = 16
+"""Sign patterns from which a constant block's hot patterns are found (:func:`_hot_maps`;
+:class:`.signs.SignedBlock` uses them where it reads its maps from a table)."""
+
+
+def _hot_maps(an, plans, lowrank: dict, study) -> dict:
     """{block: (hot pattern indices, their maps)} of the :class:`~..pattern_maps.LowRank`
-    blocks: the patterns the sign search settles on within its first m + 1 trials
-    (:class:`~..signs.OwnSigns`, solved by ``LowRank.solve``) for 256 random motions of the
-    mechanism (a fixed seed; the block's own d'Alembert loads, without the wrenches of
-    earlier blocks: a hint for speed, not a result; :func:`~..pattern_maps.hot_patterns`)."""
-    if not lowrank:
-        return {}
-    from ..blocks import block_rhs                 # noqa: PLC0415
-    from ..inertia import inertia_load             # noqa: PLC0415
-    from ..kinematics import forward               # noqa: PLC0415
-    from ..signs import OwnSigns, pattern_index    # noqa: PLC0415
-
-    rng = np.random.default_rng(18)
-    n = 256
-    qi = [rng.uniform(-np.pi, np.pi, (n, an.dof)), rng.normal(size=(n, an.dof)) * 3.0,
-          rng.normal(size=(n, an.dof)) * 20.0]
-    q, qd, qdd = (v @ np.asarray(an.S, float).T for v in qi)
-    kin = forward(an.mech, an.tree, q, qd, qdd)
-    b = inertia_load(an, kin)
+    blocks and of the others with :data:`STUDIED_PATTERNS` or more: the patterns the sign
+    search settles on within its first m + 1 trials for the random motions of ``study``
+    (:class:`_Study`; :func:`~..pattern_maps.hot_patterns`)."""
     out = {}
-    for bi, lr in lowrank.items():
-        p = plans[bi]
-        r = block_rhs(an, p, kin, b)
-        search = OwnSigns(lambda sg, idx, r=r, lr=lr: lr.solve(sg, r[idx]), len(p.signed),
-                          [int(p.offs[gi]) for gi in p.signed], n, 1.0 + np.abs(r).max(axis=1))
-        with np.errstate(all="ignore"):
-            settled = np.setdiff1d(np.arange(n), search.settle())
-        counts = Counter(pattern_index(s) for s in search.used[settled])
-        hot = hot_patterns(counts)
+    tabled = [bi for bi, p in enumerate(plans)
+              if bi not in lowrank and p.F is not None and 1 << len(p.signed) >= STUDIED_PATTERNS]
+    for bi in list(lowrank) + tabled:
         try:
-            out[bi] = (hot, np.array([p.Ainv[k] for k in hot]))
+            hot = hot_patterns(Counter(int(k) for k in study.patterns(bi)[1]))
+            out[bi] = (hot, np.array([plans[bi].Ainv[k] for k in hot]))
         except (np.linalg.LinAlgError, SharingError):
             continue
     return out
+
+
+class _Study:
+    """256 random motions of the mechanism (a fixed seed) and, per constant block, the sign
+    patterns its search settles on within its first m + 1 trials (:class:`~..signs.OwnSigns`,
+    ``LowRank.solve`` or the stored maps; the block's own d'Alembert loads, without the
+    wrenches of earlier blocks): a hint for speed, not a result (hot patterns, hot lossy
+    maps); made on first use."""
+
+    def __init__(self, an, plans, lowrank: dict):
+        self.an, self.plans, self.lowrank, self._kin, self._pat = an, plans, lowrank, None, {}
+
+    @property
+    def kin(self):
+        if self._kin is None:
+            from ..inertia import inertia_load             # noqa: PLC0415
+            from ..kinematics import forward               # noqa: PLC0415
+            rng, an, n = np.random.default_rng(18), self.an, 256
+            qi = [rng.uniform(-np.pi, np.pi, (n, an.dof)), rng.normal(size=(n, an.dof)) * 3.0,
+                  rng.normal(size=(n, an.dof)) * 20.0]
+            q, qd, qdd = (v @ np.asarray(an.S, float).T for v in qi)
+            kin = forward(an.mech, an.tree, q, qd, qdd)
+            self._kin = (kin, inertia_load(an, kin))
+        return self._kin[0]
+
+    def patterns(self, bi: int):
+        """(settled samples, their pattern indices) of constant block ``bi``."""
+        if bi not in self._pat:
+            from ..blocks import block_rhs                 # noqa: PLC0415
+            from ..signs import OwnSigns, pattern_index    # noqa: PLC0415
+            p, kin = self.plans[bi], self.kin
+            r = block_rhs(self.an, p, kin, self._kin[1])
+            lr = self.lowrank.get(bi)
+            solve = ((lambda sg, idx: lr.solve(sg, r[idx])) if lr is not None else
+                     (lambda sg, idx: r[idx] @ p.Ainv[pattern_index(sg)].T))
+            n = r.shape[0]
+            search = OwnSigns(solve, len(p.signed), [int(p.offs[gi]) for gi in p.signed], n, 1.0 + np.abs(r).max(axis=1))
+            with np.errstate(all="ignore"):
+                settled = np.setdiff1d(np.arange(n), search.settle())
+            self._pat[bi] = (settled, np.array([pattern_index(s) for s in search.used[settled]], np.int64))
+        return self._pat[bi]
+
+
+def _hot_lossy(an, plans, losses, study):
+    """``losses`` with :attr:`~.loss_program.BlockLosses.hot` of each constant block without
+    stored maps of every pair (:func:`.lossy_maps.hot_lossy_maps`)."""
+    if losses is None:
+        return None
+    blocks = dict(losses.blocks)
+    for bi, bl in losses.blocks.items():
+        if bl.phi is None or bl.maps is not None:
+            continue
+        p = plans[bi]
+        try:
+            hot = hot_lossy_maps(an, study.kin, bl, lambda k: p.Ainv[k], [int(p.offs[gi]) for gi in p.signed],
+                                 *study.patterns(bi))
+        except (np.linalg.LinAlgError, SharingError):
+            continue
+        blocks[bi] = replace(bl, hot=hot)
+    return replace(losses, blocks=blocks)

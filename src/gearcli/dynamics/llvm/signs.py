@@ -88,10 +88,13 @@ def _own_pattern(e: Emitter, t: list):
 
 
 class SignedBlock:
-    """The maps of one signed constant-frame block and how its code reads them."""
+    """The maps of one signed constant-frame block and how its code reads them: a switch
+    into straight-line code per pattern, or, past :data:`SWITCH_LIMIT`, a constant table
+    read with the ``hot`` patterns' (those random motions meet most,
+    :func:`.program._hot_maps`) cases still straight-line."""
 
-    def __init__(self, e: Emitter, maps: list, tcols: list, name: str):
-        self.maps, self.tcols = maps, tcols
+    def __init__(self, e: Emitter, maps: list, tcols: list, name: str, hot: list = ()):
+        self.maps, self.tcols, self.hot = maps, tcols, list(hot)
         self.n, self.nr = maps[0].shape
         m = len(tcols)
         self.table = None
@@ -107,6 +110,9 @@ class SignedBlock:
         """Rows ``rows`` of pattern p's map times r."""
         if self.table is None:
             return _rows_switch(e, fn, p, self.maps, rows, r, tag)
+        if self.hot:             # the hot patterns straight-line, the others from the table
+            return e.switch(fn, p, [(k, lambda A=self.maps[k]: [e.dot(floats(A[i]), r) for i in rows]) for k in self.hot],
+                            tag, default=lambda: _rows_global(e, self.table, p, self.n, self.nr, rows, r))
         return _rows_global(e, self.table, p, self.n, self.nr, rows, r)
 
 
