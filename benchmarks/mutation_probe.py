@@ -253,6 +253,8 @@ MUTATIONS = [
     Mutation("llvm-hot-tabled-pattern", "llvm: a tabled signed block's hot pattern cases each computing the next hot pattern's map",
              (("dynamics/llvm/signs.py", "lambda A=self.maps[k]: [e.dot(floats(A[i]), r) for i in rows]) for k in self.hot]",
                "lambda A=self.maps[self.hot[(j + 1) % len(self.hot)]]: [e.dot(floats(A[i]), r) for i in rows]) for j, k in enumerate(self.hot)]"),)),
+    Mutation("llvm-hot-pair-products", "llvm: a hot lossy pair's products with bearing friction's unit couples reversed",
+             (("dynamics/llvm/hot_pairs.py", "lambda P=L @ cols:", "lambda P=-(L @ cols):"),)),
     Mutation("llvm-sin-quadrant", "llvm: inline sin with the quadrant's sign flipped",
              (("dynamics/llvm/trig.py", "b.select(sin_neg, e.neg(sin_mag), sin_mag)", "b.select(sin_neg, sin_mag, e.neg(sin_mag))"),)),
 ]

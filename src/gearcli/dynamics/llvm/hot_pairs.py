@@ -3,9 +3,11 @@ pairs from their stored maps (:mod:`.lossy_maps`), for :mod:`.blocks`."""
 from __future__ import annotations
 
 import llvmlite.ir as ir
+import numpy as np
 
 from .build import I64, Emitter
 from .links import floats
+from .signs import SignedBlock
 
 
 class HotLossyBlock:
@@ -47,4 +49,14 @@ class HotLossyBlock:
         return self._either(e, fn, p, rows, r, f"{tag}_hot", lambda: self.block.rows(e, fn, p, rows, r, tag))
 
     def products(self, e: Emitter, p, W: list):
-        return self.block.products(e, p, W)
+        """As :meth:`~.losses.LossyBlock.products` (bearing friction's unit couples W_j): a
+        hot pair's L W_j constants, any other pair's from ``block`` (None where it has none)."""
+        if not isinstance(self.block.inner, SignedBlock):
+            return None
+        n, k = self.n, len(W)
+        cols = np.array(W, float).T
+        key = e.b.add(e.b.mul(p, ir.Constant(I64, 3 ** self.ml)), self.code)
+        cases = [(kk, lambda P=L @ cols: [float(v) for v in P.T.ravel()]) for kk, L in zip(self.keys, self.maps)]
+        flat = e.switch(e.b.function, key, cases, "hot_w",
+                        default=lambda: [v for col in self.block.products(e, p, W) for v in col])
+        return [flat[j * n:(j + 1) * n] for j in range(k)]
