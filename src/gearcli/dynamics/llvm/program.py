@@ -281,9 +281,9 @@ def _hot_maps(an, plans, lowrank: dict, study) -> dict:
     search settles on within its first m + 1 trials for the random motions of ``study``
     (:class:`_Study`; :func:`~..pattern_maps.hot_patterns`)."""
     out = {}
-    tabled = [bi for bi, p in enumerate(plans)
-              if bi not in lowrank and p.F is not None and 1 << len(p.signed) >= STUDIED_PATTERNS]
-    for bi in list(lowrank) + tabled:
+    many = [bi for bi, p in enumerate(plans)
+            if bi not in lowrank and p.F is not None and 1 << len(p.signed) >= STUDIED_PATTERNS]
+    for bi in list(lowrank) + many:
         try:
             hot = hot_patterns(Counter(int(k) for k in study.patterns(bi)[1]))
             out[bi] = (hot, np.array([plans[bi].Ainv[k] for k in hot]))
