@@ -34,6 +34,7 @@ import llvmlite.ir as ir
 import numpy as np
 
 from .build import D, FLAGS, I1, I64, Emitter
+from .hot_pairs import sv_code
 from .inverse_cache import InverseCache
 from .links import Sample, floats
 from .signs import SignedBlock, signs_of
@@ -144,11 +145,7 @@ def lossy_block(e: Emitter, inner, bl, sv: list, name: str):
     (s_v, sigma) when it has them, else a :class:`LossyBlock` around ``inner``."""
     if bl.maps is None:
         return LossyBlock(inner, bl, sv, name)
-    code = ir.Constant(I64, 0)
-    for i, k in enumerate(bl.rates):       # sum_i (s_v,i + 1) 3^i
-        digit = e.b.add(e.b.fptosi(e.const(sv[k]), I64), ir.Constant(I64, 1))
-        code = e.b.add(code, e.b.mul(digit, ir.Constant(I64, 3 ** i)))
-    return TabledBlock(e, bl.maps, inner.tcols, code, name)
+    return TabledBlock(e, bl.maps, inner.tcols, sv_code(e, bl, sv), name)
 
 
 class TabledBlock:
