@@ -203,7 +203,7 @@ MUTATIONS = [
              (("dynamics/llvm/losses.py", "rates.append(e.const(e.dot(e.vsub(s.w[j], s.w[c]), z)))",
                "rates.append(e.const(e.dot(s.w[j], z)))"),)),
     Mutation("llvm-table-sv", "llvm: stored (s_v, sign) maps of a constant-frame block read with s_v reversed",
-             (("dynamics/llvm/losses.py", "digit = e.b.add(e.b.fptosi(e.const(sv[k]), I64), ir.Constant(I64, 1))",
+             (("dynamics/llvm/hot_pairs.py", "digit = e.b.add(e.b.fptosi(e.const(sv[k]), I64), ir.Constant(I64, 1))",
                "digit = e.b.sub(ir.Constant(I64, 1), e.b.fptosi(e.const(sv[k]), I64))"),)),
     Mutation("llvm-bearing-split", "llvm: bearing friction, the tilting moment's x part entering the split with the wrong sign",
              (("dynamics/llvm/bearings.py", "R2y = e.mul(e.sub(e.neg(mx), e.mul(z1, fy)), inv)",
