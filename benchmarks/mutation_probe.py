@@ -255,6 +255,8 @@ MUTATIONS = [
                "lambda A=self.maps[self.hot[(j + 1) % len(self.hot)]]: [e.dot(floats(A[i]), r) for i in rows]) for j, k in enumerate(self.hot)]"),)),
     Mutation("llvm-hot-pair-products", "llvm: a hot lossy pair's products with bearing friction's unit couples reversed",
              (("dynamics/llvm/hot_pairs.py", "lambda P=L @ cols:", "lambda P=-(L @ cols):"),)),
+    Mutation("llvm-first-pattern-run", "llvm: a sign search starting from the sample before's pattern across a run of WARM samples (threads could change a result)",
+             (("dynamics/llvm/kernel.py", 'first = e.b.select(fresh, ir.Constant(I64, 0), next(before))', 'first = next(before)'),)),
     Mutation("llvm-sin-quadrant", "llvm: inline sin with the quadrant's sign flipped",
              (("dynamics/llvm/trig.py", "b.select(sin_neg, e.neg(sin_mag), sin_mag)", "b.select(sin_neg, sin_mag, e.neg(sin_mag))"),)),
 ]

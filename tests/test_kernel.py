@@ -394,3 +394,27 @@ def test_record_columns_are_read_by_name():
             layout[n].shape == () for n in layout.names) else [], layout)
         for k, name in enumerate(layout.names if len(rec) else ()):
             assert getattr(rec[0], name) == k + 1, name
+
+
+def test_a_search_starts_from_the_pattern_of_the_sample_before():
+    """Step 0 of a block's sign search tries the pattern the sample before settled on (every
+    t positive for the first sample of a run of WARM samples, so that threads change no bit):
+    seen where any pattern fits, at rest without gravity or loads (every t = 0, the loads
+    then the numpy path's, zero).  servo_joint's ring meshes pull against its sun meshes, so
+    a loaded sample's pattern is never every t positive."""
+    from gearcli.dynamics.llvm.bearings import WARM
+    from gearcli.dynamics.result_arrays import result_arrays, work_arrays
+    an = analyse(dataclasses.replace(mechanism("servo_joint.yaml"), gravity=np.zeros(3), loads=()))
+    n, loaded = WARM + 8, [0, WARM - 1]
+    q, qd, qdd = np.zeros((n, an.dof)), np.zeros((n, an.dof)), np.zeros((n, an.dof))
+    qdd[loaded] = 2.0
+    s = solver_for(an)
+    sig = s.llvm_kernel().solve(an, q, qd, qdd, {}, 1, n, result_arrays(an, n), work_arrays(n, len(s.kernel_program().signed)), {})
+    signs = np.column_stack(list(sig.values()))
+    assert (signs[0] < 0).any()
+    assert np.array_equal(signs[1:WARM - 1], np.broadcast_to(signs[0], (WARM - 2, signs.shape[1])))
+    assert (signs[WARM:] == 1.0).all()                # a new run: every t positive first
+    ref, res = (solve(an, q, qd, qdd, backend=b) for b in ("numpy", "llvm"))
+    for f in FIELDS:
+        assert np.abs(getattr(res, f) - getattr(ref, f)).max() <= TOL * np.abs(getattr(ref, f)).max(), f
+    assert np.abs(ref.gear_t[2:WARM - 1]).max() == 0.0 == np.abs(res.gear_t[WARM:]).max()

@@ -122,11 +122,13 @@ def _on_fail(e: Emitter, fail, n, b: int):
     return emit
 
 
-def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row, search: bool = True) -> None:
-    """Block b of the schedule for sample n: ``fail`` (i64*) gets the first
-    block with no consistent sign pattern (it comes filled with -1), ``sg_row`` (double*)
-    the sign of each t used.  ``search`` False: lossless, sign pattern 0 without the search
-    (:mod:`.mass`: the torques do not depend on the pattern; ``n``, ``fail``, ``sg_row`` unused)."""
+def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row, search: bool = True, first=None):
+    """Block b of the schedule for sample n; returns its sign pattern (i64; None without
+    signed meshes or search).  ``fail`` (i64*) gets the first block with no consistent sign
+    pattern (it comes filled with -1), ``sg_row`` (double*) the sign of each t used,
+    ``first`` the pattern the search tries first (None: every t positive).  ``search``
+    False: lossless, sign pattern 0 without the search (:mod:`.mass`: the torques do not
+    depend on the pattern; ``n``, ``fail``, ``sg_row`` unused)."""
     rec = prog.blocks[b]
     F, lk0, B, nloc, m, t0, a0 = (int(v) for v in (rec.F, rec.link0, rec.nlinks, rec.n, rec.m, rec.t0, rec.ainv0))
     p0, np_, k0, nt = int(rec.prop0), int(rec.nprop), int(rec.term0), int(rec.nterm)
@@ -154,8 +156,7 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row, search: bool
 
     def solve(r, tag):              # (x, p) of right-hand side r; p None: pattern 0 without a search
         if m and search:
-            args = (r, tolerance(e, r), _on_fail(e, fail, n, b), tag)
-            return resolve(e, fn, blk, *args)
+            return resolve(e, fn, blk, r, tolerance(e, r), _on_fail(e, fail, n, b), tag, first)
         if F < 0:
             return blk.solve(e, [1.0] * m, r), None
         if b in prog.lowrank:
@@ -184,3 +185,4 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row, search: bool
     if lossy is not None and F < 0:
         llvm_losses.propagate(e, s, prog.losses, lossy, x, tcols, sig)
     store(e, s, rec, prog, x)
+    return p

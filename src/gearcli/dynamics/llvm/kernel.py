@@ -27,6 +27,8 @@ from __future__ import annotations
 import llvmlite.ir as ir
 
 from . import losses as llvm_losses
+from ..signs import MAX_EXHAUSTIVE
+from .bearings import WARM
 from .blocks import block
 from .build import DP, I64, I64P, ConstantPool, Emitter
 from .links import at_rest, external, inertia, joint, joint_space, load_groups
@@ -47,8 +49,18 @@ def signature(mod: ir.Module, name: str, types: list, names: tuple) -> ir.Functi
     return fn
 
 
-def _sample(e: Emitter, fn, prog, loads, n) -> None:
-    """The code of sample n (the loop body)."""
+def _carries(rec) -> bool:
+    """A block whose search starts from the pattern of the sample before: it has signed
+    meshes and searches every pattern after its own-sign trials (m <= MAX_EXHAUSTIVE), so it
+    accepts a pattern exactly where the numpy path does, whatever it tries first."""
+    return 0 < int(rec.m) <= MAX_EXHAUSTIVE
+
+
+def _sample(e: Emitter, fn, prog, loads, n, before: list) -> list:
+    """The code of sample n (the loop body); returns the sign pattern each :func:`_carries`
+    block settled on, which the next sample's search tries first (``before``: those of the sample
+    before; :mod:`.signs`), but for the first sample of a run of WARM (the threads' ranges
+    are cut at multiples of WARM: no result depends on the threads)."""
     a = dict(zip(ARGS, fn.args))
     S = prog.S
     dof = S.shape[1]
@@ -67,12 +79,17 @@ def _sample(e: Emitter, fn, prog, loads, n) -> None:
         own = llvm_losses.joint_friction(e, s, lp)
     w = widths(prog)
     signs = e.row(a["signs"], n, max(w["signs"], 1))
+    fresh = e.b.icmp_signed("==", e.b.srem(n, ir.Constant(I64, WARM)), ir.Constant(I64, 0))
+    before, settled = iter(before), []
     for b in range(len(prog.blocks)):
-        block(e, fn, s, prog, b, n, a["fail"], signs)
+        first = e.b.select(fresh, ir.Constant(I64, 0), next(before)) if _carries(prog.blocks[b]) else None
+        p = block(e, fn, s, prog, b, n, a["fail"], signs, first=first)
+        settled += [p] if first is not None else []
     if lp is not None:
         llvm_losses.write_losses(e, s, lp, prog.gear_col, rates, own,
                                  {k: e.row(a[k], n, max(w[k], 1)) for k in LOSS_OUTPUTS})
     write_outputs(e, s, prog, ind[1], {k: e.row(a[k], n, max(w[k], 1)) for k in OUTPUTS})
+    return settled
 
 
 def build_module(prog, loads) -> ir.Module:
@@ -83,17 +100,19 @@ def build_module(prog, loads) -> ir.Module:
     fn = signature(mod, "run", types, ARGS)
     fail = fn.args[ARGS.index("fail")]
 
-    def body(e: Emitter, n):
-        _sample(e, fn, prog, loads, n)
-        return e.b.icmp_signed(">=", e.b.load(e.b.gep(fail, [n])), ir.Constant(I64, 0))
-    sample_loop(fn, body)
+    def body(e: Emitter, n, before):
+        settled = _sample(e, fn, prog, loads, n, before)
+        return e.b.icmp_signed(">=", e.b.load(e.b.gep(fail, [n])), ir.Constant(I64, 0)), settled
+    sample_loop(fn, body, carry=sum(1 for rec in prog.blocks if _carries(rec)))
     return mod
 
 
-def sample_loop(fn: ir.Function, body) -> None:
+def sample_loop(fn: ir.Function, body, carry: int | None = None) -> None:
     """The body of ``fn``: a loop over the samples start..stop-1 (its last two arguments)
     emitting ``body(emitter, n)`` (which returns an i1: the sample failed); ``fn`` returns
-    how many samples failed."""
+    how many samples failed.  With ``carry`` (a count), ``body(emitter, n, before)`` returns
+    (that i1, ``carry`` i64 values), which the next sample's body reads in ``before`` (0 for
+    the first sample of the call)."""
     entry, loop, done = fn.append_basic_block("entry"), fn.append_basic_block("sample"), fn.append_basic_block("done")
     b = ir.IRBuilder(entry)
     start, stop = fn.args[-2], fn.args[-1]
@@ -102,13 +121,18 @@ def sample_loop(fn: ir.Function, body) -> None:
     n, bad = b.phi(I64, "n"), b.phi(I64, "bad")
     n.add_incoming(start, entry)
     bad.add_incoming(ir.Constant(I64, 0), entry)
+    before = [b.phi(I64) for _ in range(carry or 0)]
     pool = ConstantPool(fn)
-    failed = body(Emitter(b, fn.module, pool), n)
+    e = Emitter(b, fn.module, pool)
+    failed, after = body(e, n, before) if carry is not None else (body(e, n), ())
     pool.finish()
     n1, bad1 = b.add(n, ir.Constant(I64, 1)), b.add(bad, b.zext(failed, I64))
     latch = b.block
     n.add_incoming(n1, latch)
     bad.add_incoming(bad1, latch)
+    for ph, v in zip(before, after):
+        ph.add_incoming(ir.Constant(I64, 0), entry)
+        ph.add_incoming(v, latch)
     b.cbranch(b.icmp_signed("<", n1, stop), loop, done)
     b.position_at_end(done)
     total = b.phi(I64, "failed")

@@ -1,9 +1,16 @@
 """Generated sign resolution of one block (paper Eq. 14; :func:`..signs.resolve_signs`).
 
-The sign search is the only control flow of the generated kernel: step 0 tries every t
-positive, steps 1..m the signs of the previous trial's own t, then every pattern in
-:func:`..signs.sign_patterns` order (m <= MAX_EXHAUSTIVE), with the tolerance of the numpy
-path; a sample with no consistent pattern records its first failing block.  A trial of a
+The sign search is the only control flow of the generated kernel: step 0 tries the pattern
+the sample before settled on (:func:`.kernel._sample`; every t positive for the first sample
+of a run of WARM samples, :data:`.bearings.WARM`, so that no result depends on the threads,
+and always with more than MAX_EXHAUSTIVE meshes), steps 1..m the signs of the previous
+trial's own t, then every pattern in :func:`..signs.sign_patterns` order (m <=
+MAX_EXHAUSTIVE), with the tolerance of the numpy path; a sample with no consistent pattern
+records its first failing block.  The numpy path starts from every t positive: both fail
+the same samples, and accept the same pattern but where a t lies within the zero tolerance
+on its wrong side, whose loads then agree to that tolerance (exactly where t = 0).  A motion
+that keeps its pattern takes one trial a sample: the servo joint's ring meshes pull against
+its sun meshes, so every t positive never fits it and took two.  A trial of a
 constant-frame block computes only the m signed t.  A trial and the
 accepted pattern's full solution are a ``switch`` over the patterns into straight-line
 code with the constant Ainv entries, or, when 2^m patterns make that code too large
@@ -116,9 +123,10 @@ class SignedBlock:
         return _rows_global(e, self.table, p, self.n, self.nr, rows, r)
 
 
-def resolve(e: Emitter, fn, blk: SignedBlock, r: list, tol, on_fail, tag: str):
+def resolve(e: Emitter, fn, blk: SignedBlock, r: list, tol, on_fail, tag: str, first=None):
     """(x (n values), p): the block's solution with the first consistent sign pattern p
-    (i64) of the search order (module docstring); ``on_fail()`` emits what a sample with
+    (i64) of the search order (module docstring; step 0 tries the pattern ``first`` (i64),
+    every t positive where None); ``on_fail()`` emits what a sample with
     no consistent pattern does (its x is then that of the last pattern tried).  ``blk``:
     a :class:`SignedBlock`, or a :class:`~.world.WorldBlock` whose trials solve the
     whole block (kept for the pattern accepted), or a block with ``trial(e, fn, p, r, tol,
@@ -135,7 +143,7 @@ def resolve(e: Emitter, fn, blk: SignedBlock, r: list, tol, on_fail, tag: str):
     prev = [e.b.phi(D) for _ in range(m)]
     own = _own_pattern(e, prev)
     late = e.b.sub(step, ir.Constant(I64, m + 1))
-    p = e.b.select(e.b.icmp_signed("==", step, ir.Constant(I64, 0)), ir.Constant(I64, 0),
+    p = e.b.select(e.b.icmp_signed("==", step, ir.Constant(I64, 0)), first if first is not None else ir.Constant(I64, 0),
                    e.b.select(e.b.icmp_signed("<=", step, ir.Constant(I64, m)), own, late))
     full = getattr(blk, "full_trial", False)     # a trial solves the whole block
     xs = blk.rows(e, fn, p, list(range(blk.n)), r, f"{tag}_x") if full else None
