@@ -259,7 +259,8 @@ def _phis(e: Emitter, ends: list, k: int):
 
 WARM, SMOOTH = 256, 0.03125
 """Samples n = k WARM .. (k + 1) WARM - 1 of a call form a run: the fixed point of a sample
-of a smooth stretch starts from the moments of the two samples before in the run (the
+of a smooth stretch starts from the moments of the two samples before in the run, and the
+sign searches from the patterns of the sample before (:func:`.kernel._sample`) (the
 driver's thread ranges start at multiples of WARM, so no result depends on the threads);
 smooth: a moment changed by at most SMOOTH of itself from the one to the other."""
 

@@ -237,7 +237,8 @@ class LlvmKernel:
         keep += [out[k] if out[k].size else none for k in OUTPUTS] + [SG]
         keep += [out[k] if out.get(k) is not None and out[k].size else none for k in LOSS_OUTPUTS] + [moments, fail]
         ptrs = [a.ctypes.data for a in keep]
-        # the threads' ranges cut at multiples of WARM: a bearing fixed point's warm start (.bearings) stays in its range
+        # the threads' ranges cut at multiples of WARM: a bearing fixed point's warm start (.bearings) and a sign
+        # search's first trial (.kernel: the pattern of the sample before) stay in their run
         cuts = sorted({min(n, WARM * round(a / WARM)) for a, _ in job_ranges(n, jobs)} | {n})
         ranges = [(a, b) for a, b in zip(cuts, cuts[1:]) if b > a]
         failed = run_parts(lambda s, e: self._run(*ptrs, s, e), ranges, threads_for(n, jobs))
