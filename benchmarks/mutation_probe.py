@@ -257,6 +257,8 @@ MUTATIONS = [
              (("dynamics/llvm/hot_pairs.py", "lambda P=L @ cols:", "lambda P=-(L @ cols):"),)),
     Mutation("llvm-first-pattern-run", "llvm: a sign search starting from the sample before's pattern across a run of WARM samples (threads could change a result)",
              (("dynamics/llvm/kernel.py", 'first = e.b.select(fresh, ir.Constant(I64, 0), next(before))', 'first = next(before)'),)),
+    Mutation("llvm-bearing-pattern-fallback", "llvm: a signed block whose bearing friction does not converge for its pattern at zero moments records the failure (instead of the whole block's loop, as the numpy path)",
+             (("dynamics/llvm/bearings.py", "failed = (lambda g, change: None) if m else (", "failed = (lambda g, change: _failed(e, prog, bb, g, change, fail, n)) if m else ("),)),
     Mutation("llvm-sin-quadrant", "llvm: inline sin with the quadrant's sign flipped",
              (("dynamics/llvm/trig.py", "b.select(sin_neg, e.neg(sin_mag), sin_mag)", "b.select(sin_neg, sin_mag, e.neg(sin_mag))"),)),
 ]

@@ -23,7 +23,7 @@ import pytest
 
 from gearcli import analyse, load_mechanism, parse_mechanism
 from gearcli.dynamics.bearing_friction import BearingFrictionError
-from gearcli.dynamics.llvm.bearings import WARM
+from gearcli.dynamics.llvm.bearings import NEWTON_JOINTS, WARM
 from gearcli.dynamics.signs import SignError
 from gearcli.dynamics.solve import solve, solver_for
 from metrics import nan_accelerations, per_sample_loads, sample_err
@@ -72,8 +72,10 @@ def worst(a, b) -> float:
 
 
 def iterations_agree(prog, qd_all, got, ref) -> None:
-    """The kernel converges each constant-frame block's bearing friction alone by Newton's
-    method (llvm.bearing_newton), the numpy path every joint at once by the fixed point: from
+    """The kernel converges each constant-frame block's bearing friction alone, by Newton's
+    method (llvm.bearing_newton) where it has up to llvm.bearings.NEWTON_JOINTS bearing
+    joints, else by the fixed point on its loads (the numpy path's iterations), the numpy
+    path every joint at once by the fixed point: from
     zero moments (the first sample of each run of llvm.bearings.WARM) a block needs no more
     levels than the fixed point's iterations, and at least two where its joints move and their
     moments change the bearing loads (the fixed point then takes more than two: the first
@@ -303,6 +305,39 @@ def test_bearing_friction_that_does_not_converge_is_the_same_error():
     ref = _failure(an, q, qd, q, "numpy", BearingFrictionError)
     got = _failure(an, q, qd, q, "llvm", BearingFrictionError)
     assert (got.sample, got.joint, got.lines()) == (ref.sample, ref.joint, ref.lines()) and ref.sample == 3
+
+
+def _planetary_with_bearing_friction(mu: float, bore: float):
+    mech = load_mechanism(MECH / "planetary_3p_rated.yaml")
+    return analyse(dataclasses.replace(mech, joints=tuple(dataclasses.replace(j, bearings=tuple(
+        dataclasses.replace(b, friction_coefficient=mu, bore=bore) for b in j.bearings)) for j in mech.joints)))
+
+
+def test_friction_that_changes_the_sign_pattern_converges_as_on_the_numpy_path():
+    """planetary_3p_rated with bearing friction large enough (mu 0.9, 40 mm bores) that the
+    converged moments change tooth force signs: the block's affine model for its pattern at
+    zero moments does not converge, the numpy path (its sign search each iteration) does;
+    so does the kernel, by the whole block's loop from zero moments (it raised
+    BearingFrictionError), to the same moments.  The block has more bearing joints than
+    llvm.bearings.NEWTON_JOINTS (the fixed point on its loads)."""
+    an = _planetary_with_bearing_friction(0.9, 0.04)
+    assert max(len(bb.joints) for bb in solver_for(an).kernel_program().losses.bearing_blocks.values()) > NEWTON_JOINTS
+    q, qd, qdd = motion(an, 40, seed=1)
+    with np.errstate(all="ignore"):
+        ref, res = (solve(an, q, qd, qdd, backend=b) for b in ("numpy", "llvm"))
+    moments_agree(res, ref)
+    assert np.max(worst(res, ref)) <= TOL
+
+
+def test_a_many_joint_block_that_does_not_converge_fails_the_same_sample():
+    """Larger still (50 mm bores): no pattern's iteration converges; both paths raise
+    BearingFrictionError at the same sample (each names the joint of largest relative
+    change in its own last iteration: the planets' are near ties)."""
+    an = _planetary_with_bearing_friction(0.9, 0.05)
+    q, qd, qdd = motion(an, 40, seed=1)
+    ref = _failure(an, q, qd, qdd, "numpy", BearingFrictionError)
+    got = _failure(an, q, qd, qdd, "llvm", BearingFrictionError)
+    assert got.sample == ref.sample and got.joint in {j.name for j in an.mech.joints if j.bearings}
 
 
 # --- the comparison catches a wrong kernel ---------------------------------------------------

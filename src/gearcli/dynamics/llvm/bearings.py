@@ -19,18 +19,23 @@ in the moments, x = x0 + sum_J s_J Mb_J g_J, g_J = X_p w_J (w_J constant in F: c
 per pattern for stored maps, the corrected map of :class:`~.losses.LossyBlock` per sample;
 in world axes w_J per sample, solved with r by each trial of the search, the block's matrix
 factored once, :meth:`~.world.WorldBlock.solve`), so are its bearings' load vectors,
-and the moments converge by Newton's method on them alone (:mod:`.bearing_newton`: from
-g(0), the fixed point's first iteration, one level where the fixed point takes five or six
-iterations, :func:`_cold`; one from the warm start in a smooth stretch; each a square root
-per bearing and one division, stopped by the fixed point's own test or by Newton's proven
-error bound).  Where no bearing load of the block depends on the moments
+and the moments converge on them alone: by Newton's method in a block of up to
+:data:`NEWTON_JOINTS` bearing joints (:mod:`.bearing_newton`: from g(0), the fixed point's
+first iteration, one level where the fixed point takes five or six iterations,
+:func:`_cold`; one from the warm start in a smooth stretch; each a square root per bearing
+and one division, stopped by the fixed point's own test or by Newton's proven error
+bound), by the fixed point in a larger one (the numpy path's iterations, each a square
+root per bearing and K products, no Jacobian).  Where no bearing load of the block depends on the moments
 (:func:`.bearing_newton.unaffected`: a link whose other unknown is its motor torque about
 the same axis takes the couple there) Mb = g(0) exactly, one iteration and no level.  The
 tooth forces must fit p (the tolerance of the shifted r; no tolerance needed where each is
 strictly on p's side of zero) at the converged moments; where
 they do not, and in a block solved in its link's axes (no constant couple), the block goes
 on from those moments and that iteration by the numpy path's loop: the whole block solved,
-its sign search included, each iteration.
+its sign search included, each iteration.  Where p's affine model does not converge in
+MAX_ITERATIONS (friction so large that it changes the tooth force signs, which the numpy
+path's search follows) a signed block starts that loop from zero moments, as the numpy path;
+only a block without signs fails there.
 
 Written per sample in the ``moments`` row: each joint's converged Mb_J, then the most
 iterations over the sample's blocks; -s_J Mb_J joins J's friction output.  A block that does
@@ -132,32 +137,34 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
 
         again = fn.append_basic_block(f"{tag}_bagain") if m else None
         lv = [loads(e, lp, k, S0[j], SG[j]) for j, k in enumerate(bb.joints)]
-        if unaffected(lv):     # the loads do not see the moments: Mb* = g(0), one iteration, nothing to fail
-            Mb, it, failb = level(e, lv, jt.moving, [0.0] * K)[0], ir.Constant(I64, 1), None
-        else:
-            Mb, it, failb, Mf = newton(e, fn, f"{tag}_ba", _cold(e, fn, f"{tag}_bc", lv, jt, start), lv, jt.moving,
-                                       lambda g, change: _failed(e, prog, bb, g, change, fail, n))
+        failed = (lambda g, change: None) if m else (lambda g, change: _failed(e, prog, bb, g, change, fail, n))
+        Mb, it, failb, Mf = _iterate(e, fn, tag, lv, jt, start, failed)
         x, start = at(Mb), None
         if m:                  # converged: do the tooth forces fit p? else the whole block's loop from Mb
             fit_bb = fn.append_basic_block(f"{tag}_bfit")
-            _fits(e, fn, tag, jt, r, p, at(Mb, tcols), Mb, (fit_bb, again))
+            refit = _fits(e, fn, tag, jt, r, p, at(Mb, tcols), Mb, (fit_bb, again))
             start = (Mb, it)
             e.b.position_at_end(fit_bb)
         ends.append((e.b.block, Mb, it, x, p))
         e.b.branch(done_bb)
-        if failb is not None:
+        if failb is not None:  # without signs a failure; with them p's model only: the whole block's loop from 0
             e.b.position_at_end(failb)
-            ends.append((failb, Mf, it, at(Mf), p))
-            e.b.branch(done_bb)
+            if m:
+                e.b.branch(again)
+            else:
+                ends.append((failb, Mf, it, at(Mf), p))
+                e.b.branch(done_bb)
         if start is not None:
             e.b.position_at_end(again)
+            if failb is not None:
+                start = _restart(e, start, refit, failb)
     if start is not None:     # the whole block solved each iteration (a world-frame block, or a changed pattern)
         sol = {}
 
         def solved(Mb):
             sol["x"], sol["p"] = solve(jt.shifted(e, r, Mb), f"{tag}_s")
             return jt.moments(e, lp, bb, [split(e, lp, k, _cols(sol["x"], c0)) for k, c0 in zip(bb.joints, bb.cols)])
-        Mb, it, failb = _loop(e, fn, f"{tag}_bs", start, solved, prog, bb, fail, n)
+        Mb, it, failb = _loop(e, fn, f"{tag}_bs", start, solved, lambda g, change: _failed(e, prog, bb, g, change, fail, n))
         ends += [(e.b.block, Mb, it, sol["x"], sol["p"]), (failb, Mb, it, sol["x"], sol["p"])]
         e.b.branch(done_bb)
         e.b.position_at_end(failb)
@@ -168,10 +175,34 @@ def converge(e: Emitter, fn, s: Sample, prog, b: int, F: int, links: list, tcols
     return x, (None if p is None else p[0])
 
 
-def _fits(e: Emitter, fn, tag: str, jt: _Joints, r: list, p, t: list, Mb: list, to: tuple) -> None:
+def _iterate(e: Emitter, fn, tag: str, lv: list, jt: _Joints, start: tuple, failed) -> tuple:
+    """(the converged Mb, its iteration, the block reached where it does not converge (None:
+    it cannot fail), the Mb that reaches it) of a block affine in its moments (``lv``: per
+    joint its bearings' :func:`.bearing_newton.loads`) from ``start``; ``failed(g, |g -
+    Mb|)`` emits what a failure does."""
+    if unaffected(lv):         # the loads do not see the moments: Mb* = g(0), one iteration
+        return level(e, lv, jt.moving, [0.0] * len(lv))[0], ir.Constant(I64, 1), None, None
+    if len(lv) > NEWTON_JOINTS:  # the fixed point on the loads: the numpy path's iterations, each cheap
+        Mb, it, failb = _loop(e, fn, f"{tag}_bfp", start, lambda M: level(e, lv, jt.moving, M)[0], failed)
+        return Mb, it, failb, Mb
+    return newton(e, fn, f"{tag}_ba", _cold(e, fn, f"{tag}_bc", lv, jt, start), lv, jt.moving, failed)
+
+
+def _restart(e: Emitter, start: tuple, refit, failb) -> tuple:
+    """The whole block's loop's start (Mb, iteration) where the tooth forces no longer fit
+    (``start``, from ``refit``) or p's affine model did not converge (zero moments, iteration
+    1, from ``failb``: as the numpy path, whose sign search follows the moments)."""
+    Mb, it = [e.b.phi(D) for _ in start[0]], e.b.phi(I64)
+    _incoming(Mb + [it], [e.const(v) for v in start[0]] + [start[1]], refit)
+    _incoming(Mb + [it], [ir.Constant(D, 0.0)] * len(Mb) + [ir.Constant(I64, 1)], failb)
+    return Mb, it
+
+
+def _fits(e: Emitter, fn, tag: str, jt: _Joints, r: list, p, t: list, Mb: list, to: tuple):
     """Branch to to[0] where the tooth forces t at the converged moments Mb fit the pattern p
     (the tolerance of the shifted r), else to to[1]: first without the tolerance (every t_i
-    strictly on p's side of zero, and Mb numbers: the common case), then with it."""
+    strictly on p's side of zero, and Mb numbers: the common case), then with it.  Returns
+    the block that branches to to[1]."""
     neg = [_sign_bit(e, p, i, len(t)) for i in range(len(t))]
     ok = _consistent(e, t, neg, ir.Constant(D, 0.0))
     for v in Mb:
@@ -180,6 +211,7 @@ def _fits(e: Emitter, fn, tag: str, jt: _Joints, r: list, p, t: list, Mb: list, 
     e.b.cbranch(ok, to[0], exact)
     e.b.position_at_end(exact)
     e.b.cbranch(_consistent(e, t, neg, tolerance(e, jt.shifted(e, r, Mb))), *to)
+    return e.b.block
 
 
 def _cold(e: Emitter, fn, tag: str, lv: list, jt: _Joints, start: tuple) -> tuple:
@@ -223,10 +255,11 @@ def _affine(e: Emitter, jt: _Joints, r: list, solve, rows, world, tag: str):
     return x0, p, [[e.mul(sg, v) for v in col] for sg, col in zip(jt.sg, X)]
 
 
-def _loop(e: Emitter, fn, tag: str, start: tuple, step, prog, bb, fail, n):
+def _loop(e: Emitter, fn, tag: str, start: tuple, step, failed):
     """Iterate Mb <- step(Mb) from ``start`` (Mb, its iteration number) until every
     |Mb' - Mb| <= TOL |Mb'| (:func:`.bearing_newton.within`): returns (the Mb that solved, its iteration, the
-    block reached after MAX_ITERATIONS, which records ``fail``), the builder at the converged exit."""
+    block reached after MAX_ITERATIONS, where ``failed(Mb', |Mb' - Mb|)`` emitted what a
+    failure does), the builder at the converged exit."""
     pre = e.b.block
     body, more, out, failb = (fn.append_basic_block(f"{tag}_{x}") for x in ("it", "more", "out", "fail"))
     e.b.branch(body)
@@ -241,7 +274,7 @@ def _loop(e: Emitter, fn, tag: str, start: tuple, step, prog, bb, fail, n):
     _incoming(Mb + [it], list(start[0]) + [start[1]], pre)
     _incoming(Mb + [it], new + [it1], more)
     e.b.position_at_end(failb)
-    _failed(e, prog, bb, new, change, fail, n)
+    failed(new, change)
     e.b.position_at_end(out)
     return Mb, it, failb
 
@@ -256,6 +289,15 @@ def _phis(e: Emitter, ends: list, k: int):
         _incoming(phis, [e.const(v) for v in vs], en[0])
     return phis
 
+
+NEWTON_JOINTS = 2
+"""The most bearing joints of a block whose moments converge by Newton's method; a block
+with more iterates the fixed point on its affine loads (:func:`_loop` on
+:func:`.bearing_newton.level`'s g): a level's K x K Jacobian (K products per bearing) and
+its solve cost more than the fixed point's extra iterations, each a square root per bearing
+(measured, 20,000 random states, thread CPU time: planetary_3p_rated's block of 5 joints
+9.2 -> 7.9 ms, the servo joint's of 6 joints 21.4 -> 19.4 ms; the Bendix wrist's blocks of 1
+or 2 joints 9.6 -> 11.6 ms the other way)."""
 
 WARM, SMOOTH = 256, 0.03125
 """Samples n = k WARM .. (k + 1) WARM - 1 of a call form a run: the fixed point of a sample
