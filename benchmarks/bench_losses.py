@@ -24,7 +24,10 @@ tick on a busy machine):
   kernel's warm start (a block's fixed point from the samples before) nothing to start from.
 
 Then (unless --bendix-only) the same losses on the many-mesh blocks of :data:`OTHERS`, each
-llvm over its own lossless kernel.
+llvm over its own lossless kernel.  Last (unless --no-floor), in a child process with a patched
+generator and a kernel cache of its own, :mod:`bearing_floor`: the bearing friction model
+evaluated once per sample and not converged, the least any exact bearing friction solve costs
+in this kernel, over its own lossless and mesh + joint kernels.
 
 The cost of losses in the compiled path (issue 19's target: at most 20 %) is each llvm row
 over the lossless llvm row of the same run.  ``--cpu``: each call timed by this thread's CPU
@@ -36,6 +39,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -102,6 +106,7 @@ def main(argv=None) -> int:
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--cpu", action="store_true", help="time by this thread's CPU time, not the wall clock")
     ap.add_argument("--bendix-only", action="store_true", help="leave out the many-mesh blocks (planetaries, servo joint)")
+    ap.add_argument("--no-floor", action="store_true", help="leave out bearing_floor.py's rows (bearing friction's least cost)")
     args = ap.parse_args(argv)
     mech = load_mechanism(ROOT / "mechanisms" / "bendix_wrist_rated.yaml")
     cases = {"lossless, llvm": (analyse(mech), "llvm"), "lossless, numpy": (analyse(mech), "numpy"),
@@ -146,6 +151,11 @@ def main(argv=None) -> int:
     if not args.bendix_only:
         print(f"Many-mesh blocks, the same losses, {args.samples:,} random samples, llvm over its lossless kernel:")
         others(args)
+    if not args.no_floor:
+        sys.stdout.flush()
+        flags = (["--cpu"] if args.cpu else []) + (["--bendix-only"] if args.bendix_only else [])
+        subprocess.run([sys.executable, str(Path(__file__).with_name("bearing_floor.py")), "--samples",
+                        str(args.samples), "--rounds", str(args.rounds), *flags], check=True)
     return 0
 
 

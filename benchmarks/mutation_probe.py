@@ -67,6 +67,7 @@ TESTS = [
     "tests/test_llvm_losses.py::test_llvm_equals_numpy_with_losses[servo_joint_rated.yaml]",
     "tests/test_llvm_losses.py::test_llvm_equals_numpy_with_losses[planetary_3p_rated.yaml]",
     "tests/test_llvm_losses.py::test_screened_trials_where_friction_reverses_a_tooth_force",
+    "tests/test_llvm_losses.py::test_friction_that_locks_the_mechanism_fails_the_same_sample_on_both_paths",
     "tests/test_losses.py::test_power_balance_with_losses[block-bendix_wrist_rated.yaml]",
     "tests/test_helical_bundled.py::test_pinocchio_rnea_per_shaft_with_tooth_forces",
     "tests/test_load_sharing.py::test_each_planet_carries_one_nth_of_the_lumped_planet",
@@ -259,6 +260,10 @@ MUTATIONS = [
              (("dynamics/llvm/kernel.py", 'first = e.b.select(fresh, ir.Constant(I64, 0), next(before))', 'first = next(before)'),)),
     Mutation("llvm-bearing-pattern-fallback", "llvm: a signed block whose bearing friction does not converge for its pattern at zero moments records the failure (instead of the whole block's loop, as the numpy path)",
              (("dynamics/llvm/bearings.py", "failed = (lambda g, change: None) if m else (", "failed = (lambda g, change: _failed(e, prog, bb, g, change, fail, n)) if m else ("),)),
+    Mutation("llvm-bearing-infinite-moment", "llvm: a bearing friction moment grown to infinity passes the fixed point's test (inf <= TOL inf)",
+             (("dynamics/llvm/bearing_newton.py", "return change, e.b.and_(ok, finite), finite", "return change, ok, ir.Constant(I1, 1)"),)),
+    Mutation("bearing-infinite-moment", "numpy: a bearing friction moment grown to infinity passes the fixed point's test (then the sign search meets the overflow)",
+             (("dynamics/bearing_friction.py", "finite = np.isfinite(new)", "finite = np.ones_like(new, dtype=bool)"),)),
     Mutation("llvm-sin-quadrant", "llvm: inline sin with the quadrant's sign flipped",
              (("dynamics/llvm/trig.py", "b.select(sin_neg, e.neg(sin_mag), sin_mag)", "b.select(sin_neg, sin_mag, e.neg(sin_mag))"),)),
 ]

@@ -340,6 +340,22 @@ def test_a_many_joint_block_that_does_not_converge_fails_the_same_sample():
     assert got.sample == ref.sample and got.joint in {j.name for j in an.mech.joints if j.bearings}
 
 
+def test_friction_that_locks_the_mechanism_fails_the_same_sample_on_both_paths():
+    """The rated Bendix wrist with absurd bearing friction (mu 5, 200 mm bores): the moments
+    grow without bound, past the largest float.  Both paths raise BearingFrictionError at
+    the same sample, never a result with an infinite friction moment (the kernel's test
+    |g - Mb| <= TOL |g| held at g = inf, so its Newton blocks returned inf and NaN loads;
+    the numpy path's sign search met the overflowed right-hand side, a SignError)."""
+    mech = load_mechanism(MECH / "bendix_wrist_rated.yaml")
+    an = analyse(dataclasses.replace(mech, joints=tuple(dataclasses.replace(j, bearings=tuple(
+        dataclasses.replace(b, friction_coefficient=5.0, bore=0.2) for b in j.bearings)) for j in mech.joints)))
+    q, qd, qdd = motion(an, 12, seed=1)
+    ref = _failure(an, q, qd, qdd, "numpy", BearingFrictionError)
+    got = _failure(an, q, qd, qdd, "llvm", BearingFrictionError)
+    assert got.sample == ref.sample == 1          # sample 0 is at rest: no bearing friction there
+    assert got.joint in {j.name for j in an.mech.joints if j.bearings}
+
+
 # --- the comparison catches a wrong kernel ---------------------------------------------------
 def _reversed_couples(lp):
     """The LossProgram with every friction couple of the kernel reversed (block maps' phi,

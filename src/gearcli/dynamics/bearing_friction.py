@@ -16,7 +16,8 @@ nonlinear.  :func:`solve_with_bearing_friction` iterates: solve with the moments
 previous reactions (zero at first), recompute the moments from the new reactions, until
 a sample's moments change by at most ``TOL`` relative (then kept; a contraction: one iteration
 multiplies the error by about mu d / (2 lever), ~1e-3).  A sample that does not converge in
-``MAX_ITERATIONS`` is an error naming it, never a silent approximation.
+``MAX_ITERATIONS``, or whose moments grow past the largest float (friction that locks the
+mechanism), is an error naming it, never a silent approximation or an infinite moment.
 """
 from __future__ import annotations
 
@@ -39,14 +40,14 @@ error); at Lambda >= 1 the friction locks the mechanism and no path converges.""
 class BearingFrictionError(GearcliError):
     """The bearing friction moments of a sample did not converge."""
 
-    def __init__(self, sample: int, joint: str, iterations: int):
+    def __init__(self, sample: int, joint: str):
         super().__init__()
-        self.sample, self.joint, self.iterations = sample, joint, iterations
+        self.sample, self.joint = sample, joint
 
     def lines(self) -> list[str]:
         return [f"sample {self.sample}: the bearing friction moments of joint '{self.joint}' did not converge "
-                f"in {self.iterations} iterations (relative tolerance {TOL:g}); the friction is too large "
-                "for the loads it changes"]
+                f"(relative tolerance {TOL:g}, at most {MAX_ITERATIONS} iterations: they still changed, or grew "
+                "past the largest float); the friction is too large for the loads it changes"]
 
 
 def friction_joints(mech) -> list[int]:
@@ -177,29 +178,44 @@ def fixed_point(an, qd_all: np.ndarray, solve_moments):
     Mb = np.zeros((N, len(joints)))
     iterations = np.zeros(N, dtype=np.int64)
     todo = np.arange(N)
+    grown = {}                      # sample -> the joint whose moment grew past the floats
     for it in range(1, MAX_ITERATIONS + 1):
         x_all = solve_moments(Mb, todo)
         every = todo.size == N
-        new = friction_moments(an.mech, joints, x_all if every else {k: x_all[k][todo] for k in keys})
-        if rest:
-            new = np.where(s if every else s[todo], new, 0.0)
-        change = np.abs(new - (Mb if every else Mb[todo]))
-        done = np.all(change <= TOL * np.abs(new) + 1e-300, axis=1)
-        if not done.any():                   # (early iterations: no gather, no scatter)
+        with np.errstate(over="ignore", invalid="ignore"):      # a moment grown past the floats
+            new = friction_moments(an.mech, joints, x_all if every else {k: x_all[k][todo] for k in keys})
+            if rest:
+                new = np.where(s if every else s[todo], new, 0.0)
+            change = np.abs(new - (Mb if every else Mb[todo]))
+        finite = np.isfinite(new)
+        done = np.all(change <= TOL * np.abs(new) + 1e-300, axis=1) & finite.all(axis=1)
+        for i in np.flatnonzero(~finite.all(axis=1)):      # never converges: out of the iteration
+            grown[int(todo[i])] = joints[int(np.argmin(finite[i]))]
+            Mb[todo[i]] = 0.0                                # (its solution no longer matters)
+        out = done | ~finite.all(axis=1)
+        if not out.any():                    # (early iterations: no gather, no scatter)
             Mb[todo if not every else slice(None)] = new
             continue
         iterations[todo[done]] = it
-        Mb[todo[~done]] = new[~done]
-        todo, change = todo[~done], change[~done]
+        Mb[todo[~out]] = new[~out]
+        todo, change = todo[~out], change[~out]
         if todo.size == 0:
             break
-    else:
-        bad = int(todo[0])
-        worst = joints[int(np.argmax(change[0] / (np.abs(Mb[bad]) + 1e-300)))]
-        raise BearingFrictionError(bad, an.mech.joints[worst].name, MAX_ITERATIONS)
+    if todo.size or grown:
+        _fail(an, joints, todo, change, Mb, grown)
     moments = np.zeros((N, J))
     moments[:, joints] = Mb
     return x_all, moments, iterations
+
+
+def _fail(an, joints: list, todo: np.ndarray, change: np.ndarray, Mb: np.ndarray, grown: dict):
+    """Raise :class:`BearingFrictionError` for the first sample that did not converge: still
+    changing after MAX_ITERATIONS (``todo``, ``change``), or grown to infinity (``grown``)."""
+    first = min([*grown, *(int(v) for v in todo[:1])])
+    if first in grown:
+        raise BearingFrictionError(first, an.mech.joints[grown[first]].name)
+    worst = joints[int(np.argmax(change[0] / (np.abs(Mb[first]) + 1e-300)))]
+    raise BearingFrictionError(first, an.mech.joints[worst].name)
 
 
 def _links(an, ji: int) -> list[int]:

@@ -164,13 +164,18 @@ def proven(e: Emitter, lv: list, moving: list, P: list, r: list, new: list):
 
 
 def within(e: Emitter, new: list, old: list):
-    """(|new - old| per joint, i1: each <= TOL |new| + 1e-300): the fixed point's test
-    (:func:`..bearing_friction.fixed_point`), of a Newton level and of :func:`.bearings._loop`."""
+    """(|new - old| per joint, i1: each <= TOL |new| + 1e-300 and every |new| finite, i1: every
+    |new| finite): the fixed point's test (:func:`..bearing_friction.fixed_point`), of a Newton
+    level and of :func:`.bearings._loop`.  A moment grown past the floats (friction that locks
+    the mechanism) never passes it (inf <= TOL inf would) and ends the iteration there, a
+    failure, as on the numpy path."""
     change = [e.call("fabs", e.sub(v, o)) for v, o in zip(new, old)]
-    ok = ir.Constant(I1, 1)
+    ok, finite, inf = ir.Constant(I1, 1), ir.Constant(I1, 1), ir.Constant(D_, float("inf"))
     for v, c in zip(new, change):
-        ok = e.b.and_(ok, e.b.fcmp_ordered("<=", c, e.const(e.add(e.mul(TOL, e.call("fabs", v)), 1e-300))))
-    return change, ok
+        size = e.call("fabs", v)
+        ok = e.b.and_(ok, e.b.fcmp_ordered("<=", c, e.const(e.add(e.mul(TOL, size), 1e-300))))
+        finite = e.b.and_(finite, e.b.fcmp_ordered("<", e.const(size), inf))
+    return change, e.b.and_(ok, finite), finite
 
 
 def newton(e: Emitter, fn, tag: str, start: tuple, lv: list, moving: list, failed):
@@ -185,7 +190,7 @@ def newton(e: Emitter, fn, tag: str, start: tuple, lv: list, moving: list, faile
     Mb, it = [e.b.phi(D_) for _ in start[0]], e.b.phi(I64)
     g, N, Dn, P = level(e, lv, moving, Mb)
     r = [e.sub(gk, m) for gk, m in zip(g, Mb)]
-    change, ok = within(e, g, Mb)
+    change, ok, finite = within(e, g, Mb)
     here = e.b.block
     e.b.cbranch(ok, out, tried)
     e.b.position_at_end(tried)
@@ -194,7 +199,7 @@ def newton(e: Emitter, fn, tag: str, start: tuple, lv: list, moving: list, faile
     e.b.cbranch(proven(e, lv, moving, P, r, new), out, more)
     e.b.position_at_end(more)
     it1 = e.b.add(it, ir.Constant(I64, 1))
-    e.b.cbranch(e.b.icmp_signed("<=", it1, ir.Constant(I64, MAX_ITERATIONS)), body, failb)
+    e.b.cbranch(e.b.and_(finite, e.b.icmp_signed("<=", it1, ir.Constant(I64, MAX_ITERATIONS))), body, failb)
     for phis, first, again in ((Mb, start[0], new), ([it], [start[1]], [it1])):
         for ph, v0, v1 in zip(phis, first, again):
             ph.add_incoming(e.const(v0), pre)

@@ -26,7 +26,7 @@ from .program import Program, load_arrays
 from .kernel import ARGS, LOSS_OUTPUTS, build_module
 from .links import load_groups
 from .outputs import OUTPUTS
-from ..bearing_friction import MAX_ITERATIONS, BearingFrictionError
+from ..bearing_friction import BearingFrictionError
 
 
 @lru_cache(maxsize=1)
@@ -248,7 +248,7 @@ class LlvmKernel:
                 raise sign_error(self.prog.names, np.where(fail < nb, fail, -1), chunk)
             s = int(np.flatnonzero(fail >= nb)[0])
             joint = an.mech.joints[self.prog.losses.bearing_joints[int(fail[s]) - nb]].name
-            raise BearingFrictionError(s, joint, MAX_ITERATIONS)
+            raise BearingFrictionError(s, joint)
 
 
 _PROGRAM_KEYS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
