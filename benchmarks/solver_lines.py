@@ -14,7 +14,7 @@ import argparse
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-LOSSES = {"losses.py", "bearing_friction.py", "llvm/losses.py", "llvm/loss_program.py", "llvm/bearings.py",
+LOSSES = {"losses.py", "bearing_friction.py", "llvm/losses.py", "llvm/friction_terms.py", "llvm/loss_program.py", "llvm/bearings.py",
           "llvm/bearing_newton.py"}
 FORWARD = {"forward.py", "simulate.py", "llvm/mass.py"}
 

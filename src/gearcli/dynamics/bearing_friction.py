@@ -78,7 +78,7 @@ def bearing_layout(mech, joints: list[int]):
     bearing), locating flags (K, 2) (1.0/0.0; a single bearing: 1, 0), friction arms
     1/2 mu_b d_b (K, 2) (0 for a missing second bearing), single-bearing mask (K,).  The
     constants of :func:`friction_moments` and of its generated twin
-    (:func:`gearcli.dynamics.llvm.losses.friction_moments`)."""
+    (:func:`gearcli.dynamics.llvm.bearings.moment`)."""
     K = len(joints)
     z1, z2, loc, arm, single = np.zeros(K), np.ones(K), np.zeros((K, 2)), np.zeros((K, 2)), np.zeros(K, bool)
     for k, ji in enumerate(joints):

@@ -50,7 +50,7 @@ from ..bearing_friction import MAX_ITERATIONS, TOL
 from .bearing_newton import level, loads, newton, unaffected, within
 from .build import D, I1, I64, Emitter
 from .links import Sample, floats
-from .losses import _sign
+from .friction_terms import _sign
 from .signs import _consistent, _sign_bit, tolerance
 
 

@@ -73,7 +73,7 @@ def mech_loads(an) -> list:
 
 
 GENERATOR = ("kernel", "blocks", "build", "links", "outputs", "signs", "solve", "trig", "world", "driver",
-             "losses", "inverse_cache", "hot_pairs", "mass", "bearings", "bearing_newton", "../result_arrays", "../signs",
+             "losses", "friction_terms", "inverse_cache", "hot_pairs", "mass", "bearings", "bearing_newton", "../result_arrays", "../signs",
              "../bearing_friction")
 """The modules (paths from :mod:`gearcli.dynamics.llvm`, without .py) whose code makes a kernel program's IR text (a test
 checks that every module they import from the package is listed or makes only hashed input)."""

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import llvmlite.ir as ir
 
-from . import losses as llvm_losses
+from . import friction_terms
 from ..signs import MAX_EXHAUSTIVE
 from .bearings import WARM
 from .blocks import block
@@ -73,11 +73,11 @@ def _sample(e: Emitter, fn, prog, loads, n, before: list) -> list:
     for L in prog.moving:
         inertia(e, s, int(L), prog.bodies[L], prog.gravity)
     external(e, s, fn, [L for L, _, _ in load_groups(loads)[1]], n, a["vals"], a["ldrow"], a["ldpt"], a["ldgrp"])
-    lp = prog.losses
+    lp, w = prog.losses, widths(prog)
     if lp is not None:
-        rates, s.sv = llvm_losses.mesh_rates(e, s, lp)
-        own = llvm_losses.joint_friction(e, s, lp)
-    w = widths(prog)
+        rows = {k: e.row(a[k], n, max(w[k], 1)) for k in LOSS_OUTPUTS}
+        rates, s.sv = friction_terms.mesh_rates(e, s, lp)
+        own = friction_terms.joint_friction(e, s, lp, rows)
     signs = e.row(a["signs"], n, max(w["signs"], 1))
     fresh = e.b.icmp_signed("==", e.b.srem(n, ir.Constant(I64, WARM)), ir.Constant(I64, 0))
     before, settled = iter(before), []
@@ -86,8 +86,7 @@ def _sample(e: Emitter, fn, prog, loads, n, before: list) -> list:
         p = block(e, fn, s, prog, b, n, a["fail"], signs, first=first)
         settled += [p] if first is not None else []
     if lp is not None:
-        llvm_losses.write_losses(e, s, lp, prog.gear_col, rates, own,
-                                 {k: e.row(a[k], n, max(w[k], 1)) for k in LOSS_OUTPUTS})
+        friction_terms.write_losses(e, s, lp, prog.gear_col, rates, own, rows)
     write_outputs(e, s, prog, ind[1], {k: e.row(a[k], n, max(w[k], 1)) for k in OUTPUTS})
     return settled
 

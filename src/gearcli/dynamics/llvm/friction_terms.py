@@ -1,0 +1,98 @@
+"""Generated friction terms of one sample (:mod:`..losses`, :mod:`.loss_program`), for :mod:`.kernel`:
+what the sample's rates give before any block solve, and the loss outputs.
+
+* :func:`mesh_rates`: each lossy mesh's rate theta'_{j,c} = (w_j - w_c) . R_c z_j and
+  s_v = sign of it (0 at rest), which the lossy blocks read (:mod:`.losses`);
+* :func:`joint_friction`: each friction joint's own friction -F_c sign(q'_J) - F_v q'_J
+  from the sample's joint rate (the law of :func:`..losses.friction_force`; the bearing
+  friction is :mod:`.bearings`'); rhs[L] -= that generalised force Q times the joint's unit
+  wrench: about the axis (revolute) or along it through the joint origin (prismatic), on
+  the child, reversed on the parent;
+* :func:`write_losses` (and :func:`joint_friction`, for the joints without bearing
+  friction): the loss outputs, as :func:`..losses.fill_losses`: ``gear_loss`` c_p |t_p|
+  |theta'_{j,c}| r_j, ``joint_friction`` the own friction less the converged bearing
+  friction s_J Mb_J of :mod:`.bearings`, ``joint_loss`` -friction * q'_J.
+"""
+from __future__ import annotations
+
+import llvmlite.ir as ir
+
+from .build import D, FLAGS, Emitter
+from .links import Sample, floats
+
+
+def _signed(e: Emitter, v, pos: float, neg: float):
+    """pos where v > 0, neg where v < 0, else 0.0 (a double; NaN gives 0: no sign pattern
+    accepts a NaN sample anyway)."""
+    zero = ir.Constant(D, 0.0)
+    return e.b.select(e.b.fcmp_ordered(">", v, zero), ir.Constant(D, pos),
+                      e.b.select(e.b.fcmp_ordered("<", v, zero), ir.Constant(D, neg), zero))
+
+
+def _sign(e: Emitter, v):
+    """sign(v) as a double: -1, 0 or 1 (np.sign; NaN gives 0: as :func:`_signed`)."""
+    return _signed(e, v, 1.0, -1.0)
+
+
+def mesh_rates(e: Emitter, s: Sample, lp) -> tuple[list, list]:
+    """(theta'_{j,c}, s_v) of every lossy mesh (doubles)."""
+    rates = []
+    for k in range(len(lp.rate_meshes)):
+        j, c = (int(v) for v in lp.rate_int[k])
+        z = e.mv(s.R[c], floats(lp.rate_flt[k]))
+        rates.append(e.const(e.dot(e.vsub(s.w[j], s.w[c]), z)))
+    return rates, [_sign(e, r) for r in rates]
+
+
+def joint_friction(e: Emitter, s: Sample, lp, rows: dict) -> dict:
+    """rhs[L] -= Q * the unit wrench of each friction joint on L; returns {joint: its own
+    friction Q} (the joints with Coulomb or viscous friction).  Writes the ``joint_friction``
+    and ``joint_loss`` of every joint without bearing friction now (:func:`write_losses` the
+    others'): kept to the sample's end, each would hold a register through every block."""
+    own, late = {}, set(int(v) for v in lp.bearing_joints)
+    for k in range(lp.joints.shape[0]):
+        ji, child, parent, prismatic = (int(v) for v in lp.joints[k, :4])
+        f = floats(lp.joint_flt[k])
+        if not (f[6] or f[7]):         # bearing friction only (.bearings)
+            continue
+        qd = e.const(s.qd[ji])         # -F_c sign(q') - F_v q' (+0 at rest, as numpy's)
+        Q = own[ji] = e.b.fsub(_signed(e, qd, -f[6], f[6]), e.const(e.mul(f[7], qd)), flags=FLAGS)
+        if ji not in late:
+            _write_joint(e, s, ji, Q, rows)
+        Rc, oc = s.R[child], s.o[child]
+        z = e.mv(Rc, f[:3])
+        for L, sign in ((child, 1.0), (parent, -1.0)):
+            if L < 0:
+                continue
+            if prismatic:
+                oj = e.vadd(oc, e.mv(Rc, f[3:6]))
+                w = z + e.cx(e.vsub(oj, s.o[L]), z)
+            else:
+                w = (0.0, 0.0, 0.0) + z
+            s.rhs[L] = tuple(e.sub(s.rhs[L][h], e.mul(e.mul(sign, Q), w[h])) for h in range(6))
+    for ji in sorted(set(range(len(s.qd))) - late - set(own)):
+        _write_joint(e, s, ji, 0.0, rows)
+    return own
+
+
+def write_losses(e: Emitter, s: Sample, lp, gear_col, rates: list, own: dict, rows: dict) -> None:
+    """The sample's ``gear_loss`` (every circuit, 0 for an ideal pair), and the
+    ``joint_friction`` and ``joint_loss`` of the joints with bearing friction (their own
+    friction ``own`` less the converged s_J Mb_J; :func:`joint_friction` wrote the others')."""
+    for k, ci in enumerate(lp.rate_meshes):
+        c, rj = floats(lp.loss_flt[k])
+        t = s.sol[int(gear_col[ci])]
+        e.store(e.mul(e.mul(e.mul(c, e.call("fabs", t)), e.call("fabs", rates[k])), rj), rows["gear_loss"], ci)
+    for ci in set(range(len(gear_col))) - set(lp.rate_meshes):
+        e.store(0.0, rows["gear_loss"], ci)
+    for ji in (int(v) for v in lp.bearing_joints):
+        f = own.get(ji, 0.0)
+        if ji in s.bearing:            # (0 - 0 = +0 at rest, as numpy's)
+            f = e.b.fsub(e.const(f), s.bearing[ji], flags=FLAGS)
+        _write_joint(e, s, ji, f, rows)
+
+
+def _write_joint(e: Emitter, s: Sample, ji: int, f, rows: dict) -> None:
+    """Joint ji's ``joint_friction`` f and ``joint_loss`` -f q'_J."""
+    e.store(f, rows["joint_friction"], ji)
+    e.store(e.neg(e.mul(f, s.qd[ji])), rows["joint_loss"], ji)
