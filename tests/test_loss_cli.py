@@ -344,3 +344,30 @@ def test_export_writes_the_mesh_loss_as_the_file_gave_it(run_cli, mech_dir, tmp_
     before = {g.name: g.loss_factor for g in load_mechanism(tmp_path / "p.yaml").gears}
     after = {g.name: g.loss_factor for g in load_mechanism(tmp_path / "p.urdf").gears}
     assert after == before and before["sun-planet1"] == 1.0 - 0.98
+
+
+def test_friction_that_locks_names_the_sample_by_its_time_and_line(run_cli, tmp_path):
+    """Bearing friction so large on the wheel's shaft (mu 0.9, 500 mm bores) that its moments
+    grow without bound: ``solve`` stops with one line naming the trajectory, the first moving
+    sample's time and file line (it is in the second chunk, where the solver's own "sample i"
+    counts from the chunk's start: "sample 21" before), and writes nothing."""
+    text = SPUR.replace("    bearings:\n      - {name: a, position: 0.0, locating: true, friction_coefficient: 0.0015, bore: 0.008}\n"
+                        "      - {name: b, position: 0.02, friction_coefficient: 0.0015, bore: 0.008}\n", "")
+    text = text.replace("  - {name: Jw, parent: frame, child: wheel, origin: {xyz: [0.075, 0, 0]}, axis: [0, 0, 1]}\n",
+                        "  - name: Jw\n    parent: frame\n    child: wheel\n    origin: {xyz: [0.075, 0, 0]}\n"
+                        "    axis: [0, 0, 1]\n    bearings:\n"
+                        "      - {name: a, position: 0.0, locating: true, friction_coefficient: 0.9, bore: 0.5}\n"
+                        "      - {name: b, position: 0.02, friction_coefficient: 0.9, bore: 0.5}\n")
+    assert text.count("friction_coefficient: 0.9") == 2
+    mech, traj, out = tmp_path / "lock.yaml", tmp_path / "lock.csv", tmp_path / "out.csv"
+    mech.write_text(text)
+    rows = [f"{0.01 * i:.2f},0,0,0" if i < 150 else f"{0.01 * i:.2f},{-0.01 * (i - 150):.2f},-1,0" for i in range(250)]
+    traj.write_text("t,q:Jw,qd:Jw,qdd:Jw\n" + "\n".join(rows) + "\n")
+    for backend in ("numpy", "llvm"):
+        r = run_cli("solve", mech, traj, "--chunk", 100, "--backend", backend, "-o", out)
+        assert r.exit_code == 2, (r.exit_code, r.stderr)
+        lines = r.stderr.strip("\n").splitlines()
+        assert len(lines) == 1 and "Traceback" not in r.stderr + r.stdout, r.stderr
+        assert lines[0].startswith(f"{traj}:152: sample t = 1.5 s: the bearing friction moments of joint 'Jw' "
+                                   "did not converge"), lines[0]
+        assert not out.exists()

@@ -12,6 +12,7 @@ import sys
 import threading
 import warnings
 from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -20,7 +21,9 @@ import numpy as np
 from .dynamics.backends import BACKENDS, Choice
 from .dynamics.solve import solve, solver_for
 from .analysis.graph import Analysis
+from .dynamics.bearing_friction import BearingFrictionError
 from .dynamics.determinacy import analyse
+from .dynamics.signs import SignError
 from . import __version__
 from .errors import GearcliError, Issue, TrajectoryError
 from .io import load_mechanism
@@ -137,7 +140,7 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
         with warnings.catch_warnings(), Prefetch(reader, depth=PREFETCH_CHUNKS) as parts:
             warnings.simplefilter("ignore")
             for part in parts:
-                with np.errstate(all="ignore"):
+                with np.errstate(all="ignore"), at_samples(reader.file, part):
                     res = solve(an, part.q, part.qd, part.qdd, method=method, chunk=chunk, verify=verify,
                                 loads=part.loads, backend=how.path, jobs=jobs, check_finite=False)  # read checked
                     tab = table(an, part.t, res)
@@ -294,6 +297,22 @@ def _output_format(out_path, inputs, precision: int | None) -> str:
     if precision is not None and fmt != "csv":
         raise OutputError(str(out_path), f"--precision applies to CSV output only, not {fmt}")
     return fmt
+
+
+@contextmanager
+def at_samples(file: str, part):
+    """Re-raise a solve's error of one sample of ``part`` (a :class:`~.io.trajectory.Trajectory`
+    read from ``file``; the error's ``sample`` its row in ``part``: :class:`SignError`,
+    :class:`BearingFrictionError`) at that sample's time and file line, where "sample i" of
+    a chunk alone would name a row counted from the chunk's start."""
+    try:
+        yield
+    except (SignError, BearingFrictionError) as exc:
+        i, text = exc.sample, exc.lines()[0]
+        text = text.removeprefix(f"sample {i}: ")
+        line = None if part.line is None else int(part.line[i])
+        raise TrajectoryError(Issue(str(file), f"sample t = {part.t[i]:.9g} s", line,
+                                    f"{text} (nothing written)")) from None
 
 
 def _sample_line(reader: TrajectoryReader, part, i: int) -> int | None:

@@ -21,7 +21,7 @@ from ..design.sizing import inertia_columns
 from ..dynamics.solve import solve
 from ..errors import Collector, GearcliError
 from ..io.trajectory import forget_rows, read_trajectory
-from ..pipeline import prismatic_independent
+from ..pipeline import at_samples, prismatic_independent
 from ..report.columns import LazyColumns
 from .heap import keep_freed_memory
 from .manifest import Case, Manifest, case_analysis
@@ -45,7 +45,8 @@ def solve_samples(an, traj_path, degrees: bool, threads: int | None = None) -> S
     rate; ``threads``: the solver's threads (None: every core)."""
     tr = read_trajectory(traj_path, an.independent_names, degrees=degrees, linear=prismatic_independent(an),
                          loads=an.mech.loads)
-    res = solve(an, tr.q, tr.qd, tr.qdd, loads=tr.loads, jobs=threads, check_finite=False)   # read checked them
+    with at_samples(traj_path, tr):
+        res = solve(an, tr.q, tr.qd, tr.qdd, loads=tr.loads, jobs=threads, check_finite=False)   # read checked them
     cols = LazyColumns(an, res, tr.t)
     cols.update(inertia_columns(an, tr.q))     # servo sizing: inertia at the rated motors
     return Samples(tr.t, cols, tr.qd @ an.S.T, backend_text(res))
