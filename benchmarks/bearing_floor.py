@@ -22,6 +22,7 @@ after it (``GEARCLI_CACHE_DIR`` is always replaced): they never reach a user's k
 """
 from __future__ import annotations
 
+import atexit
 import os
 import shutil
 import sys
@@ -29,14 +30,14 @@ import tempfile
 
 _CACHE = tempfile.mkdtemp(prefix="gearcli-bearing-floor-")
 os.environ["GEARCLI_CACHE_DIR"] = _CACHE       # before gearcli is imported: never the user's cache
+atexit.register(shutil.rmtree, _CACHE, True)   # however the script ends (--help, an error)
 
-import argparse  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import llvmlite.ir as ir  # noqa: E402
 import numpy as np  # noqa: E402
-from bench_losses import OTHERS, lossless, lossy, smooth  # noqa: E402 (benchmarks/)
+from bench_losses import OTHERS, common_args, lossless, lossy, smooth  # noqa: E402 (benchmarks/)
 from timing import load_line, median_time  # noqa: E402
 
 import gearcli.dynamics.llvm.bearings as generated  # noqa: E402
@@ -98,30 +99,22 @@ def line(label: str, med: dict) -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--samples", type=int, default=20_000)
-    ap.add_argument("--rounds", type=int, default=5)
-    ap.add_argument("--cpu", action="store_true", help="time by this thread's CPU time, not the wall clock")
-    ap.add_argument("--bendix-only", action="store_true", help="leave out the many-mesh blocks")
-    args = ap.parse_args(argv)
+    args = common_args(__doc__.splitlines()[0]).parse_args(argv)
     patch_floor()
-    try:
-        print(f"Bearing friction's floor in the generated kernel (evaluated once, not converged: "
-              f"figures wrong, timed only), {args.samples:,} samples, 1 thread, medians of {args.rounds}"
-              f"{', thread CPU time' if args.cpu else ''}; {load_line()}")
-        rng = np.random.default_rng(0)
-        bendix = rows_of("bendix_wrist_rated.yaml")
-        states = tuple(rng.uniform(-3, 3, (args.samples, bendix["lossless"].dof)) for _ in range(3))
-        print(line("bendix_wrist_rated, random states", measure(bendix, states, args)), flush=True)
-        print(line("bendix_wrist_rated, smooth motion", measure(bendix, smooth(args.samples), args)), flush=True)
-        for name in () if args.bendix_only else OTHERS:
-            rows = rows_of(name)
-            if not any(j.bearings for j in rows["lossless"].mech.joints):
-                continue
-            states = tuple(rng.uniform(-3, 3, (args.samples, rows["lossless"].dof)) for _ in range(3))
-            print(line(f"{name.removesuffix('.yaml')}, random states", measure(rows, states, args)), flush=True)
-    finally:
-        shutil.rmtree(_CACHE, ignore_errors=True)
+    print(f"Bearing friction's floor in the generated kernel (evaluated once, not converged: "
+          f"figures wrong, timed only), {args.samples:,} samples, 1 thread, medians of {args.rounds}"
+          f"{', thread CPU time' if args.cpu else ''}; {load_line()}")
+    rng = np.random.default_rng(0)
+    bendix = rows_of("bendix_wrist_rated.yaml")
+    states = tuple(rng.uniform(-3, 3, (args.samples, bendix["lossless"].dof)) for _ in range(3))
+    print(line("bendix_wrist_rated, random states", measure(bendix, states, args)), flush=True)
+    print(line("bendix_wrist_rated, smooth motion", measure(bendix, smooth(args.samples), args)), flush=True)
+    for name in () if args.bendix_only else OTHERS:
+        rows = rows_of(name)
+        if not any(j.bearings for j in rows["lossless"].mech.joints):
+            continue
+        states = tuple(rng.uniform(-3, 3, (args.samples, rows["lossless"].dof)) for _ in range(3))
+        print(line(f"{name.removesuffix('.yaml')}, random states", measure(rows, states, args)), flush=True)
     return 0
 
 

@@ -100,12 +100,18 @@ def others(args) -> None:
               f"{100 * (med['mesh + joint'] / med['lossless'] - 1):+4.0f} %, + bearing friction {bearing}")
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def common_args(description: str) -> argparse.ArgumentParser:
+    """The options this script shares with bearing_floor.py."""
+    ap = argparse.ArgumentParser(description=description)
     ap.add_argument("--samples", type=int, default=20_000)
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--cpu", action="store_true", help="time by this thread's CPU time, not the wall clock")
     ap.add_argument("--bendix-only", action="store_true", help="leave out the many-mesh blocks (planetaries, servo joint)")
+    return ap
+
+
+def main(argv=None) -> int:
+    ap = common_args(__doc__.splitlines()[0])
     ap.add_argument("--no-floor", action="store_true", help="leave out bearing_floor.py's rows (bearing friction's least cost)")
     args = ap.parse_args(argv)
     mech = load_mechanism(ROOT / "mechanisms" / "bendix_wrist_rated.yaml")
