@@ -402,7 +402,7 @@ def test_a_search_starts_from_the_pattern_of_the_sample_before():
     seen where any pattern fits, at rest without gravity or loads (every t = 0, the loads
     then the numpy path's, zero).  servo_joint's ring meshes pull against its sun meshes, so
     a loaded sample's pattern is never every t positive."""
-    from gearcli.dynamics.llvm.bearings import WARM
+    from gearcli.dynamics.llvm.signs import WARM
     from gearcli.dynamics.result_arrays import result_arrays, work_arrays
     an = analyse(dataclasses.replace(mechanism("servo_joint.yaml"), gravity=np.zeros(3), loads=()))
     n, loaded = WARM + 8, [0, WARM - 1]

@@ -23,7 +23,8 @@ import pytest
 
 from gearcli import analyse, load_mechanism, parse_mechanism
 from gearcli.dynamics.bearing_friction import BearingFrictionError
-from gearcli.dynamics.llvm.bearings import NEWTON_JOINTS, WARM
+from gearcli.dynamics.llvm.bearings import NEWTON_JOINTS
+from gearcli.dynamics.llvm.signs import WARM
 from gearcli.dynamics.signs import SignError
 from gearcli.dynamics.solve import solve, solver_for
 from metrics import nan_accelerations, per_sample_loads, sample_err
@@ -76,7 +77,7 @@ def iterations_agree(prog, qd_all, got, ref) -> None:
     method (llvm.bearing_newton) where it has up to llvm.bearings.NEWTON_JOINTS bearing
     joints, else by the fixed point on its loads (the numpy path's iterations), the numpy
     path every joint at once by the fixed point: from
-    zero moments (the first sample of each run of llvm.bearings.WARM) a block needs no more
+    zero moments (the first sample of each run of llvm.signs.WARM) a block needs no more
     levels than the fixed point's iterations, and at least two where its joints move and their
     moments change the bearing loads (the fixed point then takes more than two: the first
     step is not yet proven within the tolerance); where they do not (the fixed point's second

@@ -51,7 +51,7 @@ from .bearing_newton import level, loads, newton, unaffected, within
 from .build import D, I1, I64, Emitter
 from .links import Sample, floats
 from .friction_terms import _sign
-from .signs import _consistent, _sign_bit, tolerance
+from .signs import WARM, _consistent, _sign_bit, tolerance
 
 
 def split(e: Emitter, lp, k: int, x: list) -> list:
@@ -299,12 +299,9 @@ its solve cost more than the fixed point's extra iterations, each a square root 
 9.2 -> 7.9 ms, the servo joint's of 6 joints 21.4 -> 19.4 ms; the Bendix wrist's blocks of 1
 or 2 joints 9.6 -> 11.6 ms the other way)."""
 
-WARM, SMOOTH = 256, 0.03125
-"""Samples n = k WARM .. (k + 1) WARM - 1 of a call form a run: the fixed point of a sample
-of a smooth stretch starts from the moments of the two samples before in the run, and the
-sign searches from the patterns of the sample before (:func:`.kernel._sample`) (the
-driver's thread ranges start at multiples of WARM, so no result depends on the threads);
-smooth: a moment changed by at most SMOOTH of itself from the one to the other."""
+SMOOTH = 0.03125
+"""A smooth stretch: each moment changed by at most SMOOTH of itself from sample n-2 to n-1
+of a run (:data:`.signs.WARM`); there a sample's fixed point starts from their extrapolation."""
 
 
 def _warm(e: Emitter, lp, bb, jt: _Joints, n) -> list:

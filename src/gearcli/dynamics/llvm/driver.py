@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from . import cache as llvm_cache
-from .bearings import WARM
+from .signs import WARM
 from .jobs import job_ranges, run_parts, sign_error, threads_for
 from .program import Program, load_arrays
 from .kernel import ARGS, LOSS_OUTPUTS, build_module

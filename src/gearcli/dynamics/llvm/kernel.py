@@ -28,8 +28,8 @@ import llvmlite.ir as ir
 
 from . import friction_terms
 from ..signs import MAX_EXHAUSTIVE
-from .bearings import WARM
 from .blocks import block
+from .signs import WARM
 from .build import DP, I64, I64P, ConstantPool, Emitter
 from .links import at_rest, external, inertia, joint, joint_space, load_groups
 from .outputs import OUTPUTS, widths, write_outputs

@@ -2,7 +2,7 @@
 
 The sign search is the only control flow of the generated kernel: step 0 tries the pattern
 the sample before settled on (:func:`.kernel._sample`; every t positive for the first sample
-of a run of WARM samples, :data:`.bearings.WARM`, so that no result depends on the threads,
+of a run of :data:`WARM` samples, so that no result depends on the threads,
 and always with more than MAX_EXHAUSTIVE meshes), steps 1..m the signs of the previous
 trial's own t, then every pattern in :func:`..signs.sign_patterns` order (m <=
 MAX_EXHAUSTIVE), with the tolerance of the numpy path; a sample with no consistent pattern
@@ -25,6 +25,13 @@ import numpy as np
 from .build import D, I1, I64, Emitter
 from .links import floats
 from ..signs import MAX_EXHAUSTIVE, TOL_SIGN
+
+WARM = 256
+"""Samples n = k WARM .. (k + 1) WARM - 1 of a call form a run: a sign search starts from the
+pattern the sample before settled on (:func:`.kernel._sample`) and a bearing fixed point in a
+smooth stretch from the moments of the two samples before (:func:`.bearings._warm`), both
+within the run only; the driver's thread ranges start at multiples of WARM, so no result
+depends on the threads."""
 
 SWITCH_LIMIT = 8192
 """Constant products (2^m patterns x (n + m) rows x 6B) up to which a signed block's
