@@ -187,3 +187,16 @@ def test_cycles_to_failure_equals_both_branches_evaluated_everywhere():
         assert F.cycles_to_failure(sigma, S, kind).tobytes() == ref.tobytes()
         assert (ref < n_hi).sum() > 1000          # both branches are exercised
     assert np.shape(F.cycles_to_failure(0.5 * S, S, "bending")) == ()
+
+
+def test_a_stress_flat_to_rounding_has_no_cycle():
+    # A tooth force that flips sign at equal magnitude: the bending stress varies by an ulp
+    # (was an IndexError traceback from verify, issue 34 section 5); it has no cycle and no
+    # rainflow damage, while a real ripple of 1e-6 of the stress is still counted.
+    s = 1.2e8
+    up = np.nextafter(s, 2 * s)
+    for y in (np.array([s, up, s, up, s]), np.array([s, np.nextafter(s, 0.0)] * 50), np.r_[np.full(9, s), up]):
+        assert F.rainflow_peaks(y).size == 0
+        assert F.miner_damage(F.rainflow_peaks(y), 2e8, "bending") == 0.0
+    ripple = s * (1 + 1e-6 * np.sin(np.linspace(0, 6 * np.pi, 300)))
+    assert F.rainflow_peaks(ripple).size >= 3

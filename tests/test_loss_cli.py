@@ -371,3 +371,26 @@ def test_friction_that_locks_names_the_sample_by_its_time_and_line(run_cli, tmp_
         assert lines[0].startswith(f"{traj}:152: sample t = 1.5 s: the bearing friction moments of joint 'Jw' "
                                    "did not converge"), lines[0]
         assert not out.exists()
+
+
+def test_solve_summary_back_driven_spur_pair_by_hand(run_cli, tmp_path):
+    """The same 15/60 mm pair at eta = 0.97 with the wheel turning the other way: the brake's
+    2 N*m now drives the wheel, which back-drives the pinion.  The friction couple reverses:
+    the pinion torque is t (r_j - c rho) and the wheel's M = t (r_k + c rho), so the motor
+    receives (r_j - c rho) r_k / (r_j (r_k + c rho)) = 0.9702 of the lossless power (issue 34,
+    section 3: the summary said only "-" for a line whose power flows backward)."""
+    mech, traj = tmp_path / "spur.yaml", tmp_path / "traj.csv"
+    mech.write_text(_spur_only(SPUR))
+    traj.write_text(TRAJ.replace(",-1,0", ",1,0").replace("-0.5,", "0.5,").replace("\n1,-1,", "\n1,1,"))
+    assert traj.read_text() == "t,q:Jw,qd:Jw,qdd:Jw\n0,0,1,0\n0.5,0.5,1,0\n1,1,1,0\n"
+    r = run_cli("solve", mech, traj, "-o", tmp_path / "out.csv")
+    assert r.exit_code == 0, r.stderr
+    rj, rk, c = 0.015, 0.060, 0.03
+    rho = rj * rk / (rj + rk)
+    eta_b = (rj - c * rho) * rk / (rj * (rk + c * rho))
+    assert f"{eta_b:.4f}" == "0.9702"
+    lines = r.stdout.splitlines()
+    assert "line efficiency of motor motor: - (its power never flows forward)" in lines
+    assert (f"back-driven efficiency of motor motor: {eta_b:.4f} (motor power / lossless power where the load "
+            "drives the motor: regenerating or braking)") in lines
+    assert "(line efficiencies include the acceleration energy of each line's inertia, its rotor's too)" in lines

@@ -181,7 +181,7 @@ BAD = [
     (("    mesh_point: [0, -0.024, 0.05]", ""), "gears[0]", "a rack pair needs its mesh_point"),
     (("axis: [1, 0, 0]", "axis: [1, 0.1, 0]"), "gears[0].mesh_point", "not tangent to the pitch circle"),
     (("kind: rack", "kind: external\n    ratio: -1"), "gears[0].links[1]",
-     "slides on a prismatic joint relative to the carrier: a external gear must turn"),
+     "slides on a prismatic joint relative to the carrier: an external gear must turn"),
     (("type: prismatic", "type: slider"), "joints[1].type", "expected one of: revolute, prismatic; got 'slider'"),
 ]
 

@@ -160,6 +160,9 @@ def test_loads_option_writes_what_solve_writes(run_cli, mech_dir, tmp_path):
     ("t,motor:motor3,motor:motor5\n0,1,1\n1,1,1\n", ("--rtol", "0"), "--rtol: expected a positive number"),
     ("t,motor:motor3,motor:motor5\n0,1,1\n1,1,1\n", ("--method", "Euler"), "--method: expected one of DOP853"),
     ("t,motor:motor3,motor:motor5\n0,1,1\n1,1,1\n", ("--t-end", "-1"), "--t-end: expected a time after"),
+    # within rounding of the first time: was an AttributeError traceback (issue 34, section 5)
+    ("t,motor:motor3,motor:motor5\n0,1,1\n1,1,1\n", ("--t-end", "1e-12"), "--t-end: expected a time after"),
+    ("t,motor:motor3,motor:motor5\n5,1,1\n6,1,1\n", ("--t-end", "5.000000000000001"), "--t-end: expected a time after"),
 ])
 def test_bad_input_is_one_line_and_exit_2(run_cli, mech_dir, tmp_path, text, args, message):
     inp = write(tmp_path / "in.csv", text)
@@ -168,6 +171,14 @@ def test_bad_input_is_one_line_and_exit_2(run_cli, mech_dir, tmp_path, text, arg
     assert message in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1
     assert not (tmp_path / "traj.csv").exists()
+
+
+def test_a_step_beyond_the_span_writes_its_two_ends(run_cli, mech_dir, tmp_path):
+    """--dt larger than the span (was an AttributeError traceback: one sample, no span)."""
+    inp = write(tmp_path / "in.csv", "t,motor:motor3,motor:motor5\n0,1,1\n1,1,1\n")
+    r = run_cli("simulate", mech_dir / "paper_2dof.yaml", inp, "-o", tmp_path / "traj.csv", "--dt", "1e300")
+    assert r.exit_code == 0, r.stderr
+    assert list(read_csv(tmp_path / "traj.csv")["t"]) == [0.0, 1.0]
 
 
 def test_voltage_above_the_supply_is_refused(run_cli, tmp_path):

@@ -155,3 +155,21 @@ def test_sizing_ratings_are_exported_to_urdf_and_read_back(tmp_path):
     export_urdf(an, str(tmp_path / "m.urdf"))
     r = load_mechanism(tmp_path / "m.urdf").motors[0].rating
     assert (r.rotor_inertia, r.max_inertia_ratio, r.max_regen_energy) == (J_ROTOR, 10.0, 100.0)
+
+
+def test_inertia_ratio_plot_names_its_quantity_without_an_empty_unit(run_cli, tmp_path, monkeypatch):
+    """The inertia ratio has no unit: its plot's y label is not "... []" (issue 34, section 3)."""
+    import gearcli.batch.verify as verify
+    labels = []
+    real = verify.plot_check
+    monkeypatch.setattr(verify, "plot_check", lambda *a: (labels.append(a[5]), real(*a)))
+    (tmp_path / "stage.yaml").write_text(rated_stage(f", rotor_inertia: {J_ROTOR}, max_inertia_ratio: 0.01"))
+    t = np.linspace(0, 1, 51)
+    disc_trajectory(tmp_path / "tr.csv", t, np.sin(t), np.cos(t), -np.sin(t))
+    (tmp_path / "d.yaml").write_text("cases:\n  - {name: c, mechanism: stage.yaml, trajectories: [tr.csv], "
+                                     "cycles_per_hour: 100}\n")
+    r = run_cli("verify", tmp_path / "d.yaml", "--plots", tmp_path / "plots", "-j", "1")
+    assert r.exit_code == 1, r.stderr
+    assert "load-to-rotor inertia ratio (dimensionless)" in labels
+    assert not any(label.endswith("[]") for label in labels)
+    assert (tmp_path / "plots").is_dir() and any((tmp_path / "plots").glob("*inertia*.png"))

@@ -544,3 +544,30 @@ def test_reports_state_the_backend_each_case_ran_on(run_cli, tmp_path, monkeypat
     text = md.read_text()
     assert f"Solver backend of short: {first}\n" in text and "Solver backend of long: llvm\n" in text
     assert f"Backend of short: {first}" in r.stdout.splitlines() and "Backend of long: llvm" in r.stdout.splitlines()
+
+
+def test_life_plot_labels_the_equivalent_load_the_life_uses(run_cli, tmp_path, monkeypatch):
+    """The plot's "P_eq of the profile" is the mission-weighted P_eq the reported life is
+    computed from, not the plain mean of the trajectories' (issue 34, section 3)."""
+    import gearcli.report.check_plots as check_plots
+    seen = []
+    real = check_plots.plot_life
+    monkeypatch.setattr(check_plots, "plot_life", lambda traces, P_eq, *a: (seen.append((traces, P_eq)), real(traces, P_eq, *a)))
+    write_rotor_case(tmp_path, "[{name: x, position: 0, C: 3000, C0: 3000, type: ball}]")
+    t = np.linspace(0, T, 401)                        # rotor2: the same rotor at 3 W (9x the radial load)
+    np.savetxt(tmp_path / "rotor2.csv", np.column_stack([t, 3 * W * t, np.full_like(t, 3 * W), 0 * t]),
+               delimiter=",", header="t,q:J,qd:J,qdd:J", comments="")
+    rates = (1500.0, 100.0)
+    case = ("cases:\n  - {name: rotor, mechanism: rotor.yaml, bearing_life_h: 1.0e12,\n"
+            f"     trajectories: [{{file: rotor.csv, cycles_per_hour: {rates[0]}}}, "
+            f"{{file: rotor2.csv, cycles_per_hour: {rates[1]}}}]}}\n")
+    r, doc = run_json(run_cli, tmp_path, case, "--plots", tmp_path / "plots")
+    assert r.exit_code == 1, r.stderr
+    (traces, P_eq), = seen
+    P = [tr[3] for tr in traces]
+    assert P[1] > 1.5 * P[0]
+    revs = [rate * w * T / (2 * math.pi) for rate, w in zip(rates, (W, 3 * W))]     # revolutions an hour
+    by_hand = (sum(n * p**3 for n, p in zip(revs, P)) / sum(revs)) ** (1 / 3)
+    assert P_eq == pytest.approx(by_hand, rel=1e-9)
+    life = by_name(doc)[("rotor", "bearing J/x", "L10 life")]["value"]
+    assert life == pytest.approx((3000 / P_eq) ** 3 * 1e6 / sum(revs), rel=1e-9)

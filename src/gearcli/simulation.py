@@ -129,12 +129,13 @@ def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None
             raise GearcliError(f"--q0: joint '{name}' starts at {an.S[ji] @ x0:g}, outside its limits [{lo:g}, {hi:g}]")
     drive = read_drive_input(input_path, an.mech.motors)
     t0, t1 = float(drive.t[0]), float(drive.t[-1] if t_end is None else t_end)
-    if not (math.isfinite(t1) and t1 > t0):
-        raise GearcliError(f"--t-end: expected a time after the input's first t = {t0:g} s, got {t1:g}")
+    if not (math.isfinite(t1) and t1 - t0 > 1e-9 * max(1.0, abs(t0))):
+        raise GearcliError(f"--t-end: expected a time after the input's first t = {t0:.9g} s (by more than "
+                           f"{1e-9 * max(1.0, abs(t0)):.3g} s), got {t1:.9g}")
     if (t1 - t0) / dt > MAX_SIMULATE_SAMPLES:
         raise GearcliError(f"--dt: {dt:g} s gives more than {MAX_SIMULATE_SAMPLES:,} samples over {t1 - t0:g} s")
     t_eval = t0 + dt * np.arange(int(math.floor((t1 - t0) / dt * (1 + 1e-12))) + 1)
-    if t_eval[-1] < t1 - 1e-9 * dt:
+    if t_eval[-1] < t1 - 1e-9 * min(dt, t1 - t0):     # (a --dt beyond the span: its two ends)
         t_eval = np.append(t_eval, t1)
     if progress is not None:
         progress(total=t1 - t0)

@@ -65,7 +65,8 @@ def gear_circuit(h: Home, groups, canon, gi: int, gp, j: int, k: int, col: Colle
         ratio = geom.ratio
     if ratio is None:
         return None
-    return Circuit(gi, j, k, c, float(ratio), row_j - ratio * row_k, Rc.T @ zj_w, Rc.T @ zk_w, geom)
+    return Circuit(gi, j, k, c, float(ratio), row_j - ratio * row_k, Rc.T @ zj_w, Rc.T @ zk_w, geom,
+                   row_j=np.rint(row_j))
 
 
 def joint_types_fit(h: Home, gp, c: int, gj: CoaxialGroup, gk: CoaxialGroup, col: Collector) -> bool:
@@ -85,7 +86,7 @@ def joint_types_fit(h: Home, gp, c: int, gj: CoaxialGroup, gk: CoaxialGroup, col
                     f"to the carrier '{h.tree.links[c]}': {what} (links: [pinion, rack])")
         else:
             col.add(f"{gp.path}.links[{i}]", f"'{name}' slides on a prismatic joint relative to the carrier: "
-                    f"a {gp.kind} gear must turn (for a rack and pinion use kind: rack, links: [pinion, rack])")
+                    f"{'an' if gp.kind[:1] in 'aeiou' else 'a'} {gp.kind} gear must turn (for a rack and pinion use kind: rack, links: [pinion, rack])")
     return ok
 
 

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -44,6 +45,10 @@ class Circuit:
     # row = e_B - ratio e_A; the ideal mesh torque acts on both joints, each joint's parent
     # taking the reaction (``carrier`` is then B's parent, for display).
     joints: tuple[int, int] | None = None
+    # theta_{j,c} as a row (J,) over real joint angles (rad per rad): gear j's rotation
+    # relative to its carrier about z_j, the sum of the coaxial joints between them (each
+    # coefficient an integer); None for a joint coupling
+    row_j: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -74,6 +79,23 @@ class Analysis:
     # positions in ``circuits`` of each redundant gear set (kinematically consistent pairs
     # beyond the rank of the circuit rows): loads shared by mesh stiffness, min sum t^2/k
     redundant: tuple[tuple[int, ...], ...] = ()
+
+    @cached_property
+    def mesh_rate_rows(self) -> np.ndarray:
+        """(G, dof): theta'_{j,c} = mesh_rate_rows[ci] . q'_ind, each circuit's rate of gear
+        j relative to its carrier (rad/s), from the independent joint rates alone (zeros for
+        a joint coupling).  Coefficients within 1e-12 of the row's largest are exactly 0, so
+        a gear that holds still on its carrier has an exactly zero rate in any frames: the
+        sign that turns a mesh friction couple on comes from joint rates, never from world
+        angular velocities (whose difference leaves ~1e-17 of rounding in turned frames)."""
+        rows = np.zeros((len(self.circuits), self.dof))
+        for ci, c in enumerate(self.circuits):
+            if c.row_j is not None:
+                r = c.row_j @ self.S
+                r[np.abs(r) <= 1e-12 * max(np.abs(r).max(initial=0.0), 1.0)] = 0.0
+                rows[ci] = r
+        rows.setflags(write=False)
+        return rows
 
     @property
     def dof(self) -> int:

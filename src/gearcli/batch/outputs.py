@@ -4,9 +4,10 @@ One row per check: case, component, quantity, worst value, limit, margin in % (p
 when the check passes), worst trajectory and the time in it; failures first.  Each case
 also states the solver path that ran (``backend``: "llvm", or "numpy (auto: why)"): a
 field of every JSON check, a ``backend`` property of every JUnit test suite, a line of the
-Markdown report.  Infinite
-values (a bearing that never turns has an infinite life) are written as ``inf`` in text and
-``null`` in JSON.
+Markdown report.  An
+infinite life is written as its reason, "no damage (below the endurance limit)" for a gear
+whose Miner sum is 0 and "no revolutions (the bearing does not turn)" for a bearing, in
+text, and as ``null`` with that reason (``value_note``) in JSON.
 """
 from __future__ import annotations
 
@@ -46,10 +47,27 @@ class Row:
     trajectory: str
     time: float
     backend: str = ""
+    kind: str = ""          # the check's kind (Check.kind): "life", "fatigue", "peak", ...
 
     @property
     def name(self) -> str:
         return f"{self.component}: {self.quantity}"
+
+    @property
+    def note(self) -> str:
+        """Why the value is infinite ("" when it is finite): the words the reports print."""
+        if not math.isinf(self.value):
+            return ""
+        return INFINITE_NOTES.get(self.kind, "inf")
+
+    def shown(self) -> str:
+        """The value as the text reports print it: its reason when infinite, else :func:`fmt`."""
+        return self.note or fmt(self.value)
+
+
+INFINITE_NOTES = {"fatigue": "no damage (below the endurance limit)",
+                  "life": "no revolutions (the bearing does not turn)"}
+"""What an infinite value of a check kind means: the reports print it in place of "inf"."""
 
 
 def rows_of(results) -> list[Row]:
@@ -59,7 +77,7 @@ def rows_of(results) -> list[Row]:
         for v in r.verdicts:
             traj = r.case.trajectories[v.trajectory]
             rows.append(Row(r.case.name, v.check.component, v.check.quantity, v.value, v.check.limit,
-                            v.check.unit, v.margin, v.passed, Path(traj).name, v.time, r.backend))
+                            v.check.unit, v.margin, v.passed, Path(traj).name, v.time, r.backend, v.check.kind))
     return sorted(rows, key=lambda row: (row.passed, row.margin))
 
 
@@ -81,7 +99,7 @@ def rich_table(rows: list[Row]) -> Table:
     for r in rows:
         style = "red" if not r.passed else ("yellow" if r.margin < WARN_MARGIN else "green")
         table.add_row(Text("FAIL" if not r.passed else "ok", style=style), r.case, r.component, r.quantity,
-                      fmt(r.value), fmt(r.limit), r.unit, Text(fmt(r.margin), style=style), r.trajectory,
+                      r.shown(), fmt(r.limit), r.unit, Text(fmt(r.margin), style=style), r.trajectory,
                       f"{r.time:.4g}")
     return table
 
@@ -99,7 +117,7 @@ def write_junit(rows: list[Row], path, suite: str) -> None:
         ET.SubElement(props, "property", name="backend", value=mine[0].backend)
         for r in mine:
             tc = ET.SubElement(ts, "testcase", classname=f"{suite}.{case}", name=r.name, time="0")
-            text = (f"{r.name}: worst {with_unit(r.value, r.unit)} (limit {with_unit(r.limit, r.unit)}), margin "
+            text = (f"{r.name}: worst {r.note or with_unit(r.value, r.unit)} (limit {with_unit(r.limit, r.unit)}), margin "
                     f"{fmt(r.margin)} %, in {r.trajectory} at t = {r.time:.4g} s")
             if r.passed:
                 ET.SubElement(tc, "system-out").text = text
@@ -117,6 +135,7 @@ def _num(x: float):
 def write_json(rows: list[Row], path, manifest: str) -> None:
     doc = {"manifest": manifest, "passed": all(r.passed for r in rows),
            "checks": [{"case": r.case, "component": r.component, "quantity": r.quantity, "value": _num(r.value),
+                       **({"value_note": r.note} if r.note else {}),
                        "limit": _num(r.limit), "unit": r.unit, "margin_pct": _num(r.margin), "passed": r.passed,
                        "trajectory": r.trajectory, "time": _num(r.time), "backend": r.backend} for r in rows]}
     write_text(path, json.dumps(doc, indent=2, allow_nan=False) + "\n")   # strict JSON: never NaN/Infinity
@@ -137,7 +156,7 @@ def markdown(rows: list[Row], manifest: str) -> str:
              "|---|---|---|---|---:|---:|---|---:|---|---:|"]
     for r in rows:
         mark = "❌" if not r.passed else ("⚠️" if r.margin < WARN_MARGIN else "✅")
-        cells = [mark, r.case, r.component, r.quantity, fmt(r.value), fmt(r.limit), r.unit, fmt(r.margin),
+        cells = [mark, r.case, r.component, r.quantity, r.shown(), fmt(r.limit), r.unit, fmt(r.margin),
                  r.trajectory, f"{r.time:.4g}"]
         lines.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
     return head + "\n".join(lines) + "\n"

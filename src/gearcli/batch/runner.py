@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..design.checks import build_checks
-from ..design.evaluate import Samples, Verdict, combine, partials, profile_rates, signal
+from ..design.evaluate import Samples, Verdict, combine, partials, profile_equivalent_load, profile_rates, signal
 from ..design.sizing import inertia_columns
 from ..dynamics.solve import solve
 from ..errors import Collector, GearcliError
@@ -172,13 +172,12 @@ def profile_plot(result: CaseResult, verdict: Verdict, path, title: str):
     an = case_analysis(case.mechanism)
     samples = [solve_samples(an, tp, case.degrees) for tp in case.trajectories]
     parts = [partials([ch], s, an.mech)[0] for s in samples]
-    if ch.kind == "life":
-        traces = [(Path(tp).stem, s.t, signal(ch, s, an.mech), p[5]) for tp, s, p in zip(case.trajectories, samples, parts)]
-        P_eq = B.equivalent_load(sum(p[2] for p in parts), sum(p[3] for p in parts), ch.exponent)
-        plot_life(traces, P_eq, verdict.signal_limit, path, title)
-        return path
     rates = profile_rates(case.shares or (None,) * len(samples), [p[6] for p in parts], case.req.cycles_per_hour,
                           case.req.service_life_h)
+    if ch.kind == "life":
+        traces = [(Path(tp).stem, s.t, signal(ch, s, an.mech), p[5]) for tp, s, p in zip(case.trajectories, samples, parts)]
+        plot_life(traces, profile_equivalent_load(ch, parts, rates), verdict.signal_limit, path, title)
+        return path
     hours = [ch.limit * (r or 0.0) for r in rates]          # repetitions of each trajectory in the required life
     sig = [signal(ch, s, an.mech) for s in samples]
     counted = [F.rainflow_peaks(x) for x in sig]

@@ -102,6 +102,7 @@ def write_plots(results, directory: Path) -> list[Path]:
             label = SIGNAL_LABELS[ch.signal[0]].format(ch.signal[1] if ch.signal[0] in ("abs", "col", "running_rms") else "")
             title = (f"{r.case.name}: {ch.name} ({status}, margin {v.margin:.3g} %)\n"
                      f"worst trajectory {Path(r.case.trajectories[v.trajectory]).name}")
-            plot_check(t, y, v.signal_limit, path, title, f"{label} [{ch.signal_unit}]", LIMIT_LABELS[ch.kind])
+            ylabel = f"{label} [{ch.signal_unit}]" if ch.signal_unit else f"{label} (dimensionless)"
+            plot_check(t, y, v.signal_limit, path, title, ylabel, LIMIT_LABELS[ch.kind])
             out.append(path)
     return out

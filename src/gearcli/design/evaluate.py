@@ -176,6 +176,17 @@ class Verdict:
     signal_limit: float    # the signal level that just meets the limit (for plots)
 
 
+def profile_equivalent_load(check: Check, parts: list[tuple], rates) -> float:
+    """A bearing life check's P_eq over the profile, N: the trajectories' sums of P^p over
+    revolutions weighted by their repetitions per hour ``rates`` (:func:`profile_rates`;
+    None or a missing rate: equal repetitions), the load the life is computed from."""
+    if not isinstance(rates, (list, tuple)):
+        rates = [rates] * len(parts)
+    w = [1.0 if r is None else r for r in rates]
+    return B.equivalent_load(sum(r * p[2] for r, p in zip(w, parts)), sum(r * p[3] for r, p in zip(w, parts)),
+                             check.exponent)
+
+
 def profile_rates(shares, spans, cycles_per_hour: float | None, service_life_h: float | None) -> list:
     """Repetitions per hour of service of each trajectory of a mission profile.
 
@@ -222,8 +233,7 @@ def combine(check: Check, parts: list[tuple], rates) -> Verdict:
         factor = F.bending_cycle_factor if check.signal[0] == "bending" else F.pitting_cycle_factor
         sig_lim = check.rating * float(factor(max(cycles, 1.0)))
     else:
-        P_eq = B.equivalent_load(sum(r * p[2] for r, p in zip(w, parts)), sum(r * p[3] for r, p in zip(w, parts)),
-                                 check.exponent)
+        P_eq = profile_equivalent_load(check, parts, rates)
         rev_h = sum(r * p[4] for r, p in zip(per_hour, parts))
         value = B.rating_life_hours(B.rating_life_mrev(check.rating, P_eq, check.exponent), rev_h)
         sig_lim = B.required_equivalent_load(check.rating, check.limit, rev_h, check.exponent)

@@ -55,6 +55,11 @@ from ..errors import GearcliError
 RAINFLOW_CLASSES = 1024
 """Load classes of the rainflow count: the stress range is resolved to 1/1024 of its span."""
 
+FLAT = 1e-9
+"""A stress history whose range is at most FLAT times its largest |stress| is constant: no
+cycle (a tooth force that flips sign at equal magnitude gives a bending stress that varies
+by rounding alone, which the cycle counter cannot classify)."""
+
 _BENDING = ((3e6, 1.3558, 0.0178), (0.0, 2.3194, 0.0538))    # (N from, a, b): Y_N = a N^-b
 _CONTACT = ((1e7, 1.4488, 0.023), (0.0, 2.466, 0.056))         # Z_N = a N^-b
 
@@ -119,14 +124,17 @@ def rainflow_peaks(sigma) -> np.ndarray:
                            "pip install 'gearcli[design]'") from None
 
     y = np.asarray(sigma, float)
-    if y.size < 2 or np.ptp(y) == 0.0:
+    if y.size < 2 or np.ptp(y) <= FLAT * np.max(np.abs(y)):
         return np.zeros(0)
     y = turning_points(y)
     try:
         rev, _ = fatpack.find_reversals(y, k=RAINFLOW_CLASSES)
     except IndexError:      # fatpack needs a reversal inside the classified history; a ramp has none,
         # but the duty repeats: the ramp and the return to its start are one swing
-        rev, _ = fatpack.find_reversals(np.append(y, y[0]), k=RAINFLOW_CLASSES)
+        try:
+            rev, _ = fatpack.find_reversals(np.append(y, y[0]), k=RAINFLOW_CLASSES)
+        except IndexError:  # not even then: the classified history does not turn (no cycle)
+            return np.zeros(0)
     if rev.size < 2:
         return np.zeros(0)
     cycles, residue = fatpack.find_rainflow_cycles(rev)

@@ -40,6 +40,20 @@ class Kinematics:
     a: list
     Rj: list
     oj: list
+    qd: np.ndarray | None = None       # (N, J) every real joint's rate, rad/s (m/s)
+    qd_ind: np.ndarray | None = None   # (N, dof) the independent rates, when the caller had them
+
+    def independent_rates(self, an) -> np.ndarray:
+        """(N, dof) the independent joint rates q'_ind: as given to :func:`forward`, else
+        read off the real joint rates when every independent coordinate is a real joint."""
+        if self.qd_ind is not None:
+            return self.qd_ind
+        if self.qd is not None and all(j >= 0 for j in an.independent):
+            return self.qd[:, list(an.independent)]
+        if self.qd is not None and not self.qd.any():    # at rest: q' = S q'_ind = 0 gives q'_ind = 0
+            return np.zeros((self.qd.shape[0], an.dof))
+        raise ValueError("the kinematics were made without the independent joint rates "
+                         "(forward(..., qd_ind=...)), which relative mesh rates need")
 
     @property
     def n(self) -> int:
@@ -48,7 +62,7 @@ class Kinematics:
 
 
 def forward(mech: Mechanism, tree: Tree, q: np.ndarray, qd: np.ndarray | None = None,
-            qdd: np.ndarray | None = None) -> Kinematics:
+            qdd: np.ndarray | None = None, qd_ind: np.ndarray | None = None) -> Kinematics:
     """Positions, velocities, accelerations of all links for joint values ``q`` (N, J).
 
     ``q``, ``qd``, ``qdd`` hold every real joint's coordinate (rad, rad/s, rad/s^2) in the
@@ -110,7 +124,8 @@ def forward(mech: Mechanism, tree: Tree, q: np.ndarray, qd: np.ndarray | None = 
             rc = mv(Rj[ji], jt.p_jc)
             o[c] = oj[ji] + rc
             a[c] = a_j + cross(dw[c], rc) + cross(w[c], cross(w[c], rc))
-    return Kinematics(R, o, w, dw, a, Rj, oj)
+    return Kinematics(R, o, w, dw, a, Rj, oj, qd,
+                      None if qd_ind is None else np.atleast_2d(np.asarray(qd_ind, float)))
 
 
 def _turn_z(R0: np.ndarray, q: np.ndarray) -> np.ndarray:

@@ -52,10 +52,19 @@ def mesh_friction_moment(an, ci: int) -> np.ndarray | None:
 
 
 def relative_rate(an, kin, ci: int) -> np.ndarray:
-    """theta'_{j,c} (N,): rate of gear j relative to its carrier about j's axis, rad/s."""
-    c = an.circuits[ci]
-    zj = mv(kin.R[c.carrier], c.geometry.zj)
-    return np.sum((kin.w[c.j] - kin.w[c.carrier]) * zj, axis=1)
+    """theta'_{j,c} (N,): rate of gear j relative to its carrier about j's axis, rad/s.
+
+    Formed from the joint rates, sum_d r_d q'_d over the independent rates with the
+    coefficients r of :attr:`~gearcli.analysis.types.Analysis.mesh_rate_rows` (left to
+    right, as the kernel's :func:`.llvm.friction_terms.mesh_rates`), not from world angular
+    velocities (omega_j - omega_c) . z_j: a gear at rest on its carrier gives an exact 0, so
+    no friction couple, in any frames."""
+    r = an.mesh_rate_rows[ci]
+    qd = kin.independent_rates(an)
+    out = np.zeros(qd.shape[0])
+    for d in np.flatnonzero(r):
+        out = out + r[d] * qd[:, d]
+    return out
 
 
 def mesh_loss(an, kin, ci: int, t: np.ndarray) -> np.ndarray:

@@ -234,7 +234,7 @@ class Solver:
         """Every joint's q, qd, the kinematics and right-hand sides (inertia, loads, friction)."""
         an = self.an
         q, qd, qdd = joint_space(an, q_ind, qd_ind, qdd_ind)
-        kin = forward(an.mech, an.tree, q, qd, qdd)
+        kin = forward(an.mech, an.tree, q, qd, qdd, qd_ind=qd_ind)
         b = inertia_load(an, kin)
         subtract_external(b, external_wrenches(an, kin, values))
         subtract_joint_friction(an, kin, b, qd)

@@ -1,8 +1,9 @@
 """Generated friction terms of one sample (:mod:`..losses`, :mod:`.loss_program`), for :mod:`.kernel`:
 what the sample's rates give before any block solve, and the loss outputs.
 
-* :func:`mesh_rates`: each lossy mesh's rate theta'_{j,c} = (w_j - w_c) . R_c z_j and
-  s_v = sign of it (0 at rest), which the lossy blocks read (:mod:`.losses`);
+* :func:`mesh_rates`: each lossy mesh's rate theta'_{j,c} = r . q'_ind from the
+  independent joint rates (:func:`..losses.relative_rate`) and s_v = sign of it (0 at rest,
+  exactly, in any frames), which the lossy blocks read (:mod:`.losses`);
 * :func:`joint_friction`: each friction joint's own friction -F_c sign(q'_J) - F_v q'_J
   from the sample's joint rate (the law of :func:`..losses.friction_force`; the bearing
   friction is :mod:`.bearings`'); rhs[L] -= that generalised force Q times the joint's unit
@@ -36,11 +37,7 @@ def _sign(e: Emitter, v):
 
 def mesh_rates(e: Emitter, s: Sample, lp) -> tuple[list, list]:
     """(theta'_{j,c}, s_v) of every lossy mesh (doubles)."""
-    rates = []
-    for k in range(len(lp.rate_meshes)):
-        j, c = (int(v) for v in lp.rate_int[k])
-        z = e.mv(s.R[c], floats(lp.rate_flt[k]))
-        rates.append(e.const(e.dot(e.vsub(s.w[j], s.w[c]), z)))
+    rates = [e.const(e.dot(floats(lp.rate_flt[k]), s.qdi)) for k in range(len(lp.rate_meshes))]
     return rates, [_sign(e, r) for r in rates]
 
 

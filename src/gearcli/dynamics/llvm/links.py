@@ -45,6 +45,7 @@ class Sample:
     sv: list = field(default_factory=list)     # s_v of each lossy mesh (:mod:`.losses`)
     bearing: dict = field(default_factory=dict)   # joint: s_J Mb_J, its converged bearing friction (:mod:`.bearings`)
     frames: dict = field(default_factory=dict)
+    qdi: list = field(default_factory=list)    # (dof,) the independent joint rates (mesh rates: :mod:`.friction_terms`)
 
 
 def floats(row) -> tuple:
@@ -56,7 +57,8 @@ def joint_space(e: Emitter, S, qi: list, qdi: list, qddi: list) -> Sample:
     """The sample's q, qd, qdd of every real joint = S times the independent ones
     (``qi, qdi, qddi``: the loaded independent values)."""
     rows = [floats(S[j]) for j in range(S.shape[0])]
-    return Sample([e.dot(qi, s) for s in rows], [e.dot(qdi, s) for s in rows], [e.dot(qddi, s) for s in rows])
+    return Sample([e.dot(qi, s) for s in rows], [e.dot(qdi, s) for s in rows], [e.dot(qddi, s) for s in rows],
+                  qdi=list(qdi))
 
 
 def _joint_frame(e: Emitter, pose, Rp, op, qk, prismatic: bool):

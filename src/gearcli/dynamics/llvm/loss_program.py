@@ -5,8 +5,10 @@ field (None for a lossless mechanism).  It holds, with the model of :mod:`.losse
 
 * ``rate_meshes``: the circuits with a loss factor; the kernel computes each one's rate
   theta'_{j,c} (rad/s), its s_v = sign(rate) and its mesh power loss c_p |t_p| |rate| r_j
-  (``gear_loss``); ``rate_flt`` (R, 3) their gear j's axis z_j in carrier axes, ``rate_int``
-  (R, 2) [gear j, carrier], ``loss_flt`` (R, 2) [c_p, r_j];
+  (``gear_loss``); ``rate_flt`` (R, dof) their rows of
+  :attr:`~gearcli.analysis.types.Analysis.mesh_rate_rows` (the rate from the independent
+  joint rates: exactly 0 for a gear at rest on its carrier), ``rate_int`` (R, 2) [gear j,
+  carrier], ``loss_flt`` (R, 2) [c_p, r_j];
 * ``couple``: circuit -> (3,) the friction couple on gear j per unit of sigma s_v t in
   carrier axes (:func:`..losses.mesh_friction_moment`; gear k receives the opposite);
 * ``blocks``: block index -> :class:`BlockLosses`, the lossy signed meshes of that block;
@@ -163,7 +165,7 @@ def build_loss_program(an, plans) -> LossProgram | None:
     couple = {ci: mesh_friction_moment(an, ci) for ci in rate_meshes}
     couple = {ci: np.asarray(v, float) for ci, v in couple.items() if v is not None}
     rate_int = np.array([[an.circuits[ci].j, an.circuits[ci].carrier] for ci in rate_meshes], np.int64).reshape(-1, 2)
-    rate_flt = np.array([an.circuits[ci].geometry.zj for ci in rate_meshes], float).reshape(-1, 3)
+    rate_flt = np.array(an.mesh_rate_rows[list(rate_meshes)], float).reshape(-1, an.dof)
     block_of = {L: i for i, p in enumerate(plans) for L in p.links}
     blocks = {}
     for bi, p in enumerate(plans):

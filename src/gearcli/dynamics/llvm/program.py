@@ -311,7 +311,7 @@ class _Study:
             qi = [rng.uniform(-np.pi, np.pi, (n, an.dof)), rng.normal(size=(n, an.dof)) * 3.0,
                   rng.normal(size=(n, an.dof)) * 20.0]
             q, qd, qdd = (v @ np.asarray(an.S, float).T for v in qi)
-            kin = forward(an.mech, an.tree, q, qd, qdd)
+            kin = forward(an.mech, an.tree, q, qd, qdd, qd_ind=qi[1])
             self._kin = (kin, inertia_load(an, kin))
         return self._kin[0]
 
