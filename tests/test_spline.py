@@ -76,3 +76,17 @@ def test_spline_loads_lapack_without_the_scipy_linalg_package_same_bits():
 
     out = subprocess.run([sys.executable, "-c", PROBE], capture_output=True, text=True, check=True).stdout.split()
     assert out == ["False", "True"]
+
+
+@pytest.mark.parametrize("n", [4, 50])
+def test_a_column_that_holds_still_has_exactly_zero_rates(n):
+    """A joint held at a constant angle (0.3, not a binary fraction) has rate and acceleration
+    exactly 0, not ~1e-14 of rounding that turns its bearings (issue 34: a rest trajectory
+    gave bearing lives of 1e+64 h); the moving column beside it is unchanged."""
+    from gearcli.io.spline import derivatives
+    t = np.linspace(0.0, 1.0, n)
+    y = np.column_stack([np.full(n, 0.3), np.sin(t), np.full(n, -1e5 / 3)])
+    d1, d2 = derivatives(t, y, 2)
+    assert not d1[:, [0, 2]].any() and not d2[:, [0, 2]].any()
+    if n > 6:
+        assert np.abs(d1[:, 1] - np.cos(t)).max() < 1e-6

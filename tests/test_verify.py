@@ -571,3 +571,29 @@ def test_life_plot_labels_the_equivalent_load_the_life_uses(run_cli, tmp_path, m
     assert P_eq == pytest.approx(by_hand, rel=1e-9)
     life = by_name(doc)[("rotor", "bearing J/x", "L10 life")]["value"]
     assert life == pytest.approx((3000 / P_eq) ** 3 * 1e6 / sum(revs), rel=1e-9)
+
+
+def test_an_infinite_life_is_reported_with_its_reason(run_cli, tmp_path):
+    """The rated arm held at rest (its joints vertical: gravity loads no tooth and turns no
+    bearing): no fatigue damage and no revolutions.  The lives print their reason, not
+    "inf" or 1e+66 h, and the JSON has null with the reason (issue 34, section 3)."""
+    t = np.linspace(0, 1, 11)
+    np.savetxt(tmp_path / "rest.csv", np.column_stack([t, 0 * t, 0.3 + 0 * t]), delimiter=",",
+               header="t,q:J1,q:J2", comments="")
+    case = (f"cases:\n  - {{name: rest, mechanism: {ROOT / 'mechanisms' / 'paper_2dof_rated.yaml'}, "
+            "trajectories: [rest.csv], cycles_per_hour: 100, bearing_life_h: 20000, gear_life_h: 20000}\n")
+    r, doc = run_json(run_cli, tmp_path, case, "--markdown", tmp_path / "r.md")
+    assert r.exit_code == 0, r.stderr
+    fatigue = [c for c in doc["checks"] if c["quantity"].endswith("fatigue life")]
+    lives = [c for c in doc["checks"] if c["quantity"] == "L10 life"]
+    assert len(fatigue) == 6 and lives
+    for c in fatigue:
+        assert c["value"] is None and c["value_note"] == "no damage (below the endurance limit)"
+    for c in lives:
+        assert c["value"] is None and c["value_note"] == "no revolutions (the bearing does not turn)"
+    assert all("value_note" not in c for c in doc["checks"] if c["value"] is not None)
+    md = (tmp_path / "r.md").read_text()
+    assert md.count("| no damage (below the endurance limit) |") == 6
+    values = [ln.split(" | ")[4] for ln in md.splitlines() if ln.startswith("| ✅")]
+    assert len(values) == len(doc["checks"]) and "inf" not in values
+    assert "no damage" in r.stdout      # (the table wraps its cells to the terminal)

@@ -6,8 +6,8 @@ also states the solver path that ran (``backend``: "llvm", or "numpy (auto: why)
 field of every JSON check, a ``backend`` property of every JUnit test suite, a line of the
 Markdown report.  An
 infinite life is written as its reason, "no damage (below the endurance limit)" for a gear
-whose Miner sum is 0 and "no revolutions (the bearing does not turn)" for a bearing, in
-text, and as ``null`` with that reason (``value_note``) in JSON.
+whose Miner sum is 0 and "no revolutions (the bearing does not turn)" for a bearing, "no load" for a
+safety factor, in text, and as ``null`` with that reason (``value_note``) in JSON.
 """
 from __future__ import annotations
 
@@ -66,7 +66,8 @@ class Row:
 
 
 INFINITE_NOTES = {"fatigue": "no damage (below the endurance limit)",
-                  "life": "no revolutions (the bearing does not turn)"}
+                  "life": "no revolutions (the bearing does not turn)",
+                  "safety": "no load (a safety factor over a zero load)"}
 """What an infinite value of a check kind means: the reports print it in place of "inf"."""
 
 

@@ -178,6 +178,10 @@ def derivatives(t: np.ndarray, y: np.ndarray, order: int = 2) -> list[np.ndarray
     k = min(5, n - 1)
     if k < order:
         raise ValueError(f"{counted(n, 'sample')} allow{'s' if n == 1 else ''} a spline of degree {k} < {order}")
+    # the spline of y - y[0]: the same derivatives, but a column that holds still (a joint at
+    # rest) gives exact zeros, not ~1e-14 of rounding (rates that turn bearings and friction)
+    y = np.asarray(y, float)
+    y = y - y[:1]
     if k == 5:
         return spline_derivatives(t, y, order)     # the same values as scipy's, without importing it
     from scipy.interpolate import make_interp_spline  # noqa: PLC0415  (2 to 5 samples only)
