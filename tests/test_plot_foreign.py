@@ -142,7 +142,8 @@ def test_columns_that_are_not_numbers_are_left_out_and_named(run_cli, tmp_path, 
     lines = drawn(r, tmp_path / "fig.png")
     assert lines == ["warning: " + str(path) + ": left out 8 columns that cannot be drawn: 's' (holds structs, not numbers), "
                      "'l' (holds lists, not numbers), 'name' (holds strings, not numbers) and 5 more"]
-    assert legends["legend"] == ["t", "i", "b", "di", "u8", "dec", "f16"]
+    # u8 (to 1e19) has an axis of its own (peaks 10x apart: issue 34); the others keep file order
+    assert legends["legend"] == ["u8", "t", "i", "b", "di", "dec", "f16"]
     assert "(7 columns)" in r.stdout
 
 
@@ -185,7 +186,7 @@ def test_thousands_of_columns_draw_a_capped_figure_and_say_so(run_cli, tmp_path,
     assert len(legends["legend"]) == 24 and "(24 columns)" in r.stdout
     wide = arrow(tmp_path / "wide.parquet", {"t": T, **{f"c{i}": T * i for i in range(2000)}},
                  names=["t"] + [f"c{i}" for i in range(2000)])
-    for n in (1, 7):       # units: one axis each, at most 6
+    for n in (1, 7):       # units: at most 6 (each split further by magnitude: c_i = i T)
         table = pq.read_table(wide)
         fields = [table.schema.field(i).with_metadata({b"unit": f"u{i % n}".encode()}) for i in range(table.num_columns)]
         pq.write_table(pa.Table.from_arrays(table.columns, schema=pa.schema(fields)), wide)
@@ -193,7 +194,7 @@ def test_thousands_of_columns_draw_a_capped_figure_and_say_so(run_cli, tmp_path,
         lines = drawn(r, tmp_path / "w.png")
         assert lines == [f"warning: {wide}: drew 24 of 2,000 matching columns (at most 24 lines on 6 axes); "
                          "name fewer columns or a narrower pattern to see the others"]
-        assert legends["axes"] == min(n, 6)
+        assert len(set(legends["ylabels"])) == min(n, 6) and legends["axes"] <= 3 * min(n, 6)
 
 
 def test_megabyte_names_and_units_are_cut_with_an_ellipsis(run_cli, tmp_path, legends):
@@ -318,3 +319,20 @@ def test_bad_npz_archive_leaves_no_file_open(tmp_path):
             open_loads(path)
         gc.collect()
     assert not [w for w in caught if issubclass(w.category, ResourceWarning)]
+
+
+def test_columns_of_one_unit_ten_times_apart_get_axes_of_their_own(run_cli, tmp_path, legends):
+    """A 0.5 N*m motor torque and a 50 N*m bearing moment: two axes, each with its own
+    columns (issue 34, section 3); columns within 10x share one."""
+    t = np.linspace(0, 1, 50)
+    cols = {"motor:m": 0.5 * np.sin(6 * t), "motor:n": 0.3 * np.cos(6 * t), "joint:J1:mx": 50 * np.cos(3 * t),
+            "joint:J1:my": 20 * t, "joint:J1:fx": 100 * t}
+    path = tmp_path / "loads.csv"
+    path.write_text("t," + ",".join(cols) + "\n" + "\n".join(
+        ",".join(repr(float(v)) for v in [t[i]] + [c[i] for c in cols.values()]) for i in range(len(t))) + "\n")
+    r = run_cli("plot", path, "motor:*", "joint:J1:*", "-o", tmp_path / "f.png")
+    assert r.exit_code == 0, r.stderr
+    assert legends["axes"] == 3
+    # N*m (the motors' unit, first in the file): the moments' axis, then the torques'; then N
+    assert legends["legend"] == ["joint:J1:mx", "joint:J1:my", "motor:m", "motor:n", "joint:J1:fx"]
+    assert legends["ylabels"] == ["[N·m]", "[N·m]", "[N]"]

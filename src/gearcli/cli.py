@@ -380,9 +380,10 @@ def plot(
                                         help="Column names or shell patterns, e.g. 'motor:*' 'gear:5-1:t'."),
     output: str = typer.Option(..., "-o", "--output", metavar="FIG.png|svg|pdf", help="Figure to write."),
 ) -> None:
-    """Draw columns of a loads file over time (one axis per unit: N, N*m, rad/s, W).  Columns
-    that cannot be drawn (not numbers, no finite value) are left out with a warning; at most
-    24 lines on 6 axes are drawn."""
+    """Draw columns of a loads file over time (one axis per unit: N, N*m, rad/s, W; columns of
+    one unit whose peaks differ more than tenfold on axes of their own, at most 3 a unit).
+    Columns that cannot be drawn (not numbers, no finite value) are left out with a warning;
+    at most 24 lines of 6 units are drawn."""
     from .io.limits import input_problem  # noqa: PLC0415
     from .report.plots import plot_loads_csv  # noqa: PLC0415
 

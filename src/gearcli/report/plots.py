@@ -85,9 +85,48 @@ def _math_free(text: str) -> str:
     return text.replace("$", r"\$")
 
 
+SCALE_SPREAD = 10.0
+"""Columns of one unit whose peaks |x| differ by more than this factor get axes of their own:
+a 0.5 N*m motor torque drawn beside a 50 N*m bearing moment would be a flat line at 0."""
+
+
+MAX_SCALE_AXES = 3
+"""Axes of one unit at most (the smallest peaks share the last)."""
+
+
+def magnitude_groups(names: list[str], series: dict) -> list[list[str]]:
+    """``names`` (columns of one unit) split into groups whose peaks max |x| lie within
+    :data:`SCALE_SPREAD` of each other: sorted by peak, a group is closed when the next
+    column's peak exceeds SCALE_SPREAD times the group's smallest non-zero peak (an all-zero
+    or all-NaN column joins the smallest group; beyond :data:`MAX_SCALE_AXES` groups the
+    smallest are merged).  Each group keeps the columns' order; groups come largest peak first."""
+    def peak(n):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")             # an all-NaN column: nanmax warns
+            v = np.nanmax(np.abs(np.asarray(series[n], float))) if np.size(series[n]) else np.nan
+        return float(v) if np.isfinite(v) else 0.0
+    peaks = {n: peak(n) for n in names}
+    groups: list[list[str]] = []
+    low = None
+    for n in sorted(names, key=lambda n: peaks[n]):
+        p = peaks[n]
+        if groups and (p == 0.0 or low is None or p <= SCALE_SPREAD * low):
+            groups[-1].append(n)
+            low = low if low is not None or p == 0.0 else p
+        else:
+            groups.append([n])
+            low = p if p > 0.0 else None
+    while len(groups) > MAX_SCALE_AXES:               # the smallest share an axis
+        groups[:2] = [groups[0] + groups[1]]
+    order = {n: i for i, n in enumerate(names)}
+    return [sorted(g, key=order.get) for g in reversed(groups)]
+
+
 def plot_columns(t: np.ndarray, series: dict, units: dict, out: str | Path, title: str = "",
                  t_label: str = "t [s]") -> list[str]:
-    """Columns over time: one axis per unit (sharing t), units on the axes; returns notes on
+    """Columns over time: one axis per unit (sharing t), units on the axes, and within a
+    unit one axis per group of peaks within :data:`SCALE_SPREAD` (:func:`magnitude_groups`);
+    returns notes on
     what the figure leaves out or shows oddly, in gearcli's words (matplotlib's own warnings
     are never printed).
 
@@ -95,15 +134,16 @@ def plot_columns(t: np.ndarray, series: dict, units: dict, out: str | Path, titl
     units and the title are shown as :func:`~gearcli.report.loads_files.shown` gives them.
     """
     plt = _pyplot()
-    groups: dict[str, list[str]] = {}
+    by_unit: dict[str, list[str]] = {}
     for name in series:
-        groups.setdefault(units[name], []).append(name)
+        by_unit.setdefault(units[name], []).append(name)
+    groups = [(unit, g) for unit, names in by_unit.items() for g in magnitude_groups(names, series)]
     marker = "." if len(t) == 1 else None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         fig, axes = plt.subplots(len(groups), 1, sharex=True, figsize=(8, 2.6 * len(groups) + 0.6), squeeze=False)
         try:
-            for ax, (unit, names) in zip(axes[:, 0], groups.items()):
+            for ax, (unit, names) in zip(axes[:, 0], groups):
                 lines = [ax.plot(t, series[n], lw=1.2, marker=marker)[0] for n in names]
                 ax.set_ylabel(_math_free(f"[{shown(unit, 20)}]") if unit else "value")
                 ax.grid(alpha=0.3)
