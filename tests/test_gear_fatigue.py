@@ -200,3 +200,27 @@ def test_a_stress_flat_to_rounding_has_no_cycle():
         assert F.miner_damage(F.rainflow_peaks(y), 2e8, "bending") == 0.0
     ripple = s * (1 + 1e-6 * np.sin(np.linspace(0, 6 * np.pi, 300)))
     assert F.rainflow_peaks(ripple).size >= 3
+
+
+def test_sn_plot_names_only_the_curves_it_draws(tmp_path, monkeypatch):
+    """A pinion at rest under load has no tooth pass: the S-N plot's legend named "tooth
+    passes" with no line (a log axis drops 0 passes; issue 34, section 3).  Passes at a
+    single point are drawn as a point."""
+    pytest.importorskip("matplotlib")
+    from gearcli.report import check_plots
+    seen = []
+    save = check_plots._save
+    monkeypatch.setattr(check_plots, "_save", lambda fig, path: (
+        seen.append([(t.get_text(), ln) for ax in fig.axes for t, ln in zip(ax.get_legend().get_texts(), ax.get_lines())]),
+        save(fig, path)))
+    N = np.logspace(2, 12, 50)
+    S = 2e8 * F.bending_cycle_factor(N)
+    peaks = np.array([1.5e8, 1.2e8])
+    check_plots.plot_sn(N, S, peaks, 1e6, tmp_path / "a.png", "t", "stress [Pa]", (np.zeros(5), np.full(5, 1e8)))
+    check_plots.plot_sn(N, S, peaks, 1e6, tmp_path / "b.png", "t", "stress [Pa]", (np.array([0.0, 3e7]), np.array([1e8, 1e8])))
+    names = [[text for text, _ in fig] for fig in seen]
+    assert names[0] == ["allowable stress (S-N curve)", "counted cycles, cumulated over the required life"]
+    assert names[1][1] == "tooth passes, cumulated over the required life"
+    passes_line = seen[1][1][1]
+    assert list(passes_line.get_xdata()) == [3e7] and passes_line.get_marker() == "."
+    assert (tmp_path / "a.png").stat().st_size > 0

@@ -42,13 +42,19 @@ def plot_sn(N: np.ndarray, S: np.ndarray, peaks: np.ndarray, cycles_in_life: flo
             title: str, ylabel: str, passes: tuple | None = None) -> None:
     """An S-N curve (``S`` at ``N`` cycles) and the counted cycles over the required life:
     the rainflow cycles, largest first, against their cumulated number (``cycles_in_life``
-    in all), and ``passes`` = (cumulated tooth passes, stress) when the pinion turns; a
-    spectrum crossing the curve fails Miner's sum long before the required life."""
+    in all), and ``passes`` = (cumulated tooth passes, stress) when the pinion turns (only
+    their points with passes and stress, which a log axis can show: a curve with none is left
+    out, legend entry too); a spectrum crossing the curve fails Miner's sum long before the
+    required life."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7, 3.4))
     ax.loglog(N, S, color="red", lw=1.2, label="allowable stress (S-N curve)")
-    if passes is not None and passes[0].size:
-        ax.loglog(passes[0], passes[1], lw=1.2, label="tooth passes, cumulated over the required life")
+    if passes is not None:          # a log axis has no place for 0 passes (a pinion at rest) or 0 stress
+        shown = (np.asarray(passes[0]) > 0) & (np.asarray(passes[1]) > 0)
+        if shown.any():
+            ax.loglog(passes[0][shown], passes[1][shown], lw=1.2, marker="." if shown.sum() == 1 else None,
+                      label="tooth passes, cumulated over the required life")
+    peaks = peaks[peaks > 0]
     if peaks.size:
         order = np.sort(peaks)[::-1]
         n = np.arange(1, order.size + 1) * cycles_in_life / order.size
