@@ -365,3 +365,47 @@ def test_check_determinate_reports_singular_equations(mech_dir):
     object.__setattr__(an, "circuits", (broken,) + an.circuits[1:])
     check_determinate(an, col)
     assert len(col.issues) == 1 and "statically indeterminate" in col.issues[0].message
+
+
+TWO_STAGE = """\
+name: two_stage
+base: housing
+end_effector: carrier2
+links:
+  - name: housing
+  - {name: sun, mass: 0.08, inertia: [1.2e-5, 1.2e-5, 4.0e-6]}
+  - {name: carrier1, mass: 0.2, inertia: [1.0e-4, 1.0e-4, 1.5e-4]}
+  - {name: planet1, mass: 0.02, inertia: [6.0e-7, 6.0e-7, 8.0e-7]}
+  - {name: carrier2, mass: 0.35, inertia: [2.5e-4, 2.5e-4, 3.8e-4]}
+  - {name: planet2, mass: 0.02, inertia: [6.0e-7, 6.0e-7, 8.0e-7]}
+joints:
+  - {name: JS, parent: housing, child: sun, origin: {xyz: [0, 0, 0]}, axis: [0, 0, 1]}
+  - {name: JC1, parent: housing, child: carrier1, origin: {xyz: [0, 0, 0.01]}, axis: [0, 0, 1]}
+  - {name: JP1, parent: carrier1, child: planet1, origin: {xyz: [0.021, 0, -0.01]}, axis: [0, 0, 1]}
+  - {name: JC2, parent: housing, child: carrier2, origin: {xyz: [0, 0, 0.05]}, axis: [0, 0, 1]}
+  - {name: JP2, parent: carrier2, child: planet2, origin: {xyz: [0.021, 0, -0.01]}, axis: [0, 0, 1]}
+gears:
+  - {name: s1, links: [sun, planet1], teeth: [24, 18], mesh_point: [0.012, 0, -0.01]}
+  - {name: r1, links: [planet1, housing], kind: internal, teeth: [18, 60], mesh_point: [0.030, 0, -0.01]}
+  - {name: s2, links: [carrier1, planet2], teeth: [24, 18], mesh_point: [0.012, 0, -0.01]}
+  - {name: r2, links: [planet2, housing], kind: internal, teeth: [18, 60], mesh_point: [0.030, 0, -0.01]}
+motors:
+  - {name: motor, link: sun}
+"""
+
+
+def test_a_two_stage_planetary_line_runs_through_both_stages(run_cli, tmp_path, mech_dir):
+    """A planet in a fixed ring drives its carrier: the line goes on to the carrier, and on
+    into the second stage, instead of ending at the housing (issue 34, section 3: `graph`
+    showed 'sun -> planet1 -> housing' and no second stage).  The ratio of the line, 1/(1 +
+    60/24) per stage, is the structure matrix's."""
+    path = tmp_path / "two_stage.yaml"
+    path.write_text(TWO_STAGE)
+    r = run_cli("graph", path)
+    assert r.exit_code == 0, r.stderr
+    assert "  sun -> planet1 -> carrier1 -> planet2 -> carrier2" in r.stdout.splitlines()
+    d = json.loads(run_cli("graph", path, "--json").stdout)
+    assert d["transmission_lines"] == [["sun", "planet1", "carrier1", "planet2", "carrier2"]]
+    assert np.array(d["structure_matrix"]).ravel() == pytest.approx([(1 + 60 / 24) ** 2])
+    lines = {tuple(t) for t in lib_dict(mech_dir, "planetary_3p")["transmission_lines"]}
+    assert lines == {("sun", f"planet{k}", "carrier") for k in (1, 2, 3)}

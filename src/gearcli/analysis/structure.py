@@ -90,30 +90,38 @@ def transmission_lines(h: Home, circuits: list[Circuit], primary: list[int], cha
                         mlinks: list[int]):
     """Transmission lines: from each motor's input link along heavy edges (gear pairs) to the
     first primary link reached (a path of link ids per branch; a single link if the input
-    link is primary).  Also whether the structure matrix is pseudo-triangular: every
+    link is primary).  A gear meshing with a gear fixed to the base (a planet in its fixed
+    ring) drives its carrier: the line goes on to the carrier instead of ending at the base,
+    so a planetary's line ends at its output carrier and a two-stage planetary's runs
+    through both stages.  Also whether the structure matrix is pseudo-triangular: every
     primary link ends exactly one line."""
-    heavy: dict[int, list[int]] = {i: [] for i in range(h.L)}
+    heavy: dict[int, list[tuple[int, int]]] = {i: [] for i in range(h.L)}
     for c in circuits:
-        heavy[c.j].append(c.k)
-        heavy[c.k].append(c.j)
+        heavy[c.j].append((c.k, c.carrier))
+        heavy[c.k].append((c.j, c.carrier))
     pset = set(primary)
     tlines: list[tuple[int, ...]] = []
     for x in mlinks:
         if x in pset:
             tlines.append((x,))
         else:
-            extend_lines([x], heavy, pset, tlines)
+            extend_lines([x], heavy, pset, tlines, h.tree.base)
     ends = [line[-1] for line in tlines]
     return tlines, all(ends.count(p) == 1 for p in chain)
 
 
-def extend_lines(path: list[int], heavy: dict, pset: set, out: list) -> None:
+def extend_lines(path: list[int], heavy: dict, pset: set, out: list, base: int) -> None:
     """Depth-first extension of ``path`` along heavy edges, appending to ``out`` every
-    extension that reaches a primary link (in ``pset``)."""
-    for nb in heavy[path[-1]]:
+    extension that reaches a primary link (in ``pset``) other than the ``base``; a mesh with
+    a gear on the base leads to the pair's carrier instead (when it moves)."""
+    for nb, carrier in heavy[path[-1]]:
+        if nb == base:
+            nb = carrier
+            if nb == base:
+                continue
         if nb in path:
             continue
         if nb in pset:
             out.append(tuple(path + [nb]))
         else:
-            extend_lines(path + [nb], heavy, pset, out)
+            extend_lines(path + [nb], heavy, pset, out, base)
