@@ -439,3 +439,31 @@ def test_bad_stiffness_of_a_planet_pair_is_reported_once(run_cli, tmp_path, bund
     assert res.exit_code == 2
     assert res.stderr.splitlines() == [f"{path}:{_line(text, 'stiffness: ' + value)}: gears[0].stiffness: mesh "
                                        f"stiffness must be positive, got {value} N/m"]
+
+
+def test_a_wrong_ring_tooth_count_reports_every_problem(run_cli, tmp_path, bundled):
+    """Ring 61 teeth instead of 60: the planets' equal spacing does not fit and the ring's
+    tooth ratio contradicts its mesh radius; `check` reports both (it reported only the first,
+    issue 34, section 3), `solve` and `verify` as well, and the library raises as before."""
+    import gearcli
+    from gearcli.errors import MechanismError
+    assert bundled.count("    teeth: [18, 60]") == 1
+    text = bundled.replace("    teeth: [18, 60]", "    teeth: [18, 61]")
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    res = run_cli("check", path)
+    assert res.exit_code == 2 and res.stdout == "" and "Traceback" not in res.stderr
+    lines = res.stderr.splitlines()
+    assert lines == [
+        f"{path}:{_line(text, '    planets: 3')}: joints[2].planets: 3 equally spaced planets do not fit: "
+        "(z_sun + z_ring) / N = 85/3 is not a whole number (the planets' teeth cannot mesh the sun and the ring at "
+        "every position)",
+        f"{path}:{_line(text, 'teeth: [18, 61]')}: gears[1].teeth: tooth counts 18:61 give |ratio| 3.38889, but the "
+        "mesh geometry gives 3.33333"]
+    traj = tmp_path / "t.csv"
+    traj.write_text("t,q:JC\n0,0\n1,1\n")
+    res = run_cli("solve", path, traj, "-o", tmp_path / "o.csv")
+    assert res.exit_code == 2 and res.stderr.splitlines() == lines and not (tmp_path / "o.csv").exists()
+    with pytest.raises(MechanismError) as exc:
+        gearcli.load_mechanism(path)
+    assert [str(i) for i in exc.value.issues] == lines[:1]

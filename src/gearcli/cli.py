@@ -64,11 +64,9 @@ def load_analysis(path: Path, strict: bool = False) -> Analysis:
     (:mod:`gearcli.model.plausibility`: a mechanism in mm, ...) go to stderr, one line each,
     without changing the exit status; with ``strict`` they are errors (exit status 2).
     """
-    from .dynamics.determinacy import analyse  # noqa: PLC0415  (keeps --help fast; not the solver)
-    from .io import load_mechanism  # noqa: PLC0415
+    from .dynamics.determinacy import load_analysed  # noqa: PLC0415  (keeps --help fast; not the solver)
 
-    mech = load_mechanism(path)
-    an = analyse(mech)
+    an = load_analysed(path)
     report_mechanism_warnings(an, strict)
     return an
 

@@ -90,6 +90,18 @@ class MechanismError(GearcliError):
         return [str(i) for i in self.issues]
 
 
+class IncompleteMechanismError(MechanismError):
+    """Problems found while reading a mechanism file that did not stop it from being built:
+    ``mechanism`` is what was built despite them, for the graph analysis to find the problems
+    that remain (``gearcli check`` reports every problem at once: a wrong ring tooth count
+    breaks both the planets' assembly and the ring's mesh geometry).  Never a usable
+    mechanism: it is raised, not returned."""
+
+    def __init__(self, issues: list[Issue], mechanism):
+        super().__init__(issues)
+        self.mechanism = mechanism
+
+
 class TrajectoryError(GearcliError):
     """A trajectory file or array is invalid; ``issue`` (an :class:`Issue`: file, place
     such as ``column 2 'q:J1'``, line, message) says where when it is known."""

@@ -22,11 +22,10 @@ from .dynamics.backends import BACKENDS, Choice
 from .dynamics.solve import solve, solver_for
 from .analysis.graph import Analysis
 from .dynamics.bearing_friction import BearingFrictionError
-from .dynamics.determinacy import analyse
+from .dynamics.determinacy import analyse, load_analysed
 from .dynamics.signs import SignError
 from . import __version__
 from .errors import GearcliError, Issue, TrajectoryError
-from .io import load_mechanism
 from .io.output import OutputError, atomic_output, output_target
 from .io.trajectory import TrajectoryReader
 from .report.loss_summary import LossSummary, lossless_twin
@@ -120,7 +119,7 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
     :class:`~gearcli.report.unit_warnings.StrictError` (nothing written).
     """
     fmt = _output_format(out_path, (mech_path, traj_path), precision)   # refuse a bad -o before any work
-    an = analysis or analyse(load_mechanism(mech_path))
+    an = analysis or load_analysed(mech_path)
     reader = TrajectoryReader(traj_path, an.independent_names, degrees=degrees, chunk=chunk,
                               linear=prismatic_independent(an), loads=an.mech.loads)
     to_stdout = out_path is not None and str(out_path) == "-"

@@ -14,9 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from .analysis.graph import Analysis
-from .dynamics.determinacy import analyse
+from .dynamics.determinacy import load_analysed
 from .errors import GearcliError, counted
-from .io import load_mechanism
 from .io.output import OutputError, atomic_output, output_target
 from .pipeline import SolveReport, _output_format, solve_file
 
@@ -122,7 +121,7 @@ def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None
     for name, v in (("--rtol", rtol), ("--atol", atol), ("--dt", dt)):
         if not (math.isfinite(v) and v > 0):
             raise GearcliError(f"{name}: expected a positive number, got {v:g}")
-    an = analysis or analyse(load_mechanism(mech_path))
+    an = analysis or load_analysed(mech_path)
     x0, v0 = state_option(q0, an, "--q0"), state_option(qd0, an, "--qd0")
     for ji, name, lo, hi in joint_limits(an):
         if not lo <= an.S[ji] @ x0 <= hi:

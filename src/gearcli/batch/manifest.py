@@ -17,14 +17,14 @@ import jsonschema
 
 from ..design.checks import Check, Requirements, build_checks
 from ..errors import Collector, GearcliError
-from ..io import load_mechanism
 from ..io.limits import input_problem
 from ..io.trajectory import TrajectoryReader, forget_rows
 from ..io.schema_words import schema_messages
 from ..io.yaml_reader import json_path, number_issues
 from ..io.yaml_safe import read_text, yaml_lines
 from ..model.validate import MAX_ABS
-from ..pipeline import analyse, prismatic_independent
+from ..dynamics.determinacy import load_analysed
+from ..pipeline import prismatic_independent
 from ..io.schemas import packaged_schema
 
 REQUIREMENT_KEYS = ("cycles_per_hour", "service_life_h", "bearing_life_h", "gear_life_h", "min_static_safety",
@@ -33,7 +33,7 @@ REQUIREMENT_KEYS = ("cycles_per_hour", "service_life_h", "bearing_life_h", "gear
 
 @lru_cache(maxsize=8)
 def _analysis(mech_path: str, mtime: float | None):
-    return analyse(load_mechanism(mech_path))
+    return load_analysed(mech_path)
 
 
 def case_analysis(mech_path: str | Path):

@@ -36,6 +36,24 @@ def analyse(mech: Mechanism) -> Analysis:
     return an
 
 
+def load_analysed(path) -> Analysis:
+    """:func:`analyse` of the mechanism file ``path`` (:func:`gearcli.io.load_mechanism`),
+    with every problem at once: where the reader built the mechanism despite a problem
+    (:class:`~gearcli.errors.IncompleteMechanismError`, e.g. planets that do not fit), the
+    analysis's problems are added to the reader's."""
+    from ..errors import IncompleteMechanismError, MechanismError  # noqa: PLC0415
+    from ..io import load_mechanism                                # noqa: PLC0415
+    try:
+        mech = load_mechanism(path)
+    except IncompleteMechanismError as exc:
+        try:
+            analyse(exc.mechanism)
+        except MechanismError as more:
+            raise MechanismError(exc.issues + [i for i in more.issues if i not in exc.issues]) from None
+        raise MechanismError(exc.issues) from None
+    return analyse(mech)
+
+
 def block_unknowns(an) -> list[list]:
     """Unknown groups owned by each block of ``an.schedule``: a group belongs to the first
     block (in solution order) that holds one of its links.  Per block, a list of

@@ -122,10 +122,12 @@ def per_planet_problems(spec: dict, n: int, path: str, col: Collector) -> None:
             col.add(f"{where}.stiffness", f"mesh stiffness must be positive, got {item['stiffness']:g} N/m")
 
 
-def expand_planets(data: dict, geometry, col: Collector) -> dict:
+def expand_planets(data: dict, geometry, col: Collector, later: Collector | None = None) -> dict:
     """``data`` with every ``planets: N`` joint expanded (see the module docstring); the
     original YAML path of every list item under :data:`PATHS`.  ``geometry(spec, col, path)``
-    gives a joint's (R_pj, p_pj, R_jc, p_jc).  Issues go to ``col``."""
+    gives a joint's (R_pj, p_pj, R_jc, p_jc).  Issues go to ``col``; planets whose equal
+    spacing does not fit are expanded all the same, their issue going to ``later`` (``col``
+    when None), so that the analysis can still find the problems of their gear pairs."""
     planets = {j["child"] for j in data["joints"] if "planets" in j}
     for i, g in enumerate(data.get("gears", [])):
         if "per_planet" in g and not planets & set(g["links"]):
@@ -143,7 +145,9 @@ def expand_planets(data: dict, geometry, col: Collector) -> dict:
             col.add(f"{path}.planets", "planets need a revolute joint given by origin/axis (not dh)")
             continue
         axis = _carrier_axis(data, carrier, geometry, col, path)
-        if axis is None or _misuse(data, planet, carrier, path, col) or not _assembly_fits(data, planet, n, path, col):
+        if axis is None or _misuse(data, planet, carrier, path, col):
+            continue
+        if not _assembly_fits(data, planet, n, path, later or col) and later is None:
             continue
         a0, u = axis
         for gpath, g in lists["gears"]:

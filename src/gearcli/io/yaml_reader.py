@@ -16,7 +16,7 @@ from functools import lru_cache
 import jsonschema
 import numpy as np
 
-from ..errors import Collector
+from ..errors import Collector, IncompleteMechanismError
 from ..model.friction import JointFriction
 from ..model.mechanism import GearPair, Joint, Link, Mechanism, Motor
 from .loads_reader import yaml_loads
@@ -102,9 +102,14 @@ def parse_mechanism(text: str, file: str = "<string>") -> Mechanism:
     number_issues(data, col)
     _schema_issues(data, col, {i.path for i in col.issues})
     col.raise_if_any()
-    data = expand_planets(data, joint_geometry, col)
+    later = Collector(file, lines)       # problems that leave the mechanism buildable (planet assembly)
+    data = expand_planets(data, joint_geometry, col, later)
     col.raise_if_any()
     mech = attach_yaml_ratings(_build(data, col, file, lines), data, col)
+    if later.issues:
+        col.issues[:0] = later.issues
+    if col.issues and later.issues and len(col.issues) == len(later.issues):
+        raise IncompleteMechanismError(col.issues, mech)
     col.raise_if_any()
     return mech
 
