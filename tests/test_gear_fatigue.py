@@ -224,3 +224,32 @@ def test_sn_plot_names_only_the_curves_it_draws(tmp_path, monkeypatch):
     passes_line = seen[1][1][1]
     assert list(passes_line.get_xdata()) == [3e7] and passes_line.get_marker() == "."
     assert (tmp_path / "a.png").stat().st_size > 0
+
+
+def test_json_report_carries_the_stresses_and_rainflow_counts_it_used(run_cli, tmp_path):
+    """Every gear check's JSON entry has its peak stress (MPa); a fatigue check also the
+    rainflow cycles an hour by stress and the tooth passes an hour (issue 34, section 3).
+    Miner's sum of the listed cycles, by the S-N curve, is the rainflow part of the damage:
+    with the tooth passes' part it makes the reported life's 1/L."""
+    import json
+    out = tmp_path / "r.json"
+    from pathlib import Path
+    designs = Path(__file__).resolve().parents[1] / "designs"
+    r = run_cli("verify", designs / "paper_arm_duty.yaml", "--json", out, "-j", "1")
+    assert r.exit_code == 0, r.stderr
+    checks = json.loads(out.read_text())["checks"]
+    gear = [c for c in checks if c["component"].startswith("gear ")]
+    assert len(gear) == 12 and all("peak_stress_MPa" in c for c in gear)
+    assert not any("peak_stress_MPa" in c for c in checks if not c["component"].startswith("gear "))
+    for c in (c for c in gear if c["quantity"].endswith("fatigue life")):
+        cycles = np.array(c["rainflow_MPa_per_hour"])
+        assert cycles[0, 0] == pytest.approx(c["peak_stress_MPa"], rel=1e-12)
+        assert np.all(np.diff(cycles[:, 0]) < 0) and np.all(cycles[:, 1] % 1200 == 0)    # 1200 repetitions an hour
+        assert c["tooth_passes_per_hour"] > 0
+        kind = "bending" if c["quantity"].startswith("bending") else "contact"
+        allowable = 2.2e8 if kind == "bending" else 7.6e8
+        rainflow = np.sum(cycles[:, 1] / F.cycles_to_failure(cycles[:, 0] * 1e6, allowable, kind))
+        assert 0 < rainflow < 1 / c["value"]
+        # a tooth pass at the peak stress damages at most as much as one more cycle at that stress
+        worst_pass = c["tooth_passes_per_hour"] / F.cycles_to_failure(c["peak_stress_MPa"] * 1e6, allowable, kind)
+        assert 1 / c["value"] <= rainflow + worst_pass * (1 + 1e-9)

@@ -7,7 +7,10 @@ field of every JSON check, a ``backend`` property of every JUnit test suite, a l
 Markdown report.  An
 infinite life is written as its reason, "no damage (below the endurance limit)" for a gear
 whose Miner sum is 0 and "no revolutions (the bearing does not turn)" for a bearing, "no load" for a
-safety factor, in text, and as ``null`` with that reason (``value_note``) in JSON.
+safety factor, in text, and as ``null`` with that reason (``value_note``) in JSON.  A gear
+check's JSON entry adds the stresses it used (:func:`gearcli.design.evaluate.details_of`):
+``peak_stress_MPa``, and for fatigue ``rainflow_MPa_per_hour`` [[stress, cycles an hour],
+...] and ``tooth_passes_per_hour``.
 """
 from __future__ import annotations
 
@@ -15,7 +18,7 @@ import json
 import re
 import math
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from rich.table import Table
@@ -48,6 +51,7 @@ class Row:
     time: float
     backend: str = ""
     kind: str = ""          # the check's kind (Check.kind): "life", "fatigue", "peak", ...
+    details: dict = field(default_factory=dict, compare=False)   # Verdict.details: a gear check's stresses
 
     @property
     def name(self) -> str:
@@ -78,7 +82,7 @@ def rows_of(results) -> list[Row]:
         for v in r.verdicts:
             traj = r.case.trajectories[v.trajectory]
             rows.append(Row(r.case.name, v.check.component, v.check.quantity, v.value, v.check.limit,
-                            v.check.unit, v.margin, v.passed, Path(traj).name, v.time, r.backend, v.check.kind))
+                            v.check.unit, v.margin, v.passed, Path(traj).name, v.time, r.backend, v.check.kind, v.details))
     return sorted(rows, key=lambda row: (row.passed, row.margin))
 
 
@@ -138,7 +142,8 @@ def write_json(rows: list[Row], path, manifest: str) -> None:
            "checks": [{"case": r.case, "component": r.component, "quantity": r.quantity, "value": _num(r.value),
                        **({"value_note": r.note} if r.note else {}),
                        "limit": _num(r.limit), "unit": r.unit, "margin_pct": _num(r.margin), "passed": r.passed,
-                       "trajectory": r.trajectory, "time": _num(r.time), "backend": r.backend} for r in rows]}
+                       "trajectory": r.trajectory, "time": _num(r.time), "backend": r.backend, **r.details}
+                      for r in rows]}
     write_text(path, json.dumps(doc, indent=2, allow_nan=False) + "\n")   # strict JSON: never NaN/Infinity
 
 

@@ -8,7 +8,7 @@ whichever process or machine evaluated each trajectory.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -98,12 +98,15 @@ def bearing_of(check: Check, mech):
 
 
 def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
-    """Per check, the trajectory's (peak, t at peak, sum, weight sum, revolutions, score, span).
+    """Per check, the trajectory's (peak, t at peak, sum, weight sum, revolutions, score, span,
+    counts).
 
     ``sum``/``weight`` are the trapezoid integral of x^2 and the time span (rms,
     :mod:`gearcli.design.rms`), or the Palmgren-Miner sum n_k P_k^p / a_ISO and the
     revolutions (life, :func:`gearcli.design.bearings.life_sum`); ``score`` ranks
-    trajectories for "worst trajectory" (peak, RMS or equivalent load).
+    trajectories for "worst trajectory" (peak, RMS or equivalent load); ``counts`` (gear
+    fatigue only, else None) the cycles the damage was computed from, per repetition: the
+    rainflow cycles as ((stress, number), ...) by stress (Pa) and the tooth passes.
     """
     out = []
     span = float(s.t[-1] - s.t[0]) if s.t.size else 0.0
@@ -113,7 +116,7 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
         k = _peak_index(cache, ch, x)
         peak, tp = (float(np.abs(x[k])), float(s.t[k])) if x.size else (0.0, math.nan)
         total = wsum = revs = 0.0
-        score = peak
+        score, counts = peak, None
         if ch.kind == "rms":
             total, wsum = float(square_integral(x, s.t)), span
             score = rms_of(total, wsum, peak)
@@ -127,14 +130,16 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
         elif ch.kind == "fatigue":
             peaks = F.rainflow_peaks(x)
             total = F.miner_damage(peaks, ch.rating, ch.signal[0])
-            revs = float(len(peaks))
+            revs = passes = float(len(peaks))
             if ch.extra.get("passes") is not None:       # each pinion tooth: one cycle per revolution
                 ji, factor = ch.extra["passes"]
                 n = _revolutions(cache, s, ji) * factor
                 total += F.pass_damage(x, n, ch.rating, ch.signal[0])
                 revs += float(np.sum(n))
             score = total
-        out.append((peak, tp, total, wsum, revs, score, span))
+            levels, number = np.unique(peaks, return_counts=True)
+            counts = (tuple(zip(levels.tolist(), number.tolist())), revs - passes)
+        out.append((peak, tp, total, wsum, revs, score, span, counts))
     return out
 
 
@@ -174,6 +179,7 @@ class Verdict:
     trajectory: int        # index of the worst trajectory in the case
     time: float            # s, time of the worst sample in it
     signal_limit: float    # the signal level that just meets the limit (for plots)
+    details: dict = field(default_factory=dict, compare=False)   # what the JSON report adds (:func:`details_of`)
 
 
 def profile_equivalent_load(check: Check, parts: list[tuple], rates) -> float:
@@ -241,4 +247,25 @@ def combine(check: Check, parts: list[tuple], rates) -> Verdict:
         margin = 100.0 * (check.limit - value) / check.limit
     else:
         margin = math.inf if math.isinf(value) else 100.0 * (value - check.limit) / check.limit
-    return Verdict(check, value, margin >= 0, margin, worst, t_worst, sig_lim)
+    return Verdict(check, value, margin >= 0, margin, worst, t_worst, sig_lim, details_of(check, parts, per_hour))
+
+
+STRESS_SIGNALS = ("bending", "contact")
+
+
+def details_of(check: Check, parts: list[tuple], per_hour: list) -> dict:
+    """The stresses a gear check used, for the JSON report: the peak stress (MPa) of a
+    bending or contact check and, for a fatigue check, its rainflow cycles
+    [[stress MPa, cycles per hour], ...] (largest stress first) and tooth passes per hour,
+    each trajectory's counts times its repetitions per hour (``per_hour``)."""
+    if check.signal[0] not in STRESS_SIGNALS:
+        return {}
+    out = {"peak_stress_MPa": max(p[0] for p in parts) / 1e6}
+    if check.kind == "fatigue":
+        cycles: dict = {}
+        for rate, p in zip(per_hour, parts):
+            for stress, n in p[7][0]:
+                cycles[stress] = cycles.get(stress, 0.0) + rate * n
+        out["rainflow_MPa_per_hour"] = [[k / 1e6, cycles[k]] for k in sorted(cycles, reverse=True)]
+        out["tooth_passes_per_hour"] = sum(rate * p[7][1] for rate, p in zip(per_hour, parts))
+    return out
