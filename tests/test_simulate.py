@@ -173,6 +173,17 @@ def test_bad_input_is_one_line_and_exit_2(run_cli, mech_dir, tmp_path, text, arg
     assert not (tmp_path / "traj.csv").exists()
 
 
+@pytest.mark.parametrize("name", ["traj.parquet", "traj.feather", "traj.npz"])
+def test_a_trajectory_in_another_format_than_csv_is_refused(run_cli, mech_dir, tmp_path, name):
+    """simulate -o t.parquet wrote CSV text under that name (issue 34, section 5): the
+    trajectory is the CSV solve reads, so another loads format is refused before running."""
+    inp = write(tmp_path / "in.csv", "t,motor:motor3,motor:motor5\n0,1,1\n1,1,1\n")
+    r = run_cli("simulate", mech_dir / "paper_2dof.yaml", inp, "-o", tmp_path / name)
+    assert r.exit_code == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert f"{tmp_path / name}: -o: simulate writes its trajectory as CSV, the file `gearcli solve` reads" in r.stderr
+    assert not (tmp_path / name).exists()
+
+
 def test_a_step_beyond_the_span_writes_its_two_ends(run_cli, mech_dir, tmp_path):
     """--dt larger than the span (was an AttributeError traceback: one sample, no span)."""
     inp = write(tmp_path / "in.csv", "t,motor:motor3,motor:motor5\n0,1,1\n1,1,1\n")

@@ -597,3 +597,12 @@ def test_an_infinite_life_is_reported_with_its_reason(run_cli, tmp_path):
     values = [ln.split(" | ")[4] for ln in md.splitlines() if ln.startswith("| ✅")]
     assert len(values) == len(doc["checks"]) and "inf" not in values
     assert "no damage" in r.stdout      # (the table wraps its cells to the terminal)
+
+
+@pytest.mark.parametrize("option", ["--plots", "--spectra"])
+def test_an_empty_directory_name_is_refused_as_the_file_names_are(run_cli, tmp_path, monkeypatch, option):
+    """--plots '' wrote into the current folder, where --junit '' is refused (issue 34, section 5)."""
+    monkeypatch.chdir(tmp_path)
+    r = run_cli("verify", DESIGNS / "ci_example.yaml", option, "")
+    assert r.exit_code == 2 and r.stderr.strip() == f"{option}: empty directory name (give a directory for the files)"
+    assert list(tmp_path.iterdir()) == []

@@ -318,9 +318,9 @@ def verify(
     junit: str = typer.Option(None, "--junit", metavar="FILE", help="Write JUnit XML (one testcase per check)."),
     json_out: str = typer.Option(None, "--json", metavar="FILE", help="Write the checks as JSON."),
     markdown: str = typer.Option(None, "--markdown", metavar="FILE", help="Write a Markdown table (CI job summary)."),
-    plots: Path = typer.Option(None, "--plots", metavar="DIR", help="Write a PNG of each failing or tight "
+    plots: str = typer.Option(None, "--plots", metavar="DIR", help="Write a PNG of each failing or tight "
                                "(< 10 % margin) check along its worst trajectory."),
-    spectra: Path = typer.Option(None, "--spectra", metavar="DIR", help="Write each case's load spectra (time "
+    spectra: str = typer.Option(None, "--spectra", metavar="DIR", help="Write each case's load spectra (time "
                                  "and revolutions per hour at each load level of every motor, gear mesh and "
                                  "rated bearing) as CSV and JSON."),
     jobs: int = typer.Option(None, "-j", "--jobs", min=1, metavar="N", help="Worker processes (default: the number of cores)."),

@@ -18,6 +18,7 @@ from .dynamics.determinacy import load_analysed
 from .errors import GearcliError, counted
 from .io.output import OutputError, atomic_output, output_target
 from .pipeline import SolveReport, _output_format, solve_file
+from .report.table_files import format_of
 
 MAX_SIMULATE_SAMPLES = 10_000_000
 STALL_EVALUATIONS = 5_000    # evaluations of the dynamics without advancing STALL_FRACTION of the span
@@ -114,6 +115,9 @@ def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None
     if str(out_path) == "-":
         raise OutputError("-", "simulate writes its trajectory to a file, not to stdout (give -o TRAJ.csv)")
     output_target(out_path, inputs)
+    if format_of(str(out_path)) not in (None, "csv"):
+        raise OutputError(str(out_path), f"simulate writes its trajectory as CSV, the file `gearcli solve` reads: "
+                          f"give -o TRAJ.csv (and --loads LOADS.{format_of(str(out_path))} for the loads in that format)")
     if loads_path is not None:
         _output_format(loads_path, inputs + (out_path,), None)
     if method not in METHODS:

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import GearcliError
-from ..io.output import output_target
+from ..io.output import OutputError, output_target
 from ..report.plots import plot_check
 from ..report.rms import cumulative_rms
 from .manifest import load_manifest
@@ -49,7 +49,9 @@ def run_verify(manifest_path, *, jobs: int | None = None, dask_address: str | No
     manifest = manifest or load_manifest(manifest_path)
     check_outputs(manifest, {"--junit": junit, "--json": json_path, "--markdown": markdown_path})
     for d, option in ((plots_dir, "--plots"), (spectra_dir, "--spectra")):
-        if d:
+        if d is not None and not str(d).strip():
+            raise OutputError(option, "empty directory name (give a directory for the files)", place="")
+        if d is not None:
             make_plot_dir(Path(d), option)
     results = run_manifest(manifest, jobs=jobs, dask_address=dask_address, progress=progress)
     rows = rows_of(results)
@@ -60,8 +62,8 @@ def run_verify(manifest_path, *, jobs: int | None = None, dask_address: str | No
         write_json(rows, json_path, str(manifest_path))
     if markdown_path:
         write_markdown(rows, markdown_path, str(manifest_path))
-    plots = write_plots(results, Path(plots_dir)) if plots_dir else []
-    spectra = write_spectra(results, Path(spectra_dir)) if spectra_dir else []
+    plots = write_plots(results, Path(plots_dir)) if plots_dir is not None else []
+    spectra = write_spectra(results, Path(spectra_dir)) if spectra_dir is not None else []
     return VerifyOutcome(rows, results, plots, spectra)
 
 
