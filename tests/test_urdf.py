@@ -615,3 +615,20 @@ def test_export_command_round_trip(run_cli, mech_dir, tmp_path):
     assert rel(rb.motor, ra.motor) < 1e-12 and rel(rb.joint, ra.joint) < 1e-12
     r = run_cli("check", out)
     assert r.exit_code == 0, r.stderr
+
+
+def test_reader_warnings_are_printed_as_every_other_warning(run_cli, tmp_path):
+    """``file:line: place: warning: what``, as the plausibility warnings (they were
+    ``warning: file:line: place: what``; issue 34, section 5); --strict makes them errors."""
+    text = robot(TWO_LINKS + '  <link name="pad"/>\n' + ARM_JOINT
+                 + '  <joint name="f" type="fixed">\n    <parent link="arm"/><child link="pad"/>\n'
+                 '    <mimic joint="j1"/>\n  </joint>\n')
+    path = tmp_path / "m.urdf"
+    path.write_text(text)
+    r = run_cli("check", path)
+    assert r.exit_code == 0
+    line = f"{path}:{line_of(text, '<mimic')}: joint 'f': warning: <mimic> of a fixed joint is ignored"
+    assert line in r.stderr.splitlines()
+    r = run_cli("check", path, "--strict")
+    assert r.exit_code == 2 and any(s.endswith("(--strict)") and "<mimic> of a fixed joint" in s
+                                    for s in r.stderr.splitlines())

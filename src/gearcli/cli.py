@@ -80,7 +80,7 @@ def report_mechanism_warnings(an: Analysis, strict: bool) -> None:
     issues = mechanism_issues(an)
     if strict and (loader or issues):
         raise StrictError(issues, loader)
-    print_problems([f"warning: {w}" for w in loader] + warning_lines(issues))
+    print_problems([w.shown() if hasattr(w, "shown") else f"warning: {w}" for w in loader] + warning_lines(issues))
 
 
 STRICT_OPTION = typer.Option(False, "--strict", help="Warnings are errors (exit 2): implausible values "

@@ -31,6 +31,22 @@ MAX_PATH = 160
 MAX_MESSAGE = 400
 
 
+class LocatedWarning(str):
+    """A warning of the reader (``Mechanism.warnings``): the text ``file:line: place: what``
+    of its :class:`Issue`, which it keeps as ``issue`` so that the commands print it as every
+    other warning, ``file:line: place: warning: what``."""
+
+    def __new__(cls, issue):
+        obj = super().__new__(cls, str(issue))
+        obj.issue = issue
+        return obj
+
+    def shown(self) -> str:
+        """The warning as the commands print it."""
+        i = self.issue
+        return str(Issue(i.file, i.path, i.line, f"warning: {i.message}")) if isinstance(i, Issue) else f"warning: {self}"
+
+
 def capped(text: str, limit: int) -> str:
     """``text`` on one line, cut to ``limit`` characters with an ellipsis."""
     text = " ".join(str(text).splitlines())

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from ..errors import Collector, Issue, MechanismError
+from ..errors import Collector, Issue, LocatedWarning, MechanismError
 from ..model.mechanism import Mechanism
 from ..model.validate import number_problem
 from ..model.ratings import (BEARING_FACTOR_DEFAULTS, STEEL_ELASTIC_COEFFICIENT, BearingRating, GearRating,
@@ -270,7 +270,7 @@ def attach_urdf_ratings(mech: Mechanism, root, file: str) -> Mechanism:
         return lambda path, msg: issues.append(Issue(file, path, el.sourceline, msg))
 
     def warn(path, msg, el):
-        warnings.append(str(Issue(file, path, el.sourceline, msg)))
+        warnings.append(LocatedWarning(Issue(file, path, el.sourceline, msg)))
 
     joints = {j.name: j for j in mech.joints}
     for el in root.findall("joint"):

@@ -46,7 +46,7 @@ from pathlib import Path
 import numpy as np
 from lxml import etree
 
-from ..errors import Collector, Issue, MechanismError, plural
+from ..errors import Collector, Issue, LocatedWarning, MechanismError, plural
 from ..model.mechanism import Joint, Link, Mechanism
 from ..model.validate import check_inertia
 from ..spatial import align_z, matrix_rpy
@@ -93,7 +93,7 @@ class _Reader(StructureChecks, Mimics, Extension, UrdfLoads):
 
     def warn(self, path: str, message: str, element=None) -> None:
         line = element.sourceline if element is not None else self.col.line_of(path)
-        self.warnings.append(str(Issue(self.file, path, line, message)))
+        self.warnings.append(LocatedWarning(Issue(self.file, path, line, message)))
 
     def vector(self, el, attr: str, path: str, n: int = 3, default=None):
         text = el.get(attr) if el is not None else None
