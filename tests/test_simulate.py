@@ -163,6 +163,8 @@ def test_loads_option_writes_what_solve_writes(run_cli, mech_dir, tmp_path):
     # within rounding of the first time: was an AttributeError traceback (issue 34, section 5)
     ("t,motor:motor3,motor:motor5\n0,1,1\n1,1,1\n", ("--t-end", "1e-12"), "--t-end: expected a time after"),
     ("t,motor:motor3,motor:motor5\n5,1,1\n6,1,1\n", ("--t-end", "5.000000000000001"), "--t-end: expected a time after"),
+    # scipy's own UserWarning (with a library path) reached stderr (issue 34, section 5)
+    ("t,motor:motor3,motor:motor5\n0,1,1\n1,1,1\n", ("--rtol", "1e-300"), "--rtol: expected at least 2.22e-14"),
 ])
 def test_bad_input_is_one_line_and_exit_2(run_cli, mech_dir, tmp_path, text, args, message):
     inp = write(tmp_path / "in.csv", text)
@@ -371,7 +373,10 @@ def test_a_stiff_motor_under_an_explicit_method_stalls_with_one_line(run_cli, tm
     inp = write(tmp_path / "in.csv", "t,voltage:servo\n0,12\n0.3,12\n")
     r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv")
     assert r.exit_code == 2 and not (tmp_path / "traj.csv").exists()
-    assert r.stderr == (f"{inp}: simulation stalled at t = 0 s: 5,000 evaluations of the dynamics without advancing "
+    assert r.stderr == (f"{inp}: warning: motor 'servo''s L/R gives a time constant of 5e-10 s, 6e+08 times shorter "
+                        "than the 0.3 s simulated: the system is stiff, RK45 will crawl or diverge; give --method Radau "
+                        "or BDF\n"         # said before the integration starts (issue 34, section 5)
+                        f"{inp}: simulation stalled at t = 0 s: 5,000 evaluations of the dynamics without advancing "
                         "3e-05 s: a motor's L/R of 5e-10 s makes the system stiff: give --method Radau or BDF "
                         "(nothing written)\n")
     r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv", "--method", "Radau")
@@ -490,3 +495,25 @@ def test_bad_urdf_motor_model_is_located(run_cli, tmp_path, element, message):
     r = run_cli("check", mech)
     assert r.exit_code == 2
     assert f"s.urdf:{line}: {message}" in r.stderr and len(r.stderr.strip().splitlines()) == 1
+
+
+def test_a_stiff_viscous_joint_is_named_before_an_explicit_method_diverges(run_cli, mech_dir, tmp_path):
+    """viscous: 1e9 N*m*s/rad on the shoulder: a time constant of J/F_v ~ 4e-10 s.  RK45 is
+    warned before it starts, and its divergence is said in gearcli's words (was numpy's
+    "Singular matrix"); Radau integrates it (issue 34, section 5)."""
+    text = (mech_dir / "paper_2dof.yaml").read_text()
+    dh = "    dh: {theta_deg: 0, d: 0.0, a: 0.4, alpha_deg: 0}\n"
+    assert text.count(dh) == 1
+    mech = write(tmp_path / "visc.yaml", text.replace(dh, dh + "    friction: {viscous: 1.0e9}\n"))
+    inp = write(tmp_path / "in.csv", "t,motor:motor3,motor:motor5\n0,0.1,0.2\n1,0.1,0.2\n")
+    r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv", "--t-end", "0.01")
+    assert r.exit_code == 2 and not (tmp_path / "traj.csv").exists()
+    warning, error = r.stderr.strip().splitlines()
+    assert re.fullmatch(rf"{re.escape(str(inp))}: warning: viscous friction 1e\+09 on joint 'J1' gives a time constant "
+                        r"of [0-9.]+e-10 s, .* the system is stiff, RK45 will crawl or diverge; give --method Radau or BDF",
+                        warning), warning
+    assert "the integration diverged" in error and "--method Radau or BDF" in error and "Singular" not in error
+    r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv", "--t-end", "0.01", "--method", "Radau")
+    assert r.exit_code == 0 and r.stderr == ""
+    tr = read_csv(tmp_path / "traj.csv")
+    assert np.abs(tr["qd:J1"]).max() < 1e-9          # held by the damper: F_v qd ~ 0.2 N*m at most

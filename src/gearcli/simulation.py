@@ -25,6 +25,10 @@ STALL_EVALUATIONS = 5_000    # evaluations of the dynamics without advancing STA
 STALL_FRACTION = 1e-4
 
 
+MIN_RTOL = 100 * np.finfo(float).eps
+"""The least --rtol: solve_ivp raises a smaller one to this, with a warning of its own."""
+
+
 class StallWatch:
     """Called with the time of every evaluation of the dynamics: raises GearcliError when
     :data:`STALL_EVALUATIONS` of them pass without the time reached advancing by
@@ -101,14 +105,16 @@ def state_option(text: str | None, an: Analysis, option: str) -> np.ndarray:
 def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None, q0: str | None = None,
                   qd0: str | None = None, dt: float = 1e-3, rtol: float = 1e-6, atol: float = 1e-9,
                   method: str = "RK45", loads_path=None, progress=None,
-                  analysis: Analysis | None = None) -> SimulateReport:
+                  analysis: Analysis | None = None, warn=None) -> SimulateReport:
     """``gearcli simulate``: integrate the mechanism under the motor torques or voltages of
     ``input_path`` (:mod:`gearcli.io.drive_input`) from its first time to ``t_end`` (default
     its last), writing the trajectory CSV ``out_path`` (``t, q:, qd:, qdd:`` every ``dt``
     seconds, 17 digits: what ``gearcli solve`` reads) atomically; with ``loads_path``,
     then the loads along it as ``gearcli solve`` writes them.  ``progress(total=..)`` once,
-    then ``progress(t=...)`` with the time reached."""
-    from .dynamics.simulate import METHODS, SimulationError, joint_limits, simulate  # noqa: PLC0415
+    then ``progress(t=...)`` with the time reached; ``warn(line)`` is told, before the
+    integration starts, when an explicit method meets a stiff system
+    (:func:`~gearcli.dynamics.simulate.stiffness_hint`)."""
+    from .dynamics.simulate import METHODS, SimulationError, joint_limits, simulate, stiffness_hint  # noqa: PLC0415
     from .io.drive_input import read_drive_input  # noqa: PLC0415
 
     inputs = (mech_path, input_path)
@@ -125,6 +131,9 @@ def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None
     for name, v in (("--rtol", rtol), ("--atol", atol), ("--dt", dt)):
         if not (math.isfinite(v) and v > 0):
             raise GearcliError(f"{name}: expected a positive number, got {v:g}")
+    if rtol < MIN_RTOL:
+        raise GearcliError(f"--rtol: expected at least {MIN_RTOL:.3g} (100 machine epsilons: the integrator can "
+                           f"meet no tighter relative tolerance), got {rtol:g}")
     an = analysis or load_analysed(mech_path)
     x0, v0 = state_option(q0, an, "--q0"), state_option(qd0, an, "--qd0")
     for ji, name, lo, hi in joint_limits(an):
@@ -140,6 +149,9 @@ def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None
     t_eval = t0 + dt * np.arange(int(math.floor((t1 - t0) / dt * (1 + 1e-12))) + 1)
     if t_eval[-1] < t1 - 1e-9 * min(dt, t1 - t0):     # (a --dt beyond the span: its two ends)
         t_eval = np.append(t_eval, t1)
+    hint = stiffness_hint(an, x0, t1 - t0, method)
+    if hint is not None and warn is not None:
+        warn(f"{input_path}: warning: {hint}")
     if progress is not None:
         progress(total=t1 - t0)
     try:
@@ -167,6 +179,7 @@ def simulate_with_progress(mech_path, input_path, out_path, console, analysis, t
 
     with time_progress("simulating", console) as tick:
         report = simulate_file(mech_path, input_path, out_path, t_end=t_end, q0=q0, qd0=qd0, dt=dt, rtol=rtol,
-                               atol=atol, method=method, loads_path=loads_path, progress=tick, analysis=analysis)
+                               atol=atol, method=method, loads_path=loads_path, progress=tick, analysis=analysis,
+                               warn=lambda line: console.print(line, markup=False, highlight=False, soft_wrap=True))
     stdout_console().print("\n".join(report.summary(str(out_path), loads_path)))
     return report

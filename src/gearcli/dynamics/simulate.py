@@ -47,6 +47,49 @@ class SimulationError(Exception):
     """The integrator failed (the message says why and when)."""
 
 
+EXPLICIT = ("RK45", "RK23", "DOP853")
+"""The explicit methods: their step is bounded by the fastest time constant (stiffness)."""
+
+
+def time_constants(an, q0: np.ndarray) -> list[tuple[str, float]]:
+    """The fast time constants of the motion from (q0, at rest), s: each inductive motor's
+    L/R, and the viscous friction's fastest decay, 1 / the largest eigenvalue of
+    M(q0)^-1 D, D = sum_J F_v,J s_J s_J^T over the joints with viscous friction (s_J the
+    joint's row of q = S q_ind), named after the joint whose own F_v s_J^T M^-1 s_J is
+    largest.  An explicit method needs steps below about these."""
+    from scipy.linalg import eigh  # noqa: PLC0415
+    from .forward import mass_matrix  # noqa: PLC0415
+
+    out = [(f"motor '{m.name}''s L/R", m.model.inductance / m.model.resistance) for m in an.mech.motors
+           if m.model is not None and m.model.inductance]
+    visc = [(ji, jt.friction.viscous) for ji, jt in enumerate(an.mech.joints)
+            if jt.friction is not None and jt.friction.viscous > 0]
+    if visc:
+        M = mass_matrix(an, np.asarray(q0, float)[None, :], backend="numpy")[0]
+        S = np.asarray(an.S, float)
+        D = sum(c * np.outer(S[ji], S[ji]) for ji, c in visc)
+        lam = float(eigh(D, M, eigvals_only=True)[-1])
+        if lam > 0:
+            own = [c * S[ji] @ np.linalg.solve(M, S[ji]) for ji, c in visc]
+            ji, c = visc[int(np.argmax(own))]
+            out.append((f"viscous friction {c:g} on joint '{an.mech.joints[ji].name}'", 1.0 / lam))
+    return out
+
+
+def stiffness_hint(an, q0: np.ndarray, span: float, method: str) -> str | None:
+    """What makes the system stiff for an explicit ``method`` over ``span`` (s): the fastest
+    :func:`time_constants` when it is below 1e-5 of the span (the method then takes at
+    least ~1e5 steps), else None."""
+    if method not in EXPLICIT:
+        return None
+    fast = [(what, tau) for what, tau in time_constants(an, q0) if tau < 1e-5 * span]
+    if not fast:
+        return None
+    what, tau = min(fast, key=lambda f: f[1])
+    return (f"{what} gives a time constant of {tau:.3g} s, {span / tau:.3g} times shorter than the {span:.6g} s "
+            f"simulated: the system is stiff, {method} will crawl or diverge; give --method Radau or BDF")
+
+
 def joint_limits(an) -> list[tuple[int, str, float, float]]:
     """(joint index, name, lower, upper) of every real joint with position limits
     (``joints[].limits`` of a YAML file, a URDF ``<limit lower upper>`` on a revolute or
@@ -91,6 +134,11 @@ def _accelerations(an, q, qd, T, backend, t):
     acceleration with losses that does not settle) a :class:`SimulationError` at time(s) t."""
     try:
         return forward_dynamics(an, q, qd, T, backend=backend)
+    except np.linalg.LinAlgError:       # M from tau differences at an exploded state
+        when = f"t = {t:.9g} s" if np.ndim(t) == 0 else f"t = {t[0]:.9g} to {t[-1]:.9g} s"
+        raise SimulationError(f"{when}: the integration diverged (joint rates up to {np.abs(qd).max():.3g}: the mass "
+                              "matrix is singular to working precision there); a stiff system needs --method Radau "
+                              "or BDF") from None
     except ValueError as exc:
         when = f"t = {t:.9g} s" if np.ndim(t) == 0 else f"t = {t[0]:.9g} to {t[-1]:.9g} s"
         raise SimulationError(f"{when}: {exc}") from None
