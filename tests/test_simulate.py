@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -517,3 +518,21 @@ def test_a_stiff_viscous_joint_is_named_before_an_explicit_method_diverges(run_c
     assert r.exit_code == 0 and r.stderr == ""
     tr = read_csv(tmp_path / "traj.csv")
     assert np.abs(tr["qd:J1"]).max() < 1e-9          # held by the damper: F_v qd ~ 0.2 N*m at most
+
+
+def test_bearing_friction_that_fails_inside_simulate_names_the_time(run_cli, tmp_path):
+    """A bearing friction that does not converge (mu 0.95 on a 120 mm bore under the wheel)
+    stops simulate at the time it happens, not at "sample 0" of the evaluation (issue 34,
+    section 5)."""
+    from test_loss_cli import SPUR
+    jw = "  - {name: Jw, parent: frame, child: wheel, origin: {xyz: [0.075, 0, 0]}, axis: [0, 0, 1]}"
+    assert SPUR.count(jw) == 1
+    mech = write(tmp_path / "lock.yaml", SPUR.replace(jw, (
+        "  - name: Jw\n    parent: frame\n    child: wheel\n    origin: {xyz: [0.075, 0, 0]}\n    axis: [0, 0, 1]\n"
+        "    bearings:\n      - {name: w, position: 0.0, friction_coefficient: 0.95, bore: 0.12}")))
+    inp = write(tmp_path / "in.csv", "t,motor:motor\n0,1\n1,1\n")
+    r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv", "--qd0", "1")
+    assert r.exit_code == 2
+    assert re.fullmatch(rf"{re.escape(str(inp))}: simulation failed: t = [0-9.e-]+ s: the bearing friction moments of "
+                        r"joint '(Jp|Jw)' did not converge .*", r.stderr.strip()), r.stderr
+    assert "sample 0" not in r.stderr

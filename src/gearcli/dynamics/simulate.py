@@ -132,8 +132,13 @@ class Drive:
 def _accelerations(an, q, qd, T, backend, t):
     """:func:`~.forward.forward_dynamics`, its ValueError (a state that is not finite, an
     acceleration with losses that does not settle) a :class:`SimulationError` at time(s) t."""
+    from .bearing_friction import BearingFrictionError  # noqa: PLC0415
+    from .signs import SignError                        # noqa: PLC0415
     try:
         return forward_dynamics(an, q, qd, T, backend=backend)
+    except (SignError, BearingFrictionError) as exc:     # its "sample i" counts this call's states
+        at = t if np.ndim(t) == 0 else t[min(exc.sample, len(t) - 1)]
+        raise SimulationError(f"t = {at:.9g} s: {exc.lines()[0].removeprefix(f'sample {exc.sample}: ')}") from None
     except np.linalg.LinAlgError:       # M from tau differences at an exploded state
         when = f"t = {t:.9g} s" if np.ndim(t) == 0 else f"t = {t[0]:.9g} to {t[-1]:.9g} s"
         raise SimulationError(f"{when}: the integration diverged (joint rates up to {np.abs(qd).max():.3g}: the mass "
