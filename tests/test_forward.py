@@ -373,3 +373,26 @@ def test_reused_result_arrays_never_leak_into_returned_values():
     mass_matrix(an, q[::-1])
     assert np.array_equal(first, kept[0]) and np.array_equal(M, kept[1])
     assert np.array_equal(second, other[0]) and np.array_equal(second, first[::-1])
+
+
+@pytest.mark.parametrize("mu", [0.5, 0.8])
+def test_forward_dynamics_with_slow_bearing_friction_settles_the_same_on_both_backends(monkeypatch, mu):
+    """Bearing friction of mu on a 120 mm bore under the wheel of a spur pair: the lossless
+    M makes a correction step contract by only ~Lambda (0.5-0.85), so 60 steps did not settle
+    and each backend failed at its own sample (the result depended on the kernel cache:
+    issue 34, section 5).  Newton steps with the lossy Jacobian settle both, to the same
+    accelerations, which solve turns back into the torques."""
+    from test_loss_cli import SPUR
+    jw = "  - {name: Jw, parent: frame, child: wheel, origin: {xyz: [0.075, 0, 0]}, axis: [0, 0, 1]}"
+    an = analyse(parse_mechanism(SPUR.replace(jw, (
+        "  - name: Jw\n    parent: frame\n    child: wheel\n    origin: {xyz: [0.075, 0, 0]}\n    axis: [0, 0, 1]\n"
+        f"    bearings:\n      - {{name: w, position: 0.0, friction_coefficient: {mu}, bore: 0.12}}")), "spur.yaml"))
+    rng = np.random.default_rng(0)
+    q, qd, T = rng.uniform(-3, 3, (50, 1)), rng.normal(size=(50, 1)) * 5, rng.normal(size=(50, 1)) * 0.5
+    acc = {b: forward_dynamics(an, q, qd, T, backend=b) for b in ("numpy", "llvm")}
+    assert rel_err(acc["numpy"], acc["llvm"]) < 1e-10
+    for b in ("numpy", "llvm"):
+        assert np.abs(gearcli.solve(an, q, qd, acc[b], backend=b).motor - T).max() < 1e-10 * np.abs(T).max()
+    monkeypatch.setattr(forward, "SECANT_STEPS", forward.MAX_STEPS)      # the lossless M alone: no settling
+    with pytest.raises(ValueError, match="did not settle"):
+        forward_dynamics(an, q, qd, T, backend="numpy")

@@ -74,6 +74,9 @@ STALLED = 1e-10
 step no longer reduces it (the solve's rounding reached before :data:`TOLERANCE`)."""
 MAX_STEPS = 60
 """With losses: the most correction steps of :func:`forward_dynamics`."""
+SECANT_STEPS = 8
+"""With losses: the correction steps taken with the lossless M; a sample still not settled
+then takes Newton steps with the lossy Jacobian (:func:`_lossy_jacobian`, dof + 1 solves)."""
 
 
 def _stacked_chunks(an, q, qd, loads, backend, jobs):
@@ -195,7 +198,8 @@ def _implicit(an, q, qd, target, M, h, qdd, loads, backend, jobs) -> np.ndarray:
     """qdd with tau(q, qd, qdd) = target (N, dof) for a mechanism with losses, where tau is
     piecewise linear in qdd (|t| of the mesh friction): from ``qdd``, the secant solution
     M qdd = target - h, steps qdd -= M^-1 (tau(qdd) - target) on the samples not yet settled
-    (one solve of those samples a step; linear convergence, 10-20 steps with c = 0.03).
+    (one solve of those samples a step; linear convergence, 10-20 steps with c = 0.03), and
+    after :data:`SECANT_STEPS` of them Newton steps with the lossy Jacobian.
 
     A sample settles when its residual is within :data:`TOLERANCE` of its torque scale, the
     largest of |target|, |h| and |M| (the torques of unit accelerations: a sample near a
@@ -208,19 +212,37 @@ def _implicit(an, q, qd, target, M, h, qdd, loads, backend, jobs) -> np.ndarray:
                        np.abs(M).max(axis=(1, 2)))
     todo = np.arange(len(q))
     last = np.full(len(q), np.inf)
-    for _ in range(MAX_STEPS):
-        res = solve(an, q[todo], qd[todo], qdd[todo], loads={k: v[todo] for k, v in values.items()},
-                    backend=backend, jobs=jobs, check_finite=False)
-        r = res.tau - target[todo]
+
+    def tau(rows, acc):
+        return solve(an, q[rows], qd[rows], acc, loads={k: v[rows] for k, v in values.items()},
+                     backend=backend, jobs=jobs, check_finite=False).tau
+
+    for step in range(MAX_STEPS):
+        r = tau(todo, qdd[todo]) - target[todo]
         size = np.abs(r).max(axis=1)
         done = (size <= TOLERANCE * scale[todo]) | ((size >= last[todo]) & (size <= STALLED * scale[todo]))
         last[todo] = size
         todo, r = todo[~done], r[~done]
         if todo.size == 0:
             return qdd
-        qdd[todo] -= np.linalg.solve(M[todo], r[:, :, None])[:, :, 0]
+        J = M[todo] if step < SECANT_STEPS else _lossy_jacobian(tau, todo, qdd[todo], r + target[todo])
+        qdd[todo] -= np.linalg.solve(J, r[:, :, None])[:, :, 0]
     raise ValueError(f"forward dynamics with losses did not settle at sample {todo[0]} in {MAX_STEPS} steps "
                      "(no unique acceleration: a self-locking transmission?)")
+
+
+def _lossy_jacobian(tau, rows, qdd: np.ndarray, tau0: np.ndarray) -> np.ndarray:
+    """d tau / d qdd (n, dof, dof) of the samples ``rows`` at ``qdd`` (their torques
+    ``tau0``), by differences over a step of max(1, 1e-3 |qdd|) per sample: exact where the
+    friction's sign pattern holds across it (tau is piecewise linear in qdd), and the slope
+    of the losses that the lossless M leaves out (bearing friction of large mu d / lever
+    converges at ~Lambda a step with M: it stopped at MAX_STEPS, both backends at their own
+    sample)."""
+    n, dof = qdd.shape
+    delta = np.maximum(1.0, 1e-3 * np.abs(qdd).max(axis=1))
+    shifted = np.repeat(qdd, dof, axis=0) + (np.tile(np.eye(dof), (n, 1)) * np.repeat(delta, dof)[:, None])
+    cols = tau(np.repeat(rows, dof), shifted).reshape(n, dof, dof)      # [sample, column i, tau]
+    return np.transpose(cols - tau0[:, None, :], (0, 2, 1)) / delta[:, None, None]
 
 
 def motor_inertia(an, q, diagonal: bool = False, backend: str = "auto", jobs: int | None = None) -> np.ndarray:
