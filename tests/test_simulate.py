@@ -536,3 +536,33 @@ def test_bearing_friction_that_fails_inside_simulate_names_the_time(run_cli, tmp
     assert re.fullmatch(rf"{re.escape(str(inp))}: simulation failed: t = [0-9.e-]+ s: the bearing friction moments of "
                         r"joint '(Jp|Jw)' did not converge .*", r.stderr.strip()), r.stderr
     assert "sample 0" not in r.stderr
+
+
+def test_a_tabulated_torque_is_integrated_row_interval_by_row_interval(run_cli, tmp_path):
+    """A torque linear between rows whose slope jumps at each row: the disc's acceleration
+    is piecewise linear, its angle piecewise cubic, which RK45 integrates exactly within a
+    row interval.  Restarting at every row (issue 34, section 7) gives the closed form to
+    rounding at any --rtol; integrating across the rows, the error did not follow --rtol."""
+    rows = np.array([0.0, 0.13, 0.4, 0.71, 1.0])
+    T = np.array([0.0, 0.02, -0.01, 0.03, 0.0])
+    mech = write(tmp_path / "stage.yaml", spur_stage_yaml())
+    inp = write(tmp_path / "in.csv", "t,motor:servo\n" + "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(rows, T)))
+    a = -T / J_EFF / N_RATIO                     # the disc's acceleration at the rows (external stage)
+    # closed form: per row interval, qdd linear, qd quadratic, q cubic from the interval's start
+    t = np.linspace(0.0, 1.0, 1001)
+    k = np.clip(np.searchsorted(rows, t, side="right") - 1, 0, len(rows) - 2)
+    h = np.diff(rows)
+    v0, q0 = np.zeros(len(rows)), np.zeros(len(rows))
+    for i in range(len(rows) - 1):
+        v0[i + 1] = v0[i] + h[i] * (a[i] + a[i + 1]) / 2
+        q0[i + 1] = q0[i] + v0[i] * h[i] + h[i] ** 2 * (2 * a[i] + a[i + 1]) / 6
+    s = t - rows[k]
+    slope = (a[k + 1] - a[k]) / h[k]
+    q_exact = q0[k] + v0[k] * s + a[k] * s ** 2 / 2 + slope * s ** 3 / 6
+    scale = np.abs(q_exact).max()
+    for rtol in ("1e-4", "1e-6", "1e-9"):
+        r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv", "--rtol", rtol, "--atol", "1e-12")
+        assert r.exit_code == 0, r.stderr
+        tr = read_csv(tmp_path / "traj.csv")
+        assert np.allclose(tr["t"], t, rtol=0, atol=1e-15)
+        assert np.abs(tr["q:Jd"] - q_exact).max() < 1e-12 * scale, rtol

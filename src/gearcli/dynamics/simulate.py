@@ -10,7 +10,8 @@ model has an inductance, its winding current i (A, starting at 0).  The motor to
   the motor's speed relative to its stator (rad/s).
 
 The accelerations are :func:`~.forward.forward_dynamics` (exact, every gear and rotor),
-integrated by :func:`scipy.integrate.solve_ivp`.  Joints with position limits (YAML
+integrated by :func:`scipy.integrate.solve_ivp` row interval by row interval of the input
+(:func:`row_intervals`: its values are linear between rows, their slope may jump at one).  Joints with position limits (YAML
 ``joints[].limits``, a URDF ``<limit lower upper>``) stop the integration when they reach
 one (a terminal event); the stop is reported, with the samples up to it.
 """
@@ -181,19 +182,39 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
             ev.terminal, ev.direction = True, -1.0
             ev.joint = (name, side, bound)
             events.append(ev)
-    x0 = np.concatenate([q0, qd0, np.zeros(nL)])
-    sol = solve_ivp(rhs, (t_eval[0], t_eval[-1]), x0, method=method, t_eval=t_eval, rtol=rtol, atol=atol,
-                    events=events or None)
-    if sol.status == -1:
-        raise SimulationError(f"the integrator failed at t = {sol.t[-1] if len(sol.t) else t_eval[0]:.9g} s: {sol.message}")
-    t, x, stop = sol.t, sol.y.T, None
-    if sol.status == 1:
-        k = next(i for i, te in enumerate(sol.t_events) if len(te))
-        name, side, bound = events[k].joint
-        te = float(sol.t_events[k][0])
-        stop = f"joint '{name}' reached its {side} limit {bound:g} at t = {te:.6g} s"
-        t, x = np.append(t[t < te], te), np.vstack([x[t < te], sol.y_events[k][:1]])
+    x = np.concatenate([q0, qd0, np.zeros(nL)])
+    ts, xs, stop, nfev = [], [], None, 0
+    for a, b in row_intervals(drive.t, t_eval[0], t_eval[-1]):
+        wanted = t_eval[(t_eval > a) & (t_eval <= b)] if ts else t_eval[(t_eval >= a) & (t_eval <= b)]
+        at = np.union1d(wanted, [b])                          # b: the next interval's start
+        sol = solve_ivp(rhs, (a, b), x, method=method, t_eval=at, rtol=rtol, atol=atol, events=events or None)
+        nfev += int(sol.nfev)
+        if sol.status == -1:
+            raise SimulationError(f"the integrator failed at t = {sol.t[-1] if len(sol.t) else a:.9g} s: {sol.message}")
+        keep = np.isin(sol.t, wanted)
+        t, y = sol.t[keep], sol.y.T[keep]
+        if sol.status == 1:
+            k = next(i for i, te in enumerate(sol.t_events) if len(te))
+            name, side, bound = events[k].joint
+            te = float(sol.t_events[k][0])
+            stop = f"joint '{name}' reached its {side} limit {bound:g} at t = {te:.6g} s"
+            ts.append(np.append(t[t < te], te))
+            xs.append(np.vstack([y[t < te], sol.y_events[k][:1]]))
+            break
+        ts.append(t)
+        xs.append(y)
+        x = sol.y[:, -1]
+    t, x = np.concatenate(ts), np.concatenate(xs)
     q, qd, cur = x[:, :dof], x[:, dof:2 * dof], x[:, 2 * dof:]
     T, current = d.torques(t, qd, cur)
     qdd = _accelerations(an, q, qd, T, backend, t)
-    return Simulation(t, q, qd, qdd, T, current, stop, int(sol.nfev))
+    return Simulation(t, q, qd, qdd, T, current, stop, nfev)
+
+
+def row_intervals(rows: np.ndarray, t0: float, t1: float) -> list[tuple[float, float]]:
+    """The intervals [a, b] between the input's rows ``rows`` (s) that cover [t0, t1]: the
+    integration restarts at every row, where the input's slope may jump (across a kink an
+    integrator's error estimate fails, and its error stops following --rtol)."""
+    inner = rows[(rows > t0) & (rows < t1)]
+    edges = np.concatenate([[t0], inner, [t1]])
+    return [(float(a), float(b)) for a, b in zip(edges[:-1], edges[1:]) if b > a]
