@@ -47,15 +47,15 @@ class StallWatch:
         if t >= self.mark + self.step:
             self.mark, self.n_mark = t, self.n
         elif self.n - self.n_mark > STALL_EVALUATIONS:
-            raise GearcliError(f"{self.input_path}: simulation stalled at t = {self.mark:.6g} s: {STALL_EVALUATIONS:,} "
-                               f"evaluations of the dynamics without advancing {self.step:.3g} s{self.hint()} "
-                               "(nothing written)")
+            from .dynamics.simulate import StallError  # noqa: PLC0415
+            raise StallError(f"simulation stalled at t = {self.mark:.6g} s: {STALL_EVALUATIONS:,} evaluations "
+                                  f"of the dynamics without advancing {self.step:.3g} s{self.hint()}", self.mark)
         if self.progress is not None:
             self.progress(t)
 
     def hint(self) -> str:
-        hints = ["a joint's rate reverses at 0 where its friction holds the mechanism (gearcli models no stiction: "
-                 "README, Losses)"] if self.an.mech.has_losses else []
+        hints = ["a gear's rate reverses at 0 where its mesh or bearing friction would hold it (they hold nothing "
+                 "at rest: README, Losses)"] if self.an.mech.has_losses else []
         tau = [m.model.inductance / m.model.resistance for m in self.an.mech.motors
                if m.model is not None and m.model.inductance]
         if self.method in ("RK45", "RK23", "DOP853") and (tau or not hints):
@@ -114,7 +114,8 @@ def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None
     then ``progress(t=...)`` with the time reached; ``warn(line)`` is told, before the
     integration starts, when an explicit method meets a stiff system
     (:func:`~gearcli.dynamics.simulate.stiffness_hint`)."""
-    from .dynamics.simulate import METHODS, SimulationError, joint_limits, simulate, stiffness_hint  # noqa: PLC0415
+    from .dynamics.simulate import (METHODS, SimulationError, StallError, joint_limits,  # noqa: PLC0415
+                                    simulate, stiffness_hint)
     from .io.drive_input import read_drive_input  # noqa: PLC0415
 
     inputs = (mech_path, input_path)
@@ -157,8 +158,9 @@ def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None
     try:
         sim = simulate(an, drive, t_eval, x0, v0, rtol=rtol, atol=atol, method=method, progress=StallWatch(
             an, input_path, t0, t1, method, None if progress is None else (lambda t: progress(t=t - t0))))
-    except SimulationError as exc:
-        raise GearcliError(f"{input_path}: simulation failed: {exc} (nothing written)") from None
+    except SimulationError as exc:       # before any sample: nothing to write
+        said = str(exc) if isinstance(exc, StallError) else f"simulation failed: {exc}"
+        raise GearcliError(f"{input_path}: {said} (nothing written)") from None
     names = an.independent_names
     header = ",".join(["t"] + [f"{p}:{n}" for p in ("q", "qd", "qdd") for n in names])
     with atomic_output(out_path, inputs) as f:

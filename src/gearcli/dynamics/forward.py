@@ -194,6 +194,41 @@ def forward_dynamics(an, q, qd, motor_torques, loads: dict | None = None, backen
     return _implicit(an, q, qd, target, M, h, qdd, loads, backend, jobs) if an.mech.has_losses else qdd
 
 
+def held_dynamics(an, q, qd, motor_torques, C: np.ndarray, extra: np.ndarray | None = None,
+                  backend: str = "auto") -> tuple[np.ndarray, np.ndarray]:
+    """(qdd (N, dof), Q (N, k)): the accelerations of the independent joints with k joints
+    held at rest by friction, and the generalised friction forces Q that hold them.
+
+    ``C`` (k, dof): each held joint's row of q = S q_ind, so its rate is C qd (0) and its
+    acceleration C qdd = 0; its friction Q acts on the independent joints as C^T Q (N*m or
+    N, on the joint's child about (along) its axis, as ``joints[].friction``'s).
+    ``extra`` (N, dof): generalised forces added to the motors' A T (the explicit Coulomb
+    friction of slipping joints, :mod:`.simulate`).  Solves M qdd + h = A T + extra + C^T Q,
+    C qdd = 0, per sample (with losses, tau(qdd) for M qdd + h, as :func:`forward_dynamics`)."""
+    q, qd, T = (np.atleast_2d(np.asarray(v, float)) for v in (q, qd, motor_torques))
+    target = np.einsum("nm,dm->nd", T, an.A) + (0.0 if extra is None else extra)
+    M, h, qdd = _mass_and_h(an, q, qd, target, None, backend, None)
+    C = np.asarray(C, float).reshape(-1, an.dof)
+    k = C.shape[0]
+    Q = np.zeros((len(q), k))
+    if k:
+        sol = np.linalg.solve(_kkt(M, C), np.concatenate([target - h, np.zeros((len(q), k))], axis=1)[:, :, None])
+        qdd, Q = sol[:, :an.dof, 0], sol[:, an.dof:, 0]
+    if an.mech.has_losses:
+        qdd, Q = _settle(an, q, qd, target, M, h, qdd, Q, C, None, backend, None)
+    return qdd, Q
+
+
+def _kkt(J: np.ndarray, C: np.ndarray) -> np.ndarray:
+    """[[J, -C^T], [C, 0]] (N, dof + k, dof + k) of the held dynamics (:func:`held_dynamics`)."""
+    n, dof, k = J.shape[0], J.shape[1], C.shape[0]
+    K = np.zeros((n, dof + k, dof + k))
+    K[:, :dof, :dof] = J
+    K[:, :dof, dof:] = -C.T
+    K[:, dof:, :dof] = C
+    return K
+
+
 def _implicit(an, q, qd, target, M, h, qdd, loads, backend, jobs) -> np.ndarray:
     """qdd with tau(q, qd, qdd) = target (N, dof) for a mechanism with losses, where tau is
     piecewise linear in qdd (|t| of the mesh friction): from ``qdd``, the secant solution
@@ -207,26 +242,40 @@ def _implicit(an, q, qd, target, M, h, qdd, loads, backend, jobs) -> np.ndarray:
     rounds to them), or when a step no longer reduces a residual already within
     :data:`STALLED` of that scale (rounding reached).  ValueError naming the first sample
     that does not settle in :data:`MAX_STEPS` (e.g. a self-locking transmission)."""
+    return _settle(an, q, qd, target, M, h, qdd, np.zeros((len(q), 0)), np.zeros((0, an.dof)), loads, backend,
+                   jobs)[0]
+
+
+def _settle(an, q, qd, target, M, h, qdd, Q, C, loads, backend, jobs) -> tuple[np.ndarray, np.ndarray]:
+    """(qdd, Q) with tau(q, qd, qdd) = target + C^T Q and C qdd = 0 (no held joint: k = 0,
+    :func:`_implicit`), from the secant solution: steps with the lossless M, then Newton
+    steps with the lossy Jacobian, each solving [[J, -C^T], [C, 0]] (d qdd, d Q) = (r, 0)."""
     values = load_values(an.mech, len(q), loads)
     scale = np.maximum(np.maximum(np.abs(target).max(axis=1), np.abs(h).max(axis=1)),
                        np.abs(M).max(axis=(1, 2)))
     todo = np.arange(len(q))
     last = np.full(len(q), np.inf)
+    dof, k = an.dof, C.shape[0]
 
     def tau(rows, acc):
-        return solve(an, q[rows], qd[rows], acc, loads={k: v[rows] for k, v in values.items()},
+        return solve(an, q[rows], qd[rows], acc, loads={key: v[rows] for key, v in values.items()},
                      backend=backend, jobs=jobs, check_finite=False).tau
 
     for step in range(MAX_STEPS):
-        r = tau(todo, qdd[todo]) - target[todo]
+        r = tau(todo, qdd[todo]) - target[todo] - Q[todo] @ C
         size = np.abs(r).max(axis=1)
         done = (size <= TOLERANCE * scale[todo]) | ((size >= last[todo]) & (size <= STALLED * scale[todo]))
         last[todo] = size
         todo, r = todo[~done], r[~done]
         if todo.size == 0:
-            return qdd
-        J = M[todo] if step < SECANT_STEPS else _lossy_jacobian(tau, todo, qdd[todo], r + target[todo])
-        qdd[todo] -= np.linalg.solve(J, r[:, :, None])[:, :, 0]
+            return qdd, Q
+        J = M[todo] if step < SECANT_STEPS else _lossy_jacobian(tau, todo, qdd[todo], r + target[todo] + Q[todo] @ C)
+        if k == 0:
+            qdd[todo] -= np.linalg.solve(J, r[:, :, None])[:, :, 0]
+        else:
+            d = np.linalg.solve(_kkt(J, C), np.concatenate([r, np.zeros((len(todo), k))], axis=1)[:, :, None])[:, :, 0]
+            qdd[todo] -= d[:, :dof]
+            Q[todo] -= d[:, dof:]
     raise ValueError(f"forward dynamics with losses did not settle at sample {todo[0]} in {MAX_STEPS} steps "
                      "(no unique acceleration: a self-locking transmission?)")
 

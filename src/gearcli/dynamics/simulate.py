@@ -21,7 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .forward import forward_dynamics
+
+from .stick_slip import Mode, StickSlip
 
 METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 
@@ -45,7 +46,15 @@ class Simulation:
 
 
 class SimulationError(Exception):
-    """The integrator failed (the message says why and when)."""
+    """The integrator failed (the message says why and when; ``t``: when, s)."""
+
+    def __init__(self, message: str, t: float | None = None):
+        super().__init__(message)
+        self.t = t
+
+
+class StallError(SimulationError):
+    """The integrator's step collapsed (``gearcli.simulation.StallWatch``)."""
 
 
 EXPLICIT = ("RK45", "RK23", "DOP853")
@@ -130,24 +139,27 @@ class Drive:
         return (u - self.R[k] * current - self.kt[k] * w) / self.L
 
 
-def _accelerations(an, q, qd, T, backend, t):
-    """:func:`~.forward.forward_dynamics`, its ValueError (a state that is not finite, an
-    acceleration with losses that does not settle) a :class:`SimulationError` at time(s) t."""
+def _accelerations(ss, mode, q, qd, T, backend, t):
+    """(qdd, Q) of :meth:`.stick_slip.StickSlip.accelerations` (the held dynamics of the
+    mode); its failures a :class:`SimulationError` at time(s) t: a value that is not finite,
+    an acceleration with losses that does not settle, a sign search or bearing friction
+    that fails (named by its time), an integration that diverged."""
     from .bearing_friction import BearingFrictionError  # noqa: PLC0415
     from .signs import SignError                        # noqa: PLC0415
+    when = f"t = {t:.9g} s" if np.ndim(t) == 0 else f"t = {t[0]:.9g} to {t[-1]:.9g} s"
+    first = float(t) if np.ndim(t) == 0 else float(t[0])
     try:
-        return forward_dynamics(an, q, qd, T, backend=backend)
+        return ss.accelerations(mode, np.atleast_2d(q), np.atleast_2d(qd), np.atleast_2d(T), backend)
     except (SignError, BearingFrictionError) as exc:     # its "sample i" counts this call's states
         at = t if np.ndim(t) == 0 else t[min(exc.sample, len(t) - 1)]
-        raise SimulationError(f"t = {at:.9g} s: {exc.lines()[0].removeprefix(f'sample {exc.sample}: ')}") from None
+        raise SimulationError(f"t = {at:.9g} s: {exc.lines()[0].removeprefix(f'sample {exc.sample}: ')}",
+                              float(at)) from None
     except np.linalg.LinAlgError:       # M from tau differences at an exploded state
-        when = f"t = {t:.9g} s" if np.ndim(t) == 0 else f"t = {t[0]:.9g} to {t[-1]:.9g} s"
         raise SimulationError(f"{when}: the integration diverged (joint rates up to {np.abs(qd).max():.3g}: the mass "
                               "matrix is singular to working precision there); a stiff system needs --method Radau "
-                              "or BDF") from None
+                              "or BDF", first) from None
     except ValueError as exc:
-        when = f"t = {t:.9g} s" if np.ndim(t) == 0 else f"t = {t[0]:.9g} to {t[-1]:.9g} s"
-        raise SimulationError(f"{when}: {exc}") from None
+        raise SimulationError(f"{when}: {exc}", first) from None
 
 
 def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10, method: str = "DOP853",
@@ -164,16 +176,28 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
     dof = an.dof
     d = Drive(an, drive)
     nL = int(d.inductive.sum())
+    ss = StickSlip(an)
+    state = {"mode": Mode(), "memo": (None, None, None)}
 
-    def rhs(t, x):
+    def dynamics(t, x):
+        """(qdd, Q) at (t, x) in the current mode; the last one kept for the events."""
+        key = (t, x.tobytes())
+        if state["memo"][0] == key:
+            return state["memo"][1:]
         q, qd, cur = x[:dof], x[dof:2 * dof], x[2 * dof:]
         T, _ = d.torques(t, qd, cur)
-        qdd = _accelerations(an, q, qd, T, backend, t)[0]
+        qdd, Q = _accelerations(ss, state["mode"], q, qd, T, backend, t)
+        state["memo"] = (key, qdd[0], Q[0])
+        return qdd[0], Q[0]
+
+    def rhs(t, x):
+        qdd = dynamics(t, x)[0]
         if progress is not None:
             progress(t)
+        qd, cur = x[dof:2 * dof], x[2 * dof:]
         return np.concatenate([qd, qdd, d.current_rate(t, qd, cur)]) if nL else np.concatenate([qd, qdd])
 
-    events = []
+    limits = []
     for ji, name, lo, hi in joint_limits(an):
         row = an.S[ji]
         for side, bound in (("lower", lo), ("upper", hi)):
@@ -181,33 +205,113 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
             ev = (lambda t, x, row=row, b=bound, s=sign: s * (row @ x[:dof] - b))
             ev.terminal, ev.direction = True, -1.0
             ev.joint = (name, side, bound)
-            events.append(ev)
+            limits.append(ev)
     x = np.concatenate([q0, qd0, np.zeros(nL)])
-    ts, xs, stop, nfev = [], [], None, 0
-    for a, b in row_intervals(drive.t, t_eval[0], t_eval[-1]):
-        wanted = t_eval[(t_eval > a) & (t_eval <= b)] if ts else t_eval[(t_eval >= a) & (t_eval <= b)]
-        at = np.union1d(wanted, [b])                          # b: the next interval's start
+    segments, stop, nfev = [], None, 0
+    if ss.units:                  # joints at rest at the start: held where their friction can
+        at_rest = [k for k in range(len(ss.units)) if ss.rate(k, x[dof:2 * dof]) == 0.0]
+        state["mode"], x[dof:2 * dof] = _switch(ss, Mode(), at_rest, x, d, t_eval[0], dof, backend)
+    try:
+        for a, b in row_intervals(drive.t, t_eval[0], t_eval[-1]):
+            while True:
+                first = not segments
+                wanted = t_eval[(t_eval >= a) & (t_eval <= b)] if first else t_eval[(t_eval > a) & (t_eval <= b)]
+                switches = ss.events(state["mode"], x[dof:2 * dof], dof, lambda t, y: dynamics(t, y)[1])
+                events = limits + switches
+                sol = _integrate(solve_ivp, rhs, a, b, x, wanted, method, rtol, atol, events, segments, state["mode"])
+                nfev += int(sol.nfev)
+                if sol.status != 1:
+                    x = sol.y[:, -1]
+                    break
+                k = next(i for i, te in enumerate(sol.t_events) if len(te))
+                te, xe = float(sol.t_events[k][0]), sol.y_events[k][0].copy()
+                _keep(segments, sol, wanted[wanted < te], state["mode"])
+                if hasattr(events[k], "joint"):
+                    name, side, bound = events[k].joint
+                    stop = f"joint '{name}' reached its {side} limit {bound:g} at t = {te:.6g} s"
+                    segments.append((np.array([te]), xe[None, :], state["mode"]))
+                    raise _Stopped()
+                ji, kind = events[k].switch
+                mode = state["mode"]
+                if kind == "stick":
+                    state["mode"], xe[dof:2 * dof] = _switch(ss, mode, [ji], xe, d, te, dof, backend)
+                else:
+                    Q = dynamics(te, xe)[1][mode.stuck.index(ji)]
+                    released = Mode(tuple(j for j in mode.stuck if j != ji), {**mode.start, ji: -np.sign(Q) or 1.0})
+                    state["mode"], xe[dof:2 * dof] = _switch(ss, released, [], xe, d, te, dof, backend)
+                state["memo"] = (None, None, None)
+                x, a = xe, te
+                if a >= b:
+                    break
+    except _Stopped:
+        pass
+    except SimulationError as exc:       # the motion up to the failure is kept (and written)
+        if not segments:
+            raise
+        stop = str(exc)
+    return _samples(ss, d, segments, stop, nfev, dof, backend)
+
+
+class _Stopped(Exception):
+    """A joint limit ended the integration."""
+
+
+def _integrate(solve_ivp, rhs, a, b, x, wanted, method, rtol, atol, events, segments, mode):
+    """solve_ivp over [a, b] from x with samples ``wanted`` (and b, the next start); the
+    samples up to b kept in ``segments`` (when no event ends it).  On a failure, the
+    samples before it (integrated again up to the last of them) are kept, then the
+    SimulationError (``t``: when) goes on."""
+    at = np.union1d(wanted, [b])
+    try:
         sol = solve_ivp(rhs, (a, b), x, method=method, t_eval=at, rtol=rtol, atol=atol, events=events or None)
-        nfev += int(sol.nfev)
-        if sol.status == -1:
-            raise SimulationError(f"the integrator failed at t = {sol.t[-1] if len(sol.t) else a:.9g} s: {sol.message}")
-        keep = np.isin(sol.t, wanted)
-        t, y = sol.t[keep], sol.y.T[keep]
-        if sol.status == 1:
-            k = next(i for i, te in enumerate(sol.t_events) if len(te))
-            name, side, bound = events[k].joint
-            te = float(sol.t_events[k][0])
-            stop = f"joint '{name}' reached its {side} limit {bound:g} at t = {te:.6g} s"
-            ts.append(np.append(t[t < te], te))
-            xs.append(np.vstack([y[t < te], sol.y_events[k][:1]]))
-            break
-        ts.append(t)
-        xs.append(y)
-        x = sol.y[:, -1]
-    t, x = np.concatenate(ts), np.concatenate(xs)
+    except SimulationError as exc:
+        before = wanted[wanted < (exc.t if exc.t is not None else a)]
+        if before.size == 1 and before[0] == a:       # the start alone: its state is x
+            segments.append((before, x[None, :].copy(), mode))
+        elif before.size:
+            try:
+                again = solve_ivp(rhs, (a, float(before[-1])), x, method=method, t_eval=before, rtol=rtol, atol=atol)
+                _keep(segments, again, before, mode)
+            except SimulationError:
+                pass
+        raise
+    if sol.status == -1:
+        raise SimulationError(f"the integrator failed at t = {sol.t[-1] if len(sol.t) else a:.9g} s: {sol.message}")
+    if sol.status == 0:
+        _keep(segments, sol, wanted, mode)
+    return sol
+
+
+def _keep(segments: list, sol, wanted: np.ndarray, mode) -> None:
+    keep = np.isin(sol.t, wanted)
+    if keep.any():
+        segments.append((sol.t[keep], sol.y.T[keep], mode))
+
+
+def _switch(ss, mode, at_rest, x, d, t, dof, backend):
+    """:meth:`StickSlip.classify` at state x and time t: (the new mode, q' with the held
+    joints' rates exactly 0)."""
+    q, qd, cur = x[:dof], x[dof:2 * dof], x[2 * dof:]
+    T, _ = d.torques(t, qd, cur)
+    try:
+        return ss.classify(mode, at_rest, q, qd, T, backend)
+    except ValueError as exc:
+        raise SimulationError(f"t = {t:.9g} s: {exc}", t) from None
+
+
+def _samples(ss, d, segments, stop, nfev, dof, backend) -> Simulation:
+    """The :class:`Simulation` of the kept ``segments`` (t, x, mode): accelerations of each
+    segment's samples in its mode, one call per segment."""
+    t = np.concatenate([s[0] for s in segments])
+    x = np.concatenate([s[1] for s in segments])
     q, qd, cur = x[:, :dof], x[:, dof:2 * dof], x[:, 2 * dof:]
     T, current = d.torques(t, qd, cur)
-    qdd = _accelerations(an, q, qd, T, backend, t)
+    qdd = np.empty_like(q)
+    at = 0
+    for ts, _, mode in segments:
+        sl = slice(at, at + len(ts))
+        qdd[sl] = _accelerations(ss, mode, q[sl], qd[sl], T[sl], backend, t[sl])[0]
+        at += len(ts)
     return Simulation(t, q, qd, qdd, T, current, stop, nfev)
 
 

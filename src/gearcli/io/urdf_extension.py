@@ -149,7 +149,7 @@ class Extension:
 
     def joint_friction(self, el, path: str, prismatic: bool) -> JointFriction:
         """A gearcli:friction element inside a joint: ``coulomb`` and ``viscous``, both >= 0."""
-        self.unknown_attrs(el, ("coulomb", "viscous"), f"{path}.gearcli:friction")
+        self.unknown_attrs(el, ("coulomb", "viscous", "static"), f"{path}.gearcli:friction")
         values = {}
         for key, units in (("coulomb", ("N*m", "N")), ("viscous", ("N*m*s/rad", "N*s/m"))):
             v = self.vector(el, key, path, n=1)
@@ -157,6 +157,13 @@ class Extension:
             if not v >= 0:
                 self.add(f"{path}.gearcli:friction", f"{key} friction must be >= 0, got {v:g} {units[prismatic]}", el)
             values[key] = v
+        v = self.vector(el, "static", path, n=1)
+        if v is not None:
+            if not float(v[0]) >= values["coulomb"]:
+                u = ("N*m", "N")[prismatic]
+                self.add(f"{path}.gearcli:friction", f"static friction must be >= the Coulomb friction "
+                         f"{values['coulomb']:g} {u}, got {float(v[0]):g} {u}", el)
+            values["static"] = float(v[0])
         return JointFriction(**values)
 
     def check_gear_pair(self, el, path: str, j: str | None, k: str | None, kw: dict, ratio) -> None:

@@ -244,6 +244,12 @@ def joint_friction(spec: dict, col: Collector, path: str) -> JointFriction | Non
             u = unit[key][0 if spec.get("type") == "prismatic" else 1]
             col.add(f"{path}.friction.{key}", f"{key} friction must be >= 0, got {v:g} {u}")
         values[key] = v
+    if "static" in fr:
+        v, u = float(fr["static"]), unit["coulomb"][0 if spec.get("type") == "prismatic" else 1]
+        if not v >= values["coulomb"]:
+            col.add(f"{path}.friction.static", f"static friction must be >= the Coulomb friction "
+                    f"{values['coulomb']:g} {u}, got {v:g} {u}")
+        values["static"] = v
     return JointFriction(**values)
 
 

@@ -18,10 +18,18 @@ class JointFriction:
 
     ``coulomb``: N*m (revolute) or N (prismatic), >= 0.
     ``viscous``: N*m*s/rad (revolute) or N*s/m (prismatic), >= 0.
+    ``static``: the largest friction that holds the joint at rest (``gearcli simulate``'s
+    stick-slip, Karnopp's model), N*m or N, >= coulomb; None: equal to ``coulomb``.
     """
 
     coulomb: float = 0.0
     viscous: float = 0.0
+    static: float | None = None
+
+    @property
+    def holding(self) -> float:
+        """The static friction F_s: ``static``, or ``coulomb`` when not given."""
+        return self.coulomb if self.static is None else self.static
 
     @property
     def active(self) -> bool:

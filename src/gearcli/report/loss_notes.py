@@ -38,8 +38,8 @@ def gear_loss_dicts(an: Analysis) -> list[dict]:
 
 
 def joint_loss_dicts(an: Analysis) -> list[dict]:
-    """Each joint with friction: joint, type, coulomb, viscous and its bearings with friction
-    (name, friction_coefficient, bore in m)."""
+    """Each joint with friction: joint, type, coulomb, viscous (static when given) and its
+    bearings with friction (name, friction_coefficient, bore in m)."""
     out = []
     for jt in an.mech.joints:
         bearings = [{"name": b.name, "friction_coefficient": b.friction_coefficient, "bore": b.bore}
@@ -47,7 +47,8 @@ def joint_loss_dicts(an: Analysis) -> list[dict]:
         fr = jt.friction
         if bearings or (fr is not None and fr.active):
             out.append({"joint": jt.name, "type": jt.type, "coulomb": fr.coulomb if fr else 0.0,
-                        "viscous": fr.viscous if fr else 0.0, "bearings": bearings})
+                        "viscous": fr.viscous if fr else 0.0, "bearings": bearings,
+                        **({"static": fr.static} if fr is not None and fr.static is not None else {})})
     return out
 
 
@@ -67,7 +68,8 @@ def loss_notes(an: Analysis) -> list[str]:
         force, rate = ("N", "N*s/m") if d["type"] == "prismatic" else ("N*m", "N*m*s/rad")
         parts = []
         if d["coulomb"] or d["viscous"]:
-            parts.append(f"Coulomb {d['coulomb']:.6g} {force}, viscous {d['viscous']:.6g} {rate}")
+            parts.append(f"Coulomb {d['coulomb']:.6g} {force}, viscous {d['viscous']:.6g} {rate}"
+                         + (f", static {d['static']:.6g} {force}" if d.get("static") is not None else ""))
         parts += [f"bearing '{b['name']}' (mu {b['friction_coefficient']:.6g}, bore {b['bore']:.6g} m)"
                   for b in d["bearings"]]
         lines.append(f"friction of joint '{d['joint']}': " + ", ".join(parts))

@@ -225,7 +225,8 @@ def _add_mimics(an: Analysis, jel: dict, corr: dict) -> None:
             etree.SubElement(jel[jt.name], q("joint"), label=str(jt.label))
         if jt.friction is not None and jt.friction.active:
             etree.SubElement(jel[jt.name], q("friction"), coulomb=_num(jt.friction.coulomb),
-                             viscous=_num(jt.friction.viscous))
+                             viscous=_num(jt.friction.viscous),
+                             **({} if jt.friction.static is None else {"static": _num(jt.friction.static)}))
 
 
 def _add_transmissions(an: Analysis, root) -> None:
