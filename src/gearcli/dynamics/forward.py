@@ -194,7 +194,7 @@ def forward_dynamics(an, q, qd, motor_torques, loads: dict | None = None, backen
     return _implicit(an, q, qd, target, M, h, qdd, loads, backend, jobs) if an.mech.has_losses else qdd
 
 
-def held_dynamics(an, q, qd, motor_torques, C: np.ndarray, extra: np.ndarray | None = None,
+def held_dynamics(an, q, qd, motor_torques, C: np.ndarray, loads: dict | None = None,
                   backend: str = "auto") -> tuple[np.ndarray, np.ndarray]:
     """(qdd (N, dof), Q (N, k)): the accelerations of the independent joints with k joints
     held at rest by friction, and the generalised friction forces Q that hold them.
@@ -202,12 +202,12 @@ def held_dynamics(an, q, qd, motor_torques, C: np.ndarray, extra: np.ndarray | N
     ``C`` (k, dof): each held joint's row of q = S q_ind, so its rate is C qd (0) and its
     acceleration C qdd = 0; its friction Q acts on the independent joints as C^T Q (N*m or
     N, on the joint's child about (along) its axis, as ``joints[].friction``'s).
-    ``extra`` (N, dof): generalised forces added to the motors' A T (the explicit Coulomb
-    friction of slipping joints, :mod:`.simulate`).  Solves M qdd + h = A T + extra + C^T Q,
-    C qdd = 0, per sample (with losses, tau(qdd) for M qdd + h, as :func:`forward_dynamics`)."""
+    ``loads`` as :func:`forward_dynamics`'s (the slipping joints' Coulomb friction as a
+    couple on their links, :mod:`.stick_slip`).  Solves M qdd + h = A T + C^T Q, C qdd = 0,
+    per sample (with losses, tau(qdd) for M qdd + h, as :func:`forward_dynamics`)."""
     q, qd, T = (np.atleast_2d(np.asarray(v, float)) for v in (q, qd, motor_torques))
-    target = np.einsum("nm,dm->nd", T, an.A) + (0.0 if extra is None else extra)
-    M, h, qdd = _mass_and_h(an, q, qd, target, None, backend, None)
+    target = np.einsum("nm,dm->nd", T, an.A)
+    M, h, qdd = _mass_and_h(an, q, qd, target, loads, backend, None)
     C = np.asarray(C, float).reshape(-1, an.dof)
     k = C.shape[0]
     Q = np.zeros((len(q), k))
@@ -215,7 +215,7 @@ def held_dynamics(an, q, qd, motor_torques, C: np.ndarray, extra: np.ndarray | N
         sol = np.linalg.solve(_kkt(M, C), np.concatenate([target - h, np.zeros((len(q), k))], axis=1)[:, :, None])
         qdd, Q = sol[:, :an.dof, 0], sol[:, an.dof:, 0]
     if an.mech.has_losses:
-        qdd, Q = _settle(an, q, qd, target, M, h, qdd, Q, C, None, backend, None)
+        qdd, Q = _settle(an, q, qd, target, M, h, qdd, Q, C, loads, backend, None)
     return qdd, Q
 
 

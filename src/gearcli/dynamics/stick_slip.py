@@ -27,11 +27,13 @@ depends on the other held ones' (not parallel: three joints of a two-dof differe
 held by them and holds nothing itself.
 
 The joints' own Coulomb friction is taken out of the mechanism the accelerations are solved
-on (:attr:`StickSlip.analysis`, the twin without it) and applied here as generalised forces
-C^T Q (the joint's row s_J of q = S q_ind: Q_J on the joint is s_J Q_J on the independent
-joints), so that a rate of exactly 0 takes the direction it starts in.  Viscous, mesh and
-bearing friction stay in the twin: a mesh or bearing at rest has no couple (sign 0), and
-holds nothing (README, Losses).
+on (:attr:`StickSlip.analysis`, the twin without it) and applied as external loads of the
+twin where it acts: a couple -F_c sign(q'_J) about the joint's axis on its child (a force
+along it for a prismatic joint), reversed on its parent, so that a rate of exactly 0 takes
+the direction it starts in and the tooth forces (and so the mesh friction) are those of
+the friction where it is.  A held joint's friction enters as C^T Q on the independent
+joints (its row s_J of q = S q_ind).  Viscous, mesh and bearing friction stay in the twin:
+a mesh or bearing at rest has no couple (sign 0), and holds nothing (README, Losses).
 """
 from __future__ import annotations
 
@@ -40,6 +42,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..model.friction import JointFriction
+from ..model.loads import Load
 from .forward import held_dynamics
 
 
@@ -77,11 +80,25 @@ class StickSlip:
             else:
                 self.units.append([s, fr.coulomb, fr.holding, [ji]])
         self.analysis = an
+        self.couples = []        # (load name, joint, unit, sign of a_J in the unit, child side, axis, prismatic)
         if joints:
             mech = an.mech
             twin = tuple(replace(jt, friction=JointFriction(0.0, jt.friction.viscous)) if ji in joints else jt
                          for ji, jt in enumerate(mech.joints))
-            self.analysis = analyse(replace(mech, joints=twin))
+            loads = list(mech.loads)
+            for k, unit in enumerate(self.units):
+                for ji in unit[3]:
+                    jt = mech.joints[ji]
+                    a = np.sign(S[ji] @ unit[0])
+                    R_jc, p_jc = np.asarray(jt.R_jc, float), np.asarray(jt.p_jc, float)
+                    sides = [(jt.child, R_jc[2, :], -R_jc.T @ p_jc, 1.0)]
+                    if jt.parent != mech.base:
+                        sides.append((jt.parent, np.asarray(jt.R_pj, float)[:, 2], np.asarray(jt.p_pj, float), -1.0))
+                    for link, axis, point, side in sides:
+                        name = f"stick-slip {jt.name} on {link}"
+                        loads.append(Load(name, link, "link", point))
+                        self.couples.append((name, ji, k, a, side, axis, jt.type == "prismatic"))
+            self.analysis = analyse(replace(mech, joints=twin, loads=tuple(loads)))
 
     def name(self, u: int) -> str:
         """The unit's joints, e.g. "joint 'Jw'" or "joints 'Jp', 'Jw'"."""
@@ -92,18 +109,22 @@ class StickSlip:
         """Unit u's rate u . q'."""
         return qd @ self.units[u][0]
 
-    def extra(self, mode: Mode, qd: np.ndarray) -> np.ndarray:
-        """(N, dof) the slipping units' Coulomb friction -F_c sign(u . q') u (the direction d
-        at a rate of exactly 0)."""
+    def loads(self, mode: Mode, qd: np.ndarray) -> dict:
+        """{load: (N, 6)}: each slipping joint's Coulomb friction -F_c sign(q'_J) (the unit's
+        direction d at a rate of exactly 0) as a couple about (a force along) its axis on the
+        child, the opposite on the parent (link frames); 0 for a held joint (C^T Q holds it)."""
         qd = np.atleast_2d(qd)
-        out = np.zeros_like(qd)
-        for k, (s, fc, _, _) in enumerate(self.units):
-            if k in mode.stuck or not fc:
-                continue
-            sign = np.sign(qd @ s)
-            if k in mode.start:
-                sign = np.where(sign == 0.0, mode.start[k], sign)
-            out -= (fc * sign)[:, None] * s
+        out = {}
+        for name, ji, k, a, side, axis, prismatic in self.couples:
+            w = np.zeros((qd.shape[0], 6))
+            if k not in mode.stuck:
+                sign = np.sign(qd @ self.units[k][0])
+                if k in mode.start:
+                    sign = np.where(sign == 0.0, mode.start[k], sign)
+                Q = -self.an.mech.joints[ji].friction.coulomb * a * sign
+                w[:, :3] = 0.0
+                w[:, (0 if prismatic else 3):(3 if prismatic else 6)] = side * Q[:, None] * axis
+            out[name] = w
         return out
 
     def rows(self, held) -> tuple[np.ndarray, list]:
@@ -121,7 +142,7 @@ class StickSlip:
         twin with the held units' rows and the slipping units' friction (a dependent held
         unit's Q is 0)."""
         C, kept = self.rows(mode.stuck)
-        qdd, Qk = held_dynamics(self.analysis, q, qd, T, C, self.extra(mode, qd), backend)
+        qdd, Qk = held_dynamics(self.analysis, q, qd, T, C, self.loads(mode, qd), backend)
         Q = np.zeros((qdd.shape[0], len(mode.stuck)))
         for i, k in enumerate(kept):
             Q[:, mode.stuck.index(k)] = Qk[:, i]
