@@ -707,3 +707,32 @@ def test_auto_solves_losses_compiled():
     fast, ref = solve(an, q, qd, qdd, backend="llvm"), solve(an, q, qd, qdd, backend="numpy")
     assert solve(an, q, qd, qdd).backend == "llvm" and ref.backend == "numpy"
     assert np.allclose(fast.motor, ref.motor, rtol=1e-12, atol=1e-12 * np.abs(ref.motor).max())
+
+
+@pytest.mark.parametrize("friction, message", [
+    ("{coulomb: 0.5, static: 0.3}", "joints[0].friction.static: static friction must be >= the Coulomb friction 0.5 N*m, got 0.3 N*m"),
+    ("{static: -1}", "joints[0].friction.static: static friction must be >= the Coulomb friction 0 N*m, got -1 N*m"),
+])
+def test_static_friction_below_coulomb_is_refused(run_cli, tmp_path, friction, message):
+    text = (MECH / "paper_2dof.yaml").read_text()
+    dh = "    dh: {theta_deg: 0, d: 0.0, a: 0.4, alpha_deg: 0}\n"
+    (tmp_path / "m.yaml").write_text(text.replace(dh, dh + f"    friction: {friction}\n", 1))
+    r = run_cli("check", tmp_path / "m.yaml")
+    assert r.exit_code == 2 and message in r.stderr and len(r.stderr.splitlines()) == 1
+
+
+def test_static_friction_is_described_and_survives_the_urdf_round_trip(run_cli, tmp_path):
+    from gearcli import load_mechanism
+    text = (MECH / "paper_2dof.yaml").read_text()
+    dh = "    dh: {theta_deg: 0, d: 0.0, a: 0.4, alpha_deg: 0}\n"
+    (tmp_path / "m.yaml").write_text(text.replace(dh, dh + "    friction: {coulomb: 0.5, static: 0.75}\n", 1))
+    r = run_cli("check", tmp_path / "m.yaml")
+    assert r.exit_code == 0
+    assert "friction of joint 'J1': Coulomb 0.5 N*m, viscous 0 N*m*s/rad, static 0.75 N*m" in r.stdout.splitlines()
+    assert run_cli("export", tmp_path / "m.yaml", "-o", tmp_path / "m.urdf").exit_code == 0
+    assert 'static="0.75"' in (tmp_path / "m.urdf").read_text()
+    back = load_mechanism(tmp_path / "m.urdf")
+    fr = next(j.friction for j in back.joints if j.name == "J1")
+    assert (fr.coulomb, fr.static, fr.holding) == (0.5, 0.75, 0.75)
+    plain = load_mechanism(MECH / "paper_2dof.yaml")
+    assert all(j.friction is None for j in plain.joints)

@@ -30,11 +30,12 @@ MIN_RTOL = 100 * np.finfo(float).eps
 
 
 class StallWatch:
-    """Called with the time of every evaluation of the dynamics: raises GearcliError when
+    """Called with the time of every evaluation of the dynamics: raises StallError when
     :data:`STALL_EVALUATIONS` of them pass without the time reached advancing by
     :data:`STALL_FRACTION` of the span (the integrator's step collapsed: a smooth motion
-    needs a few hundred evaluations a second).  Coulomb friction that holds a mechanism at
-    rest does this (with no stiction model the joint's rate reverses at 0 at every step), and
+    needs a few hundred evaluations a second).  Mesh or bearing friction that would hold a
+    gear at rest does this (they hold nothing at rest: its rate reverses at 0 at every step;
+    a joint's own Coulomb friction sticks, :mod:`gearcli.dynamics.stick_slip`), and
     so does a stiff system (a motor's L/R far below the motion's time scale) under an
     explicit method; the message says which applies."""
 
