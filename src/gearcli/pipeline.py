@@ -121,7 +121,8 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
     fmt = _output_format(out_path, (mech_path, traj_path), precision)   # refuse a bad -o before any work
     an = analysis or load_analysed(mech_path)
     reader = TrajectoryReader(traj_path, an.independent_names, degrees=degrees, chunk=chunk,
-                              linear=prismatic_independent(an), loads=an.mech.loads)
+                              linear=prismatic_independent(an), loads=an.mech.loads,
+                              payloads=[p.name for p in an.mech.payloads])
     to_stdout = out_path is not None and str(out_path) == "-"
     rows = reader.check() if to_stdout or fmt == "npz" else reader.count()   # exact count first
     watch = RateWatch(reader, an, strict)
@@ -141,7 +142,8 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
             for part in parts:
                 with np.errstate(all="ignore"), at_samples(reader.file, part):
                     res = solve(an, part.q, part.qd, part.qdd, method=method, chunk=chunk, verify=verify,
-                                loads=part.loads, backend=how.path, jobs=jobs, check_finite=False)  # read checked
+                                loads=part.loads, backend=how.path, jobs=jobs, check_finite=False,  # read checked
+                                attach=part.attach)
                     tab = table(an, part.t, res)
                     if losses is not None:
                         losses.add(an, part.t, res, lossless_motor(twin, part, method, chunk, backend, jobs))
@@ -180,7 +182,7 @@ def lossless_motor(twin: Analysis, part, method: str, chunk: int, backend: str, 
     """Motor torques (N, M) of a chunk's motion without losses (the lines' output power for
     the summary's line efficiencies, :mod:`gearcli.report.loss_summary`)."""
     return solve(twin, part.q, part.qd, part.qdd, method=method, chunk=chunk, loads=part.loads,
-                 backend=backend, jobs=jobs, check_finite=False).motor
+                 backend=backend, jobs=jobs, check_finite=False, attach=part.attach).motor
 
 
 def _run(solve_chunks, table_file) -> None:

@@ -141,7 +141,7 @@ def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None
     for ji, name, lo, hi in joint_limits(an):
         if not lo <= an.S[ji] @ x0 <= hi:
             raise GearcliError(f"--q0: joint '{name}' starts at {an.S[ji] @ x0:g}, outside its limits [{lo:g}, {hi:g}]")
-    drive = read_drive_input(input_path, an.mech.motors)
+    drive = read_drive_input(input_path, an.mech.motors, [p.name for p in an.mech.payloads])
     t0, t1 = float(drive.t[0]), float(drive.t[-1] if t_end is None else t_end)
     if not (math.isfinite(t1) and t1 - t0 > 1e-9 * max(1.0, abs(t0))):
         raise GearcliError(f"--t-end: expected a time after the input's first t = {t0:.9g} s (by more than "
@@ -163,10 +163,13 @@ def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None
         said = str(exc) if isinstance(exc, StallError) else f"simulation failed: {exc}"
         raise GearcliError(f"{input_path}: {said} (nothing written)") from None
     names = an.independent_names
-    header = ",".join(["t"] + [f"{p}:{n}" for p in ("q", "qd", "qdd") for n in names])
+    payloads = list(drive.attach)           # carried where attached: the trajectory says where
+    header = ",".join(["t"] + [f"{p}:{n}" for p in ("q", "qd", "qdd") for n in names] + [f"attach:{p}" for p in payloads])
+    flags = [[float(p in drive.attached_at(t)) for p in payloads] for t in sim.t] if payloads else np.zeros((len(sim.t), 0))
     with atomic_output(out_path, inputs) as f:
         f.write(header + "\n")
-        np.savetxt(f, np.column_stack([sim.t, sim.q, sim.qd, sim.qdd]), delimiter=",", fmt="%.17g")
+        np.savetxt(f, np.column_stack([sim.t, sim.q, sim.qd, sim.qdd, np.asarray(flags, float).reshape(len(sim.t), -1)]),
+                   delimiter=",", fmt="%.17g")
     report = SimulateReport(an, sim, Path(out_path))
     if loads_path is not None:
         report.loads = solve_file(mech_path, out_path, loads_path, analysis=an)

@@ -302,7 +302,8 @@ def _prepare_case(spec: dict, where: str, base: Path, col: Collector, issues: li
     for tp in trajs if degrees is not None else ():   # a bad 'degrees': the rows' scale is unknown
         try:
             TrajectoryReader(tp, an.independent_names, degrees=degrees,
-                             linear=prismatic_independent(an), loads=an.mech.loads).check(keep=True)  # rows only,
+                             linear=prismatic_independent(an), loads=an.mech.loads,
+                             payloads=[p.name for p in an.mech.payloads]).check(keep=True)  # rows only,
             # no spline; the rows are kept for the job that solves the file in this process
         except GearcliError as exc:
             issues += exc.lines()

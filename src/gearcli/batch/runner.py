@@ -44,11 +44,12 @@ def solve_samples(an, traj_path, degrees: bool, threads: int | None = None) -> S
     first reads it: :class:`~gearcli.report.columns.LazyColumns`), and every real joint's
     rate; ``threads``: the solver's threads (None: every core)."""
     tr = read_trajectory(traj_path, an.independent_names, degrees=degrees, linear=prismatic_independent(an),
-                         loads=an.mech.loads)
+                         loads=an.mech.loads, payloads=[p.name for p in an.mech.payloads])
     with at_samples(traj_path, tr):
-        res = solve(an, tr.q, tr.qd, tr.qdd, loads=tr.loads, jobs=threads, check_finite=False)   # read checked them
+        res = solve(an, tr.q, tr.qd, tr.qdd, loads=tr.loads, jobs=threads, check_finite=False,   # read checked them
+                    attach=tr.attach)
     cols = LazyColumns(an, res, tr.t)
-    cols.update(inertia_columns(an, tr.q))     # servo sizing: inertia at the rated motors
+    cols.update(inertia_columns(an, tr.q, tr.attach))     # servo sizing: inertia at the rated motors
     return Samples(tr.t, cols, tr.qd @ an.S.T, backend_text(res))
 
 

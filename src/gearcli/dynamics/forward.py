@@ -151,7 +151,7 @@ def _mass_and_h(an, q, qd, target, loads, backend, jobs):
     return M, h, np.linalg.solve(M, (target - h)[:, :, None])[:, :, 0]
 
 
-def mass_matrix(an, q, backend: str = "auto", jobs: int | None = None) -> np.ndarray:
+def mass_matrix(an, q, backend: str = "auto", jobs: int | None = None, attach: dict | None = None) -> np.ndarray:
     """Mass matrix M(q) of the independent joints (paper Eq. 25-26), (N, dof, dof).
 
     ``q`` (N, dof) or (dof,): independent joint angles (rad; m for a prismatic joint) in the
@@ -160,15 +160,19 @@ def mass_matrix(an, q, backend: str = "auto", jobs: int | None = None) -> np.nda
     (rad/s^2; m/s^2): the kinetic energy is 1/2 qd^T M qd.  It includes every link of the
     mechanism: gears, shafts and motor rotors (their inertia as given on their links),
     exactly.  Symmetric positive definite for a well-posed mechanism.  ``backend``,
-    ``jobs`` as in :func:`gearcli.solve`.  Raises ValueError for a bad shape or a value
-    that is not finite.
+    ``jobs`` and ``attach`` (the payloads carried at each sample) as in
+    :func:`gearcli.solve`.  Raises ValueError for a bad shape or a value that is not finite.
     """
     (q,) = sample_arrays({"q": (q, an.dof, joint_names(an))})
+    if attach:                  # payloads carried at some samples (:mod:`.payloads`)
+        from .payloads import attach_flags, by_groups  # noqa: PLC0415
+        return by_groups(an, attach_flags(an, attach, len(q)), lambda a, rows: mass_matrix(a, q[rows], backend, jobs),
+                         len(q))
     return _mass_and_h(an, q, np.zeros_like(q), np.zeros_like(q), None, backend, jobs)[0]
 
 
 def forward_dynamics(an, q, qd, motor_torques, loads: dict | None = None, backend: str = "auto",
-                     jobs: int | None = None) -> np.ndarray:
+                     jobs: int | None = None, attach: dict | None = None) -> np.ndarray:
     """Accelerations qdd (N, dof) of the independent joints under given motor torques.
 
     ``q``, ``qd`` (N, dof) or (dof,): independent joint angles and rates (rad, rad/s; m,
@@ -177,7 +181,8 @@ def forward_dynamics(an, q, qd, motor_torques, loads: dict | None = None, backen
     joint axis (N*m; N for a linear input), ``an.mech.motors`` order: the same convention
     as :attr:`gearcli.Result.motor`.  ``loads``: external loads as in :func:`gearcli.solve`
     (``{name: (N, 6) or (6,)}``; loads not given keep the file's constants); gravity is the
-    mechanism's.  Returns qdd in rad/s^2 (m/s^2).
+    mechanism's; ``attach`` the payloads carried at each sample, as in :func:`gearcli.solve`.
+    Returns qdd in rad/s^2 (m/s^2).
 
     The exact inverse of :func:`gearcli.solve`: ``solve(an, q, qd, forward_dynamics(an, q,
     qd, T)).motor == T`` to rounding.  It solves M qdd = A T - h with M and h of the mass
@@ -188,6 +193,13 @@ def forward_dynamics(an, q, qd, motor_torques, loads: dict | None = None, backen
     motors = [f"motor '{m.name}'" for m in an.mech.motors]
     q, qd, T = sample_arrays({"q": (q, an.dof, joint_names(an)), "qd": (qd, an.dof, joint_names(an)),
                               "motor_torques": (motor_torques, len(motors), motors)})
+    if attach:                  # payloads carried at some samples (:mod:`.payloads`)
+        from .payloads import attach_flags, by_groups  # noqa: PLC0415
+
+        def run(a, rows):
+            part = {k: (np.asarray(v, float)[rows] if np.ndim(v) == 2 else v) for k, v in (loads or {}).items()}
+            return forward_dynamics(a, q[rows], qd[rows], T[rows], part or None, backend, jobs)
+        return by_groups(an, attach_flags(an, attach, len(q)), run, len(q))
     target = np.einsum("nm,dm->nd", T, an.A)    # A T per sample; not matmul: BLAS threads would
     # start, then spin on the second core through the kernel calls below (up to 2x slower)
     M, h, qdd = _mass_and_h(an, q, qd, target, loads, backend, jobs)
@@ -294,7 +306,8 @@ def _lossy_jacobian(tau, rows, qdd: np.ndarray, tau0: np.ndarray) -> np.ndarray:
     return np.transpose(cols - tau0[:, None, :], (0, 2, 1)) / delta[:, None, None]
 
 
-def motor_inertia(an, q, diagonal: bool = False, backend: str = "auto", jobs: int | None = None) -> np.ndarray:
+def motor_inertia(an, q, diagonal: bool = False, backend: str = "auto", jobs: int | None = None,
+                  attach: dict | None = None) -> np.ndarray:
     """Inertia seen at the motors, (N, M, M) (or its diagonal (N, M) with ``diagonal``).
 
     In motor coordinates theta_m = A^T q_ind (rad; m for a linear input), the kinetic energy
@@ -305,7 +318,7 @@ def motor_inertia(an, q, diagonal: bool = False, backend: str = "auto", jobs: in
     the Bendix wrist) the off-diagonal terms couple them; the diagonal is what servo sizing
     compares with the rotor inertia.
     """
-    M = mass_matrix(an, q, backend=backend, jobs=jobs)
+    M = mass_matrix(an, q, backend=backend, jobs=jobs, attach=attach)
     Ainv = np.linalg.inv(an.A)
     J = Ainv @ M @ Ainv.T
     J = 0.5 * (J + np.swapaxes(J, 1, 2))

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 
+from .payloads import carrying
 from .stick_slip import Mode, StickSlip
 
 METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
@@ -176,8 +177,17 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
     dof = an.dof
     d = Drive(an, drive)
     nL = int(d.inductive.sum())
-    ss = StickSlip(an)
-    state = {"mode": Mode(), "memo": (None, None, None)}
+    variants = {}
+
+    def stick_slip(t):
+        """The stick-slip joints of the mechanism carrying the payloads attached at t."""
+        attached = drive.attached_at(t)
+        if attached not in variants:
+            variants[attached] = StickSlip(carrying(an, attached))
+        return variants[attached]
+
+    ss = stick_slip(t_eval[0])
+    state = {"mode": Mode(), "memo": (None, None, None), "ss": ss}
 
     def dynamics(t, x):
         """(qdd, Q) at (t, x) in the current mode; the last one kept for the events."""
@@ -186,7 +196,7 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
             return state["memo"][1:]
         q, qd, cur = x[:dof], x[dof:2 * dof], x[2 * dof:]
         T, _ = d.torques(t, qd, cur)
-        qdd, Q = _accelerations(ss, state["mode"], q, qd, T, backend, t)
+        qdd, Q = _accelerations(state["ss"], state["mode"], q, qd, T, backend, t)
         state["memo"] = (key, qdd[0], Q[0])
         return qdd[0], Q[0]
 
@@ -213,23 +223,27 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
         state["mode"], x[dof:2 * dof] = _switch(ss, Mode(), at_rest, x, d, t_eval[0], dof, backend)
     try:
         for a, b in row_intervals(drive.t, t_eval[0], t_eval[-1]):
+            ss = state["ss"] = stick_slip(a)         # a pick or a place happens at a row
+            state["memo"] = (None, None, None)
             while True:
-                first = not segments
-                wanted = t_eval[(t_eval >= a) & (t_eval <= b)] if first else t_eval[(t_eval > a) & (t_eval <= b)]
+                # [a, b): a sample at a row takes the row's values (a pick or a place there)
+                last = b >= t_eval[-1]
+                wanted = t_eval[(t_eval >= a) & ((t_eval < b) | (last & (t_eval <= b)))]
                 switches = ss.events(state["mode"], x[dof:2 * dof], dof, lambda t, y: dynamics(t, y)[1])
                 events = limits + switches
-                sol = _integrate(solve_ivp, rhs, a, b, x, wanted, method, rtol, atol, events, segments, state["mode"])
+                sol = _integrate(solve_ivp, rhs, a, b, x, wanted, method, rtol, atol, events, segments,
+                                 (state["mode"], ss))
                 nfev += int(sol.nfev)
                 if sol.status != 1:
                     x = sol.y[:, -1]
                     break
                 k = next(i for i, te in enumerate(sol.t_events) if len(te))
                 te, xe = float(sol.t_events[k][0]), sol.y_events[k][0].copy()
-                _keep(segments, sol, wanted[wanted < te], state["mode"])
+                _keep(segments, sol, wanted[wanted < te], (state["mode"], ss))
                 if hasattr(events[k], "joint"):
                     name, side, bound = events[k].joint
                     stop = f"joint '{name}' reached its {side} limit {bound:g} at t = {te:.6g} s"
-                    segments.append((np.array([te]), xe[None, :], state["mode"]))
+                    segments.append((np.array([te]), xe[None, :], (state["mode"], ss)))
                     raise _Stopped()
                 ji, kind = events[k].switch
                 mode = state["mode"]
@@ -249,7 +263,7 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
         if not segments:
             raise
         stop = str(exc)
-    return _samples(ss, d, segments, stop, nfev, dof, backend)
+    return _samples(d, segments, stop, nfev, dof, backend)
 
 
 class _Stopped(Exception):
@@ -299,16 +313,17 @@ def _switch(ss, mode, at_rest, x, d, t, dof, backend):
         raise SimulationError(f"t = {t:.9g} s: {exc}", t) from None
 
 
-def _samples(ss, d, segments, stop, nfev, dof, backend) -> Simulation:
-    """The :class:`Simulation` of the kept ``segments`` (t, x, mode): accelerations of each
-    segment's samples in its mode, one call per segment."""
+def _samples(d, segments, stop, nfev, dof, backend) -> Simulation:
+    """The :class:`Simulation` of the kept ``segments`` (t, x, (mode, stick-slip joints of
+    the payloads attached)): accelerations of each segment's samples in its mode, one call
+    per segment."""
     t = np.concatenate([s[0] for s in segments])
     x = np.concatenate([s[1] for s in segments])
     q, qd, cur = x[:, :dof], x[:, dof:2 * dof], x[:, 2 * dof:]
     T, current = d.torques(t, qd, cur)
     qdd = np.empty_like(q)
     at = 0
-    for ts, _, mode in segments:
+    for ts, _, (mode, ss) in segments:
         sl = slice(at, at + len(ts))
         qdd[sl] = _accelerations(ss, mode, q[sl], qd[sl], T[sl], backend, t[sl])[0]
         at += len(ts)

@@ -269,7 +269,7 @@ def solver_for(an) -> Solver:
 
 def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, verify: bool = False,
           loads: dict | None = None, backend: str = "auto", jobs: int | None = None,
-          out: Result | None = None, check_finite: bool = True) -> Result:
+          out: Result | None = None, check_finite: bool = True, attach: dict | None = None) -> Result:
     """Inverse dynamics along a trajectory.
 
     Parameters
@@ -312,6 +312,10 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
     check_finite : bool
         Refuse a NaN or infinite ``q``, ``qd`` or ``qdd`` (default; ValueError naming the
         sample and joint); False skips the check, for inputs already checked (:mod:`.inputs`).
+    attach : dict, optional
+        ``{payload name: (N,) of 0 and 1}``: where each payload of ``an.mech.payloads`` is
+        carried (a payload not given is not); the samples are solved in groups by the set
+        attached (:mod:`.payloads`; ``out`` is not used then).
 
     Raises
     ------
@@ -322,6 +326,17 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
         load value that is not finite, an unknown
         backend, the retired backend "kernel", or backend "llvm" where it is unavailable.
     """
+    if attach:
+        from .payloads import attach_flags, by_groups  # noqa: PLC0415
+        q, qd, qdd = (np.atleast_2d(np.asarray(v, float)) for v in (q, qd, qdd))
+        n = q.shape[0]
+        flags = attach_flags(an, attach, n)
+
+        def run(a, rows):
+            part = {k: (np.asarray(v, float)[rows] if np.ndim(v) == 2 else v) for k, v in (loads or {}).items()}
+            return solver_for(a).solve(q[rows], qd[rows], qdd[rows], method=method, chunk=chunk, verify=verify,
+                                       loads=part or None, backend=backend, jobs=jobs, check_finite=check_finite)
+        return by_groups(an, flags, run, n)
     return solver_for(an).solve(q, qd, qdd, method=method, chunk=chunk, verify=verify, loads=loads,
                                 backend=backend, jobs=jobs, out=out, check_finite=check_finite)
 

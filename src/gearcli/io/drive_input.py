@@ -10,7 +10,7 @@ file, line and column): :class:`~.trajectory.TrajectoryReader` reads the rows.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +31,13 @@ class DriveInput:
     voltage: np.ndarray
     line: np.ndarray
     file: str
+    attach: dict = field(default_factory=dict)   # {payload: (n,) 0 or 1}, held from each row to the next
+
+    def attached_at(self, t: float) -> tuple[str, ...]:
+        """The payloads attached at time t: each row's ``attach:`` value holds until the
+        next row (a pick or a place is a step, not a ramp)."""
+        i = max(int(np.searchsorted(self.t, t, side="right")) - 1, 0)
+        return tuple(name for name, v in self.attach.items() if v[i] == 1.0)
 
     def at(self, t) -> np.ndarray:
         """The values at time(s) t: (M,) for a scalar t, (n, M) for an array; linear between
@@ -43,7 +50,8 @@ class DriveInput:
 class _DriveReader(TrajectoryReader):
     """The row reading of :class:`TrajectoryReader` with the columns of a drive input."""
 
-    def __init__(self, path, motors):   # noqa: super().__init__ is for q columns
+    def __init__(self, path, motors, payloads=()):   # noqa: super().__init__ is for q columns
+        self.payloads = tuple(payloads)
         self.path, self.names, self.degrees, self.loads, self.linear = Path(path), [], False, (), set()
         self.chunk, self.file = 1 << 62, str(path)
         with self._open() as f:
@@ -64,8 +72,15 @@ class _DriveReader(TrajectoryReader):
             pos[h] = i
         names = {m.name: m for m in motors}
         expected = "expected t and, for every motor, motor:<motor> (N*m) or voltage:<motor> (V)"
+        self.attach_cols = {}
         for h, i in pos.items():
             kind, _, name = h.partition(":")
+            if kind == "attach":
+                if name not in self.payloads:
+                    raise fail(self.file, 1, column_place(self.header, i), f"'{show(name)}' is not a payload "
+                               f"(mechanism payloads: {', '.join(self.payloads) or 'none'})")
+                self.attach_cols[name] = i
+                continue
             if h != "t" and (kind not in ("motor", "voltage") or name not in names):
                 what = f"'{show(name)}' is not a motor of the mechanism" if kind in ("motor", "voltage") else "unknown column"
                 raise fail(self.file, 1, column_place(self.header, i), f"{what} ({expected}: {', '.join(names)})")
@@ -85,10 +100,11 @@ class _DriveReader(TrajectoryReader):
         return pos["t"]
 
 
-def read_drive_input(path, motors) -> DriveInput:
-    """Read and check a drive input CSV for ``motors`` (``mech.motors``); raises
+def read_drive_input(path, motors, payloads=()) -> DriveInput:
+    """Read and check a drive input CSV for ``motors`` (``mech.motors``) and the payload
+    names ``payloads`` (``attach:<payload>`` columns, 0 or 1); raises
     :class:`~gearcli.errors.TrajectoryError` naming the file, line and column."""
-    r = _DriveReader(path, motors)
+    r = _DriveReader(path, motors, payloads)
     parts = list(r._raw())
     data = np.concatenate([d for d, _ in parts]) if parts else np.zeros((0, len(r.header)))
     lines = np.concatenate([ln for _, ln in parts]) if parts else np.zeros(0, int)
@@ -105,4 +121,11 @@ def read_drive_input(path, motors) -> DriveInput:
                             f"{m.model.supply_voltage:g} V")
     if len(data) < 2:
         raise fail(r.file, None, "", f"{counted(len(data), 'row')}: give at least 2 (values are linear between rows)")
-    return DriveInput(data[:, r.cols["t"]], values, r.voltage, lines, r.file)
+    attach = {}
+    for name, c in r.attach_cols.items():
+        bad = np.flatnonzero((data[:, c] != 0.0) & (data[:, c] != 1.0))
+        if bad.size:
+            raise fail(r.file, int(lines[bad[0]]), column_place(r.header, c),
+                       f"expected 0 or 1 (payload '{show(name)}' off or attached), got {data[bad[0], c]:g}")
+        attach[name] = data[:, c]
+    return DriveInput(data[:, r.cols["t"]], values, r.voltage, lines, r.file, attach)

@@ -37,6 +37,27 @@ def yaml_loads(data: dict, col: Collector, links: set, base: str) -> tuple[Load,
     return tuple(out)
 
 
+def yaml_payloads(data: dict, col: Collector, links: set, base: str, loads) -> tuple[Load, ...]:
+    """The ``payloads:`` list of a schema-valid mechanism mapping as loads with a mass, no
+    wrench, at their centre of mass (problems go to ``col``; names unique among the loads
+    too: a payload attached becomes one)."""
+    out: list[Load] = []
+    seen: dict[str, str] = {ld.name: ld.path for ld in loads}
+    for i, spec in enumerate(data.get("payloads", [])):
+        path = f"payloads[{i}]"
+        name = spec["name"]
+        if name in seen:
+            col.add(f"{path}.name", f"duplicate name '{name}' (first at {seen[name]})")
+        seen[name] = path
+        why = load_link_problem(spec["link"], links, base)
+        if why:
+            col.add(f"{path}.link", why.replace("load on", "payload on", 1).replace("the load would", "it would"))
+        mass, inertia = payload(spec["mass"], spec.get("inertia"), path, col.add)
+        out.append(Load(name, spec["link"], "link", np.asarray(spec.get("com", [0.0, 0.0, 0.0]), float),
+                        path=path, mass=mass, inertia=inertia))
+    return tuple(out)
+
+
 def payload(mass, inertia, path: str, add) -> tuple[float, np.ndarray]:
     """A payload's mass (kg) and inertia (3, 3) about its point (kg*m^2), checked: mass not
     negative, inertia a physical tensor (positive semi-definite, triangle inequality), and

@@ -52,7 +52,8 @@ SEPARATORS = ",;\t"
 class Trajectory:
     """Samples of the independent joints: ``t`` (N,), ``q``, ``qd``, ``qdd`` (N, dof);
     ``line`` (N,) the file line of every sample (None for arrays not read from a file);
-    ``loads`` {load name: (N, 6)} for the external loads with ``load:`` columns."""
+    ``loads`` {load name: (N, 6)} for the external loads with ``load:`` columns;
+    ``attach`` {payload name: (N,) 0 or 1} for the payloads with ``attach:`` columns."""
 
     t: np.ndarray
     q: np.ndarray
@@ -60,6 +61,7 @@ class Trajectory:
     qdd: np.ndarray
     line: np.ndarray | None = None
     loads: dict | None = None
+    attach: dict | None = None
 
 
 def _expected(names: list[str]) -> str:
@@ -67,9 +69,10 @@ def _expected(names: list[str]) -> str:
     return "expected t, " + ", ".join(qs) + " and optional qd:/qdd: columns, separated by ',', ';' or tab"
 
 
-def _columns(header: list[str], names: list[str], file: str, loads=()) -> dict:
-    """Map of column kind -> list of column indices (or None) per independent joint, and
-    ``"load"`` -> the load columns (:func:`~.load_columns.load_columns`)."""
+def _columns(header: list[str], names: list[str], file: str, loads=(), payloads=()) -> dict:
+    """Map of column kind -> list of column indices (or None) per independent joint,
+    ``"load"`` -> the load columns (:func:`~.load_columns.load_columns`) and ``"attach"`` ->
+    {payload: column} of the ``attach:<payload>`` columns (``payloads``: their names)."""
     pos: dict[str, int] = {}
     for i, h in enumerate(header):
         if h in pos:
@@ -78,6 +81,14 @@ def _columns(header: list[str], names: list[str], file: str, loads=()) -> dict:
     lcols = load_columns(pos, loads, file)
     known = {"t"} | {f"{p}:{n}" for p in ("q", "qd", "qdd") for n in names}
     known |= {h for h in pos if h.startswith("load:")}
+    attach = {}
+    for h, i in pos.items():
+        if h.startswith("attach:"):
+            if h[7:] not in payloads:
+                raise fail(file, 1, column_place(header, i), f"'{show(h[7:])}' is not a payload (mechanism payloads: "
+                           f"{show(', '.join(payloads), 80) or 'none'})")
+            attach[h[7:]] = i
+            known.add(h)
     for h, i in pos.items():
         if h not in known:
             joint = h.partition(":")[2] if h.partition(":")[0] in ("q", "qd", "qdd") else ""   # e.g. a gear shaft
@@ -88,7 +99,7 @@ def _columns(header: list[str], names: list[str], file: str, loads=()) -> dict:
     for n in names:
         if f"q:{n}" not in pos:
             raise fail(file, 1, "", f"missing column 'q:{show(n)}' (independent joint '{show(n)}')")
-    out = {"t": pos["t"], "load": lcols}
+    out = {"t": pos["t"], "load": lcols, "attach": attach}
     for p in ("q", "qd", "qdd"):
         cols = [pos.get(f"{p}:{n}") for n in names]
         if p != "q" and any(c is None for c in cols) and any(c is not None for c in cols):
@@ -153,9 +164,10 @@ class TrajectoryReader:
     """
 
     def __init__(self, path: str | Path, names, degrees: bool = False, chunk: int = 100_000,
-                 linear=(), loads=()):
+                 linear=(), loads=(), payloads=()):
         self.path, self.names, self.degrees = Path(path), list(names), degrees
         self.loads = tuple(loads)
+        self.payloads = tuple(payloads)
         self.linear = set(linear)
         self.chunk = max(int(chunk), 2 * PAD + 1)
         self.file = str(path)
@@ -167,7 +179,7 @@ class TrajectoryReader:
         check_utf8(self.file, [head], [1])
         self.sep = next((s for s in SEPARATORS if s in head), ",")
         self.header = split_row(head, self.sep)
-        self.cols = _columns(self.header, self.names, self.file, self.loads)
+        self.cols = _columns(self.header, self.names, self.file, self.loads, self.payloads)
         self.scale = self._column_scale()
 
     def _open(self):
@@ -309,7 +321,15 @@ class TrajectoryReader:
             (qdd,) = self._derive(t, qd, 1, lines, "qd")
         sl = slice(a, a + len(cur[0]))
         loads = load_samples(cur[0], c["load"], self.loads)
-        return Trajectory(t[sl], q[sl], qd[sl], qdd[sl], lines[sl], loads)
+        attach = {}
+        for name, col in c["attach"].items():
+            v = cur[0][:, col]
+            bad = np.flatnonzero((v != 0.0) & (v != 1.0))
+            if bad.size:
+                raise fail(self.file, int(cur[1][bad[0]]), column_place(self.header, col),
+                           f"expected 0 or 1 (payload '{show(name)}' off or attached), got {v[bad[0]]:g}")
+            attach[name] = v
+        return Trajectory(t[sl], q[sl], qd[sl], qdd[sl], lines[sl], loads, attach or None)
 
     def _too_few(self, n: int, need: int, kind: str) -> TrajectoryError:
         given = "positions only" if kind == "q" else "no qdd: columns"
@@ -337,9 +357,10 @@ class TrajectoryReader:
         return out
 
 
-def read_trajectory(path, names, degrees: bool = False, linear=(), loads=()) -> Trajectory:
+def read_trajectory(path, names, degrees: bool = False, linear=(), loads=(), payloads=()) -> Trajectory:
     """Read a whole trajectory CSV into memory (see :class:`TrajectoryReader`)."""
-    parts = list(TrajectoryReader(path, names, degrees, chunk=1 << 62, linear=linear, loads=loads))
+    parts = list(TrajectoryReader(path, names, degrees, chunk=1 << 62, linear=linear, loads=loads,
+                                  payloads=payloads))
     return parts[0]
 
 

@@ -19,7 +19,7 @@ import numpy as np
 from ..errors import Collector, IncompleteMechanismError
 from ..model.friction import JointFriction
 from ..model.mechanism import GearPair, Joint, Link, Mechanism, Motor
-from .loads_reader import yaml_loads
+from .loads_reader import yaml_loads, yaml_payloads
 from .planets import expand_planets, item_path
 from .ratings_reader import attach_yaml_ratings
 from ..model.geometry import dh_transform, origin_axis_transform
@@ -168,12 +168,14 @@ def _build(data: dict, col: Collector, file: str, lines: dict) -> Mechanism:
     links, link_list = _links(data, col)
     for key in ("base", "end_effector"):
         links.ref(data[key], key)
+    loads = yaml_loads(data, col, set(links.first), data["base"])
     return Mechanism(
         name=data["name"], base=data["base"], end_effector=data["end_effector"],
         links=tuple(link_list), joints=tuple(_joints(data, col, links)),
         gears=tuple(_gears(data, col, links)), motors=tuple(_motors(data, col, links)),
         gravity=np.asarray(data.get("gravity", [0.0, 0.0, -9.81]), float),
-        source=file, lines=dict(lines), loads=yaml_loads(data, col, set(links.first), data["base"]),
+        source=file, lines=dict(lines), loads=loads,
+        payloads=yaml_payloads(data, col, set(links.first), data["base"], loads),
     )
 
 

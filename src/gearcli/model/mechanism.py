@@ -146,6 +146,9 @@ class Mechanism:
     open_loop: str = "chain"
     warnings: tuple[str, ...] = ()  # input problems that were worked around (e.g. URDF)
     loads: tuple[Load, ...] = ()    # external loads on links (model.loads)
+    # payloads that are picked and placed (``payloads:``): a Load with a mass and no wrench,
+    # carried only where attached (:meth:`attached`; trajectory columns attach:<name>)
+    payloads: tuple[Load, ...] = ()
 
     @property
     def has_losses(self) -> bool:
@@ -154,6 +157,14 @@ class Mechanism:
         return any(g.loss_factor for g in self.gears) or any(
             (j.friction is not None and j.friction.active) or any(b.friction_arm for b in j.bearings or ())
             for j in self.joints)
+
+    def attached(self, names) -> "Mechanism":
+        """The mechanism carrying the payloads ``names`` (an iterable of payload names): each
+        becomes a load with its mass and inertia, rigidly attached to its link
+        (:attr:`bodies`); it has no payloads left to attach."""
+        from dataclasses import replace  # noqa: PLC0415
+        names = set(names)
+        return replace(self, loads=self.loads + tuple(p for p in self.payloads if p.name in names), payloads=())
 
     def link(self, name: str) -> Link:
         """The link called ``name``."""
