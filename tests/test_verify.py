@@ -606,3 +606,26 @@ def test_an_empty_directory_name_is_refused_as_the_file_names_are(run_cli, tmp_p
     r = run_cli("verify", DESIGNS / "ci_example.yaml", option, "")
     assert r.exit_code == 2 and r.stderr.strip() == f"{option}: empty directory name (give a directory for the files)"
     assert list(tmp_path.iterdir()) == []
+
+
+def test_first_call_rule_counts_the_whole_command(run_cli, tmp_path, monkeypatch):
+    """Three trajectories of 2,001 samples of one mechanism, an empty kernel cache: 6,003
+    samples are one compile's worth, so verify solves them with llvm (each was a small first
+    call sent to numpy: 73 s for a new lossy SCARA; issue 34, section 4).  One trajectory
+    alone (run first: nothing compiled yet) stays with numpy, and says why."""
+    monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path / "cache"))
+    bearings = "[{name: a, position: 0, C: 5000, C0: 2000, type: ball, locating: true}]"
+    write_rotor_case(tmp_path, bearings, name="rotor")
+    t = np.linspace(0, T, 2001)
+    for k in range(3):
+        np.savetxt(tmp_path / f"r{k}.csv", np.column_stack([t, W * t, np.full_like(t, W), 0 * t]),
+                   delimiter=",", header="t,q:J,qd:J,qdd:J", comments="")
+    backends = []
+    for trajs in ("[r0.csv]", "[r0.csv, r1.csv, r2.csv]"):
+        (tmp_path / "m.yaml").write_text(f"cases:\n  - {{name: c, mechanism: rotor.yaml, trajectories: {trajs}, "
+                                         "cycles_per_hour: 100, bearing_life_h: 1000}\n")
+        r = run_cli("verify", tmp_path / "m.yaml", "--json", tmp_path / "r.json", "-j", "1")
+        assert r.exit_code in (0, 1), r.stderr
+        backends.append({c["backend"] for c in json.loads((tmp_path / "r.json").read_text())["checks"]})
+    assert backends == [{"numpy (auto: first-call rule: fewer than 5,000 samples, and the kernel is neither "
+                         "compiled nor in the disk cache)"}, {"llvm"}]

@@ -37,9 +37,10 @@ class Job:
     path: str
     degrees: bool
     req: object   # design.checks.Requirements
+    backend: str = "auto"   # the path the whole command's work chose (:func:`command_backends`)
 
 
-def solve_samples(an, traj_path, degrees: bool, threads: int | None = None) -> Samples:
+def solve_samples(an, traj_path, degrees: bool, threads: int | None = None, backend: str = "auto") -> Samples:
     """Solve a trajectory file: times, every output column (each computed when a check
     first reads it: :class:`~gearcli.report.columns.LazyColumns`), and every real joint's
     rate; ``threads``: the solver's threads (None: every core)."""
@@ -47,7 +48,7 @@ def solve_samples(an, traj_path, degrees: bool, threads: int | None = None) -> S
                          loads=an.mech.loads, payloads=[p.name for p in an.mech.payloads])
     with at_samples(traj_path, tr):
         res = solve(an, tr.q, tr.qd, tr.qdd, loads=tr.loads, jobs=threads, check_finite=False,   # read checked them
-                    attach=tr.attach)
+                    attach=tr.attach, backend=backend)
     cols = LazyColumns(an, res, tr.t)
     cols.update(inertia_columns(an, tr.q, tr.attach))     # servo sizing: inertia at the rated motors
     return Samples(tr.t, cols, tr.qd @ an.S.T, backend_text(res))
@@ -66,13 +67,32 @@ def run_job(job: Job, threads: int | None = None) -> tuple[list[tuple], str]:
     keep_freed_memory()          # no page faults for every new array (:mod:`.heap`)
     an = case_analysis(job.mechanism)
     checks = build_checks(an, job.req, Collector(job.mechanism))
-    samples = solve_samples(an, job.path, job.degrees, threads)
+    samples = solve_samples(an, job.path, job.degrees, threads, job.backend)
     return partials(checks, samples, an.mech), samples.backend
 
 
 def jobs_of(manifest: Manifest) -> list[Job]:
-    return [Job(ci, ti, str(c.mechanism), str(tp), c.degrees, c.req)
+    backends = command_backends(manifest)
+    return [Job(ci, ti, str(c.mechanism), str(tp), c.degrees, c.req, backends[str(c.mechanism)])
             for ci, c in enumerate(manifest.cases) for ti, tp in enumerate(c.trajectories)]
+
+
+def command_backends(manifest: Manifest) -> dict[str, str]:
+    """{mechanism: the backend of its solves}: "auto"'s first-call rule applied to the whole
+    command's work, every sample of every trajectory of that mechanism in the manifest
+    (``verify`` knows them all before it starts: 20 trajectories of 2,201 samples are one
+    compile's worth, not 20 small first calls sent to numpy).  The path chosen is passed
+    to every job, so the report's backend line says "llvm" or why numpy."""
+    from ..dynamics.solve import solver_for      # noqa: PLC0415
+    rows: dict[str, int] = {}
+    for c in manifest.cases:
+        for tp in c.trajectories:
+            rows[str(c.mechanism)] = rows.get(str(c.mechanism), 0) + _lines(tp)
+    out = {}
+    for mech, n in rows.items():
+        how = solver_for(case_analysis(mech)).choice("block", "auto", max(n, 1))
+        out[mech] = "llvm" if how.path == "llvm" else "auto"
+    return out
 
 
 @dataclass(frozen=True)
@@ -204,3 +224,12 @@ def worst_samples(result: CaseResult, verdict: Verdict) -> tuple[np.ndarray, np.
     an = case_analysis(result.case.mechanism)
     s = solve_samples(an, result.case.trajectories[verdict.trajectory], result.case.degrees)
     return s.t, signal(verdict.check, s, an.mech)
+
+
+def _lines(path) -> int:
+    """Data rows of a (checked) trajectory file: its line count less the header."""
+    try:
+        with open(path, "rb") as f:
+            return max(sum(buf.count(b"\n") for buf in iter(lambda: f.read(1 << 20), b"")) - 1, 0)
+    except OSError:
+        return 0
