@@ -76,6 +76,7 @@ def payload(mass, inertia, path: str, add) -> tuple[float, np.ndarray]:
 
 
 LOAD_ATTRS = ("name", "link", "frame", "point", "force", "moment", "mass", "inertia")
+PAYLOAD_ATTRS = ("name", "link", "mass", "com", "inertia")
 
 
 class UrdfLoads:
@@ -87,21 +88,26 @@ class UrdfLoads:
     link's frame and re-expressed in the frame of the body the link belongs to (fixed joints
     merged)."""
 
-    def extension_loads(self, elements) -> tuple[Load, ...]:
+    def extension_loads(self, elements, payloads: bool = False) -> tuple[Load, ...]:
+        """The loads of ``gearcli:load`` elements, or with ``payloads`` the payloads that are
+        picked and placed of ``gearcli:payload`` elements (name, link, mass, com, inertia:
+        the centre of mass and the inertia about it, URDF link frame and axes)."""
         out: list[Load] = []
         seen: dict[str, int] = {}
+        kind, attrs = ("payload", PAYLOAD_ATTRS) if payloads else ("load", LOAD_ATTRS)
         for el in elements:
             name = el.get("name")
-            path = f"gearcli:load '{name}'"
+            path = f"gearcli:{kind} '{name}'"
             self.lines[path] = el.sourceline
-            self.unknown_attrs(el, LOAD_ATTRS, path)
-            if not name or not el.get("link") or not el.get("frame"):
-                self.add(path, "gearcli:load needs attributes name, link and frame", el)
+            self.unknown_attrs(el, attrs, path)
+            if not name or not el.get("link") or not (payloads or el.get("frame")):
+                self.add(path, f"gearcli:{kind} needs attributes name, link and "
+                         + ("mass" if payloads else "frame"), el)
                 continue
             if name in seen:
-                self.add(path, f"duplicate load name '{name}' (first at line {seen[name]})", el)
+                self.add(path, f"duplicate {kind} name '{name}' (first at line {seen[name]})", el)
             seen[name] = el.sourceline
-            frame = el.get("frame")
+            frame = "link" if payloads else el.get("frame")
             if frame not in LOAD_FRAMES:
                 self.add(path, f"unknown load frame '{frame}' (expected {' or '.join(LOAD_FRAMES)})", el)
             link = el.get("link")
@@ -113,7 +119,8 @@ class UrdfLoads:
                          f"{why} (link '{link}' is fixed to it)", el)
                 continue
             body = ref[0]
-            vals = [self.vector(el, k, path, default=np.zeros(3)) for k in ("point", "force", "moment")]
+            vals = [self.vector(el, k, path, default=np.zeros(3))
+                    for k in (("com" if payloads else "point"), "force", "moment")]
             T = ref[1]
             R, p = T[:3, :3], T[:3, 3]
             point = R @ vals[0] + p

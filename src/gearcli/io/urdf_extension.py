@@ -36,7 +36,7 @@ class Extension:
     ``leader`` and ``chain_leader``."""
 
     def read_extension(self) -> dict:
-        ext = {"mechanism": None, "gears": [], "motors": [], "loads": []}
+        ext = {"mechanism": None, "gears": [], "motors": [], "loads": [], "payloads": []}
         for el in self.root:
             if not isinstance(el.tag, str) or etree.QName(el).namespace != NS:
                 continue
@@ -56,11 +56,13 @@ class Extension:
                 ext["motors"].append(el)
             elif local == "load":
                 ext["loads"].append(el)
+            elif local == "payload":
+                ext["payloads"].append(el)
             elif local in ("motor_rating", "gear_rating", "motor_model"):
                 continue  # read by io.ratings_reader
             else:
                 self.add(f"gearcli:{local}", f"unknown gearcli element gearcli:{local} (expected gearcli:mechanism, "
-                         "gearcli:gear, gearcli:motor or gearcli:load)", el)
+                         "gearcli:gear, gearcli:motor, gearcli:load or gearcli:payload)", el)
         return ext
 
     def unknown_attrs(self, el, allowed, path: str) -> None:

@@ -134,6 +134,7 @@ class _Reader(StructureChecks, Mimics, Extension, UrdfLoads):
         joints = self.absorb_offsets(joints)
         motors = self.motors(ext, bool(ext["gears"]) or bad_pairs)
         loads = self.extension_loads(ext["loads"])
+        payloads = self.extension_loads(ext["payloads"], payloads=True)
         self.col.raise_if_any()
         mech_el = ext["mechanism"]
         end_effector, open_loop = self.end_effector(mech_el)
@@ -145,7 +146,7 @@ class _Reader(StructureChecks, Mimics, Extension, UrdfLoads):
             name=root.get("name") or Path(self.file).stem, base=self.base, end_effector=end_effector,
             links=tuple(links), joints=tuple(joints), gears=tuple(gears), motors=tuple(motors),
             gravity=np.asarray(gravity, float), source=self.file, lines=dict(self.lines),
-            open_loop=open_loop, warnings=tuple(self.warnings), loads=loads,
+            open_loop=open_loop, warnings=tuple(self.warnings), loads=loads, payloads=payloads,
         )
 
     # -- values (yourdfpy) ----------------------------------------------------------------------

@@ -275,7 +275,14 @@ def _add_extension(an: Analysis, root, corr: dict) -> None:
 
 
 def _add_loads(mech: Mechanism, root, corr: dict) -> None:
-    """One gearcli:load per external load, re-expressed in its link's URDF frame."""
+    """One gearcli:load per external load, re-expressed in its link's URDF frame, and one
+    gearcli:payload per payload that is picked and placed."""
+    for pl in mech.payloads:
+        R, _ = corr[pl.link]
+        I = R.T @ pl.inertia @ R
+        etree.SubElement(root, q("payload"), name=pl.name, link=pl.link, mass=_num(pl.mass),
+                         com=_vec(_to_urdf(corr, pl.link, pl.point)),
+                         inertia=_vec([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]))
     for ld in mech.loads:
         R, _ = corr[ld.link]
         f, m = (R.T @ ld.force, R.T @ ld.moment) if ld.frame == "link" else (ld.force, ld.moment)
