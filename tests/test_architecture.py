@@ -24,8 +24,8 @@ STAGE = {
     "batch": 8,
     "cli": 9, "exits": 9,      # exits: how a command ends (statuses, stderr lines), for cli
 }
-MAX_MODULE_LINES = 400
-MAX_FUNCTION_LINES = 60          # code lines, docstring excluded
+MAX_FUNCTION_LINES = 60          # code lines, docstring excluded: beyond, a warning (issue 39:
+HARD_FUNCTION_LINES = 120        # modules are split by concept, not cut to fit a line count)
 LONG_ALLOWED = {("dynamics/kinematics.py", "forward")}   # the kinematics recursion (issue 7)
 
 
@@ -113,19 +113,22 @@ def _code_lines(fn: ast.FunctionDef) -> int:
     return fn.end_lineno - fn.lineno + 1 - doc
 
 
-def test_modules_and_functions_are_small():
-    big, long = [], []
+def test_functions_are_small_enough_to_read_against_the_paper():
+    """A function over MAX_FUNCTION_LINES code lines is a warning (split it where a concept
+    ends); over HARD_FUNCTION_LINES a failure.  Modules have no line cap (issue 39)."""
+    import warnings
+    long, too_long = [], []
     for name, path in modules().items():
         text = path.read_text()
         rel = str(path.relative_to(SRC))
-        if text.count("\n") > MAX_MODULE_LINES:
-            big.append(f"{rel}: {text.count(chr(10))} lines")
         for node in ast.walk(ast.parse(text)):
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 n = _code_lines(node)
                 if n > MAX_FUNCTION_LINES and (rel, node.name) not in LONG_ALLOWED:
-                    long.append(f"{rel}: {node.name} ({n} lines)")
-    assert not big and not long, "\n".join(big + long)
+                    (too_long if n > HARD_FUNCTION_LINES else long).append(f"{rel}: {node.name} ({n} lines)")
+    if long:
+        warnings.warn("long functions: " + "; ".join(long))
+    assert not too_long, "\n".join(too_long)
 
 
 def test_readme_equation_table_names_existing_functions():

@@ -396,3 +396,15 @@ def test_forward_dynamics_with_slow_bearing_friction_settles_the_same_on_both_ba
     monkeypatch.setattr(forward, "SECANT_STEPS", forward.MAX_STEPS)      # the lossless M alone: no settling
     with pytest.raises(ValueError, match="did not settle"):
         forward_dynamics(an, q, qd, T, backend="numpy")
+
+
+@pytest.mark.parametrize("backend", ["numpy", "llvm"])
+@pytest.mark.parametrize("name", ["paper_2dof.yaml", "bendix_wrist.yaml", "planetary_3p.yaml", "servo_joint.yaml",
+                                  "rack_axis.yaml", "geared_arm.urdf"])
+def test_mass_matrix_is_exactly_symmetric(name, backend):
+    """M == M^T to the bit, as documented (issue 39: a mutation that dropped the
+    symmetrisation passed the whole suite, whose tolerances hid a 1e-16 asymmetry)."""
+    an = analyse(load_mechanism(MECH_DIR / name))
+    q, _, _ = random_state(an, 50, seed=4)
+    M = mass_matrix(an, q, backend=backend)
+    assert np.array_equal(M, np.swapaxes(M, 1, 2))

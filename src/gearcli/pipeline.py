@@ -1,7 +1,7 @@
 """File to file: mechanism + trajectory CSV -> loads CSV and summary (``gearcli solve``).
 
-Data flow: :func:`~gearcli.loader.load_mechanism` -> :func:`~gearcli.graph.analyse` ->
-:class:`~gearcli.trajectory.TrajectoryReader` (chunks) -> :func:`~gearcli.dynamics.solve` ->
+Data flow: :func:`~gearcli.io.load_mechanism` -> :func:`~gearcli.analysis.graph.analyse` ->
+:class:`~gearcli.io.trajectory.TrajectoryReader` (chunks) -> :func:`~gearcli.dynamics.solve` ->
 :mod:`~gearcli.report`.  Memory is bounded by the chunk size, whatever the file length.
 """
 from __future__ import annotations

@@ -12,7 +12,7 @@ Links are vertices, joints thin edges labelled by their axis line, gear pairs he
   carrier and fundamental circuit of each gear pair, transmission lines;
 * the linear map q = S q_ind from the independent (EOLC) joint angles to every real joint
   angle, and the structure matrix A (input rotations = A^T q_ind, paper Eq. 22);
-* the solution schedule (:mod:`gearcli.schedule`).
+* the solution schedule (:mod:`gearcli.analysis.schedule`).
 
 Problems are reported with the file and YAML path of the offending element.
 """

@@ -102,7 +102,7 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
     counts).
 
     ``sum``/``weight`` are the trapezoid integral of x^2 and the time span (rms,
-    :mod:`gearcli.design.rms`), or the Palmgren-Miner sum n_k P_k^p / a_ISO and the
+    :mod:`gearcli.report.rms`), or the Palmgren-Miner sum n_k P_k^p / a_ISO and the
     revolutions (life, :func:`gearcli.design.bearings.life_sum`); ``score`` ranks
     trajectories for "worst trajectory" (peak, RMS or equivalent load); ``counts`` (gear
     fatigue only, else None) the cycles the damage was computed from, per repetition: the

@@ -15,7 +15,7 @@ Sources
   table of Shigley's *Mechanical Engineering Design* (Budynas & Nisbett), Table 11-1:
   :data:`CATALOGUE_FA_C0`, :data:`CATALOGUE_E`, :data:`CATALOGUE_Y`.  It is used when a
   ball bearing gives no ``f0``.
-* Rolling-element types (:data:`gearcli.model.ratings.BEARING_TYPES`): life exponent p = 3
+* Rolling-element types (:data:`gearcli.model.ratings.BEARING_FACTOR_DEFAULTS`): life exponent p = 3
   for ball, 10/3 for roller bearings (ISO 281 §7.2); a cylindrical roller bearing
   (contact angle 0) carries no axial load, P = Fr (ISO 281 §7.3.2); a single-row tapered
   roller bearing of contact angle a has e = 1.5 tan a, X = 0.4, Y = 0.4 cot a (ISO 281

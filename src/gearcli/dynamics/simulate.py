@@ -207,15 +207,7 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
         qd, cur = x[dof:2 * dof], x[2 * dof:]
         return np.concatenate([qd, qdd, d.current_rate(t, qd, cur)]) if nL else np.concatenate([qd, qdd])
 
-    limits = []
-    for ji, name, lo, hi in joint_limits(an):
-        row = an.S[ji]
-        for side, bound in (("lower", lo), ("upper", hi)):
-            sign = 1.0 if side == "lower" else -1.0
-            ev = (lambda t, x, row=row, b=bound, s=sign: s * (row @ x[:dof] - b))
-            ev.terminal, ev.direction = True, -1.0
-            ev.joint = (name, side, bound)
-            limits.append(ev)
+    limits = _limit_events(an)
     x = np.concatenate([q0, qd0, np.zeros(nL)])
     segments, stop, nfev = [], None, 0
     if ss.units:                  # joints at rest at the start: held where their friction can
@@ -245,14 +237,8 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
                     stop = f"joint '{name}' reached its {side} limit {bound:g} at t = {te:.6g} s"
                     segments.append((np.array([te]), xe[None, :], (state["mode"], ss)))
                     raise _Stopped()
-                ji, kind = events[k].switch
-                mode = state["mode"]
-                if kind == "stick":
-                    state["mode"], xe[dof:2 * dof] = _switch(ss, mode, [ji], xe, d, te, dof, backend)
-                else:
-                    Q = dynamics(te, xe)[1][mode.stuck.index(ji)]
-                    released = Mode(tuple(j for j in mode.stuck if j != ji), {**mode.start, ji: -np.sign(Q) or 1.0})
-                    state["mode"], xe[dof:2 * dof] = _switch(ss, released, [], xe, d, te, dof, backend)
+                state["mode"], xe[dof:2 * dof] = _after_switch(ss, state["mode"], events[k].switch, xe, d, te,
+                                                               dof, backend, dynamics)
                 state["memo"] = (None, None, None)
                 x, a = xe, te
                 if a >= b:
@@ -264,6 +250,32 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
             raise
         stop = str(exc)
     return _samples(d, segments, stop, nfev, dof, backend)
+
+
+def _limit_events(an) -> list:
+    """The terminal events of the joints' position limits (``joint``: name, side, bound)."""
+    dof, out = an.dof, []
+    for ji, name, lo, hi in joint_limits(an):
+        row = an.S[ji]
+        for side, bound in (("lower", lo), ("upper", hi)):
+            sign = 1.0 if side == "lower" else -1.0
+            ev = (lambda t, x, row=row, b=bound, s=sign: s * (row @ x[:dof] - b))
+            ev.terminal, ev.direction = True, -1.0
+            ev.joint = (name, side, bound)
+            out.append(ev)
+    return out
+
+
+def _after_switch(ss, mode, switch, xe, d, te, dof, backend, dynamics):
+    """(mode, q') after the stick-slip event ``switch`` = (unit, "stick" or "slip") at
+    (te, xe): a unit whose rate reached 0 is held if it can be; a held one whose friction
+    reached F_s slips in the direction -sign Q (the others classified again)."""
+    k, kind = switch
+    if kind == "stick":
+        return _switch(ss, mode, [k], xe, d, te, dof, backend)
+    Q = dynamics(te, xe)[1][mode.stuck.index(k)]
+    released = Mode(tuple(j for j in mode.stuck if j != k), {**mode.start, k: -np.sign(Q) or 1.0})
+    return _switch(ss, released, [], xe, d, te, dof, backend)
 
 
 class _Stopped(Exception):

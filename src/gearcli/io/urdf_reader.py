@@ -1,4 +1,4 @@
-"""URDF robot descriptions -> :class:`~gearcli.model.Mechanism`.
+"""URDF robot descriptions -> :class:`~gearcli.model.mechanism.Mechanism`.
 
 What each URDF element becomes (README, "URDF in and out", has the table with examples):
 
@@ -14,12 +14,12 @@ What each URDF element becomes (README, "URDF in and out", has the table with ex
 * ``<inertial>``: the tensor, given about the centre of mass in the ``<origin>`` frame
   (xyz and rpy), is rotated into the link frame; links without ``<inertial>`` are massless;
 * ``<mimic joint="A" multiplier="m" offset="c"/>`` in joint B: a coupling
-  ``q_B = m q_A + c`` (a :class:`~gearcli.model.GearPair` with ``joints=(B, A)``).  The
+  ``q_B = m q_A + c`` (a :class:`~gearcli.model.mechanism.GearPair` with ``joints=(B, A)``).  The
   offset is absorbed into B's joint frame (B's coordinate is counted from the offset), so
   the kinematics stays linear.  Without gear geometry the coupling is ideal: a torque pair
   on the two joints, each joint's parent taking the reaction;
 * ``<transmission>``: actuators driving joints through reductions
-  (:mod:`gearcli.transmissions`); every movable joint that is neither a mimic follower nor
+  (:mod:`gearcli.io.urdf_transmissions`); every movable joint that is neither a mimic follower nor
   driven by a transmission gets a direct-drive motor named after the joint (unless the file
   has ``gearcli:gear`` elements, whose motors must then be listed);
 * extension elements in the namespace :data:`NS` (other URDF tools ignore them):
@@ -28,7 +28,7 @@ What each URDF element becomes (README, "URDF in and out", has the table with ex
   ``<gearcli:load .../>`` (an external load, :mod:`gearcli.io.loads_reader`), and,
   inside a ``<joint>``, ``<gearcli:joint label=/>`` and ``<gearcli:gear .../>`` (the mesh
   geometry of that joint's mimic coupling).  Elements and attributes marked
-  ``gearcli:derived="true"`` were written by :mod:`gearcli.urdf_export` for other tools and
+  ``gearcli:derived="true"`` were written by :mod:`gearcli.report.urdf_writer` for other tools and
   are ignored here (the gearcli elements hold the exact data).
 
 The primary links are a tree (``Mechanism.open_loop = "tree"``): the independent

@@ -1,6 +1,6 @@
 """URDF ``<transmission>`` elements -> actuators acting on joints with coefficients.
 
-Every supported transmission becomes one :class:`~gearcli.model.Motor` per actuator with
+Every supported transmission becomes one :class:`~gearcli.model.mechanism.Motor` per actuator with
 ``joints = ((joint, c), ...)``: the actuator's input rotation is ``theta_a = sum c q_joint``
 and its torque ``tau_a`` acts as ``c * tau_a`` about (along) each joint's axis, on the
 joint's child and, reversed, on its parent.  So the joint torques are ``tau_j = C^T tau_a``

@@ -1,4 +1,4 @@
-"""Mechanism files (YAML) -> :class:`~gearcli.model.Mechanism`.
+"""Mechanism files (YAML) -> :class:`~gearcli.model.mechanism.Mechanism`.
 
 Parsing keeps each node's line (``yaml.compose``) under its YAML path, e.g.
 ``gears[2].mesh_point``, so that every later check can say where a problem is.  The file is

@@ -17,7 +17,7 @@ write):
   dependent joint whose motion follows one independent joint alone as
   ``<mimic gearcli:derived="true">``, and motors on one joint as ``<transmission
   gearcli:derived="true">`` (both for other tools; gearcli ignores them on reading);
-* the exact gearcli data in extension elements (namespace :data:`gearcli.urdf.NS`):
+* the exact gearcli data in extension elements (namespace :data:`gearcli.io.urdf_xml.NS`):
   ``gearcli:mechanism`` (end effector, gravity, open loop), ``gearcli:gear`` (full gear
   geometry; angles in rad), ``gearcli:motor`` (link, stator, transmission coefficients),
   ``gearcli:load`` (external loads, in the URDF link frame), ``gearcli:joint`` (axis labels)

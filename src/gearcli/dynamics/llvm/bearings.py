@@ -6,7 +6,7 @@ on its parent), Mb_J = sum_b 1/2 mu_b d_b P_b from J's reaction [fx fy fz mx my]
 first block of J's child and parent solves (:class:`~.loss_program.BearingBlock`): the couple
 reaches no earlier block.  So in schedule order the fixed point is local to each block: only
 its own joints' moments change its solution, and the converged couples on the links of later
-blocks are loads there, as the joints' own friction (:func:`.losses.joint_friction`).
+blocks are loads there, as the joints' own friction (:func:`.friction_terms.joint_friction`).
 
 Per block, from Mb = 0 (iteration 1; in a smooth stretch of the motion the extrapolated
 moments of the two samples before, :func:`_warm`), as :func:`..bearing_friction.fixed_point`
@@ -349,7 +349,7 @@ def _failed(e: Emitter, prog, bb, new: list, change: list, fail, n) -> None:
 def _outputs(e: Emitter, s: Sample, lp, b: int, bb, jt: _Joints, Mb, it, links, n) -> None:
     """The converged Mb and the most iterations so far over the sample's blocks into its
     ``moments`` row, s_J Mb_J into ``s.bearing`` (the joint friction outputs,
-    :func:`.losses.write_losses`); the couples -s_J Mb_J z_J on the joints' links of later
+    :func:`.friction_terms.write_losses`); the couples -s_J Mb_J z_J on the joints' links of later
     blocks (rhs[L] -= Q w, reversed on the parent)."""
     fn = e.b.function
     row = e.row(next(a for a in fn.args if a.name == "moments"), n, lp.out_width)
