@@ -123,3 +123,26 @@ def test_the_real_timer_calls_poll(monkeypatch):
     assert bar.calls == ["start", ("add_task", "verify", 3, 0)]
     p.stop()
     assert made[0].cancelled and bar.calls[-1] == "stop"
+
+
+@pytest.mark.parametrize("mech, traj, backend", [("servo_joint_rated.yaml", "servo_joint_duty.csv", "llvm"),
+                                                 ("paper_2dof.yaml", "paper_2dof_traj.csv", "numpy")])
+def test_the_bar_moves_within_a_chunk_and_the_result_is_the_same(tmp_path, mech, traj, backend):
+    """A run shorter than one 20,000-sample chunk moved the bar once, at its end (issue 34,
+    section 4): the part is solved in steps of ~1/40 of the run (multiples of the kernel's
+    256-sample warm-start runs), and the table is the same bytes as without a bar."""
+    from pathlib import Path
+
+    from gearcli.pipeline import solve_file
+    root = Path(__file__).resolve().parents[1] / "mechanisms"
+    steps = []
+
+    def progress(total=None, advance=None):
+        if advance is not None:
+            steps.append(advance)
+    solve_file(root / mech, root / traj, tmp_path / "a.csv", precision=17, backend=backend, progress=progress)
+    solve_file(root / mech, root / traj, tmp_path / "b.csv", precision=17, backend=backend)
+    rows = len((root / traj).read_text().splitlines()) - 1
+    assert sum(steps) == rows and len(steps) >= min(8, rows // 256)
+    assert all(s % 256 == 0 for s in steps[:-1])
+    assert (tmp_path / "a.csv").read_bytes() == (tmp_path / "b.csv").read_bytes()

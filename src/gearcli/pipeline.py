@@ -27,7 +27,7 @@ from .dynamics.signs import SignError
 from . import __version__
 from .errors import GearcliError, Issue, TrajectoryError
 from .io.output import OutputError, atomic_output, output_target
-from .io.trajectory import TrajectoryReader
+from .io.trajectory import Trajectory, TrajectoryReader
 from .report.loss_summary import LossSummary, lossless_twin
 from .report.columns import Summary, column_names, column_units, first_non_finite, table
 from .report.table_files import CONVENTIONS, FORMATS, extension, format_of, open_table
@@ -140,28 +140,35 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
         with warnings.catch_warnings(), Prefetch(reader, depth=PREFETCH_CHUNKS) as parts:
             warnings.simplefilter("ignore")
             for part in parts:
-                with np.errstate(all="ignore"), at_samples(reader.file, part):
-                    res = solve(an, part.q, part.qd, part.qdd, method=method, chunk=chunk, verify=verify,
-                                loads=part.loads, backend=how.path, jobs=jobs, check_finite=False,  # read checked
-                                attach=part.attach)
-                    tab = table(an, part.t, res)
-                    if losses is not None:
-                        losses.add(an, part.t, res, lossless_motor(twin, part, method, chunk, backend, jobs))
-                record(table_file, part, tab, res)
+                tabs, residual = [], 0.0
+                for sub in progress_slices(part, step):     # the part's solve in steps the bar shows
+                    with np.errstate(all="ignore"), at_samples(reader.file, sub):
+                        res = solve(an, sub.q, sub.qd, sub.qdd, method=method, chunk=chunk, verify=verify,
+                                    loads=sub.loads, backend=how.path, jobs=jobs, check_finite=False,  # read checked
+                                    attach=sub.attach)
+                        tabs.append(table(an, sub.t, res))
+                        if losses is not None:
+                            losses.add(an, sub.t, res, lossless_motor(twin, sub, method, chunk, backend, jobs))
+                    residual = max(residual, res.residual) if verify else residual
+                    if progress is not None:
+                        progress(advance=len(sub.t))
+                record(table_file, part, tabs[0] if len(tabs) == 1 else np.concatenate(tabs), residual)
 
-    def record(table_file, part, tab, res):
+    # with a progress bar, a part's solve goes in steps of a multiple of the kernel's warm-start
+    # runs (results bit-identical to one call: the runs restart at the same samples), ~1/40 of the run
+    step = None if progress is None else max(WARM_RUN, rows // 40 // WARM_RUN * WARM_RUN)
+
+    def record(table_file, part, tab, residual):
         nonlocal worst, n
         watch.see(part)
         _check_loads(reader, part, tab, names)
         if verify:
-            _check_residual(reader, part, res.residual)
-            worst = max(worst, res.residual)
+            _check_residual(reader, part, residual)
+            worst = max(worst, residual)
         summary.add(tab)
         if table_file is not None:
             table_file.write(tab)
         n += len(part.t)
-        if progress is not None:
-            progress(advance=len(part.t))
 
     def opened(f):
         meta = {"gearcli_version": __version__, "mechanism": str(mech_path), "trajectory": str(traj_path),
@@ -176,6 +183,26 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
         with atomic_output(out, (mech_path, traj_path), binary=fmt != "csv") as f:
             _run(solve_chunks, opened(f))
     return SolveReport(an, n, summary, worst if verify else None, out, losses, watch.issues, how)
+
+
+WARM_RUN = 256
+"""Samples of the kernel's warm-start run (:data:`gearcli.dynamics.llvm.signs.WARM`, not
+imported: that imports llvmlite): a progress step is a multiple of it."""
+
+
+def progress_slices(part, step: int | None):
+    """``part`` (a :class:`~.io.trajectory.Trajectory`) whole, or in slices of ``step``
+    samples (its loads and attach flags sliced with it)."""
+    n = len(part.t)
+    if step is None or step >= n:
+        yield part
+        return
+    for s in range(0, n, step):
+        sl = slice(s, s + step)
+        yield Trajectory(part.t[sl], part.q[sl], part.qd[sl], part.qdd[sl],
+                         None if part.line is None else part.line[sl],
+                         None if part.loads is None else {k: v[sl] for k, v in part.loads.items()},
+                         None if part.attach is None else {k: v[sl] for k, v in part.attach.items()})
 
 
 def lossless_motor(twin: Analysis, part, method: str, chunk: int, backend: str, jobs) -> np.ndarray:
