@@ -138,7 +138,7 @@ def test_many_problems_print_the_first_fifty_and_count_the_rest(run_cli, tmp_pat
     assert res.exit_code == 2 and MAX_SHOWN == 50 and len(got) == 51
     first = line_of(text, "unknown_key_0:")
     assert got[:50] == [f"{path}:{first + i}: unknown_key_{i}: unknown key 'unknown_key_{i}' (allowed: "
-                        "name, description, gravity, base, end_effector, links, joints, gears, motors, loads)"
+                        "name, description, gravity, base, end_effector, links, joints, gears, motors, loads, payloads)"
                         for i in range(50)]
     assert got[50] == "… and 19,950 more problems"
     with pytest.raises(MechanismError) as info:
