@@ -46,7 +46,8 @@ import numpy as np
 
 from ...io.cache_root import BadEntry, cache_root, read_entry, remove_entry, write_entry
 
-FORMAT = 2                          # ours: change when the entry layout or the key changes
+FORMAT = 3                          # ours: change when the entry layout, the key or what an IR compiles to
+# changes (3: the middle-end passes skipped for a large IR, driver.pass_level)
 MAGIC = b"gearcli-llvm-obj\x00"
 _HEAD = len(MAGIC) + 8 + 8 + 32     # magic, header and payload lengths (little endian), SHA-256
 MAX_ENTRIES = 500

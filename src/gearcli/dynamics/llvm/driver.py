@@ -1,7 +1,8 @@
 """Compiling the generated kernel (:mod:`.kernel`) and running it, on one or more threads.
 
-LLVM through llvmlite: the IR is optimised at O3 for the host CPU (new pass manager) and
-compiled by MCJIT in memory, once per :class:`~..solve.Solver` (:class:`LlvmKernel` keeps
+LLVM through llvmlite: the IR is optimised for the host CPU (new pass manager: O3, or no
+middle-end pass for an IR above :data:`BIG_IR`, :func:`pass_level`; code generation at O3)
+and compiled by MCJIT in memory, once per :class:`~..solve.Solver` (:class:`LlvmKernel` keeps
 the engine alive: freeing it frees the code); the machine code is also kept on disk
 (:mod:`.cache`), so a later process generating the same IR loads it instead; one solving the
 same kernel program with the same generator source (:func:`generator_digest`) loads it without
@@ -94,8 +95,26 @@ def generator_digest() -> str | None:
     return h.hexdigest()
 
 
+BIG_IR = 1 << 20
+"""Characters of IR text above which the middle-end passes are skipped (O0 pipeline; the
+code generator still runs at O3).  The generator folds constants and emits straight-line
+SSA, so the O3 passes add little to such code but most of its compile time: measured
+2026-12-07 (jobs=1, 20,000 samples, medians of 7, load ~1): planetary_5p with every loss
+(4.6 MB of IR) 10.7 -> 3.7 s cold compile, 11.9 -> 12.8 ms a solve; planetary_3p_rated
+(4.7 MB) 3.7 -> 1.7 s, 12.6 -> 13.2 ms; servo_joint_rated (1.1 MB) 2.3 -> 1.4 s, 36.3 ->
+31.0 ms; planetary_5p (1.3 MB) 2.7 -> 0.8 s, 8.9 -> 9.1 ms.  Below it (the Bendix wrist,
+the paper's arm) O3 stays: compile is cheap there."""
+
+
+def pass_level(ir: str) -> int:
+    """The optimisation level of the middle-end pass pipeline for IR text ``ir``: 3, or 0
+    above :data:`BIG_IR` (a function of the IR alone, so the disk cache's object key, the IR
+    and the host, still names one machine code)."""
+    return 0 if len(ir) > BIG_IR else 3
+
+
 class Jit:
-    """An IR module compiled for the host CPU (O3); ``address(name)`` of its functions.
+    """An IR module compiled for the host CPU (:func:`pass_level`); ``address(name)`` of its functions.
 
     ``module``: the module, or a function making it, called only when needed
     (``build_seconds``: what that took, 0 before).  The machine code comes from the disk
@@ -143,10 +162,10 @@ class Jit:
         return self._ir
 
     def _optimised(self, llvm, tm):
-        """``self.ir`` parsed, verified and optimised (O3 pass pipeline)."""
+        """``self.ir`` parsed, verified and optimised (the pass pipeline of :func:`pass_level`)."""
         mod = llvm.parse_assembly(self.ir)
         mod.verify()
-        pto = llvm.create_pipeline_tuning_options(3)
+        pto = llvm.create_pipeline_tuning_options(pass_level(self.ir))
         pto.loop_vectorization = False     # nothing to gain (measured), ~15% of the pass time
         pb = llvm.create_pass_builder(tm, pto)
         pb.getModulePassManager().run(mod, pb)
