@@ -22,7 +22,8 @@ from gearcli import __version__
 from gearcli.dynamics.solve import solve
 from gearcli.io.output import atomic_output
 from gearcli.io.trajectory import TrajectoryReader
-from gearcli.pipeline import analyse, load_mechanism, prismatic_independent
+from gearcli.io import load_mechanism
+from gearcli.pipeline import analyse, prismatic_independent
 from gearcli.report.columns import Summary, column_names, column_units, first_non_finite, table
 from gearcli.report.table_files import open_table
 
