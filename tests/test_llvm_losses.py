@@ -416,3 +416,28 @@ def test_bundled_design_with_losses_takes_the_llvm_path():
     rel = doc["cases"][0]["mechanism"]
     an = analyse(load_mechanism((DESIGNS / rel).resolve()))
     assert an.mech.has_losses and solver_for(an).choice().path == "llvm"
+
+
+@pytest.mark.parametrize("mu, bore", [(0.9, 0.12), (0.99, 0.11)])
+def test_slow_bearing_friction_converges_on_both_paths(monkeypatch, mu, bore):
+    """A spur pair whose wheel turns in a bearing of mu 0.9-0.99 on a bore near its pitch
+    diameter: the fixed point contracts by ~0.96 an iteration, so 500 plain iterations did
+    not reach the tolerance on the numpy path while the kernel's Newton levels converge in
+    2-7 ("auto" then succeeded or failed by the trajectory's length; issue 34, section 5).
+    The numpy path's Anderson rescue converges, to the kernel's moments within their
+    tolerances (each stops within 1e-12 of its own iterate; ~1/(1 - Lambda) = 25 apart)."""
+    from gearcli import parse_mechanism
+    from gearcli.dynamics import bearing_friction
+    from test_loss_cli import SPUR
+    jw = "  - {name: Jw, parent: frame, child: wheel, origin: {xyz: [0.075, 0, 0]}, axis: [0, 0, 1]}"
+    an = analyse(parse_mechanism(SPUR.replace(jw, (
+        "  - name: Jw\n    parent: frame\n    child: wheel\n    origin: {xyz: [0.075, 0, 0]}\n    axis: [0, 0, 1]\n"
+        f"    bearings:\n      - {{name: w, position: 0.0, friction_coefficient: {mu}, bore: {bore}}}")), "s.yaml"))
+    t = np.linspace(0, 1, 200)
+    q, qd, qdd = np.sin(3 * t)[:, None], 3 * np.cos(3 * t)[:, None], -9 * np.sin(3 * t)[:, None]
+    ref, res = (solve(an, q, qd, qdd, backend=b) for b in ("numpy", "llvm"))
+    assert ref.bearing_iterations.max() > bearing_friction.MAX_ITERATIONS        # the rescue was needed
+    assert np.max(worst(res, ref)) <= 1e-11
+    monkeypatch.setattr(bearing_friction, "RESCUE", 0)
+    with pytest.raises(bearing_friction.BearingFrictionError):
+        solve(an, q, qd, qdd, backend="numpy")
