@@ -149,7 +149,7 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
                         tabs.append(table(an, sub.t, res))
                         if losses is not None:
                             losses.add(an, sub.t, res, lossless_motor(twin, sub, method, chunk, backend, jobs))
-                    residual = max(residual, res.residual) if verify else residual
+                    residual = float(np.max([residual, res.residual])) if verify else residual   # NaN stays NaN
                     if progress is not None:
                         progress(advance=len(sub.t))
                 record(table_file, part, tabs[0] if len(tabs) == 1 else np.concatenate(tabs), residual)

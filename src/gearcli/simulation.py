@@ -79,7 +79,8 @@ class SimulateReport:
     def summary(self, output: str, loads: str | None) -> list[str]:
         """What ``gearcli simulate`` prints on stdout."""
         sim = self.simulation
-        out = [f"Wrote {counted(len(sim.t), 'row')} to {output} (t = {sim.t[0]:g} to {sim.t[-1]:g} s, "
+        rows = len(sim.t) if sim.rows is None else sim.rows
+        out = [f"Wrote {counted(rows, 'row')} to {output} (t = {sim.t[0]:g} to {sim.t[-1]:g} s, "
                f"{counted(sim.nfev, 'evaluation')} of the dynamics)"]
         if self.loads is not None:
             out.append(f"Wrote {counted(self.loads.samples, 'row')} of loads to {loads}")
@@ -156,20 +157,22 @@ def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None
         warn(f"{input_path}: warning: {hint}")
     if progress is not None:
         progress(total=t1 - t0)
-    try:
-        sim = simulate(an, drive, t_eval, x0, v0, rtol=rtol, atol=atol, method=method, progress=StallWatch(
-            an, input_path, t0, t1, method, None if progress is None else (lambda t: progress(t=t - t0))))
-    except SimulationError as exc:       # before any sample: nothing to write
-        said = str(exc) if isinstance(exc, StallError) else f"simulation failed: {exc}"
-        raise GearcliError(f"{input_path}: {said} (nothing written)") from None
     names = an.independent_names
     payloads = list(drive.attach)           # carried where attached: the trajectory says where
     header = ",".join(["t"] + [f"{p}:{n}" for p in ("q", "qd", "qdd") for n in names] + [f"attach:{p}" for p in payloads])
-    flags = [[float(p in drive.attached_at(t)) for p in payloads] for t in sim.t] if payloads else np.zeros((len(sim.t), 0))
-    with atomic_output(out_path, inputs) as f:
-        f.write(header + "\n")
-        np.savetxt(f, np.column_stack([sim.t, sim.q, sim.qd, sim.qdd, np.asarray(flags, float).reshape(len(sim.t), -1)]),
-                   delimiter=",", fmt="%.17g")
+    watch = StallWatch(an, input_path, t0, t1, method, None if progress is None else (lambda t: progress(t=t - t0)))
+    try:
+        with atomic_output(out_path, inputs) as f:      # rows written as they are integrated
+            f.write(header + "\n")
+
+            def write(part):
+                flags = np.array([[float(p in drive.attached_at(t)) for p in payloads] for t in part.t],
+                                 float).reshape(len(part.t), -1)
+                np.savetxt(f, np.column_stack([part.t, part.q, part.qd, part.qdd, flags]), delimiter=",", fmt="%.17g")
+            sim = simulate(an, drive, t_eval, x0, v0, rtol=rtol, atol=atol, method=method, progress=watch, sink=write)
+    except SimulationError as exc:       # before any sample: nothing written (the output is removed)
+        said = str(exc) if isinstance(exc, StallError) else f"simulation failed: {exc}"
+        raise GearcliError(f"{input_path}: {said} (nothing written)") from None
     report = SimulateReport(an, sim, Path(out_path))
     if loads_path is not None:
         report.loads = solve_file(mech_path, out_path, loads_path, analysis=an)

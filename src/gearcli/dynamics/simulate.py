@@ -44,6 +44,7 @@ class Simulation:
     current: np.ndarray
     stop: str | None
     nfev: int
+    rows: int | None = None     # samples in all (a streamed run's, whose arrays are empty)
 
 
 class SimulationError(Exception):
@@ -164,13 +165,17 @@ def _accelerations(ss, mode, q, qd, T, backend, t):
 
 
 def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10, method: str = "DOP853",
-             progress=None, backend: str = "auto") -> Simulation:
+             progress=None, backend: str = "auto", sink=None) -> Simulation:
     """Integrate from (q0, qd0) at t_eval[0] to t_eval[-1]; samples at ``t_eval`` (s).
 
     ``drive`` a :class:`~gearcli.io.drive_input.DriveInput`; ``rtol``, ``atol``, ``method``
     those of :func:`scipy.integrate.solve_ivp` (atol in rad, rad/s, A); ``progress(t)`` is
     called with the time reached.  Raises :class:`SimulationError` when the integrator
-    fails or the state stops being finite.
+    fails or the state stops being finite before any sample; after one, the samples up to
+    there are kept and ``stop`` says why.  With ``sink``, each run of samples is passed to
+    ``sink(simulation)`` as soon as it is integrated (a :class:`Simulation` of those samples,
+    in time order) and the one returned holds no samples: ``t`` the first and last times,
+    ``rows`` their count (streaming: memory bounded by :data:`PIECE` samples).
     """
     from scipy.integrate import solve_ivp  # noqa: PLC0415  (scipy is a dependency; import when used)
 
@@ -209,7 +214,7 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
 
     limits = _limit_events(an)
     x = np.concatenate([q0, qd0, np.zeros(nL)])
-    segments, stop, nfev = [], None, 0
+    segments, stop, nfev = _Kept(sink, d, dof, backend), None, 0
     if ss.units:                  # joints at rest at the start: held where their friction can
         at_rest = [k for k in range(len(ss.units)) if ss.rate(k, x[dof:2 * dof]) == 0.0]
         state["mode"], x[dof:2 * dof] = _switch(ss, Mode(), at_rest, x, d, t_eval[0], dof, backend)
@@ -221,13 +226,18 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
                 # [a, b): a sample at a row takes the row's values (a pick or a place there)
                 last = b >= t_eval[-1]
                 wanted = t_eval[(t_eval >= a) & ((t_eval < b) | (last & (t_eval <= b)))]
+                piece = b if len(wanted) <= PIECE else float(wanted[PIECE])   # at most PIECE samples held
+                wanted = wanted[wanted < piece] if piece < b else wanted
                 switches = ss.events(state["mode"], x[dof:2 * dof], dof, lambda t, y: dynamics(t, y)[1])
                 events = limits + switches
-                sol = _integrate(solve_ivp, rhs, a, b, x, wanted, method, rtol, atol, events, segments,
+                sol = _integrate(solve_ivp, rhs, a, piece, x, wanted, method, rtol, atol, events, segments,
                                  (state["mode"], ss))
                 nfev += int(sol.nfev)
                 if sol.status != 1:
                     x = sol.y[:, -1]
+                    if piece < b:
+                        a = piece
+                        continue
                     break
                 k = next(i for i, te in enumerate(sol.t_events) if len(te))
                 te, xe = float(sol.t_events[k][0]), sol.y_events[k][0].copy()
@@ -249,7 +259,40 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
         if not segments:
             raise
         stop = str(exc)
+    if sink is not None:
+        return Simulation(np.array(segments.ends), *(np.zeros((0, n)) for n in (dof, dof, dof, len(d.kt), len(d.kt))),
+                          stop, nfev, segments.rows)
     return _samples(d, segments, stop, nfev, dof, backend)
+
+
+PIECE = 20_000
+"""Output samples integrated in one call at most (the integration restarts after them): a
+run of millions of samples (--dt 1e-7) is held a piece at a time, not whole."""
+
+
+class _Kept(list):
+    """The samples integrated so far, as segments (t, x, (mode, stick-slip units)); with a
+    ``sink`` each segment's samples (t, q, qd, qdd, motor torques, currents) go to it as
+    soon as they are kept, in time order, and only the count and the first and last times
+    stay (:func:`simulate`'s streaming)."""
+
+    def __init__(self, sink, d, dof, backend):
+        super().__init__()
+        self.sink, self.d, self.dof, self.backend = sink, d, dof, backend
+        self.rows, self.ends = 0, []
+
+    def append(self, segment) -> None:
+        if self.sink is None:
+            super().append(segment)
+            self.rows += len(segment[0])
+            return
+        sim = _samples(self.d, [segment], None, 0, self.dof, self.backend)
+        self.sink(sim)
+        self.rows += len(sim.t)
+        self.ends = [self.ends[0] if self.ends else float(sim.t[0]), float(sim.t[-1])]
+
+    def __bool__(self) -> bool:
+        return self.rows > 0
 
 
 def _limit_events(an) -> list:
