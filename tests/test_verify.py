@@ -629,3 +629,47 @@ def test_first_call_rule_counts_the_whole_command(run_cli, tmp_path, monkeypatch
         backends.append({c["backend"] for c in json.loads((tmp_path / "r.json").read_text())["checks"]})
     assert backends == [{"numpy (auto: first-call rule: fewer than 5,000 samples, and the kernel is neither "
                          "compiled nor in the disk cache)"}, {"llvm"}]
+
+
+@pytest.mark.parametrize("d_p", [0.1, 2.0])
+def test_crossed_roller_life_and_static_safety_by_hand(run_cli, tmp_path, d_p):
+    """One crossed-roller bearing carries the rotor's radial force m w^2 r, its weight m g
+    axially and its tilting moment m r (h w^2 + g) (module notes).  P_c = x (F_r + 2 M/d_p)
+    + y F_a: d_p = 0.1 m gives F_a/F = 0.55 (x = 1, y = 0.45), d_p = 2 m gives 1.74 (x = y =
+    0.67); L10h = (C/P_c)^(10/3) 1e6 / revolutions an hour; static P0 = F + 0.44 F_a (issue 35:
+    read as a plain radial load, the life came out 1,150x too long)."""
+    bearing = (f"[{{name: xrb, position: 0, C: 5000, C0: 8000, type: crossed_roller, pitch_diameter: {d_p}}}]")
+    r, doc = run_json(run_cli, tmp_path, "cases:\n" + write_rotor_case(tmp_path, bearing))
+    assert r.exit_code in (0, 1), r.stderr
+    Fr, Fa, Mt = M * W ** 2 * R, M * G, M * R * (H * W ** 2 + G)
+    F = Fr + 2 * Mt / d_p
+    x, y = (1.0, 0.45) if Fa / F <= 1.5 else (0.67, 0.67)
+    assert (Fa / F <= 1.5) == (d_p == 0.1)
+    P = x * F + y * Fa
+    life = by_name(doc)[("rotor", "bearing J/xrb", "L10 life")]["value"]
+    assert life == pytest.approx((5000 / P) ** (10 / 3) * 1e6 / (3600 * W / (2 * math.pi)), rel=1e-9)
+    s0 = by_name(doc)[("rotor", "bearing J/xrb", "static safety s0")]["value"]
+    assert s0 == pytest.approx(8000 / (F + 0.44 * Fa), rel=1e-9)
+    if d_p == 0.1:      # the moment left out (a plain radial bearing): a life 17x too long
+        assert (P / (x * Fr + y * Fa)) ** (10 / 3) > 15
+
+
+@pytest.mark.parametrize("bearings, message", [
+    ("[{name: a, position: 0, C: 5000, C0: 8000, type: crossed_roller}]", "needs its pitch_diameter"),
+    ("[{name: a, position: 0, C: 5000, C0: 8000, type: ball, pitch_diameter: 0.1}]", "pitch_diameter is for a crossed_roller"),
+    ("[{name: a, position: 0, C: 5000, C0: 8000, type: crossed_roller, pitch_diameter: 0.1}, "
+     "{name: b, position: 0.1, C: 5000, C0: 8000, type: ball}]", "a crossed-roller bearing is a joint's only bearing"),
+])
+def test_crossed_roller_input_problems_are_located(run_cli, tmp_path, bearings, message):
+    (tmp_path / "rotor.yaml").write_text(rotor_yaml(bearings))
+    r = run_cli("check", tmp_path / "rotor.yaml")
+    assert r.exit_code == 2 and message in r.stderr and "rotor.yaml:" in r.stderr
+
+
+def test_crossed_roller_survives_the_urdf_round_trip(run_cli, tmp_path):
+    bearing = "[{name: xrb, position: 0, C: 5000, C0: 8000, type: crossed_roller, pitch_diameter: 0.1}]"
+    (tmp_path / "rotor.yaml").write_text(rotor_yaml(bearing))
+    assert run_cli("export", tmp_path / "rotor.yaml", "-o", tmp_path / "rotor.urdf").exit_code == 0
+    from gearcli import load_mechanism
+    b = load_mechanism(tmp_path / "rotor.urdf").joints[0].bearings[0]
+    assert (b.type, b.pitch_diameter, b.C, b.C0) == ("crossed_roller", 0.1, 5000.0, 8000.0)

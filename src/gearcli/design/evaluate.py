@@ -80,6 +80,12 @@ def _signal(check: Check, s: Samples, mech, cache: dict) -> np.ndarray:
         if ("loads", jt.name) not in cache:
             cache[("loads", jt.name)] = bearing_loads(s, jt.name, jt.bearings)
         Fr, Fa = cache[("loads", jt.name)][check.signal[2]]
+        if b.type == "crossed_roller":           # its only bearing: the joint's tilting moment too,
+            c, z = s.cols, b.position            # about the bearing's centre, z along the axis:
+            M = np.hypot(c[f"joint:{jt.name}:mx"] + z * c[f"joint:{jt.name}:fy"],    # M_O - z e_z x F
+                         c[f"joint:{jt.name}:my"] - z * c[f"joint:{jt.name}:fx"])
+            return (iso281.crossed_roller_load if kind == "bearing_P" else iso281.crossed_roller_static_load)(
+                Fr, Fa, M, b.pitch_diameter)
         if kind == "bearing_P":
             return iso281.bearing_equivalent_load(b, Fr, Fa)
         return B.static_equivalent_load(Fr, Fa, b.X0, b.Y0)

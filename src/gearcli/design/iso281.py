@@ -140,6 +140,25 @@ def bearing_equivalent_load(b, Fr, Fa) -> np.ndarray:
     return dynamic_equivalent_load(Fr, Fa, X, Y, e)
 
 
+def crossed_roller_load(Fr, Fa, M, d_p: float) -> np.ndarray:
+    """Dynamic equivalent radial load P_c of a crossed-roller bearing, N (catalogue: THK
+    "Cross-Roller Ring", IKO "Crossed Roller Bearings"; ``../shared/drive-elements.md`` A):
+    its tilting moment M (N*m) acts as a radial load 2 M/d_p on the rollers of pitch
+    diameter d_p (m), F = F_r + 2 M/d_p, and P_c = x F + y F_a with x = 1, y = 0.45 while
+    F_a/F <= 1.5, else x = y = 0.67 (a pure axial load, F = 0: the second branch)."""
+    Fr, Fa, M = (np.abs(np.asarray(v, float)) for v in (Fr, Fa, M))
+    F = Fr + 2.0 * M / d_p
+    low = Fa <= 1.5 * F
+    return np.where(low, F + 0.45 * Fa, 0.67 * (F + Fa))
+
+
+def crossed_roller_static_load(Fr, Fa, M, d_p: float) -> np.ndarray:
+    """Static equivalent radial load of a crossed-roller bearing, N: F_r + 2 M/d_p + 0.44 F_a
+    (THK, "Cross-Roller Ring": static equivalent radial load)."""
+    Fr, Fa, M = (np.abs(np.asarray(v, float)) for v in (Fr, Fa, M))
+    return Fr + 2.0 * M / d_p + 0.44 * Fa
+
+
 def life_exponent(kind: str) -> float:
     """p of L10 = (C/P)^p: 3 for ball bearings, 10/3 for every roller type."""
     return 3.0 if kind == "ball" else 10.0 / 3.0

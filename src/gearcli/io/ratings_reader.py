@@ -24,6 +24,7 @@ MOTOR_KEYS = ("peak_torque", "rms_torque", "max_speed", "max_power", "thermal_wi
               "max_inertia_ratio", "max_regen_energy")   # and torque_speed (YAML only: a table)
 MODEL_KEYS = ("kt", "resistance", "inductance", "supply_voltage")   # motors[].model, <gearcli:motor_model>
 BEARING_KEYS = ("name", "position", "C", "C0", "type", "X", "Y", "e", "X0", "Y0", "locating", "M", "f0", "a_ISO",
+                "pitch_diameter",
                 "kappa", "e_C", "Cu", "friction_coefficient", "bore")
 RATING_KEYS = ("C", "C0", "type")     # a rated bearing has all three (the design checks need them)
 LIFE_FACTOR_KEYS = ("kappa", "e_C", "Cu")
@@ -73,7 +74,16 @@ def bearing_ratings(specs: list[dict], path: str, add) -> tuple[BearingRating, .
     out = []
     for i, spec in enumerate(specs):
         p = f"{path}[{i}]"
-        _positive(spec, ("C", "C0", "X", "Y", "e", "M", "f0", "a_ISO", "kappa", "e_C", "Cu", "bore"), p, add)
+        _positive(spec, ("C", "C0", "X", "Y", "e", "M", "f0", "a_ISO", "kappa", "e_C", "Cu", "bore", "pitch_diameter"),
+                  p, add)
+        crossed = spec.get("type") == "crossed_roller"
+        if crossed and spec.get("pitch_diameter") is None:
+            add(f"{p}.pitch_diameter", "a crossed-roller bearing needs its pitch_diameter d_p (m): its tilting moment "
+                "M loads it as 2 M/d_p")
+        elif crossed and len(specs) != 1:
+            add(f"{p}.type", "a crossed-roller bearing is a joint's only bearing (it carries the tilting moment itself)")
+        elif spec.get("pitch_diameter") is not None and not crossed:
+            add(f"{p}.pitch_diameter", "pitch_diameter is for a crossed_roller bearing")
         if not _rated_or_friction(spec, p, add):
             continue
         if "type" not in spec:      # friction only: no rating, no factors
@@ -89,7 +99,7 @@ def bearing_ratings(specs: list[dict], path: str, add) -> tuple[BearingRating, .
             add(f"{p}.locating", "a joint's only bearing takes the axial load: it cannot be non-locating")
         _life_factor_keys(spec, p, add)
         opt = {k: None if spec.get(k) is None else float(spec[k])
-               for k in ("M", "f0", "a_ISO", "friction_coefficient", "bore") + LIFE_FACTOR_KEYS}
+               for k in ("M", "f0", "a_ISO", "friction_coefficient", "bore", "pitch_diameter") + LIFE_FACTOR_KEYS}
         out.append(BearingRating(spec["name"], float(spec["position"]), float(spec["C"]), float(spec["C0"]),
                                  spec["type"], *(None if f[k] is None else float(f[k]) for k in ("X", "Y", "e")),
                                  float(f["X0"]), float(f["Y0"]), bool(spec.get("locating", len(specs) == 1)),

@@ -20,6 +20,10 @@ BEARING_FACTOR_DEFAULTS = {
     "cylindrical_roller": {"X": 1.0, "Y": 0.0, "e": 0.0, "X0": 1.0, "Y0": 0.0},
     "tapered_roller": _TAPERED,
     "roller": _TAPERED,
+    # a single crossed-roller bearing: P_c (gearcli.design.iso281.crossed_roller_load) and the
+    # catalogues' static P0 = F_r + 2 M/d_p + 0.44 F_a (THK, "Cross-Roller Ring", static
+    # equivalent radial load); X, Y, e unused
+    "crossed_roller": {"X": 1.0, "Y": 0.45, "e": 1.5, "X0": 1.0, "Y0": 0.44},
 }
 """Default ISO 281 (X, Y, e) and ISO 76 (X0, Y0) factors by rolling-element type (README,
 "Bearings"); None: from ISO 281 Table 3 at each sample's f0 Fa/C0
@@ -109,6 +113,7 @@ class BearingRating:
     # P_b the magnitude of the bearing's load (dynamics.bearing_friction); bore in m.
     friction_coefficient: float | None = None
     bore: float | None = None
+    pitch_diameter: float | None = None     # m: a crossed-roller bearing's d_p (its moment as 2 M/d_p)
 
     @property
     def rated(self) -> bool:

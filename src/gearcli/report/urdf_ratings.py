@@ -30,7 +30,7 @@ def add_rating_elements(mech, root, joint_elements: dict) -> None:
             etree.SubElement(joint_elements[jt.name], _q("bearing"),
                              _attrs(b, ("name", "position", "C", "C0", "type", "X", "Y", "e", "X0", "Y0",
                                         "locating", "M", "f0", "a_ISO", "kappa", "e_C", "Cu",
-                                        "friction_coefficient", "bore")))
+                                        "friction_coefficient", "bore", "pitch_diameter")))
     for m in mech.motors:
         if m.rating is not None:
             etree.SubElement(root, _q("motor_rating"), {"motor": m.name,
