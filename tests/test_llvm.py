@@ -185,12 +185,15 @@ def test_auto_takes_numpy_when_llvmlite_does_not_import():
                                        "backend 'llvm' unavailable: llvmlite does not import"]
 
 
-def test_retired_kernel_backend_is_refused():
-    """The numba kernel was retired (issue 18): backend "kernel" is a ValueError saying so."""
-    an = analyse(load_mechanism(MECH / "paper_2dof.yaml"))
-    q = np.zeros((3, an.dof))
-    with pytest.raises(ValueError, match=r"^backend 'kernel' \(the numba kernel\) was retired: use 'llvm'"):
-        solve(an, q, q, q, backend="kernel")
+def test_an_unknown_backend_is_refused():
+    """Only "auto", "llvm" and "numpy" (the retired numba kernel's "kernel" is an unknown
+    name now: issue 39 removed its remains)."""
+    from pathlib import Path
+    an = analyse(load_mechanism(Path(__file__).resolve().parents[1] / "mechanisms" / "paper_2dof.yaml"))
+    q = np.zeros((2, an.dof))
+    for name in ("kernel", "numba", ""):
+        with pytest.raises(ValueError, match=rf"^unknown backend '{name}' \(expected one of auto, llvm, numpy\)"):
+            solve(an, q, q, q, backend=name)
 
 
 def _paper_with_loads(count: int):

@@ -35,7 +35,7 @@ from gearcli import analyse
 from gearcli import load_mechanism
 from gearcli.spatial import align_z
 from gearcli.io.urdf_reader import load_urdf, parse_urdf
-from gearcli.report.efforts import joint_efforts
+from oracles import joint_efforts
 from gearcli.report.urdf_writer import export_urdf
 
 pin = pytest.importorskip("pinocchio")

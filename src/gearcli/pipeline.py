@@ -79,7 +79,7 @@ def check_solve_options(an: Analysis, method: str, backend: str) -> Analysis:
     must be available for the mechanism when asked for)."""
     if method not in ("block", "full"):
         raise GearcliError(f"--method: expected 'block' or 'full', got '{method}'")
-    if backend not in BACKENDS and backend != "kernel":   # "kernel": the solver's own answer (retired)
+    if backend not in BACKENDS:
         raise GearcliError(f"--backend: expected one of {', '.join(BACKENDS)}, got '{backend}'")
     try:
         solver_for(an).choice(method, backend)

@@ -20,9 +20,6 @@ mechanism as LLVM IR (:mod:`.llvm.kernel`: method "block"; its machine code is k
     a call in less time than a cold compile takes (0.15-0.3 s for 5-10 moving links, ~4 s
     for Talos' 44; numpy solves ~200,000 samples/s of Bendix plus ~1.5 ms a call).  A run of
     small calls (a simulation's steps) compiles once they add up: 4-sample calls at the 20th.
-
-The old "kernel" backend (numba, retired in issue 18) is refused with
-:data:`KERNEL_RETIRED`.
 """
 from __future__ import annotations
 
@@ -35,9 +32,6 @@ a kernel that is neither compiled nor in the disk cache; below, numpy solves the
 CALL_SAMPLES = 250
 """The least a call counts for, in samples: numpy's fixed cost of a call (~1-1.5 ms for the
 Bendix, measured) is about that many samples' work (~5 us each)."""
-KERNEL_RETIRED = ("backend 'kernel' (the numba kernel) was retired: use 'llvm' (the generated kernel) "
-                  "or 'auto'")
-
 
 @dataclass(frozen=True)
 class Choice:
@@ -82,8 +76,6 @@ def _first_call(sol, n: int | None) -> str | None:
 def choose(sol, method: str, backend: str, n: int | None) -> Choice:
     """The path a solve of n samples (None: a large call) by the :class:`~.solve.Solver`
     ``sol`` takes."""
-    if backend == "kernel":
-        raise ValueError(KERNEL_RETIRED)
     if backend not in BACKENDS:
         raise ValueError(f"unknown backend '{backend}' (expected one of {', '.join(BACKENDS)})")
     if backend == "numpy":

@@ -297,7 +297,7 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
         llvm, except numpy for method "full", where llvmlite does not import or the kernel
         refuses the mechanism (a block with > 32 signed meshes), and by the first-call rule
         of :mod:`.backends` (``Result.backend`` says which ran, ``Result.backend_note`` why numpy).  Both give the
-        same results to rounding.  "kernel" (the retired numba kernel) is a ValueError.
+        same results to rounding.
     jobs : int, optional
         Threads a compiled kernel splits the samples over (contiguous ranges; results
         bitwise identical for any number); None: every usable core.  The numpy path uses one.
@@ -324,7 +324,7 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
     ValueError
         for bad shapes (of ``out`` too), a non-finite motion value, an unknown load name or a
         load value that is not finite, an unknown
-        backend, the retired backend "kernel", or backend "llvm" where it is unavailable.
+        backend, or backend "llvm" where it is unavailable.
     """
     if attach:
         from .payloads import attach_flags, by_groups  # noqa: PLC0415
