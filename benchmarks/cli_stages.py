@@ -23,7 +23,7 @@ from gearcli.dynamics.solve import solve
 from gearcli.io.output import atomic_output
 from gearcli.io.trajectory import TrajectoryReader
 from gearcli.io import load_mechanism
-from gearcli.pipeline import analyse, prismatic_independent
+from gearcli.pipeline import analyse
 from gearcli.report.columns import Summary, column_names, column_units, first_non_finite, table
 from gearcli.report.table_files import open_table
 
@@ -52,7 +52,7 @@ def stage_times(mech: Path, traj: Path, chunk: int = 20_000) -> dict[str, float]
     """Seconds of every stage of ``gearcli solve mech traj -o out.parquet|csv``, one after the
     other in this thread (after a warm-up solve), by the command's own functions."""
     an = analyse(load_mechanism(mech))
-    reader = TrajectoryReader(traj, an.independent_names, chunk=chunk, linear=prismatic_independent(an),
+    reader = TrajectoryReader(traj, an.independent_names, chunk=chunk, linear=an.prismatic_independent,
                               loads=an.mech.loads)
     out: dict[str, float] = {}
     t0 = time.perf_counter()

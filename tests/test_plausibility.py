@@ -17,7 +17,6 @@ from gearcli.io.trajectory import TrajectoryReader
 from gearcli.model.mechanism import Link
 from gearcli.model.plausibility import (MAX_DENSITY, MIN_DENSITY, ellipsoid_density, link_density,
                                         sphere_density)
-from gearcli.pipeline import prismatic_independent
 from gearcli.report.unit_warnings import RateWatch, mechanism_issues
 
 MECH_DIR = Path(__file__).resolve().parents[1] / "mechanisms"
@@ -155,7 +154,7 @@ def test_rate_watch_bounds_on_the_bundled_trajectories():
     for traj in sorted(MECH_DIR.glob("*_traj.csv")):
         mech = next(p for p in BUNDLED if p.stem == traj.name.removesuffix("_traj.csv"))
         an = analyse(load_mechanism(mech))
-        reader = TrajectoryReader(traj, an.independent_names, linear=prismatic_independent(an))
+        reader = TrajectoryReader(traj, an.independent_names, linear=an.prismatic_independent)
         watch = RateWatch(reader, an)
         for part in reader:
             watch.see(part)

@@ -42,12 +42,6 @@ VERIFY_TOLERANCE = 1e-8
 not finite); a sound solve gives ~1e-15."""
 
 
-def prismatic_independent(an: Analysis) -> list[str]:
-    """Names of the independent coordinates that are prismatic joints (m, not rad)."""
-    return [n for n, ji in zip(an.independent_names, an.independent)
-            if ji >= 0 and an.mech.joints[ji].type == "prismatic"]
-
-
 @dataclass
 class SolveReport:
     """What :func:`solve_file` did: the analysis, the number of samples, the load summary,
@@ -118,10 +112,10 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
     ``warnings``; with ``strict`` the first one is a
     :class:`~gearcli.report.unit_warnings.StrictError` (nothing written).
     """
-    fmt = _output_format(out_path, (mech_path, traj_path), precision)   # refuse a bad -o before any work
+    fmt = output_format(out_path, (mech_path, traj_path), precision)   # refuse a bad -o before any work
     an = analysis or load_analysed(mech_path)
     reader = TrajectoryReader(traj_path, an.independent_names, degrees=degrees, chunk=chunk,
-                              linear=prismatic_independent(an), loads=an.mech.loads,
+                              linear=an.prismatic_independent, loads=an.mech.loads,
                               payloads=[p.name for p in an.mech.payloads])
     to_stdout = out_path is not None and str(out_path) == "-"
     rows = reader.check() if to_stdout or fmt == "npz" else reader.count()   # exact count first
@@ -310,7 +304,7 @@ class BackgroundWriter:
         self.file.abort()
 
 
-def _output_format(out_path, inputs, precision: int | None) -> str:
+def output_format(out_path, inputs, precision: int | None) -> str:
     """The format of ``out_path`` (``csv`` when None); raises for a bad target, an unknown
     extension or a bad ``precision``."""
     if precision is not None and not (isinstance(precision, int) and 1 <= precision <= 17):

@@ -17,7 +17,7 @@ from .analysis.graph import Analysis
 from .dynamics.determinacy import load_analysed
 from .errors import GearcliError, counted
 from .io.output import OutputError, atomic_output, output_target
-from .pipeline import SolveReport, _output_format, solve_file
+from .pipeline import SolveReport, output_format, solve_file
 from .report.table_files import format_of
 
 MAX_SIMULATE_SAMPLES = 10_000_000
@@ -128,7 +128,7 @@ def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None
         raise OutputError(str(out_path), f"simulate writes its trajectory as CSV, the file `gearcli solve` reads: "
                           f"give -o TRAJ.csv (and --loads LOADS.{format_of(str(out_path))} for the loads in that format)")
     if loads_path is not None:
-        _output_format(loads_path, inputs + (out_path,), None)
+        output_format(loads_path, inputs + (out_path,), None)
     if method not in METHODS:
         raise GearcliError(f"--method: expected one of {', '.join(METHODS)}, got '{method}'")
     for name, v in (("--rtol", rtol), ("--atol", atol), ("--dt", dt)):

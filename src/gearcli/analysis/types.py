@@ -98,6 +98,12 @@ class Analysis:
         return rows
 
     @property
+    def prismatic_independent(self) -> list[str]:
+        """Names of the independent coordinates that are prismatic joints (m, not rad)."""
+        return [n for n, ji in zip(self.independent_names, self.independent)
+                if ji >= 0 and self.mech.joints[ji].type == "prismatic"]
+
+    @property
     def dof(self) -> int:
         """Degrees of freedom: the number of independent coordinates."""
         return self.S.shape[1]

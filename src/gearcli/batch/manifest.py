@@ -24,7 +24,6 @@ from ..io.yaml_reader import json_path, number_issues
 from ..io.yaml_safe import read_text, yaml_lines
 from ..model.validate import MAX_ABS
 from ..dynamics.determinacy import load_analysed
-from ..pipeline import prismatic_independent
 from ..io.schemas import packaged_schema
 
 REQUIREMENT_KEYS = ("cycles_per_hour", "service_life_h", "bearing_life_h", "gear_life_h", "min_static_safety",
@@ -302,7 +301,7 @@ def _prepare_case(spec: dict, where: str, base: Path, col: Collector, issues: li
     for tp in trajs if degrees is not None else ():   # a bad 'degrees': the rows' scale is unknown
         try:
             TrajectoryReader(tp, an.independent_names, degrees=degrees,
-                             linear=prismatic_independent(an), loads=an.mech.loads,
+                             linear=an.prismatic_independent, loads=an.mech.loads,
                              payloads=[p.name for p in an.mech.payloads]).check(keep=True)  # rows only,
             # no spline; the rows are kept for the job that solves the file in this process
         except GearcliError as exc:

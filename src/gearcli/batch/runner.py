@@ -21,7 +21,7 @@ from ..design.sizing import inertia_columns
 from ..dynamics.solve import solve
 from ..errors import Collector, GearcliError
 from ..io.trajectory import forget_rows, read_trajectory
-from ..pipeline import at_samples, prismatic_independent
+from ..pipeline import at_samples
 from ..report.columns import LazyColumns
 from .heap import keep_freed_memory
 from .manifest import Case, Manifest, case_analysis
@@ -53,7 +53,7 @@ def solve_samples(an, traj_path, degrees: bool, threads: int | None = None, back
     trajectory is solved :data:`STREAM` samples at a time and only the columns the checks
     read are kept (found on the first part: 1e6 samples of the rated arm took 1.5 GB, its
     solve 0.26 GB)."""
-    tr = read_trajectory(traj_path, an.independent_names, degrees=degrees, linear=prismatic_independent(an),
+    tr = read_trajectory(traj_path, an.independent_names, degrees=degrees, linear=an.prismatic_independent,
                          loads=an.mech.loads, payloads=[p.name for p in an.mech.payloads])
     if checks is not None and len(tr.t) > STREAM:
         return _streamed(an, traj_path, tr, threads, backend, checks)

@@ -87,7 +87,7 @@ def _fixed_in(an, g) -> set[int]:
     return {an.circuits[g.index].carrier}
 
 
-def _primary_side(an, g) -> int:
+def primary_side(an, g) -> int:
     """The link that receives +column of group g."""
     if g.kind == "joint":
         return an.tree.index[an.mech.joints[g.index].child]
@@ -121,7 +121,7 @@ def _propagation_columns(an, F, gs, signed, to_F, cols) -> tuple[dict, dict]:
     joint's basis is its parent's (the solution is then rotated by -q to the child's)."""
     C, parent_side = {}, {}
     for gi, g in enumerate(gs):
-        P = _primary_side(an, g)
+        P = primary_side(an, g)
         if gi in signed:
             cp, cm = to_F(cols.group(g, P, 1.0), P), to_F(cols.group(g, P, -1.0), P)
             C[gi] = ((cp + cm) / 2, (cp - cm) / 2)
@@ -140,7 +140,7 @@ def _friction_columns(an, blk, gs, signed, to_F, cols) -> tuple[np.ndarray | Non
     fric = np.zeros((len(signed), 6 * len(blk)))
     fric_C = {}
     for n, gi in enumerate(signed):
-        g, P = gs[gi], _primary_side(an, gs[gi])
+        g, P = gs[gi], primary_side(an, gs[gi])
         couple = cols.mesh_friction(g.index, P)
         if couple is None:
             continue
@@ -325,7 +325,7 @@ def solve_blocks(an, plans, kin: Kinematics, b: dict, q_all: np.ndarray):
                 if gi in p.fric_C:     # friction couple, sigma s_v t = s_v |t|
                     wF = wF + (np.abs(xg) * sv[:, p.signed.index(gi), None]) @ p.fric_C[gi].T
                 w = wF if at_rest else _rotate(kin.R[p.F], wF)           # world axes, about o_F
-                P = _primary_side(an, g)
+                P = primary_side(an, g)
                 for L in p.later[gi]:
                     _subtract(rhs[L], 1.0 if L == P else -1.0, w, kin.o[p.F], kin.o[L])
             if gi in p.signed:

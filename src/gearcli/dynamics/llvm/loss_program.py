@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..bearing_friction import bearing_layout, friction_joints
-from ..blocks import _primary_side
+from ..blocks import primary_side
 from ..kinematics import forward
 from ..losses import mesh_friction_moment
 from ..pattern_maps import PatternMaps
@@ -182,7 +182,7 @@ def build_loss_program(an, plans) -> LossProgram | None:
             blocks[bi] = BlockLosses(tuple(pos), rates, circ, None, None, later, rows)
         else:
             assert p.fric is not None and all(p.signed[n] in p.fric_C for n in pos)
-            assert all(_primary_side(an, p.groups[p.signed[n]]) == an.circuits[ci].j for n, ci in zip(pos, circ))
+            assert all(primary_side(an, p.groups[p.signed[n]]) == an.circuits[ci].j for n, ci in zip(pos, circ))
             couple_F = np.array([p.fric_C[p.signed[n]][3:, 0] for n in pos], float)
             blocks[bi] = BlockLosses(tuple(pos), rates, circ, np.ascontiguousarray(p.fric[pos], float),
                                      couple_F, later, maps=_table(p, pos))

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 
 from ...analysis.schedule import unknown_groups
-from ..blocks import _primary_side
+from ..blocks import primary_side
 from .basis import basis as _basis
 from .lossy_maps import hot_lossy_maps
 from .output_maps import output_constants
@@ -142,13 +142,13 @@ class _Builder:
     def propagation(self, an, p, gi, g, later, first: int) -> bool:
         """Append group gi's propagation record (False: merged into the previous one)."""
         Cp, Cs = p.C[gi]
-        if Cs is None and self._merge(int(p.offs[gi]), g.size, _primary_side(an, g), later, Cp, first):
+        if Cs is None and self._merge(int(p.offs[gi]), g.size, primary_side(an, g), later, Cp, first):
             return False
         off = self.add_floats(self.cmat, Cp)
         if Cs is not None:
             self.add_floats(self.cmat, Cs)
         self.prec.append(dict(col0=int(p.offs[gi]), ncols=g.size, signed=int(Cs is not None), cmat0=off,
-                              primary=_primary_side(an, g), later0=len(self.later), nlater=len(later)))
+                              primary=primary_side(an, g), later0=len(self.later), nlater=len(later)))
         self.later += later
         return True
 
