@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..spatial import cross, mv
+from ..spatial import cross
 
 
 def mesh_friction_moment(an, ci: int) -> np.ndarray | None:
