@@ -88,7 +88,7 @@ def test_iso_factor_defaults_are_the_documented_ones():
     r = BEARING_FACTOR_DEFAULTS["tapered_roller"]
     tan15 = math.tan(math.radians(15))
     assert r["e"] == pytest.approx(1.5 * tan15, abs=0.005) and r["Y"] == pytest.approx(0.4 / tan15, abs=0.005)
-    assert [I.life_exponent(k) for k in BEARING_FACTOR_DEFAULTS] == [3.0] + [pytest.approx(10 / 3)] * 3
+    assert [I.life_exponent(k) for k in BEARING_FACTOR_DEFAULTS] == [3.0] + [pytest.approx(10 / 3)] * 4
 
 
 def test_lewis_example_shigley_14_1():

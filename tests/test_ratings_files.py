@@ -86,7 +86,7 @@ def test_urdf_module_disagreeing_with_the_mesh_names_the_rating_element(run_cli,
 
 
 @pytest.mark.parametrize("edit, message", [
-    (('type="ball" Y="1.8"', 'type="balls" Y="1.8"'), "gearcli:bearing[1].type: bearing type must be one of ball, cylindrical_roller, tapered_roller, roller, got 'balls'"),
+    (('type="ball" Y="1.8"', 'type="balls" Y="1.8"'), "gearcli:bearing[1].type: bearing type must be one of ball, cylindrical_roller, tapered_roller, roller, crossed_roller, got 'balls'"),
     (('C0="5000" type="ball" Y', 'C0="5e3" tipe="ball" Y'), "unknown attribute 'tipe'"),
     (('locating="true"', 'locating="false"'), "with two bearings, exactly one needs 'locating: true'"),
     (('motor="elbow_motor"', 'motor="elbow"'), "unknown motor 'elbow' (known: shoulder_motor, elbow_motor, gripper_motor)"),
@@ -107,7 +107,7 @@ def test_urdf_rating_errors(run_cli, tmp_path, edit, message):
 
 @pytest.mark.parametrize("edit, message", [
     ("{name: xrb, position: 0.0, C: 2900, C0: 3300, type: roller, M: 15}",
-     "joints[2].bearings[0].type: expected one of: ball, cylindrical_roller, tapered_roller, roller; got 'rolling'"),
+     "joints[2].bearings[0].type: expected one of: ball, cylindrical_roller, tapered_roller, roller, crossed_roller; got 'rolling'"),
     ("rating: {peak_torque: 0.5, rms_torque: 0.3, max_speed: 15, max_power: 5}}",
      "motors[0].rating.rms_torque: rms_torque 0.9 exceeds peak_torque 0.5"),
 ])
