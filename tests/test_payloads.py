@@ -153,3 +153,13 @@ def test_payloads_survive_the_urdf_round_trip_bit_for_bit(run_cli, tmp_path):
         r = run_cli("solve", tmp_path / src, traj, "-o", tmp_path / out, "--precision", "17")
         assert r.exit_code == 0, r.stderr
     assert (tmp_path / "a.csv").read_text() == (tmp_path / "b.csv").read_text()
+
+
+def test_check_and_graph_describe_the_payload(run_cli, tmp_path):
+    (tmp_path / "arm.yaml").write_text(ARM)
+    r = run_cli("check", tmp_path / "arm.yaml")
+    assert r.exit_code == 0
+    assert ("payload 'box' on link 'arm': 1.5 kg at [0.4, 0, 0] m (link frame), carried where a trajectory's "
+            "attach:box is 1") in r.stdout.splitlines()
+    d = json.loads(run_cli("graph", tmp_path / "arm.yaml", "--json").stdout)
+    assert [(p["name"], p["link"], p["mass"], p["com"]) for p in d["payloads"]] == [("box", "arm", 1.5, [0.4, 0, 0])]

@@ -25,6 +25,12 @@ def load_dicts(an: Analysis) -> list[dict]:
             for ld in an.mech.loads]
 
 
+def payload_dicts(an: Analysis) -> list[dict]:
+    """Each payload that is picked and placed: name, link, mass (kg), com (m, link frame)."""
+    return [{"name": p.name, "link": p.link, "mass": float(p.mass), "com": [float(v) for v in p.point],
+             "inertia": [[float(v) for v in row] for row in p.inertia]} for p in an.mech.payloads]
+
+
 def pair_dicts(an: Analysis) -> list[dict]:
     """Each helical pair (helix angle, hands of j and k) and rack (pinion, rack, pitch
     radius r and x_rack = x_per_rad * theta_pinion), in circuit order."""
@@ -43,12 +49,15 @@ def pair_dicts(an: Analysis) -> list[dict]:
 
 def feature_notes(an: Analysis) -> list[str]:
     """Human-readable lines: ``load 'tip' on link '2' (frame base): force [..] N, moment [..]
-    N*m at [..] m``, ``helical pair ...``, ``rack pair ...``, then the losses
+    N*m at [..] m``, ``payload 'box' on link 'arm': ...``, ``helical pair ...``, ``rack pair
+    ...``, then the losses
     (:func:`gearcli.report.loss_notes.loss_notes`)."""
     lines = [f"load '{d['name']}' on link '{d['link']}' (frame {d['frame']}): force {_vec(d['force'])} N, "
              f"moment {_vec(d['moment'])} N*m at {_vec(d['point'])} m (link frame)"
              + (f"; payload mass {d['mass']:.6g} kg (its weight and inertia move with the link)" if "mass" in d else "")
              for d in load_dicts(an)]
+    lines += [f"payload '{d['name']}' on link '{d['link']}': {d['mass']:.6g} kg at {_vec(d['com'])} m (link frame), "
+              f"carried where a trajectory's attach:{d['name']} is 1" for d in payload_dicts(an)]
     for d in pair_dicts(an):
         if d["kind"] == "helical":
             hands = ", ".join(f"'{k}' {v} hand" for k, v in d["hands"].items())

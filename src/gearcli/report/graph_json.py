@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from ..analysis.graph import Analysis, Circuit
 from ..model.mechanism import Mechanism
-from .features import load_dicts, pair_dicts
+from .features import load_dicts, pair_dicts, payload_dicts
 from .loss_notes import loss_dicts
 from .sharing import sharing_sets
 
@@ -45,6 +45,7 @@ def analysis_dict(an: Analysis) -> dict:
         "solve_order": [[n[i] for i in block] for block in an.schedule],
         "load_sharing": sharing_sets(an),
         "loads": load_dicts(an),
+        "payloads": payload_dicts(an),
         "helical_and_rack_pairs": pair_dicts(an),
         "losses": loss_dicts(an),
     } | ({"open_loop": "tree"} if an.open_loop == "tree" else {})
