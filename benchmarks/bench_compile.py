@@ -67,6 +67,7 @@ def subjects(tmp: Path | None = None, chains=CHAINS) -> list[tuple[str, Path]]:
     if tmp is not None:
         out.append(("planetary_5p, every loss (10 lossy pairs)", lossy_copy(ROOT / "mechanisms" / "planetary_5p.yaml",
                                                                              tmp / "planetary_5p_lossy.yaml")))
+        out.append(("lossy drive, 14 links, 16 lossy pairs", ROOT / "benchmarks" / "lossy_drive_16_pairs.yaml"))
         sys.path.insert(0, str(ROOT / "tests"))
         from big_mechanisms import geared_chain  # noqa: PLC0415
         for links in chains:
@@ -109,12 +110,15 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--startup-repeat", type=int, default=5)
     ap.add_argument("--no-cli", action="store_true", help="skip the gearcli solve wall times")
+    ap.add_argument("--only", nargs="*", help="only the mechanisms whose names contain one of these words")
     args = ap.parse_args()
     print(f"# llvm kernel: compile cost, fresh processes, medians of {args.repeat}\n{load_line()} at start\n")
     print("| mechanism | moving links | IR build | LLVM (O3; O0 passes above 1 MB of IR), cold | IR text + load, cached | IR size | instructions | "
           "first llvm solve, cold | first llvm solve, cached |\n|---|---|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
         for name, path in subjects(Path(tmp)):
+            if args.only and not any(w in name for w in args.only):
+                continue
             med, warm = llvm_runs(path, args.repeat, Path(tmp) / name.replace(" ", "_"))
             from gearcli import analyse, load_mechanism  # noqa: PLC0415
             links = len(analyse(load_mechanism(path)).tree.moving)
