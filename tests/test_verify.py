@@ -677,7 +677,8 @@ def test_crossed_roller_survives_the_urdf_round_trip(run_cli, tmp_path):
 
 def test_a_long_trajectory_is_solved_in_parts_with_the_same_verdicts(run_cli, tmp_path, monkeypatch):
     """verify solves a long trajectory STREAM samples at a time, keeping only the columns its
-    checks read (1e6 samples of the rated arm: 1.48 -> 1.02 GB peak; issue 34, section 5):
+    checks read, evaluates the checks one component at a time and returns the fast parser's
+    buffers (1e6 samples of the rated arm: 1.48 -> 0.65 GB peak; issue 34, section 5):
     the report is the same bytes as one whole solve (parts of 512 samples, a multiple of the
     kernel's warm-start run; motors, bearings, gears, every check kind of the arm)."""
     import gearcli.batch.runner as runner

@@ -114,10 +114,16 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
     fatigue only, else None) the cycles the damage was computed from, per repetition: the
     rainflow cycles as ((stress, number), ...) by stress (Pa) and the tooth passes.
     """
-    out = []
+    out: list = [None] * len(checks)
     span = float(s.t[-1] - s.t[0]) if s.t.size else 0.0
     cache: dict = {}
-    for ch in checks:
+    component = None
+    # one component's checks after another, its signals (bearing loads, stresses, revolutions)
+    # dropped when the next begins: a long trajectory holds a few (N,) arrays, not every check's
+    for i, ch in sorted(enumerate(checks), key=lambda ic: ic[1].component):
+        if ch.component != component:
+            cache.clear()
+            component = ch.component
         x = signal(ch, s, mech, cache)
         k = _peak_index(cache, ch, x)
         peak, tp = (float(np.abs(x[k])), float(s.t[k])) if x.size else (0.0, math.nan)
@@ -145,7 +151,7 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
             score = total
             levels, number = np.unique(peaks, return_counts=True)
             counts = (tuple(zip(levels.tolist(), number.tolist())), revs - passes)
-        out.append((peak, tp, total, wsum, revs, score, span, counts))
+        out[i] = (peak, tp, total, wsum, revs, score, span, counts)
     return out
 
 
