@@ -152,7 +152,7 @@ def test_kernel_equals_numpy_on_robots(case, backend, tmp_path):
 def test_low_rank_block_without_hot_patterns():
     """planetary_5p's block (10 signed meshes, 1,024 patterns) solved from one base matrix
     (pattern_maps.LowRank): with no hot pattern every trial is the generated k x k solve
-    (llvm.solve), which must equal the numpy path's direct pattern maps too."""
+    (llvm.dense_solve), which must equal the numpy path's direct pattern maps too."""
     from gearcli.dynamics.external import load_values
     from gearcli.dynamics.llvm.driver import LlvmKernel
     from gearcli.dynamics.result_arrays import result_arrays, work_arrays

@@ -73,7 +73,7 @@ def mech_loads(an) -> list:
     return [(an.tree.index[ld.link], ld.frame == "link", np.asarray(ld.point, float)) for ld in an.mech.loads]
 
 
-GENERATOR = ("kernel", "blocks", "build", "links", "outputs", "signs", "solve", "trig", "world", "driver",
+GENERATOR = ("kernel", "blocks", "build", "links", "outputs", "signs", "dense_solve", "trig", "world", "driver",
              "losses", "friction_terms", "inverse_cache", "hot_pairs", "mass", "bearings", "bearing_newton", "../result_arrays", "../signs",
              "../bearing_friction")
 """The modules (paths from :mod:`gearcli.dynamics.llvm`, without .py) whose code makes a kernel program's IR text (a test

@@ -14,7 +14,7 @@ import llvmlite.ir as ir
 from .build import D, I1, Emitter
 from .links import floats
 from .signs import signs_of
-from .solve import loop_solve
+from .dense_solve import loop_solve
 
 
 PIVOT_GROWTH = 100.0
@@ -113,7 +113,7 @@ class WorldBlock:
     :func:`..sharing.mesh_weights`) is solved through a square basis (``free``: the columns
     left out, :func:`.basis._free_columns`; :meth:`_by_basis`), or where none was
     found from the KKT system of :func:`..sharing.kkt` (:meth:`_least_load`), each with
-    the loop code of :mod:`.solve`, the
+    the loop code of :mod:`.dense_solve`, the
     matrices in stack arrays of the ``fn`` ``run``.
 
     ``full_trial``: a trial solves the whole block (:func:`.signs.resolve` keeps
@@ -141,7 +141,7 @@ class WorldBlock:
     def _by_basis(self, e: Emitter, A: list, R: list) -> list:
         """The least-load solution through the basis A_B (every column but the d ``free``):
         [p | Q] = A_B^-1 [r | A_free] (:func:`lu_solve` in the stored row order, or the
-        pivoting loop code of :mod:`.solve` when a static pivot is poor), then the free unknowns from
+        pivoting loop code of :mod:`.dense_solve` when a static pivot is poor), then the free unknowns from
         (Q^T W_B Q + W_free) x_free = Q^T W_B p (d x d, :func:`eliminate`) and x_B = p - Q x_free:
         the minimiser of sum w x^2 over the solutions of A x = r, for each r of ``R``."""
         k, (free, order, swaps), w = len(R[0]), self.free, self.weights
@@ -236,7 +236,7 @@ class LowRankBlock:
     first, and the ones random motions meet most, :func:`.program._hot_maps`) is a
     product with its map, straight-line with the constants (a ``switch`` over them); any
     other pattern computes y = Y r and g = G r, solves the k x k system
-    (C_sigma + W) c = g (a call of the loop code of :mod:`.solve`: such a pattern is
+    (C_sigma + W) c = g (a call of the loop code of :mod:`.dense_solve`: such a pattern is
     rare, its code small) and takes x = y - Z c."""
 
     def __init__(self, lr, tcols: list, hot):
