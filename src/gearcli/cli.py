@@ -260,7 +260,8 @@ def _print_summary(console, report, verify: bool) -> None:
 @reports_bad_input
 def simulate(
     mech: Path = typer.Argument(..., metavar="MECH", help=MECH_HELP, show_default=False),
-    drive: Path = typer.Argument(..., metavar="INPUT.csv", show_default=False, help="t, motor:<m> (N*m) or voltage:<m> (V)."),
+    drive: Path = typer.Argument(..., metavar="INPUT.csv", show_default=False,
+                                 help="t, motor:<m> (N*m) or voltage:<m> (V), optional attach:<payload> (0 or 1)."),
     output: str = typer.Option(..., "-o", "--output", metavar="TRAJ.csv", help="Trajectory to write (t, q:, qd:, qdd:)."),
     t_end: float = typer.Option(None, "--t-end", metavar="T", help="End time, s (default: the input's last t)."),
     q0: str = typer.Option(None, "--q0", metavar="Q1,Q2,...", help="Initial joint angles, rad (m) (default 0)."),
@@ -272,7 +273,9 @@ def simulate(
     loads: str = typer.Option(None, "--loads", metavar="LOADS.csv", help="Also write the loads, as 'gearcli solve'."),
 ) -> None:
     """Integrate the exact geared dynamics under motor torques or voltages, losses included (its energy falls by them;
-    --loads has gear:<pair>:loss, joint:<joint>:loss in W, joint:<joint>:friction); a joint limit stops it (exit 1)."""
+    --loads has gear:<pair>:loss, joint:<joint>:loss in W, joint:<joint>:friction).  Joints with Coulomb friction stick
+    and slip (joints[].friction.static); attach:<payload> columns (0/1, held from row to row) carry payloads.  A joint
+    limit, a stall or a failure after the first sample stops it: the trajectory up to there is written (exit 1)."""
     from .simulation import simulate_with_progress  # noqa: PLC0415
     report = simulate_with_progress(mech, drive, output, stderr_console(), load_analysis(mech), t_end, q0, qd0, dt, rtol, atol, method, loads)
     if report.simulation.stop:
