@@ -178,7 +178,7 @@ def graph(
 # solve
 # ---------------------------------------------------------------------------------------
 TRAJ_HELP = ("Trajectory CSV: header t,q:<joint>,... for every independent joint (rad; m if prismatic), optional "
-             "qd:/qdd: columns (rad/s, rad/s^2), load:<name>:fx..mz (N, N*m); time t in s, strictly increasing.")
+             "qd:/qdd: columns (rad/s, rad/s^2), load:<name>:fx..mz (N, N*m), attach:<payload> (0 or 1); time t in s, strictly increasing.")
 
 METHOD_OPTION = typer.Option("block", "--method", metavar="block|full", help="'block': level-by-level schedule (fast); 'full': cross-check.")
 JOBS_OPTION = typer.Option(None, "--jobs", "-j", min=1, metavar="N",
