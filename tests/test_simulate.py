@@ -700,3 +700,25 @@ def test_a_long_run_is_integrated_and_written_a_piece_at_a_time(run_cli, mech_di
     a, b = read_csv(tmp_path / "whole.csv"), read_csv(tmp_path / "pieces.csv")
     assert np.array_equal(a["t"], b["t"])
     assert np.abs(a["q:J1"] - b["q:J1"]).max() < 1e-8 and np.abs(a["qd:J2"] - b["qd:J2"]).max() < 1e-7
+
+
+@pytest.mark.parametrize("static", [100.0, 50.0])
+def test_a_linear_guide_sticks_or_slips_under_the_process_force(run_cli, mech_dir, tmp_path, static):
+    """rack_axis: the 80 N process force pushes the carriage against its guide's friction
+    (Coulomb 40 N, static 100 or 50 N), the motor off.  100 N holds it (it stays at 0);
+    50 N cannot, and it slides back at a = -(80 - 40) / (m + J/r^2) with m = 6 kg and the
+    pinion's 7.2e-5 kg*m^2 on r = 24 mm: a prismatic joint's friction is a force along its axis."""
+    text = (mech_dir / "rack_axis.yaml").read_text()
+    guide = "    type: prismatic\n    origin: {xyz: [0, -0.024, 0.05]}\n    axis: [1, 0, 0]\n"
+    assert text.count(guide) == 1
+    mech = write(tmp_path / "rack.yaml", text.replace(guide, guide + f"    friction: {{coulomb: 40, static: {static}}}\n"))
+    inp = write(tmp_path / "in.csv", "t,motor:motor\n0,0\n0.5,0\n")
+    r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv", "--rtol", "1e-10", "--atol", "1e-12")
+    assert r.exit_code == 0, r.stderr
+    tr = read_csv(tmp_path / "traj.csv")
+    if static == 100.0:
+        assert np.all(tr["q:Jx"] == 0.0) and np.abs(tr["qd:Jx"]).max() <= 1e-12
+    else:
+        a = -(80.0 - 40.0) / (6.0 + 7.2e-5 / 0.024 ** 2)
+        assert np.abs(tr["qdd:Jx"][1:] - a).max() <= 1e-9 * abs(a)
+        assert tr["q:Jx"][-1] == pytest.approx(0.5 * a * 0.5 ** 2, rel=1e-9)
