@@ -39,6 +39,16 @@ def test_the_mechanism_reference_is_generated_from_the_schema():
         "docs/reference/mechanism.md differs from the schema: run python docs/gen_reference.py"
 
 
+def test_the_cli_reference_is_generated_from_the_commands():
+    sys.path.insert(0, str(DOCS))
+    try:
+        import gen_cli
+    finally:
+        sys.path.pop(0)
+    assert (DOCS / "reference" / "cli.md").read_text() == gen_cli.page(), \
+        "docs/reference/cli.md differs from the commands' help: run python docs/gen_cli.py"
+
+
 def _pages_with_commands():
     for page in sorted(DOCS.rglob("*.md")):
         lines = [ln[2:] for block in re.findall(r"```console\n(.*?)```", page.read_text(), re.S)
