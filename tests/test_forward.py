@@ -168,8 +168,9 @@ def kernel_error(an, q, qd, loads=None) -> tuple[float, float]:
     """max over samples of |M_llvm - M_numpy| and |h_llvm - h_numpy|, each relative to the
     sample's largest reference torque (of M and h: the reference's columns tau(e_i) - h
     round at the size of h)."""
-    M, h, _ = forward._mass_and_h(an, q, qd, np.zeros_like(q), loads, "llvm", None)
-    Mr, hr, _ = forward._mass_and_h(an, q, qd, np.zeros_like(q), loads, "numpy", None)
+    from gearcli.dynamics.solve import solver_for
+    M, h, _ = forward._mass_and_h(solver_for(an), q, qd, np.zeros_like(q), loads, "llvm", None)
+    Mr, hr, _ = forward._mass_and_h(solver_for(an), q, qd, np.zeros_like(q), loads, "numpy", None)
     scale = np.maximum(np.abs(Mr).max(axis=(1, 2)), np.abs(hr).max(axis=1))
     return (float(np.max(np.abs(M - Mr).max(axis=(1, 2)) / scale)),
             float(np.max(np.abs(h - hr).max(axis=1) / scale)))
@@ -224,7 +225,7 @@ def test_beyond_max_kernel_dof_the_stacked_llvm_solve(monkeypatch):
     q, qd, _ = random_state(an, 20, seed=14)
     assert max(kernel_error(an, q, qd)) < 1e-12
     sol = solver_for(an)
-    assert sol not in forward._KERNELS and sol.compiled_llvm()
+    assert sol.mass_kernel[0] is None and sol.compiled_llvm()
 
 
 def test_first_call_rule_keeps_a_small_first_call_on_the_reference(monkeypatch, tmp_path):
@@ -239,10 +240,10 @@ def test_first_call_rule_keeps_a_small_first_call_on_the_reference(monkeypatch, 
     sol = solver_for(an)
     q, qd, T = random_state(an, FIRST_CALL_SAMPLES // (an.dof + 1), seed=13)
     small = forward_dynamics(an, q[:10], qd[:10], T[:10])
-    assert forward._KERNELS[sol][0] is None and not sol.compiled_llvm()
+    assert sol.mass_kernel[0] is None and not sol.compiled_llvm()
     assert rel_err(small, forward_dynamics(an, q[:10], qd[:10], T[:10], backend="numpy")) < 1e-12
     forward_dynamics(an, q, qd, T)
-    assert forward._KERNELS[sol][0] is not None
+    assert sol.mass_kernel[0] is not None
 
 
 def test_round_trip_with_per_sample_loads():
@@ -408,3 +409,26 @@ def test_mass_matrix_is_exactly_symmetric(name, backend):
     q, _, _ = random_state(an, 50, seed=4)
     M = mass_matrix(an, q, backend=backend)
     assert np.array_equal(M, np.swapaxes(M, 1, 2))
+
+
+def test_an_explicit_solver_holds_its_own_kernels():
+    """gearcli.Solver(an, backend=...): solve, forward_dynamics, mass_matrix and
+    motor_inertia with the solver's kernels and defaults, the same values as the module
+    functions; a solver made for llvm compiles its own kernels, the convenience's stay
+    untouched (issue 39, section 2)."""
+    from gearcli.dynamics.solve import solver_for
+    an = analyse(load_mechanism(MECH_DIR / "bendix_wrist.yaml"))
+    q, qd, T = random_state(an, 30, seed=9)
+    s = gearcli.Solver(an, backend="llvm", jobs=1)
+    assert not s.compiled_llvm() and s.mass_kernel[0] is None
+    qdd = s.forward_dynamics(q, qd, T)
+    assert s.mass_kernel[0] is not None
+    res = s.solve(q, qd, qdd)
+    assert s.compiled_llvm() and res.backend == "llvm"
+    assert rel_err(res.motor, T) < 1e-12
+    assert rel_err(qdd, forward_dynamics(an, q, qd, T, backend="numpy")) < 1e-10
+    assert rel_err(s.mass_matrix(q), mass_matrix(an, q, backend="numpy")) < 1e-12
+    assert rel_err(s.motor_inertia(q), motor_inertia(an, q, backend="numpy")) < 1e-12
+    assert solver_for(an) is not s
+    numpy_solver = gearcli.Solver(an, backend="numpy")
+    assert numpy_solver.solve(q, qd, qdd).backend == "numpy" and not numpy_solver.compiled_llvm()

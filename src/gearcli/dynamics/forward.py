@@ -54,7 +54,6 @@ acceleration: ValueError.
 """
 from __future__ import annotations
 
-import weakref
 
 import numpy as np
 
@@ -62,7 +61,7 @@ from .backends import CALL_SAMPLES, FIRST_CALL_SAMPLES
 from .external import load_values
 from .inputs import joint_names, sample_arrays
 from .llvm.cache import has_program
-from .solve import solve, solver_for
+from .solve import solver_for
 
 CHUNK = 2_000
 """Forward samples per batched solve (each becomes dof + 1 inverse-dynamics samples)."""
@@ -79,7 +78,7 @@ SECANT_STEPS = 8
 then takes Newton steps with the lossy Jacobian (:func:`_lossy_jacobian`, dof + 1 solves)."""
 
 
-def _stacked_chunks(an, q, qd, loads, backend, jobs):
+def _stacked_chunks(sol, q, qd, loads, backend, jobs):
     """The reference of :func:`_mass_and_h`: yield (slice, tau (m, dof + 1, dof)) chunk by
     chunk, [:, 0] = tau(q, qd, 0) = h, [:, 1 + i] = tau(q, qd, e_i), from one solve of
     m * (dof + 1) samples per chunk (``backend`` "numpy": the numpy reference)."""
@@ -91,12 +90,9 @@ def _stacked_chunks(an, q, qd, loads, backend, jobs):
         sl = slice(s, min(s + CHUNK, n))
         m = sl.stop - sl.start
         part = {name: np.repeat(w[sl], k, axis=0) for name, w in loads.items()}
-        res = solve(an, np.repeat(q[sl], k, axis=0), np.repeat(qd[sl], k, axis=0), np.tile(unit, (m, 1)),
-                    loads=part, backend=backend, jobs=jobs, check_finite=False)
+        res = sol.solve(np.repeat(q[sl], k, axis=0), np.repeat(qd[sl], k, axis=0), np.tile(unit, (m, 1)),
+                        loads=part, backend=backend, jobs=jobs, check_finite=False)
         yield sl, res.tau.reshape(m, k, dof)
-
-
-_KERNELS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 MAX_KERNEL_DOF = 12
@@ -106,52 +102,54 @@ chains at load 4: 8 joints 2.2 s, 16 10 s, 24 43 s, against 0.7, 1.3 and 2.2 s f
 solve kernel)."""
 
 
-def _mass_kernel(an, n: int, backend: str):
+def _mass_kernel(sol, n: int, backend: str):
     """(the mass kernel (:class:`.llvm.mass.MassKernel`) for a call of n samples, or None
     and the backend of the stacked solve instead).  ``backend`` as :func:`gearcli.solve`'s:
     "numpy" the numpy reference; "llvm" the kernel (or ValueError); "auto" the kernel where
     the llvm backend can run, by the first-call rule of :mod:`.backends` (a call counting as
     n (dof + 1) samples, the solve's work it replaces; its own compile and disk cache
     entries), else the numpy reference.  Beyond :data:`MAX_KERNEL_DOF`: the stacked solve."""
+    an = sol.an
     if backend == "numpy":
         return None, "numpy"
-    sol = solver_for(an)
     if sol.choice("block", backend, None).path == "numpy":      # ValueError for a bad backend
         return None, "numpy"
     if an.dof > MAX_KERNEL_DOF:
         return None, backend
     from .llvm.mass import MassKernel  # noqa: PLC0415  (imports llvmlite)
-    kernel, seen = _KERNELS.get(sol, (None, 0))
+    kernel, seen = sol.mass_kernel
     if kernel is None:
         seen += max(n * (an.dof + 1), CALL_SAMPLES)
         prog = sol.kernel_program()
         if backend == "auto" and seen < FIRST_CALL_SAMPLES and not has_program(MassKernel.ids(prog, an)[1]):
-            _KERNELS[sol] = (None, seen)
+            sol.mass_kernel = (None, seen)
             return None, "numpy"
         kernel = MassKernel(prog, an)
-        _KERNELS[sol] = (kernel, seen)
+        sol.mass_kernel = (kernel, seen)
     return kernel, backend
 
 
-def _mass_and_h(an, q, qd, target, loads, backend, jobs):
+def _mass_and_h(sol, q, qd, target, loads, backend, jobs):
     """(M (N, dof, dof), h (N, dof), qdd (N, dof) = M^-1 (target - h)) of every sample: the
     mass kernel's (lossless) or the numpy reference's (for a lossy mechanism the secant of
     the module docstring)."""
+    an = sol.an
     n, dof = q.shape
     values = load_values(an.mech, n, loads)      # checked, (n, 6) each
-    kernel, stacked = _mass_kernel(an, n, backend)
+    kernel, stacked = _mass_kernel(sol, n, backend)
     got = None if kernel is None else kernel.run(an, q, qd, values, target, jobs)
     if got is not None:
         return got
     M, h = np.empty((n, dof, dof)), np.empty((n, dof))       # stacked (also a kernel sample not finite:
-    for sl, tau in _stacked_chunks(an, q, qd, values, stacked, jobs):      # then the solve names it)
+    for sl, tau in _stacked_chunks(sol, q, qd, values, stacked, jobs):      # then the solve names it)
         M[sl] = np.swapaxes(tau[:, 1:, :] - tau[:, :1, :], 1, 2)
         M[sl] = 0.5 * (M[sl] + np.swapaxes(M[sl], 1, 2))
         h[sl] = tau[:, 0, :]
     return M, h, np.linalg.solve(M, (target - h)[:, :, None])[:, :, 0]
 
 
-def mass_matrix(an, q, backend: str = "auto", jobs: int | None = None, attach: dict | None = None) -> np.ndarray:
+def mass_matrix(an, q, backend: str = "auto", jobs: int | None = None, attach: dict | None = None,
+                solver=None) -> np.ndarray:
     """Mass matrix M(q) of the independent joints (paper Eq. 25-26), (N, dof, dof).
 
     ``q`` (N, dof) or (dof,): independent joint angles (rad; m for a prismatic joint) in the
@@ -168,11 +166,11 @@ def mass_matrix(an, q, backend: str = "auto", jobs: int | None = None, attach: d
         from .payloads import attach_flags, by_groups  # noqa: PLC0415
         return by_groups(an, attach_flags(an, attach, len(q)), lambda a, rows: mass_matrix(a, q[rows], backend, jobs),
                          len(q))
-    return _mass_and_h(an, q, np.zeros_like(q), np.zeros_like(q), None, backend, jobs)[0]
+    return _mass_and_h(solver or solver_for(an), q, np.zeros_like(q), np.zeros_like(q), None, backend, jobs)[0]
 
 
 def forward_dynamics(an, q, qd, motor_torques, loads: dict | None = None, backend: str = "auto",
-                     jobs: int | None = None, attach: dict | None = None) -> np.ndarray:
+                     jobs: int | None = None, attach: dict | None = None, solver=None) -> np.ndarray:
     """Accelerations qdd (N, dof) of the independent joints under given motor torques.
 
     ``q``, ``qd`` (N, dof) or (dof,): independent joint angles and rates (rad, rad/s; m,
@@ -202,12 +200,13 @@ def forward_dynamics(an, q, qd, motor_torques, loads: dict | None = None, backen
         return by_groups(an, attach_flags(an, attach, len(q)), run, len(q))
     target = np.einsum("nm,dm->nd", T, an.A)    # A T per sample; not matmul: BLAS threads would
     # start, then spin on the second core through the kernel calls below (up to 2x slower)
-    M, h, qdd = _mass_and_h(an, q, qd, target, loads, backend, jobs)
-    return _implicit(an, q, qd, target, M, h, qdd, loads, backend, jobs) if an.mech.has_losses else qdd
+    sol = solver or solver_for(an)
+    M, h, qdd = _mass_and_h(sol, q, qd, target, loads, backend, jobs)
+    return _implicit(sol, q, qd, target, M, h, qdd, loads, backend, jobs) if an.mech.has_losses else qdd
 
 
 def held_dynamics(an, q, qd, motor_torques, C: np.ndarray, loads: dict | None = None,
-                  backend: str = "auto") -> tuple[np.ndarray, np.ndarray]:
+                  backend: str = "auto", solver=None) -> tuple[np.ndarray, np.ndarray]:
     """(qdd (N, dof), Q (N, k)): the accelerations of the independent joints with k joints
     held at rest by friction, and the generalised friction forces Q that hold them.
 
@@ -219,15 +218,16 @@ def held_dynamics(an, q, qd, motor_torques, C: np.ndarray, loads: dict | None = 
     per sample (with losses, tau(qdd) for M qdd + h, as :func:`forward_dynamics`)."""
     q, qd, T = (np.atleast_2d(np.asarray(v, float)) for v in (q, qd, motor_torques))
     target = np.einsum("nm,dm->nd", T, an.A)
-    M, h, qdd = _mass_and_h(an, q, qd, target, loads, backend, None)
+    sol = solver or solver_for(an)
+    M, h, qdd = _mass_and_h(sol, q, qd, target, loads, backend, None)
     C = np.asarray(C, float).reshape(-1, an.dof)
     k = C.shape[0]
     Q = np.zeros((len(q), k))
     if k:
-        sol = np.linalg.solve(_kkt(M, C), np.concatenate([target - h, np.zeros((len(q), k))], axis=1)[:, :, None])
-        qdd, Q = sol[:, :an.dof, 0], sol[:, an.dof:, 0]
+        x = np.linalg.solve(_kkt(M, C), np.concatenate([target - h, np.zeros((len(q), k))], axis=1)[:, :, None])
+        qdd, Q = x[:, :an.dof, 0], x[:, an.dof:, 0]
     if an.mech.has_losses:
-        qdd, Q = _settle(an, q, qd, target, M, h, qdd, Q, C, loads, backend, None)
+        qdd, Q = _settle(sol, q, qd, target, M, h, qdd, Q, C, loads, backend, None)
     return qdd, Q
 
 
@@ -241,7 +241,7 @@ def _kkt(J: np.ndarray, C: np.ndarray) -> np.ndarray:
     return K
 
 
-def _implicit(an, q, qd, target, M, h, qdd, loads, backend, jobs) -> np.ndarray:
+def _implicit(sol, q, qd, target, M, h, qdd, loads, backend, jobs) -> np.ndarray:
     """qdd with tau(q, qd, qdd) = target (N, dof) for a mechanism with losses, where tau is
     piecewise linear in qdd (|t| of the mesh friction): from ``qdd``, the secant solution
     M qdd = target - h, steps qdd -= M^-1 (tau(qdd) - target) on the samples not yet settled
@@ -254,14 +254,15 @@ def _implicit(an, q, qd, target, M, h, qdd, loads, backend, jobs) -> np.ndarray:
     rounds to them), or when a step no longer reduces a residual already within
     :data:`STALLED` of that scale (rounding reached).  ValueError naming the first sample
     that does not settle in :data:`MAX_STEPS` (e.g. a self-locking transmission)."""
-    return _settle(an, q, qd, target, M, h, qdd, np.zeros((len(q), 0)), np.zeros((0, an.dof)), loads, backend,
-                   jobs)[0]
+    return _settle(sol, q, qd, target, M, h, qdd, np.zeros((len(q), 0)), np.zeros((0, sol.an.dof)), loads,
+                   backend, jobs)[0]
 
 
-def _settle(an, q, qd, target, M, h, qdd, Q, C, loads, backend, jobs) -> tuple[np.ndarray, np.ndarray]:
+def _settle(sol, q, qd, target, M, h, qdd, Q, C, loads, backend, jobs) -> tuple[np.ndarray, np.ndarray]:
     """(qdd, Q) with tau(q, qd, qdd) = target + C^T Q and C qdd = 0 (no held joint: k = 0,
     :func:`_implicit`), from the secant solution: steps with the lossless M, then Newton
     steps with the lossy Jacobian, each solving [[J, -C^T], [C, 0]] (d qdd, d Q) = (r, 0)."""
+    an = sol.an
     values = load_values(an.mech, len(q), loads)
     scale = np.maximum(np.maximum(np.abs(target).max(axis=1), np.abs(h).max(axis=1)),
                        np.abs(M).max(axis=(1, 2)))
@@ -270,8 +271,8 @@ def _settle(an, q, qd, target, M, h, qdd, Q, C, loads, backend, jobs) -> tuple[n
     dof, k = an.dof, C.shape[0]
 
     def tau(rows, acc):
-        return solve(an, q[rows], qd[rows], acc, loads={key: v[rows] for key, v in values.items()},
-                     backend=backend, jobs=jobs, check_finite=False).tau
+        return sol.solve(q[rows], qd[rows], acc, loads={key: v[rows] for key, v in values.items()},
+                         backend=backend, jobs=jobs, check_finite=False).tau
 
     for step in range(MAX_STEPS):
         r = tau(todo, qdd[todo]) - target[todo] - Q[todo] @ C
@@ -307,7 +308,7 @@ def _lossy_jacobian(tau, rows, qdd: np.ndarray, tau0: np.ndarray) -> np.ndarray:
 
 
 def motor_inertia(an, q, diagonal: bool = False, backend: str = "auto", jobs: int | None = None,
-                  attach: dict | None = None) -> np.ndarray:
+                  attach: dict | None = None, solver=None) -> np.ndarray:
     """Inertia seen at the motors, (N, M, M) (or its diagonal (N, M) with ``diagonal``).
 
     In motor coordinates theta_m = A^T q_ind (rad; m for a linear input), the kinetic energy
@@ -318,7 +319,7 @@ def motor_inertia(an, q, diagonal: bool = False, backend: str = "auto", jobs: in
     the Bendix wrist) the off-diagonal terms couple them; the diagonal is what servo sizing
     compares with the rotor inertia.
     """
-    M = mass_matrix(an, q, backend=backend, jobs=jobs, attach=attach)
+    M = mass_matrix(an, q, backend=backend, jobs=jobs, attach=attach, solver=solver)
     Ainv = np.linalg.inv(an.A)
     J = Ainv @ M @ Ainv.T
     J = 0.5 * (J + np.swapaxes(J, 1, 2))
