@@ -22,7 +22,7 @@ _EXPORTS = {
     "parse_mechanism": "io.yaml_reader",
     "analyse": "pipeline",
     "solve": "dynamics.solve",
-    "Solver": "dynamics.solve",
+    "Solver": "dynamics.forward",
     "Result": "dynamics.solve",
     "mass_matrix": "dynamics.forward",
     "forward_dynamics": "dynamics.forward",
@@ -40,8 +40,8 @@ __all__ = ["__version__", *_EXPORTS]
 
 if TYPE_CHECKING:  # pragma: no cover
     from .analysis.graph import Analysis
-    from .dynamics.forward import forward_dynamics, mass_matrix, motor_inertia
-    from .dynamics.solve import Result, Solver, solve
+    from .dynamics.forward import Solver, forward_dynamics, mass_matrix, motor_inertia
+    from .dynamics.solve import Result, solve
     from .errors import GearcliError, MechanismError
     from .io import load_mechanism
     from .io.trajectory import read_trajectory

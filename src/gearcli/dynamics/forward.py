@@ -61,6 +61,7 @@ from .backends import CALL_SAMPLES, FIRST_CALL_SAMPLES
 from .external import load_values
 from .inputs import joint_names, sample_arrays
 from .llvm.cache import has_program
+from .solve import Solver as _Solver
 from .solve import solver_for
 
 CHUNK = 2_000
@@ -324,3 +325,31 @@ def motor_inertia(an, q, diagonal: bool = False, backend: str = "auto", jobs: in
     J = Ainv @ M @ Ainv.T
     J = 0.5 * (J + np.swapaxes(J, 1, 2))
     return np.diagonal(J, axis1=1, axis2=2).copy() if diagonal else J
+
+
+class Solver(_Solver):
+    """An explicit solver of one analysed mechanism (``gearcli.Solver(an, backend="auto",
+    jobs=None)``): it holds the block plans and the compiled solve and mass kernels as long
+    as it lives (Pinocchio's Model/Data in spirit), and its methods take the arguments of
+    :func:`gearcli.solve`, :func:`forward_dynamics`, :func:`mass_matrix` and
+    :func:`motor_inertia` without the analysis, ``backend`` and ``jobs`` defaulting to its
+    own.  The module functions keep one (plain) solver per analysis, a convenience;
+    "auto"'s first-call rule counts each solver's own calls."""
+
+    def forward_dynamics(self, q, qd, motor_torques, loads: dict | None = None, backend: str | None = None,
+                         jobs: int | None = None, attach: dict | None = None):
+        """:func:`.forward.forward_dynamics` of this solver's mechanism, with its kernels."""
+        return forward_dynamics(self.an, q, qd, motor_torques, loads, backend or self.backend,
+                                jobs if jobs is not None else self.jobs, attach, solver=self)
+
+    def mass_matrix(self, q, backend: str | None = None, jobs: int | None = None, attach: dict | None = None):
+        """:func:`.forward.mass_matrix` of this solver's mechanism, with its kernels."""
+        return mass_matrix(self.an, q, backend or self.backend, jobs if jobs is not None else self.jobs, attach,
+                           solver=self)
+
+    def motor_inertia(self, q, diagonal: bool = False, backend: str | None = None, jobs: int | None = None,
+                      attach: dict | None = None):
+        """:func:`.forward.motor_inertia` of this solver's mechanism, with its kernels."""
+        return motor_inertia(self.an, q, diagonal, backend or self.backend, jobs if jobs is not None else self.jobs,
+                             attach, solver=self)
+

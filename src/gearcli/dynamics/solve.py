@@ -114,14 +114,10 @@ def joint_space(an, q_ind, qd_ind=None, qdd_ind=None):
 class Solver:
     """Inverse dynamics of one analysed mechanism: owns the precomputed block plans.
 
-    ``solver = gearcli.Solver(an, backend="auto")`` holds what solving ``an`` needs: the
-    block plans, the compiled solve kernel and mass kernel (compiled on first use, kept as
-    long as the solver: Pinocchio's Model/Data in spirit).  ``solver.solve(q, qd, qdd)``,
-    ``solver.forward_dynamics(q, qd, T)``, ``solver.mass_matrix(q)`` and
-    ``solver.motor_inertia(q)`` take the arguments of :func:`solve` and of
-    :mod:`.forward`'s functions without the analysis; ``backend`` and ``jobs`` given here
-    are their defaults.  :func:`solve` and the other module functions keep one solver per
-    analysis (a convenience).  "auto"'s first-call rule counts this solver's own calls.
+    ``Solver(an).solve(q, qd, qdd)``: the block plans, the compiled solve kernel and the mass
+    kernel's state (:mod:`.forward`) of one analysis; ``backend`` and ``jobs`` are the
+    defaults of its calls.  :func:`solve` keeps one per analysis; the public
+    :class:`gearcli.Solver` (:class:`.forward.Solver`) adds the forward-dynamics methods.
     """
 
     def __init__(self, an, backend: str = "auto", jobs: int | None = None):
@@ -134,26 +130,6 @@ class Solver:
         self._llvm, self.llvm_problem = None, None      # llvm_problem: str | None
         self.samples_solved = 0          # by the block method, every backend ("auto"'s first-call rule)
         self.mass_kernel = (None, 0)     # (the mass kernel, or None; samples "auto" counted: .forward)
-
-    def forward_dynamics(self, q, qd, motor_torques, loads: dict | None = None, backend: str | None = None,
-                         jobs: int | None = None, attach: dict | None = None):
-        """:func:`.forward.forward_dynamics` of this solver's mechanism, with its kernels."""
-        from .forward import forward_dynamics  # noqa: PLC0415  (.forward imports this module)
-        return forward_dynamics(self.an, q, qd, motor_torques, loads, backend or self.backend,
-                                jobs if jobs is not None else self.jobs, attach, solver=self)
-
-    def mass_matrix(self, q, backend: str | None = None, jobs: int | None = None, attach: dict | None = None):
-        """:func:`.forward.mass_matrix` of this solver's mechanism, with its kernels."""
-        from .forward import mass_matrix  # noqa: PLC0415
-        return mass_matrix(self.an, q, backend or self.backend, jobs if jobs is not None else self.jobs, attach,
-                           solver=self)
-
-    def motor_inertia(self, q, diagonal: bool = False, backend: str | None = None, jobs: int | None = None,
-                      attach: dict | None = None):
-        """:func:`.forward.motor_inertia` of this solver's mechanism, with its kernels."""
-        from .forward import motor_inertia  # noqa: PLC0415
-        return motor_inertia(self.an, q, diagonal, backend or self.backend, jobs if jobs is not None else self.jobs,
-                             attach, solver=self)
 
     def kernel_program(self):
         """The compiled kernel's program of this mechanism (:mod:`.llvm.program`), or None
