@@ -166,8 +166,7 @@ def simulate_file(mech_path, input_path, out_path, *, t_end: float | None = None
             f.write(header + "\n")
 
             def write(part):
-                flags = np.array([[float(p in drive.attached_at(t)) for p in payloads] for t in part.t],
-                                 float).reshape(len(part.t), -1)
+                flags = drive.attach_flags(part.t)
                 np.savetxt(f, np.column_stack([part.t, part.q, part.qd, part.qdd, flags]), delimiter=",", fmt="%.17g")
             sim = simulate(an, drive, t_eval, x0, v0, rtol=rtol, atol=atol, method=method, progress=watch, sink=write)
     except SimulationError as exc:       # before any sample: nothing written (the output is removed)

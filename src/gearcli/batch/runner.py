@@ -20,7 +20,7 @@ from ..design.evaluate import Samples, Verdict, combine, partials, profile_equiv
 from ..design.sizing import inertia_columns
 from ..dynamics.solve import solve
 from ..errors import Collector, GearcliError
-from ..io.trajectory import forget_rows, read_trajectory
+from ..io.trajectory import count_rows, forget_rows, read_trajectory
 from ..pipeline import at_samples
 from ..report.columns import LazyColumns
 from .heap import keep_freed_memory
@@ -99,7 +99,7 @@ def run_job(job: Job, threads: int | None = None) -> tuple[list[tuple], str]:
     """(the partials of every check of the job's case on the job's trajectory, the solver
     path that ran, :func:`backend_text`) (``threads``: the solver's threads; the pools give
     each worker its share of the cores)."""
-    if _lines(job.path) <= STREAM:   # no page faults for every new array (:mod:`.heap`); not for a
+    if _rows(job.path) <= STREAM:   # no page faults for every new array (:mod:`.heap`); not for a
         keep_freed_memory()          # long trajectory, whose freed arrays would stay as resident memory
     an = case_analysis(job.mechanism)
     checks = build_checks(an, job.req, Collector(job.mechanism))
@@ -123,7 +123,7 @@ def command_backends(manifest: Manifest) -> dict[str, str]:
     rows: dict[str, int] = {}
     for c in manifest.cases:
         for tp in c.trajectories:
-            rows[str(c.mechanism)] = rows.get(str(c.mechanism), 0) + _lines(tp)
+            rows[str(c.mechanism)] = rows.get(str(c.mechanism), 0) + _rows(tp)
     out = {}
     for mech, n in rows.items():
         how = solver_for(case_analysis(mech)).choice("block", "auto", max(n, 1))
@@ -262,10 +262,10 @@ def worst_samples(result: CaseResult, verdict: Verdict) -> tuple[np.ndarray, np.
     return s.t, signal(verdict.check, s, an.mech)
 
 
-def _lines(path) -> int:
-    """Data rows of a (checked) trajectory file: its line count less the header."""
+
+def _rows(path) -> int:
+    """Data rows of a trajectory (0 when it cannot be read: the job then says why)."""
     try:
-        with open(path, "rb") as f:
-            return max(sum(buf.count(b"\n") for buf in iter(lambda: f.read(1 << 20), b"")) - 1, 0)
+        return count_rows(path)
     except OSError:
         return 0

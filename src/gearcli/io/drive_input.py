@@ -33,11 +33,16 @@ class DriveInput:
     file: str
     attach: dict = field(default_factory=dict)   # {payload: (n,) 0 or 1}, held from each row to the next
 
+    def attach_flags(self, t) -> np.ndarray:
+        """(n, P) 0/1 of every payload (``attach`` order) at the times t (n,): each row's
+        ``attach:`` value holds until the next row (a pick or a place is a step, not a ramp)."""
+        i = np.maximum(np.searchsorted(self.t, np.atleast_1d(t), side="right") - 1, 0)
+        return np.column_stack([v[i] for v in self.attach.values()]) if self.attach else np.zeros((len(i), 0))
+
     def attached_at(self, t: float) -> tuple[str, ...]:
-        """The payloads attached at time t: each row's ``attach:`` value holds until the
-        next row (a pick or a place is a step, not a ramp)."""
-        i = max(int(np.searchsorted(self.t, t, side="right")) - 1, 0)
-        return tuple(name for name, v in self.attach.items() if v[i] == 1.0)
+        """The payloads attached at time t (:meth:`attach_flags`)."""
+        flags = self.attach_flags(t)[0]
+        return tuple(name for name, f in zip(self.attach, flags) if f == 1.0)
 
     def at(self, t) -> np.ndarray:
         """The values at time(s) t: (M,) for a scalar t, (n, M) for an array; linear between

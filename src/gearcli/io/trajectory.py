@@ -210,13 +210,8 @@ class TrajectoryReader:
         return scale
 
     def count(self) -> int:
-        """Number of samples (data rows), by a fast line count."""
-        with open(self.path, "rb") as f:
-            n = sum(buf.count(b"\n") for buf in iter(lambda: f.read(1 << 20), b""))
-            f.seek(-1, 2)
-            if f.read(1) != b"\n":
-                n += 1
-        return max(n - 1, 0)
+        """Number of samples (data rows), by a fast line count (:func:`count_rows`)."""
+        return count_rows(self.path)
 
     def _raw(self):
         """Yield (array of rows in SI units (n, ncol), line numbers (n,)), checked: the
@@ -356,6 +351,18 @@ class TrajectoryReader:
                 raise fail(self.file, int(lines[r]), f"{what}:{show(self.names[j])}",
                            "derived by spline is not finite (time steps too small for the values?)")
         return out
+
+
+def count_rows(path) -> int:
+    """Data rows of a trajectory file (its lines less the header; a last line without its
+    newline counts), by a fast line count; OSError when it cannot be read."""
+    with open(path, "rb") as f:
+        n = sum(buf.count(b"\n") for buf in iter(lambda: f.read(1 << 20), b""))
+        if f.tell():
+            f.seek(-1, 2)
+            if f.read(1) != b"\n":
+                n += 1
+    return max(n - 1, 0)
 
 
 def read_trajectory(path, names, degrees: bool = False, linear=(), loads=(), payloads=()) -> Trajectory:
