@@ -20,6 +20,8 @@ def _type(spec: dict) -> str:
         return ", ".join(f"`{v}`" for v in spec["enum"])
     if spec.get("type") == "array" and "items" in spec:
         return f"list of {_type(spec['items'])}"
+    if "if" in spec and "then" in spec:
+        return f"{_type(spec['then'])} (by kind) or {_type(spec['else'])}"
     if "oneOf" in spec:
         return " or ".join(_type(s) for s in spec["oneOf"])
     return str(spec.get("type", "value"))

@@ -52,3 +52,27 @@ q = 2.0 * np.pi * np.sin(0.5 * w * t) + 0.3 * np.sin(3 * w * t)
 qd = np.pi**2 * np.cos(0.5 * w * t) + 0.9 * w * np.cos(3 * w * t)
 qdd = -0.5 * np.pi**3 * np.sin(0.5 * w * t) - 2.7 * w**2 * np.sin(3 * w * t)
 write_trajectory("mechanisms/planetary_3p_traj.csv", ["JC"], t, q[:, None], qd[:, None], qdd[:, None])
+
+
+def quintic_moves(t, stops):
+    """q, qd, qdd (N,) of rest-to-rest quintic moves: stops [(t_start, t_end, q_from, q_to)],
+    dwelling between them."""
+    q, qd, qdd = np.full_like(t, stops[0][2]), np.zeros_like(t), np.zeros_like(t)
+    for t0, t1, a, b in stops:
+        T, d = t1 - t0, b - a
+        tau = np.clip((t - t0) / T, 0.0, 1.0)
+        inside = (t >= t0) & (t <= t1)
+        q = np.where(t >= t0, a + d * (10 * tau**3 - 15 * tau**4 + 6 * tau**5), q)
+        qd = np.where(inside, d / T * (30 * tau**2 - 60 * tau**3 + 30 * tau**4), qd)
+        qdd = np.where(inside, d / T**2 * (60 * tau - 180 * tau**2 + 120 * tau**3), qdd)
+    return q, qd, qdd
+
+
+# cobot_joint: a pick-and-place cycle of the output J2 (rad): carry the part from -1 to +1 rad in
+# 2 s (1.875 rad/s at most: 1790 rpm at the wave generator), dwell, place it (attach:part 0 from
+# 2.5 s), swing back empty in 2 s, dwell, pick the next one (attach:part 1 from 5.5 s); 6 s.
+tc = np.linspace(0.0, 6.0, 6001)
+q, qd, qdd = quintic_moves(tc, [(0.0, 2.0, -1.0, 1.0), (3.0, 5.0, 1.0, -1.0)])
+attach = ((tc < 2.5) | (tc >= 5.5)).astype(float)
+np.savetxt("mechanisms/cobot_joint_traj.csv", np.column_stack([tc, q, qd, qdd, attach]), delimiter=",",
+           header="t,q:J2,qd:J2,qdd:J2,attach:part", comments="", fmt="%.17g")

@@ -21,6 +21,7 @@ import pytest
 from gearcli import analyse, load_mechanism, parse_mechanism, solve
 from gearcli.dynamics.kinematics import forward
 from gearcli.model.friction import JointFriction
+from gearcli.model.reducers import SpeedTable
 from gearcli.report.columns import named_columns
 
 MECH = Path(__file__).resolve().parents[1] / "mechanisms"
@@ -98,6 +99,9 @@ def own_losses(an, q, qd, res):
     parts = []
     for ci, c in enumerate(an.circuits):
         gp = mech.gears[c.gear]
+        if gp.reducer is not None:
+            parts.append(own_reducer_loss(an, kin, ci, res))
+            continue
         if not gp.loss_factor:
             continue
         zj = np.einsum("nij,j->ni", kin.R[c.carrier], c.geometry.zj)
@@ -108,6 +112,31 @@ def own_losses(an, q, qd, res):
         for b, P in zip(jt.bearings or (), own_bearing_loads(jt, res.joint[:, ji]) if jt.bearings else ()):
             parts.append(0.5 * b.friction_coefficient * b.bore * P * np.abs(qda[:, ji]))
     return np.sum(parts, axis=0), parts
+
+
+def own_reducer_loss(an, kin, ci, res):
+    """A reducer's loss from the model statement (drive-elements.md A): the axis u = z_O, a and b
+    the input's and the output's rates relative to the housing about u from the link angular
+    velocities, T the printed gear:<r>:torque; the torque on I is -(T/i0)/eta_f where T b > 0,
+    -(T/i0) eta_b where T b < 0, plus -T0 sign(a); the loss is minus the power the element
+    delivers, -(tau_I a + T b).  The printed input_torque is checked against tau_I on the way."""
+    c, gp = an.circuits[ci], an.mech.gears[an.circuits[ci].gear]
+    red, i0 = gp.reducer, gp.ratio
+    RH = kin.R[c.carrier]
+    zI, zO = np.einsum("nij,j->ni", RH, c.zj), np.einsum("nij,j->ni", RH, c.zk)
+    a = np.sum((kin.w[c.j] - kin.w[c.carrier]) * zO, axis=1)
+    b = np.sum((kin.w[c.k] - kin.w[c.carrier]) * zO, axis=1)
+    cols = named_columns(an, res)
+    T = cols[f"gear:{gp.name}:torque"]
+    eta_f = np.interp(np.abs(a), red.forward.speeds, red.forward.values)
+    eta_b = np.interp(np.abs(a), red.backward.speeds, red.backward.values)
+    flow = np.sign(T * b)
+    tau_I = -(T / i0) * np.where(flow > 0, 1 / eta_f, np.where(flow < 0, eta_b, 1.0))
+    if red.no_load_torque is not None:
+        tau_I = tau_I - np.interp(np.abs(a), red.no_load_torque.speeds, red.no_load_torque.values) * np.sign(a)
+    scale = 1.0 + np.abs(T)
+    assert np.max(np.abs(cols[f"gear:{gp.name}:input_torque"] - tau_I * np.sum(zI * zO, axis=1)) / scale) < 1e-11
+    return -(tau_I * a + T * b)
 
 
 def _load(name):
@@ -144,7 +173,15 @@ def test_lossless_mechanism_outputs_unchanged_and_without_loss_columns(name):
     def stripped(m, mu):
         """m without losses: none at all (mu None), or every one written as zero (mu 0)."""
         fr = None if mu is None else JointFriction(0.0, 0.0)
-        return dataclasses.replace(m, gears=tuple(dataclasses.replace(g, loss_factor=0.0) for g in m.gears),
+
+        def red(r):
+            """A reducer without losses: none at all, or efficiency 1 and a zero no-load torque."""
+            if r is None:
+                return None
+            return r.lossless() if mu is None else dataclasses.replace(
+                r.lossless(), no_load_torque=SpeedTable.constant(0.0))
+        return dataclasses.replace(m, gears=tuple(dataclasses.replace(g, loss_factor=0.0, reducer=red(g.reducer))
+                                                  for g in m.gears),
                                    joints=tuple(dataclasses.replace(j, friction=fr, bearings=None if not j.bearings else
                                                 tuple(dataclasses.replace(b, friction_coefficient=mu) for b in j.bearings))
                                                 for j in m.joints))

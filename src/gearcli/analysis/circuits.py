@@ -47,6 +47,8 @@ def circuits(h: Home, groups: list[CoaxialGroup], canon: np.ndarray, col: Collec
 def gear_circuit(h: Home, groups, canon, gi: int, gp, j: int, k: int, col: Collector) -> Circuit | None:
     """Circuit of gear pair ``gp`` between links j and k: theta_{j,c} - e theta_{k,c} = 0,
     with the ratio e given or derived from the mesh geometry."""
+    if gp.reducer is not None:
+        return reducer_circuit(h, groups, canon, gi, gp, j, k, col)
     found = gear_carrier(h, groups, gp, j, k, col)
     if found is None:
         return None
@@ -66,6 +68,33 @@ def gear_circuit(h: Home, groups, canon, gi: int, gp, j: int, k: int, col: Colle
     if ratio is None:
         return None
     return Circuit(gi, j, k, c, float(ratio), row_j - ratio * row_k, Rc.T @ zj_w, Rc.T @ zk_w, geom,
+                   row_j=np.rint(row_j))
+
+
+def reducer_circuit(h: Home, groups, canon, gi: int, gp, j: int, k: int, col: Collector) -> Circuit | None:
+    """Circuit of a coaxial reducer (:mod:`gearcli.model.reducers`): input j, output k and
+    housing c (``gp.carrier``) in one coaxial group, so that the joints on the paths from the
+    housing to the input and to the output turn about one line; theta_{j,c} = e theta_{k,c}
+    with e = i0 (z_j . z_k) about each member's own axis (i0 is about one common axis)."""
+    c = h.idx[gp.carrier]
+    shared = [g for g in groups_of(groups, j) if k in g.members and c in g.members]
+    if not shared:
+        col.add(f"{gp.path}.links", f"the {gp.kind} reducer's input '{gp.j}', output '{gp.k}' and housing "
+                f"'{gp.carrier}' do not turn about one axis: the joints from the housing to the input and to "
+                "the output must be colinear (within 1e-9 rad and 1e-9 m)")
+        return None
+    g = shared[0]
+    for n, x in enumerate((j, k)):
+        if h.mech.joints[h.jin[x if x != g.carrier else c]].type != "revolute":
+            col.add(f"{gp.path}.links[{n}]", f"'{h.tree.links[x]}' slides on a prismatic joint: a reducer's members turn")
+            return None
+    if gp.ratio is None:
+        return None
+    row_j, zj_w = relative_rotation(h, canon, j, c, g)
+    row_k, zk_w = relative_rotation(h, canon, k, c, g)
+    ratio = gp.ratio * float(np.sign(zj_w @ zk_w))
+    Rc = h.kin.R[c]
+    return Circuit(gi, j, k, c, ratio, row_j - ratio * row_k, Rc.T @ zj_w, Rc.T @ zk_w, None,
                    row_j=np.rint(row_j))
 
 

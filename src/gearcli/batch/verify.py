@@ -16,9 +16,13 @@ from .spectra import write_spectra
 SIGNAL_LABELS = {"abs": "|{}|", "col": "RMS of {} from the start", "rate": "|joint rate|", "running_rms": "running RMS of {}", "bearing_P": "dynamic equivalent load P",
                  "bearing_P0": "static equivalent load P0", "bending": "Lewis root bending stress",
                  "contact": "Hertz contact stress", "inertia_ratio": "load-to-rotor inertia ratio",
-                 "envelope": "|T| / T_max(speed)", "regen_power": "regenerative power"}
+                 "envelope": "|T| / T_max(speed)", "regen_power": "regenerative power",
+                 "reducer_speed": "|input speed relative to the housing|"}
 LIMIT_LABELS = {"peak": "limit", "rms": "RMS limit", "safety": "allowable / required safety",
-                "life": "P_eq giving the required life", "energy": "energy limit (integral over the cycle)"}
+                "life": "P_eq giving the required life", "energy": "energy limit (integral over the cycle)",
+                "reducer_average": "average torque limit (T_av, speed-weighted)",
+                "reducer_speed_average": "average input speed limit (n_av)",
+                "reducer_life": "T_av giving the required life"}
 
 
 @dataclass

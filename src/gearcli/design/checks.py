@@ -12,7 +12,10 @@ and how the samples of a duty cycle are reduced to the value compared with the l
 * ``life``: ISO 281 rating life in hours >= limit (``rating`` = C, ``exponent`` = p);
 * ``fatigue``: gear tooth life in hours (rainflow + Miner, :mod:`gearcli.design.fatigue`)
   >= limit (``rating`` = the allowable stress).
-* ``energy``: the integral of the signal over each trajectory (a cycle), worst one <= limit.
+* ``energy``: the integral of the signal over each trajectory (a cycle), worst one <= limit;
+* ``reducer_average``, ``reducer_speed_average``, ``reducer_life``: a reducer's
+  speed-weighted average torque T_av, average input speed n_av (<= limit) and catalogue life
+  (>= limit) over the duty cycle (:mod:`gearcli.model.reducers`).
 
 Servo sizing (inertia ratio, torque-speed envelope, regenerative energy) is in :mod:`.sizing`.
 """
@@ -40,6 +43,7 @@ class Requirements:
     service_life_h: float | None = None
     bearing_life_h: float | None = None
     gear_life_h: float | None = None
+    reducer_life_h: float | None = None
     min_static_safety: float = 1.0
     min_bending_safety: float = 1.0
     min_contact_safety: float = 1.0
@@ -70,8 +74,39 @@ class Check:
 def build_checks(an, req: Requirements, col: Collector) -> list[Check]:
     """Every check of the analysed mechanism ``an`` under ``req``; problems go to ``col``."""
     checks = _motor_checks(an) + sizing_checks(an, Check) + _bearing_checks(an, req, col) + _gear_checks(an, req, col)
-    checks += _joint_limit_checks(an) + _column_checks(an, req, col)
+    checks += _reducer_checks(an, req) + _joint_limit_checks(an) + _column_checks(an, req, col)
     return checks
+
+
+def _reducer_checks(an, req: Requirements) -> list[Check]:
+    """The catalogue checks of every rated reducer (:class:`~gearcli.model.reducers.ReducerRating`):
+    repeated peak torque (max |T|), maximum input speed (max |a|), average torque T_av, average
+    input speed n_av and, with ``reducer_life_h``, the life L = L_n (n_N/n_av) (T_N/T_av)^p.
+    T is ``gear:<r>:torque``; a, the input's rate relative to the housing, is the circuit's row
+    over the real joint rates (``extra["row"]``)."""
+    out = []
+    for c in an.circuits:
+        gp = an.mech.gears[c.gear]
+        r = gp.reducer.rating if gp.reducer is not None else None
+        if r is None:
+            continue
+        comp, T = f"reducer {gp.name}", ("abs", f"gear:{gp.name}:torque")
+        speed = ("reducer_speed", gp.name)
+        x = {"row": tuple(float(v) for v in c.row_j), "rating": r}
+        if r.repeated_peak_torque is not None:
+            out.append(Check(comp, "repeated peak torque", "N·m", r.repeated_peak_torque, "peak", T, "N·m"))
+        if r.max_input_speed is not None:
+            out.append(Check(comp, "input speed", "rad/s", r.max_input_speed, "peak", speed, "rad/s", extra=x))
+        if r.average_torque_limit is not None:
+            out.append(Check(comp, "average torque T_av", "N·m", r.average_torque_limit, "reducer_average", T,
+                             "N·m", exponent=r.life_exponent, extra=x))
+        if r.average_input_speed_limit is not None:
+            out.append(Check(comp, "average input speed n_av", "rad/s", r.average_input_speed_limit,
+                             "reducer_speed_average", speed, "rad/s", extra=x))
+        if req.reducer_life_h is not None:
+            out.append(Check(comp, f"{r.life_basis} life", "h", req.reducer_life_h, "reducer_life", T, "N·m",
+                             rating=r.rated_torque, exponent=r.life_exponent, extra=x))
+    return out
 
 
 def _motor_checks(an) -> list[Check]:

@@ -19,6 +19,7 @@ from . import sizing
 from .checks import Check
 from ..report.rms import running_rms, rms_of, square_integral
 from .gears import hertz_contact_stress, lewis_bending_stress
+from ..model.reducers import reducer_life
 from ..model.shaft import split_two_bearings
 
 
@@ -72,6 +73,8 @@ def _signal(check: Check, s: Samples, mech, cache: dict) -> np.ndarray:
         return np.abs(s.rates[:, check.signal[1]])
     if kind == "running_rms":
         return running_rms(s.cols[check.signal[1]], s.t, check.signal[2])
+    if kind == "reducer_speed":         # |a|: the input's rate relative to the housing
+        return np.abs(s.rates @ np.asarray(check.extra["row"]))
     if kind in sizing.SIGNALS:
         return sizing.signal(check, s.cols)
     if kind in ("bearing_P", "bearing_P0"):
@@ -139,6 +142,9 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
             total = B.life_sum(x, n, ch.exponent, iso281.life_factor(bearing_of(ch, mech), x))
             wsum = revs = float(np.sum(n))
             score = B.equivalent_load(total, wsum, ch.exponent)
+        elif ch.kind in REDUCER_KINDS:
+            total, wsum, revs = _reducer_sums(ch, s, x)
+            score = total
         elif ch.kind == "fatigue":
             peaks = F.rainflow_peaks(x)
             total = F.miner_damage(peaks, ch.rating, ch.signal[0])
@@ -155,7 +161,47 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
     return out
 
 
-NON_NEGATIVE = frozenset({"abs", "rate", "running_rms", "bearing_P", "bearing_P0", "bending", "contact"})
+REDUCER_KINDS = ("reducer_average", "reducer_speed_average", "reducer_life")
+
+
+def _reducer_sums(ch: Check, s: Samples, x: np.ndarray) -> tuple[float, float, float]:
+    """A reducer check's sums over one trajectory (trapezoid weights dt_k): T_av and the life,
+    (sum |a| |T|^p dt, sum |a| dt, span); n_av, (sum |a| dt, span, span)."""
+    dt = _trapezoid_weights(s.t)
+    a = np.abs(s.rates @ np.asarray(ch.extra["row"]))
+    span = float(s.t[-1] - s.t[0]) if s.t.size else 0.0
+    turned = float(np.sum(a * dt))
+    if ch.kind == "reducer_speed_average":
+        return turned, span, span
+    return float(np.sum(a * x ** ch.exponent * dt)), turned, span
+
+
+def _trapezoid_weights(t: np.ndarray) -> np.ndarray:
+    """dt_k of the trapezoid rule on the samples t (N,): sum_k y_k dt_k = the integral of y."""
+    w = np.zeros_like(t)
+    if t.size > 1:
+        d = np.diff(t)
+        w[:-1] += d / 2
+        w[1:] += d / 2
+    return w
+
+
+def reducer_duty(check: Check, parts: list[tuple], rates) -> tuple[float, float]:
+    """(T_av N*m, n_av rad/s) of a reducer over the duty cycle: T_av from the trajectories' sums
+    weighted by their repetitions per hour; n_av = the input's turning per hour / 3600 s when
+    the repetitions are known (the cycle's pauses count), else per second of the trajectories."""
+    w = [1.0 if r is None else r for r in rates]
+    known = all(r is not None for r in rates)
+    if check.kind == "reducer_speed_average":
+        turned = sum(r * p[2] for r, p in zip(w, parts))
+        return math.nan, turned / (3600.0 if known else max(sum(p[3] for p in parts), 1e-300))
+    num, den = sum(r * p[2] for r, p in zip(w, parts)), sum(r * p[3] for r, p in zip(w, parts))
+    T_av = (num / den) ** (1.0 / check.exponent) if den > 0 else 0.0
+    n_av = den / (3600.0 if known else max(sum(p[6] for p in parts), 1e-300))
+    return T_av, n_av
+
+
+NON_NEGATIVE = frozenset({"reducer_speed", "abs", "rate", "running_rms", "bearing_P", "bearing_P0", "bending", "contact"})
 """Signals that are never negative by construction: their largest |x| is their largest x."""
 
 
@@ -245,6 +291,8 @@ def combine(check: Check, parts: list[tuple], rates) -> Verdict:
     elif check.kind == "safety":
         value = B.static_safety(check.rating, peak)
         sig_lim = check.rating / check.limit
+    elif check.kind in REDUCER_KINDS:
+        value, sig_lim = _reducer_value(check, parts, rates)
     elif check.kind == "fatigue":
         value = F.life_hours(sum(r * p[2] for r, p in zip(per_hour, parts)))
         cycles = check.limit * sum(r * p[4] for r, p in zip(per_hour, parts))
@@ -255,11 +303,29 @@ def combine(check: Check, parts: list[tuple], rates) -> Verdict:
         rev_h = sum(r * p[4] for r, p in zip(per_hour, parts))
         value = B.rating_life_hours(B.rating_life_mrev(check.rating, P_eq, check.exponent), rev_h)
         sig_lim = B.required_equivalent_load(check.rating, check.limit, rev_h, check.exponent)
-    if check.kind in ("peak", "rms", "energy"):
+    if check.kind in ("peak", "rms", "energy", "reducer_average", "reducer_speed_average"):
         margin = 100.0 * (check.limit - value) / check.limit
     else:
         margin = math.inf if math.isinf(value) else 100.0 * (value - check.limit) / check.limit
     return Verdict(check, value, margin >= 0, margin, worst, t_worst, sig_lim, details_of(check, parts, per_hour))
+
+
+def _reducer_value(check: Check, parts: list[tuple], rates) -> tuple[float, float]:
+    """(value, signal level that just meets the limit) of a reducer check: T_av and its limit;
+    n_av and its limit; the life L = L_n (n_N/n_av) (T_N/T_av)^p (h) and the T_av that gives the
+    required life, T_N (L_n n_N / (n_av L_req))^(1/p)."""
+    if not isinstance(rates, (list, tuple)):
+        rates = [rates] * len(parts)
+    T_av, n_av = reducer_duty(check, parts, rates)
+    if check.kind == "reducer_average":
+        return T_av, check.limit
+    if check.kind == "reducer_speed_average":
+        return n_av, check.limit
+    r = check.extra["rating"]
+    life = reducer_life(r, T_av, n_av)
+    need = (r.rated_torque * (r.rated_life * r.rated_input_speed / (n_av * check.limit)) ** (1.0 / r.life_exponent)
+            if n_av > 0 else math.inf)
+    return life, need
 
 
 STRESS_SIGNALS = ("bending", "contact")

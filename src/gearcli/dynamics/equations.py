@@ -22,6 +22,8 @@ the motors acting on it.  :meth:`Columns.balance` assembles the columns of one l
   sigma = sign(t) (paper Eq. 14), at the pitch point; gear k receives the opposite;
 * mesh (ideal coupling): a moment about j's axis on j, -ratio times one about k's axis on k,
   the carrier taking the reaction;
+* reducer (:mod:`gearcli.model.reducers`: j the input, k the output, the carrier the
+  housing): as an ideal coupling, the moment on j times the power-flow factor c_r(sigma, a);
 * mesh (joint coupling q_B = ratio q_A, GearPair.joints): a unit generalised force of joint
   B and -ratio times one of joint A, each on the joint's child and reversed on its parent
   (a moment about the axis of a revolute joint, a force along that of a prismatic one);
@@ -32,6 +34,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.gears import helical_terms
+from ..model.reducers import power_flow_factor
 from ..spatial import cross, mv
 from .kinematics import Kinematics
 from .losses import mesh_friction_moment, relative_rate
@@ -93,6 +96,9 @@ class Columns:
                     self.world[ci].update(fr=mv(Rc, fr), sv=np.sign(relative_rate(an, kin, ci)))
             else:
                 self.world[ci] = dict(zj=mv(Rc, c.zj), zk=mv(Rc, c.zk))
+                red = an.mech.gears[c.gear].reducer
+                if red is not None and red.power_flow_lossy:   # the input's rate a, for c_r
+                    self.world[ci].update(red=red, a=relative_rate(an, kin, ci))
 
     def joint(self, ji: int, L: int) -> np.ndarray:
         """(N, 6, 5) columns of joint ``ji``'s reaction on link L."""
@@ -155,13 +161,16 @@ class Columns:
                 sv = np.asarray(sigma, float).reshape(-1, 1) * wv["sv"][:, None]
                 col[:, 3:] += sign * sv * wv["fr"]
             return col[:, :, None]
+        cr = 1.0        # a lossy reducer's power-flow factor c_r (model.reducers), (N, 1)
+        if "red" in wv:
+            cr = power_flow_factor(wv["red"], np.broadcast_to(np.asarray(sigma, float), wv["a"].shape), wv["a"])[:, None]
         col = 0.0
         if L == c.j:
-            col = col + _moment(wv["zj"])
+            col = col + cr * _moment(wv["zj"])
         if L == c.k:
             col = col - c.ratio * _moment(wv["zk"])
         if L == c.carrier:
-            col = col - _moment(wv["zj"]) + c.ratio * _moment(wv["zk"])
+            col = col - cr * _moment(wv["zj"]) + c.ratio * _moment(wv["zk"])
         return col[:, :, None]
 
     def group(self, g, L: int, sigma=1.0) -> np.ndarray:

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model.reducers import input_torque, no_load_torque, reducer_loss
 from ..spatial import cross
 
 
@@ -59,12 +60,52 @@ def relative_rate(an, kin, ci: int) -> np.ndarray:
     right, as the kernel's :func:`.llvm.friction_terms.mesh_rates`), not from world angular
     velocities (omega_j - omega_c) . z_j: a gear at rest on its carrier gives an exact 0, so
     no friction couple, in any frames."""
+    return mesh_rate(an, kin.independent_rates(an), ci)
+
+
+def mesh_rate(an, qd_ind: np.ndarray, ci: int) -> np.ndarray:
+    """theta'_{j,c} (N,) of circuit ``ci`` from the independent rates ``qd_ind`` (N, dof)
+    (:func:`relative_rate`)."""
     r = an.mesh_rate_rows[ci]
-    qd = kin.independent_rates(an)
-    out = np.zeros(qd.shape[0])
+    out = np.zeros(qd_ind.shape[0])
     for d in np.flatnonzero(r):
-        out = out + r[d] * qd[:, d]
+        out = out + r[d] * qd_ind[:, d]
     return out
+
+
+def reducers(an):
+    """(circuit index, Reducer) of every coaxial reducer of ``an``."""
+    gears = an.mech.gears
+    return [(ci, gears[c.gear].reducer) for ci, c in enumerate(an.circuits) if gears[c.gear].reducer is not None]
+
+
+def subtract_reducer_drag(an, kin, b: dict) -> None:
+    """b_L -= the reducers' no-load running torques (:func:`gearcli.model.reducers.no_load_torque`:
+    on the input about z_I, the opposite on the housing), in place: known loads, like joint
+    friction."""
+    moving = set(an.tree.moving)
+    for ci, red in reducers(an):
+        if red.no_load_torque is None:
+            continue
+        c = an.circuits[ci]
+        tq = no_load_torque(red, relative_rate(an, kin, ci))
+        z = np.einsum("nij,j->ni", kin.R[c.carrier], c.zj)
+        w = np.concatenate([np.zeros_like(z), tq[:, None] * z], axis=1)
+        for L, sign in ((c.j, 1.0), (c.carrier, -1.0)):
+            if L in moving:
+                b[L] -= sign * w
+
+
+def fill_reducers(an, qd_ind: np.ndarray, res) -> None:
+    """A solved ``res``'s reducer fields, in place, from its unknowns u (``gear_t``) and the
+    independent rates ``qd_ind``: ``gear_sep`` holds the torque each reducer exerts on its input
+    about z_I, losses included (:func:`gearcli.model.reducers.input_torque`), and ``gear_loss``
+    (a lossy mechanism) its dissipated power (:func:`gearcli.model.reducers.reducer_loss`)."""
+    for ci, red in reducers(an):
+        a, u = mesh_rate(an, qd_ind, ci), res.gear_t[:, ci]
+        res.gear_sep[:, ci] = input_torque(red, u, a)
+        if res.gear_loss is not None:
+            res.gear_loss[:, ci] = reducer_loss(red, u, a)
 
 
 def mesh_loss(an, kin, ci: int, t: np.ndarray) -> np.ndarray:

@@ -37,7 +37,8 @@ from .llvm.output_maps import gear_outputs
 from .llvm.program import MAX_SIGNED, build_program
 from .kinematics import forward
 from .bearing_friction import solve_with_bearing_friction, subtract_bearing_friction
-from .losses import LOSS_FIELDS, fill_kernel_losses, fill_losses, subtract_joint_friction
+from .losses import (LOSS_FIELDS, fill_kernel_losses, fill_losses, fill_reducers, subtract_joint_friction,
+                     subtract_reducer_drag)
 from .result_arrays import check_out, copy_into, result_arrays, work_arrays
 from .signs import SignError, sign_violation
 
@@ -136,6 +137,12 @@ class Solver:
         when the kernel cannot be used here (``self.kernel_problem`` says why); built on
         first use."""
         if self._program is None and self.kernel_problem is None:
+            lossy = [self.an.mech.gears[c.gear].name for c in self.an.circuits
+                     if self.an.mech.gears[c.gear].reducer is not None and self.an.mech.gears[c.gear].reducer.lossy]
+            if lossy:
+                self.kernel_problem = (f"the losses of reducer '{lossy[0]}' (efficiency, no-load torque) are "
+                                       "modelled by the numpy path only")
+                return None
             self._program = build_program(self.an, self.plans)
             if not self._program.covered:
                 self.kernel_problem = (f"a block has more than {MAX_SIGNED} signed meshes, or a singular "
@@ -192,6 +199,7 @@ class Solver:
             if how.path != "numpy":
                 return self._by_kernel(how, q, qd, qdd, values, jobs, chunk, verify, out)
             res = self._by_numpy(q, qd, qdd, method, chunk, verify, values)
+        fill_reducers(self.an, qd, res)
         res.motor_speed = qd @ self.an.A
         if out is not None:
             copy_into(out, res)
@@ -206,6 +214,7 @@ class Solver:
         res = Result(**arrays) if out is None else out
         res.residual, res.backend, res.backend_note = None, how.path, how.note
         fill_kernel_losses(res, arrays, losses)
+        fill_reducers(self.an, qd, res)
         if verify:
             x_all = _unknowns(self.an, res)
             worst = 0.0
@@ -245,6 +254,7 @@ class Solver:
         b = inertia_load(an, kin)
         subtract_external(b, external_wrenches(an, kin, values))
         subtract_joint_friction(an, kin, b, qd)
+        subtract_reducer_drag(an, kin, b)
         return q, qd, kin, b
 
     def _chunk(self, q_ind, qd_ind, qdd_ind, method, verify, values) -> Result:

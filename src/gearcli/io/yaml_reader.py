@@ -23,7 +23,9 @@ from .loads_reader import yaml_loads, yaml_payloads
 from .planets import expand_planets, item_path
 from .ratings_reader import attach_yaml_ratings
 from ..model.geometry import dh_transform, origin_axis_transform
+from ..model.reducers import REDUCER_KINDS
 from ..model.validate import check_inertia, gear_pair_problems, inertia_matrix, number_problem
+from .reducer_specs import reducer_spec
 from .schema_words import schema_messages
 from .yaml_safe import read_text, yaml_lines
 from .schemas import packaged_schema
@@ -290,6 +292,9 @@ def _gears(data: dict, col: Collector, links: _Names) -> list[GearPair]:
     names = _Names(col, "gear pair")
     for i, spec in enumerate(data.get("gears", [])):
         path = item_path(data, "gears", i)
+        if spec.get("kind") in REDUCER_KINDS:
+            gears.append(_reducer(spec, col, links, names, path))
+            continue
         j, k = spec["links"]
         links.ref(j, f"{path}.links[0]")
         links.ref(k, f"{path}.links[1]")
@@ -314,6 +319,19 @@ def _gears(data: dict, col: Collector, links: _Names) -> list[GearPair]:
             loss_factor=mesh_loss_factor(spec, col, path),
         ))
     return gears
+
+
+def _reducer(spec: dict, col: Collector, links: _Names, names: _Names, path: str) -> GearPair:
+    """A strain-wave or cycloidal reducer (links: [input, output, housing]) as a GearPair with
+    j = input, k = output, carrier = housing, ratio = i0 (:mod:`gearcli.model.reducers`)."""
+    i, o, h = spec["links"]
+    for n, (name, role) in enumerate(((i, "input"), (o, "output"), (h, "housing"))):
+        links.ref(name, f"{path}.links[{n}]")
+    if len({i, o, h}) < 3:
+        col.add(f"{path}.links", f"a reducer's input, output and housing must be three different links, got {[i, o, h]}")
+    names.declare(spec.get("name", f"{i}-{o}"), path)
+    i0, red = reducer_spec(spec, path, col.add)
+    return GearPair(spec.get("name", f"{i}-{o}"), i, o, spec["kind"], i0, carrier=h, path=path, reducer=red)
 
 
 def _stiffness(spec: dict, col: Collector, path: str) -> float | None:

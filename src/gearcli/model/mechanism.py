@@ -24,6 +24,7 @@ import numpy as np
 from .friction import JointFriction
 from .loads import Load, with_payloads
 from .ratings import BearingRating, GearRating, JointLimit, MotorModel, MotorRating
+from .reducers import Reducer
 
 
 @dataclass(frozen=True, eq=False)
@@ -106,6 +107,10 @@ class GearPair:
     # mesh dissipates c |t| v_p, v_p the pitch-line speed relative to the carrier
     # (dynamics.losses.mesh_couple); 0 = lossless.
     loss_factor: float = 0.0
+    # A coaxial reducer (kind strain_wave or cycloidal, model.reducers): j is its input, k its
+    # output, carrier its housing, ratio the basic ratio i0; its efficiency, no-load torque,
+    # torsional stiffness and catalogue rating.  None for a gear pair.
+    reducer: Reducer | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -152,9 +157,9 @@ class Mechanism:
 
     @property
     def has_losses(self) -> bool:
-        """True when any gear pair has a loss factor, or any joint has friction of its own or
-        in its bearings."""
-        return any(g.loss_factor for g in self.gears) or any(
+        """True when any gear pair has a loss factor, any reducer an efficiency below 1 or a
+        no-load torque, or any joint has friction of its own or in its bearings."""
+        return any(g.loss_factor or (g.reducer is not None and g.reducer.lossy) for g in self.gears) or any(
             (j.friction is not None and j.friction.active) or any(b.friction_arm for b in j.bearings or ())
             for j in self.joints)
 

@@ -12,7 +12,11 @@ Columns, in order (units SI):
   the tooth force on that gear along its outward radial direction at the pitch point and
   along its positive axis), for j then k; per ideal pair (no geometry)
   ``gear:<pair>:torque`` (N*m, mesh torque on j about its axis; N for a coupling of a
-  prismatic joint);
+  prismatic joint); per reducer (``kind: strain_wave | cycloidal``) ``gear:<r>:torque`` (N*m,
+  the output torque T on the output about its joint axis), ``gear:<r>:input_torque`` (N*m,
+  the torque the reducer exerts on its input about the input's joint axis, losses included)
+  and, with a ``torsional_stiffness``, ``gear:<r>:windup`` (rad, the output's torsion angle
+  under T, odd in T; reported, not fed back);
 * per real joint ``joint:<joint>:fx, fy, fz, mx, my, mz`` (N, N*m): reaction wrench the
   parent exerts on the child, in the joint frame, about its origin; then
   ``joint:<joint>:radial`` = hypot(fx, fy), ``axial`` = |fz|, ``bending`` = hypot(mx, my);
@@ -20,7 +24,8 @@ Columns, in order (units SI):
   rate A^T qd) and ``motor:<motor>:power`` (W, torque x speed, negative when braking),
   appended last so that the columns above keep their positions;
 * only for a mechanism with losses (``gears[].efficiency``, ``joints[].friction``), appended
-  after those: per gear pair with geometry ``gear:<pair>:loss`` (W, mesh power loss), then
+  after those: per gear pair with geometry and per reducer ``gear:<pair>:loss`` (W, mesh or
+  reducer power loss), then
   per real joint ``joint:<joint>:friction`` (N*m, N for a prismatic joint: the friction on
   the child about (along) the axis; not included in ``mz``/``fz``) and ``joint:<joint>:loss``
   (W).
@@ -33,6 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..dynamics.solve import Result
+from ..model.reducers import windup
 from .rms import rms_of, square_integral
 from ..errors import counted
 
@@ -47,6 +53,11 @@ def column_names(an) -> list[str]:
     cols += [f"tau:{n}" for n in an.independent_names]
     for c in an.circuits:
         gp = mech.gears[c.gear]
+        if gp.reducer is not None:
+            cols += [f"gear:{gp.name}:torque", f"gear:{gp.name}:input_torque"]
+            if gp.reducer.torsional_stiffness is not None:
+                cols.append(f"gear:{gp.name}:windup")
+            continue
         if c.geometry is None:
             cols.append(f"gear:{gp.name}:torque")
             continue
@@ -58,10 +69,16 @@ def column_names(an) -> list[str]:
     for m in mech.motors:
         cols += [f"motor:{m.name}:speed", f"motor:{m.name}:power"]
     if mech.has_losses:
-        cols += [f"gear:{mech.gears[c.gear].name}:loss" for c in an.circuits if c.geometry is not None]
+        cols += [f"gear:{mech.gears[c.gear].name}:loss" for c in an.circuits if has_loss_column(an, c)]
         for jt in mech.joints:
             cols += [f"joint:{jt.name}:friction", f"joint:{jt.name}:loss"]
     return cols
+
+
+def has_loss_column(an, c) -> bool:
+    """True when circuit ``c`` has a ``gear:<pair>:loss`` column (a lossy mechanism's pairs with
+    tooth geometry and its reducers)."""
+    return c.geometry is not None or an.mech.gears[c.gear].reducer is not None
 
 
 TRANSPOSE_ROWS = 512
@@ -87,6 +104,13 @@ def column_sources(an, t: np.ndarray, res: Result) -> dict:
     for di in range(res.tau.shape[1]):
         put(lambda di=di: res.tau[:, di])
     for ci, circ in enumerate(an.circuits):
+        red = an.mech.gears[circ.gear].reducer
+        if red is not None:         # T = -e u on the output about z_O; the input torque (gear_sep)
+            put(lambda ci=ci, e=circ.ratio: -e * res.gear_t[:, ci])
+            put(lambda ci=ci: res.gear_sep[:, ci])
+            if red.torsional_stiffness is not None:
+                put(lambda ci=ci, e=circ.ratio, red=red: windup(red, -e * res.gear_t[:, ci]))
+            continue
         put(lambda ci=ci: res.gear_t[:, ci])
         if circ.geometry is not None:
             put(lambda ci=ci: res.gear_sep[:, ci])
@@ -118,7 +142,7 @@ def column_sources(an, t: np.ndarray, res: Result) -> dict:
         put(lambda mi=mi: res.motor[:, mi] * res.motor_speed[:, mi])
     if an.mech.has_losses:
         for ci, circ in enumerate(an.circuits):
-            if circ.geometry is not None:
+            if has_loss_column(an, circ):
                 put(lambda ci=ci: res.gear_loss[:, ci])
         for ji in range(res.joint.shape[1]):
             put(lambda ji=ji: res.joint_friction[:, ji])
@@ -178,7 +202,9 @@ def column_unit(name: str) -> str:
         return "W"
     if name == "t":
         return "s"
-    if name.startswith("tau:") or last in ("torque", "mx", "my", "mz", "bending") or (
+    if name.startswith("gear:") and last == "windup":
+        return "rad"
+    if name.startswith("tau:") or last in ("torque", "input_torque", "mx", "my", "mz", "bending") or (
             last == "friction" and name.startswith("joint:")):
         return "N·m"
     return "N"

@@ -47,6 +47,38 @@ def pair_dicts(an: Analysis) -> list[dict]:
     return out
 
 
+def reducer_dicts(an: Analysis) -> list[dict]:
+    """Each coaxial reducer (:mod:`gearcli.model.reducers`): kind, input, output, housing, the
+    basic ratio i0, efficiencies (constant ones; a table: its rows), no-load torque (N*m)."""
+    out = []
+    for c in an.circuits:
+        gp = an.mech.gears[c.gear]
+        red = gp.reducer
+        if red is None:
+            continue
+
+        def value(tab):
+            return tab.values[0] if tab.is_constant else [list(r) for r in zip(tab.speeds, tab.values)]
+        out.append({"reducer": gp.name, "kind": gp.kind, "input": gp.j, "output": gp.k, "housing": gp.carrier,
+                    "ratio": gp.ratio, "efficiency": {"forward": value(red.forward), "backward": value(red.backward)},
+                    "no_load_torque": None if red.no_load_torque is None else value(red.no_load_torque)})
+    return out
+
+
+def _reducer_line(d: dict) -> str:
+    i0 = d["ratio"]
+    eff = d["efficiency"]
+    text = (f"{d['kind'].replace('_', '-')} reducer '{d['reducer']}': input '{d['input']}', output '{d['output']}', "
+            f"housing '{d['housing']}', i0 = {i0:.6g} (input : output relative to the housing); pure torques, "
+            f"T on the output, -T/i0 on the input, -T(1 - 1/i0) = {-(1 - 1 / i0):.6g} T on the housing "
+            f"(a heavy edge input-output whose carrier is the housing)")
+    if eff["forward"] != 1.0 or eff["backward"] != 1.0:
+        text += f"; efficiency forward {eff['forward']}, backward {eff['backward']}"
+    if d["no_load_torque"] is not None:
+        text += f"; no-load torque {d['no_load_torque']} N*m"
+    return text
+
+
 def feature_notes(an: Analysis) -> list[str]:
     """Human-readable lines: ``load 'tip' on link '2' (frame base): force [..] N, moment [..]
     N*m at [..] m``, ``payload 'box' on link 'arm': ...``, ``helical pair ...``, ``rack pair
@@ -65,4 +97,5 @@ def feature_notes(an: Analysis) -> list[str]:
         else:
             lines.append(f"rack pair '{d['pair']}': pinion '{d['pinion']}' (pitch radius {d['pitch_radius']:.6g} m) "
                          f"drives rack '{d['rack']}': x = {d['x_per_rad']:.6g} m/rad * theta")
+    lines += [_reducer_line(d) for d in reducer_dicts(an)]
     return lines + loss_notes(an)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from ..analysis.graph import Analysis, Circuit
 from ..model.mechanism import Mechanism
-from .features import load_dicts, pair_dicts, payload_dicts
+from .features import load_dicts, pair_dicts, reducer_dicts, payload_dicts
 from .loss_notes import loss_dicts
 from .sharing import sharing_sets
 
@@ -47,6 +47,7 @@ def analysis_dict(an: Analysis) -> dict:
         "loads": load_dicts(an),
         "payloads": payload_dicts(an),
         "helical_and_rack_pairs": pair_dicts(an),
+        "reducers": reducer_dicts(an),
         "losses": loss_dicts(an),
     } | ({"open_loop": "tree"} if an.open_loop == "tree" else {})
 

@@ -28,14 +28,16 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..errors import counted
+from .columns import has_loss_column
 
 
 def lossless_twin(mech):
     """The same mechanism with every loss removed: efficiency 1, no joint friction, no
-    bearing friction (the bearings' ratings stay)."""
+    bearing friction, reducers without losses (the ratings stay)."""
     def frictionless(bearings):
         return bearings and tuple(replace(b, friction_coefficient=None) for b in bearings)
-    return replace(mech, gears=tuple(replace(g, loss_factor=0.0) for g in mech.gears),
+    return replace(mech, gears=tuple(replace(g, loss_factor=0.0, reducer=g.reducer and g.reducer.lossless())
+                                     for g in mech.gears),
                    joints=tuple(replace(j, friction=None, bearings=frictionless(j.bearings)) for j in mech.joints))
 
 
@@ -68,7 +70,7 @@ class LossSummary:
     @classmethod
     def for_mechanism(cls, an) -> "LossSummary":
         mech = an.mech
-        el = [f"gear {mech.gears[c.gear].name}" for c in an.circuits if c.geometry is not None]
+        el = [f"gear {mech.gears[c.gear].name}" for c in an.circuits if has_loss_column(an, c)]
         el += [f"joint {jt.name}" for jt in mech.joints]
         s = cls(el, [m.name for m in mech.motors])
         s.energy = np.zeros(len(el))
@@ -81,7 +83,7 @@ class LossSummary:
     def add(self, an, t: np.ndarray, res, lossless_motor: np.ndarray) -> None:
         """Accumulate a chunk: its times ``t`` (N,), the lossy ``res`` and the lossless motor
         torques (N, M) of the same motion."""
-        geo = [ci for ci, c in enumerate(an.circuits) if c.geometry is not None]
+        geo = [ci for ci, c in enumerate(an.circuits) if has_loss_column(an, c)]
         loss = np.concatenate([res.gear_loss[:, geo], res.joint_loss], axis=1)
         p_lossy = res.motor * res.motor_speed
         p_ideal = lossless_motor * res.motor_speed
