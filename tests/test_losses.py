@@ -108,7 +108,8 @@ def own_losses(an, q, qd, res):
         rate = np.sum((kin.w[c.j] - kin.w[c.carrier]) * zj, axis=1)
         parts.append(gp.loss_factor * np.abs(res.gear_t[:, ci]) * np.abs(rate) * c.geometry.r_j)
     for ji, jt in enumerate(mech.joints):
-        parts.append(jt.friction.coulomb * np.abs(qda[:, ji]) + jt.friction.viscous * qda[:, ji] ** 2)
+        if jt.friction is not None:
+            parts.append(jt.friction.coulomb * np.abs(qda[:, ji]) + jt.friction.viscous * qda[:, ji] ** 2)
         for b, P in zip(jt.bearings or (), own_bearing_loads(jt, res.joint[:, ji]) if jt.bearings else ()):
             parts.append(0.5 * b.friction_coefficient * b.bore * P * np.abs(qda[:, ji]))
     return np.sum(parts, axis=0), parts

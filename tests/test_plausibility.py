@@ -154,7 +154,8 @@ def test_rate_watch_bounds_on_the_bundled_trajectories():
     for traj in sorted(MECH_DIR.glob("*_traj.csv")):
         mech = next(p for p in BUNDLED if p.stem == traj.name.removesuffix("_traj.csv"))
         an = analyse(load_mechanism(mech))
-        reader = TrajectoryReader(traj, an.independent_names, linear=an.prismatic_independent)
+        reader = TrajectoryReader(traj, an.independent_names, linear=an.prismatic_independent,
+                                  payloads=[p.name for p in an.mech.payloads])
         watch = RateWatch(reader, an)
         for part in reader:
             watch.see(part)

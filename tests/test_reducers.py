@@ -131,6 +131,39 @@ def test_housing_takes_minus_T_times_one_minus_one_over_i0():
     assert c["joint:Jh:bending"][0] == pytest.approx(abs(housing_share - c["motor:m"][0]), rel=1e-13)
 
 
+LOSSY_SWIVEL = HOUSING.replace("gravity: [0, 0, 0]", "gravity: [0, -9.81, -3]").replace(
+    "ratio: 81}", "ratio: 81, efficiency: {forward: [[0, 0.6], [50, 0.8], [200, 0.85]], backward: [[0, 0.3], [100, 0.5]]},"
+    " no_load_torque: [[0, 0.02], [300, 0.2]]}")
+
+
+@pytest.mark.parametrize("backend", ["numpy", "llvm"])
+def test_lossy_reducer_on_a_moving_housing_balances_power(backend):
+    """The swivel with speed-dependent efficiencies and no-load torque (tables), its housing
+    tilting: the motors' power = dT/dt - P_gravity + the reducer's loss (computed from the model
+    statement in tests/test_losses.py, sharing no code with the solver), every loss >= 0, to
+    1e-9, on both paths; the kernel equals numpy to 1e-12 of each sample's largest load."""
+    from test_losses import energy_terms, own_losses
+    an = analyse(parse_mechanism(LOSSY_SWIVEL))
+    rng = np.random.default_rng(5)
+    q, qd, qdd = rng.uniform(-2, 2, (300, 2)), rng.uniform(-4, 4, (300, 2)), rng.uniform(-9, 9, (300, 2))
+    qd[::5, 1] = 0.0                       # the output at rest relative to the housing: lossless
+    res = solve(an, q, qd, qdd, backend=backend)
+    assert res.backend == backend
+    dT, Pg, Pe = energy_terms(an, q, qd, qdd)
+    total, parts = own_losses(an, q, qd, res)
+    P_motor = np.sum(res.motor * res.motor_speed, axis=1)
+    scale = 1.0 + np.abs(P_motor) + np.abs(dT) + np.abs(Pg) + total
+    assert np.max(np.abs(P_motor - (dT - Pg - Pe + total)) / scale) < 1e-9
+    assert all(np.all(p >= -1e-12 * scale) for p in parts) and np.all(total[::5] < 1e-12 * scale[::5])
+    assert np.max(np.abs(res.gear_loss[:, 0] - total) / scale) < 1e-11
+    if backend == "llvm":
+        ref = named_columns(an, solve(an, q, qd, qdd, backend="numpy"))
+        got = named_columns(an, res)
+        big = 1.0 + np.max(np.abs(np.column_stack(list(ref.values())[1:])), axis=1)
+        for k in ref:
+            assert np.max(np.abs(got[k] - ref[k]) / big) < 1e-12, k
+
+
 # --- deliberate bugs: each physics term's hand case catches its bug ---------------------------------
 
 def test_the_hand_case_catches_a_missing_one_over_i0(monkeypatch):

@@ -137,12 +137,6 @@ class Solver:
         when the kernel cannot be used here (``self.kernel_problem`` says why); built on
         first use."""
         if self._program is None and self.kernel_problem is None:
-            lossy = [self.an.mech.gears[c.gear].name for c in self.an.circuits
-                     if self.an.mech.gears[c.gear].reducer is not None and self.an.mech.gears[c.gear].reducer.lossy]
-            if lossy:
-                self.kernel_problem = (f"the losses of reducer '{lossy[0]}' (efficiency, no-load torque) are "
-                                       "modelled by the numpy path only")
-                return None
             self._program = build_program(self.an, self.plans)
             if not self._program.covered:
                 self.kernel_problem = (f"a block has more than {MAX_SIGNED} signed meshes, or a singular "

@@ -4,6 +4,8 @@ what the sample's rates give before any block solve, and the loss outputs.
 * :func:`mesh_rates`: each lossy mesh's rate theta'_{j,c} = r . q'_ind from the
   independent joint rates (:func:`..losses.relative_rate`) and s_v = sign of it (0 at rest,
   exactly, in any frames), which the lossy blocks read (:mod:`.losses`);
+* :func:`reducer_terms`: each lossy reducer's input rate, power-flow coefficients and its
+  no-load torque (a known load);
 * :func:`joint_friction`: each friction joint's own friction -F_c sign(q'_J) - F_v q'_J
   from the sample's joint rate (the law of :func:`..losses.friction_force`; the bearing
   friction is :mod:`.bearings`'); rhs[L] -= that generalised force Q times the joint's unit
@@ -39,6 +41,45 @@ def mesh_rates(e: Emitter, s: Sample, lp) -> tuple[list, list]:
     """(theta'_{j,c}, s_v) of every lossy mesh (doubles)."""
     rates = [e.const(e.dot(floats(lp.rate_flt[k]), s.qdi)) for k in range(len(lp.rate_meshes))]
     return rates, [_sign(e, r) for r in rates]
+
+
+def interp(e: Emitter, x, table):
+    """np.interp(x, speeds, values) of a table (speeds, values) at x >= 0: linear between rows,
+    held beyond the ends (a constant: folded)."""
+    xs, ys = (tuple(float(v) for v in col) for col in table)
+    y = ys[0]
+    if len(xs) == 1:
+        return y
+    for i in range(len(xs) - 1):
+        slope = (ys[i + 1] - ys[i]) / (xs[i + 1] - xs[i])
+        seg = e.add(ys[i], e.mul(slope, e.sub(x, xs[i])))
+        y = e.b.select(e.b.fcmp_ordered(">", x, ir.Constant(D, xs[i])), e.const(seg), e.const(y))
+    return e.b.select(e.b.fcmp_ordered(">=", x, ir.Constant(D, xs[-1])), ir.Constant(D, ys[-1]), y)
+
+
+def reducer_terms(e: Emitter, s: Sample, red) -> list:
+    """Per lossy reducer (:class:`.loss_program.ReducerLosses`): (s_a, A, B, z_I in world
+    axes) for the world-frame block columns (:func:`.losses.world_columns`), a = its rate row
+    . q'_ind (exactly 0 at rest); rhs -= its no-load torque -T0(|a|) s_a about z_I on the
+    input (+ on the housing), a known load (:func:`..losses.subtract_reducer_drag`)."""
+    out = []
+    for k in range(len(red.circuits)):
+        a = e.const(e.dot(floats(red.rate_flt[k]), s.qdi))
+        sa, speed = _sign(e, a), e.call("fabs", a)
+        j, c, housing = (int(v) for v in red.links[k])
+        z = e.mv(s.R[housing], floats(red.axis[k]))
+        fwd, bwd, t0 = red.tables[k]
+        inv_f, eta_b = e.div(1.0, interp(e, speed, fwd)), interp(e, speed, bwd)
+        A = e.const(e.sub(e.mul(0.5, e.add(inv_f, eta_b)), 1.0))
+        B = e.const(e.mul(0.5, e.sub(eta_b, inv_f)))
+        out.append((sa, A, B, z))
+        if t0 is None:
+            continue
+        tq = e.const(e.neg(e.mul(interp(e, speed, t0), sa)))
+        for L, sign in ((j, 1.0), (c, -1.0)):
+            if L >= 0:
+                s.rhs[L] = s.rhs[L][:3] + tuple(e.sub(s.rhs[L][3 + h], e.mul(e.mul(sign, tq), z[h])) for h in range(3))
+    return out
 
 
 def joint_friction(e: Emitter, s: Sample, lp, rows: dict) -> dict:

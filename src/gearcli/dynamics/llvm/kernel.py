@@ -77,6 +77,8 @@ def _sample(e: Emitter, fn, prog, loads, n, before: list) -> list:
     if lp is not None:
         rows = {k: e.row(a[k], n, max(w[k], 1)) for k in LOSS_OUTPUTS}
         rates, s.sv = friction_terms.mesh_rates(e, s, lp)
+        if lp.reducers is not None:
+            s.red = friction_terms.reducer_terms(e, s, lp.reducers)
         own = friction_terms.joint_friction(e, s, lp, rows)
     signs = e.row(a["signs"], n, max(w["signs"], 1))
     fresh = e.b.icmp_signed("==", e.b.srem(n, ir.Constant(I64, WARM)), ir.Constant(I64, 0))

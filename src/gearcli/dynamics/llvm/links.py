@@ -46,6 +46,7 @@ class Sample:
     bearing: dict = field(default_factory=dict)   # joint: s_J Mb_J, its converged bearing friction (:mod:`.bearings`)
     frames: dict = field(default_factory=dict)
     qdi: list = field(default_factory=list)    # (dof,) the independent joint rates (mesh rates: :mod:`.friction_terms`)
+    red: list = field(default_factory=list)    # per lossy reducer (s_a, A, B, z_I world) (:func:`.friction_terms.reducer_terms`)
 
 
 def floats(row) -> tuple:

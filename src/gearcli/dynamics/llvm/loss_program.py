@@ -67,6 +67,36 @@ class BlockLosses:
     rows: tuple = ()
     maps: tuple | None = None
     hot: tuple = ()
+    # the block's signed reducers (world frame): (position in its signed unknowns, index in
+    # ReducerLosses, ((block row, +1 input / -1 housing), ...), ((later link, sign), ...))
+    reducers: tuple = ()
+
+
+@dataclass(frozen=True, eq=False)
+class ReducerLosses:
+    """The lossy coaxial reducers (:mod:`gearcli.model.reducers`) for the kernel.
+
+    Per reducer: ``circuits`` its circuit; ``rate_flt`` (R, dof) its rate row (a = the input's
+    rate relative to the housing about z_I, from the independent rates); ``links`` (R, 3)
+    [input, housing] (-1 where not moving) and the housing; ``axis`` (R, 3) z_I in the housing's axes;
+    ``tables``: (eta_f, eta_b, T0 or None) each as (speeds, values) over |a| (linear between
+    rows, held beyond the ends); ``signed``: 1 when its efficiency is below 1 (its torque on
+    the input then depends on sign(u) sign(a)).  The kernel adds to the input's column
+    delta = A |s_a| + B sigma s_a times z_I (minus on the housing), A = (1/eta_f + eta_b)/2 - 1,
+    B = (eta_b - 1/eta_f)/2: c_r = 1 + delta is 1/eta_f where sigma s_a = -1, eta_b where +1,
+    1 at rest; and the no-load torque -T0 s_a about z_I on the input (the opposite on the
+    housing) as a known load."""
+
+    circuits: tuple
+    rate_flt: np.ndarray
+    links: np.ndarray
+    axis: np.ndarray
+    tables: tuple
+    signed: tuple
+
+    def parts(self) -> list:
+        return [self.circuits, self.rate_flt.tobytes(), self.links.tobytes(), self.axis.tobytes(), self.signed,
+                repr(self.tables).encode()]
 
 
 @dataclass(frozen=True, eq=False)
@@ -102,6 +132,7 @@ class LossProgram:
     bearing_flt: np.ndarray | None = None         # (K, 6) [z1, z2, locating 1, 2, arm 1, 2] (bearing_layout)
     bearing_single: tuple = field(default=())     # (K,) 1: the joint has one bearing
     bearing_blocks: dict = field(default_factory=dict)   # block -> BearingBlock
+    reducers: ReducerLosses | None = None                # the lossy reducers
 
     @property
     def out_width(self) -> int:
@@ -119,9 +150,11 @@ class LossProgram:
         for b in sorted(self.bearing_blocks):
             bb = self.bearing_blocks[b]
             out += [b, bb.joints, bb.cols, b"" if bb.wF is None else bb.wF.tobytes()]
+        if self.reducers is not None:
+            out += self.reducers.parts()
         for b in sorted(self.blocks):
             bl = self.blocks[b]
-            out += [b, bl.positions, bl.rates, bl.circuits, bl.later, bl.rows]
+            out += [b, bl.positions, bl.rates, bl.circuits, bl.later, bl.rows, bl.reducers]
             out += [a.tobytes() for a in (bl.phi, bl.couple_F) + (bl.maps or ()) if a is not None]
             out += [v for key, L in bl.hot for v in (key, L.tobytes())]
         return out
@@ -167,9 +200,16 @@ def build_loss_program(an, plans) -> LossProgram | None:
     rate_int = np.array([[an.circuits[ci].j, an.circuits[ci].carrier] for ci in rate_meshes], np.int64).reshape(-1, 2)
     rate_flt = np.array(an.mesh_rate_rows[list(rate_meshes)], float).reshape(-1, an.dof)
     block_of = {L: i for i, p in enumerate(plans) for L in p.links}
+    red = _reducer_losses(an)
     blocks = {}
     for bi, p in enumerate(plans):
         pos = [n for n, gi in enumerate(p.signed) if p.groups[gi].kind == "mesh" and p.groups[gi].index in couple]
+        reds = _block_reducers(an, p, bi, block_of, red)
+        if reds:
+            assert p.F is None, "a reducer's unknown is solved in world axes"
+            if not pos:
+                blocks[bi] = BlockLosses((), (), (), None, None, (), (), reducers=reds)
+                continue
         if not pos:
             continue
         circ = tuple(p.groups[p.signed[n]].index for n in pos)
@@ -179,7 +219,7 @@ def build_loss_program(an, plans) -> LossProgram | None:
         if p.F is None:
             rows = tuple(tuple((p.links.index(L), 1 if L == an.circuits[ci].j else -1)
                                for L in p.groups[p.signed[n]].links if L in p.links) for n, ci in zip(pos, circ))
-            blocks[bi] = BlockLosses(tuple(pos), rates, circ, None, None, later, rows)
+            blocks[bi] = BlockLosses(tuple(pos), rates, circ, None, None, later, rows, reducers=reds)
         else:
             assert p.fric is not None and all(p.signed[n] in p.fric_C for n in pos)
             assert all(primary_side(an, p.groups[p.signed[n]]) == an.circuits[ci].j for n, ci in zip(pos, circ))
@@ -203,7 +243,44 @@ def build_loss_program(an, plans) -> LossProgram | None:
     bflt = np.ascontiguousarray(np.column_stack([z1, z2, loc, arm]).reshape(-1, 6), float)
     return LossProgram(rate_meshes, rate_int, rate_flt, couple, blocks, np.array(jrec, np.int64).reshape(-1, 5),
                        np.array(jflt, float).reshape(-1, 8), loss_flt, tuple(bj), bflt, tuple(int(v) for v in single),
-                       _bearing_blocks(an, plans, bj))
+                       _bearing_blocks(an, plans, bj), red)
+
+
+def _reducer_losses(an) -> ReducerLosses | None:
+    """The :class:`ReducerLosses` of ``an``'s lossy reducers, None without one."""
+    gears, moving = an.mech.gears, set(an.tree.moving)
+    circ = tuple(ci for ci, c in enumerate(an.circuits)
+                 if gears[c.gear].reducer is not None and gears[c.gear].reducer.lossy)
+    if not circ:
+        return None
+    tables, signed = [], []
+    for ci in circ:
+        r = gears[an.circuits[ci].gear].reducer
+        t0 = None if r.no_load_torque is None else (r.no_load_torque.speeds, r.no_load_torque.values)
+        tables.append(((r.forward.speeds, r.forward.values), (r.backward.speeds, r.backward.values), t0))
+        signed.append(int(r.power_flow_lossy))
+    links = [[c.j if c.j in moving else -1, c.carrier if c.carrier in moving else -1, c.carrier]
+             for c in (an.circuits[ci] for ci in circ)]
+    return ReducerLosses(circ, np.array(an.mesh_rate_rows[list(circ)], float).reshape(-1, an.dof),
+                         np.array(links, np.int64).reshape(-1, 3),
+                         np.array([an.circuits[ci].zj for ci in circ], float).reshape(-1, 3), tuple(tables), tuple(signed))
+
+
+def _block_reducers(an, p, bi: int, block_of: dict, red: ReducerLosses | None) -> tuple:
+    """:attr:`BlockLosses.reducers` of block plan ``p`` (index ``bi``)."""
+    if red is None:
+        return ()
+    out = []
+    for n, gi in enumerate(p.signed):
+        g = p.groups[gi]
+        if g.kind != "mesh" or g.index not in red.circuits:
+            continue
+        c = an.circuits[g.index]
+        sides = ((c.j, 1), (c.carrier, -1))
+        rows = tuple((p.links.index(L), s) for L, s in sides if L in p.links)
+        later = tuple((L, s) for L, s in sides if L not in p.links and L in block_of and block_of[L] > bi)
+        out.append((n, red.circuits.index(g.index), rows, later))
+    return tuple(out)
 
 
 def _bearing_blocks(an, plans, bj: list) -> dict:

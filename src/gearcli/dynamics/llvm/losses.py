@@ -15,7 +15,8 @@ for :mod:`.blocks` (the sample's rates, joint friction and loss outputs: :mod:`.
       t_l = (I + M D)^-1 t0   (an ml x ml solve),   x = X_sigma r - X_sigma Phi D t_l;
 
 * :func:`world_columns`: a world-frame block's friction couples added to its matrix per
-  sample (sigma s_v (R_c couple) on gear j's rows, minus on k's);
+  sample (sigma s_v (R_c couple) on gear j's rows, minus on k's), and its reducers' power-flow
+  change delta z_I (:class:`.loss_program.ReducerLosses`; + on the input, - on the housing);
 * :func:`couples_F`, :func:`propagate`: the solved couples s_v |t| on the links of later
   blocks (constant frame: in the mesh's propagation record, :func:`.blocks.propagate`).
 """
@@ -295,7 +296,19 @@ def world_columns(lp, bl, s: Sample):
             for row, sign in rows:
                 for h in range(3):
                     A[6 * row + 3 + h][tcols[n]] = e.add(A[6 * row + 3 + h][tcols[n]], e.mul(coef, e.mul(float(sign), fr[h])))
+        for n, k, rows, _ in bl.reducers:
+            delta, z = _reducer_delta(e, s.red[k], sig[n])
+            for row, sign in rows:
+                for h in range(3):
+                    A[6 * row + 3 + h][tcols[n]] = e.add(A[6 * row + 3 + h][tcols[n]], e.mul(e.mul(float(sign), delta), z[h]))
     return add
+
+
+def _reducer_delta(e: Emitter, terms, sigma):
+    """(delta, z_I): a reducer's power-flow change of its input column, delta = A |s_a| + B
+    sigma s_a (:class:`.loss_program.ReducerLosses`), and its axis in world axes."""
+    sa, A, B, z = terms
+    return e.add(e.mul(A, e.mul(sa, sa)), e.mul(B, e.mul(sigma, sa))), z
 
 
 def _carrier(lp, k: int) -> int:
@@ -320,4 +333,10 @@ def propagate(e: Emitter, s: Sample, lp, bl, x: list, tcols: list, sig: list) ->
         amount = e.mul(e.mul(sig[n], s.sv[k]), x[tcols[n]])
         for L, sign in bl.later[a]:
             s.rhs[L] = s.rhs[L][:3] + tuple(e.sub(s.rhs[L][3 + h], e.mul(float(sign), e.mul(amount, m[h])))
+                                            for h in range(3))
+    for n, k, _, later in bl.reducers:          # the power-flow change delta u z_I (+ input, - housing)
+        delta, z = _reducer_delta(e, s.red[k], sig[n])
+        amount = e.mul(delta, x[tcols[n]])
+        for L, sign in later:
+            s.rhs[L] = s.rhs[L][:3] + tuple(e.sub(s.rhs[L][3 + h], e.mul(float(sign), e.mul(amount, z[h])))
                                             for h in range(3))
