@@ -76,3 +76,22 @@ q, qd, qdd = quintic_moves(tc, [(0.0, 2.0, -1.0, 1.0), (3.0, 5.0, 1.0, -1.0)])
 attach = ((tc < 2.5) | (tc >= 5.5)).astype(float)
 np.savetxt("mechanisms/cobot_joint_traj.csv", np.column_stack([tc, q, qd, qdd, attach]), delimiter=",",
            header="t,q:J2,qd:J2,qdd:J2,attach:part", comments="", fmt="%.17g")
+
+# cobot_6axis: J1..J6 (rad), 4 s of smooth motion at 1 kHz, output speeds to ~1.5 rad/s
+# (150 rad/s = 1430 rpm at the wave generators), carrying the part throughout
+t6 = np.linspace(0.0, 4.0, 4001)
+amp = np.array([1.2, 0.6, 0.9, 1.0, 1.2, 1.5])
+freq = np.array([0.25, 0.35, 0.3, 0.45, 0.4, 0.5]) * 2 * np.pi
+phase = np.array([0.0, 0.4, 0.8, 1.2, 1.6, 2.0])
+off = np.array([0.0, -0.6, 1.2, -0.5, 0.0, 0.0])
+arg = freq * t6[:, None] + phase
+q6, qd6, qdd6 = off + amp * np.sin(arg), amp * freq * np.cos(arg), -amp * freq**2 * np.sin(arg)
+np.savetxt("mechanisms/cobot_6axis_traj.csv", np.column_stack([t6, q6, qd6, qdd6, np.ones_like(t6)]), delimiter=",",
+           header=",".join(["t"] + [f"{p}:J{i}" for p in ("q", "qd", "qdd") for i in range(1, 7)] + ["attach:part"]),
+           comments="", fmt="%.17g")
+
+# rv_turret: the first axis J1 (rad) swinging -90 -> +90 deg in 1.5 s, dwelling 0.5 s, and back:
+# a 4 s cycle (3.93 rad/s at most at the output: 4540 rpm at the RV input)
+tr = np.linspace(0.0, 4.0, 4001)
+q, qd, qdd = quintic_moves(tr, [(0.0, 1.5, -np.pi / 2, np.pi / 2), (2.0, 3.5, np.pi / 2, -np.pi / 2)])
+write_trajectory("mechanisms/rv_turret_traj.csv", ["J1"], tr, q[:, None], qd[:, None], qdd[:, None])

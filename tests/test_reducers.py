@@ -294,3 +294,108 @@ def test_members_off_one_axis_are_a_located_error(run_cli, tmp_path):
     r = run_cli("check", tmp_path / "m.yaml")
     assert r.exit_code == 2 and "gears[0].links" in r.stderr and "do not turn about one axis" in r.stderr
 
+
+
+# --- URDF ------------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("text", [LOSSY_SWIVEL, HOIST.format(i0=-100.0, extra="", kind="strain_wave", axis=1)],
+                         ids=["lossy-tables", "lossless"])
+@pytest.mark.parametrize("backend", ["numpy", "llvm"])
+def test_urdf_round_trip_solves_bit_identically(run_cli, tmp_path, text, backend):
+    """gearcli export writes a gearcli:reducer (efficiency and no-load tables, stiffness, its
+    gearcli:rating); read back, the reducer is the same and every output column is bit for bit
+    the YAML's, on both paths."""
+    from gearcli import load_mechanism
+    (tmp_path / "m.yaml").write_text(text)
+    r = run_cli("export", tmp_path / "m.yaml", "-o", tmp_path / "m.urdf")
+    assert r.exit_code == 0, r.stderr
+    a, b = (analyse(load_mechanism(tmp_path / f)) for f in ("m.yaml", "m.urdf"))
+    assert a.mech.gears[0].reducer == b.mech.gears[0].reducer and a.mech.gears[0].ratio == b.mech.gears[0].ratio
+    rng = np.random.default_rng(2)
+    q, qd, qdd = (rng.uniform(-3, 3, (200, a.dof)) for _ in range(3))
+    ca, cb = (named_columns(x, solve(x, q, qd, qdd, backend=backend)) for x in (a, b))
+    assert list(ca) == list(cb) and all(np.array_equal(ca[k], cb[k]) for k in ca)
+
+
+def test_cobot_joint_urdf_keeps_the_rating_and_the_crossed_roller(run_cli, tmp_path):
+    """The bundled cobot joint exported and read back: the reducer's catalogue rating, teeth and
+    the crossed-roller output bearing are the file's."""
+    from gearcli import load_mechanism
+    r = run_cli("export", MECHS / "cobot_joint.yaml", "-o", tmp_path / "c.urdf")
+    assert r.exit_code == 0, r.stderr
+    a, b = load_mechanism(MECHS / "cobot_joint.yaml"), load_mechanism(tmp_path / "c.urdf")
+    assert b.gears[0].reducer.rating == a.gears[0].reducer.rating and b.gears[0].teeth == (200, 202)
+    assert b.joints[1].bearings == a.joints[1].bearings
+
+
+@pytest.mark.parametrize("attrs, message", [
+    ('efficiency_forward="1.5"', ".efficiency_forward: forward efficiency eta_f must be in (0, 1], got 1.5"),
+    ('efficiency_forward="0 0.5 10"', "a table is pairs"),
+    ('ratio="1"', "must not be 0 or 1"),
+    ('kind="planetary" ratio="-50"', "kind must be one of strain_wave, cycloidal"),
+])
+def test_urdf_reducer_problems_are_located(run_cli, tmp_path, attrs, message):
+    """A bad gearcli:reducer: one line naming the element, exit 2."""
+    (tmp_path / "m.yaml").write_text(HOIST.format(i0=-100.0, extra="", kind="strain_wave", axis=1))
+    assert run_cli("export", tmp_path / "m.yaml", "-o", tmp_path / "m.urdf").exit_code == 0
+    text = (tmp_path / "m.urdf").read_text()
+    key = attrs.split("=")[0]
+    import re
+    text = re.sub(rf' {key}="[^"]*"', "", text) if key in text else text
+    if "kind=" in attrs:
+        text = text.replace('kind="strain_wave" ', "").replace(' ratio="-100.0"', "")
+    text = text.replace("<gearcli:reducer ", f"<gearcli:reducer {attrs} ")
+    (tmp_path / "m.urdf").write_text(text)
+    r = run_cli("check", tmp_path / "m.urdf")
+    assert r.exit_code == 2 and "Traceback" not in r.stderr
+    assert any("gearcli:reducer 'hd'" in ln and message in ln for ln in r.stderr.splitlines()), r.stderr
+
+
+# --- mass matrix, forward dynamics, simulate ---------------------------------------------------------
+
+@pytest.mark.parametrize("backend", ["numpy", "llvm"])
+def test_mass_matrix_reflects_the_input_through_i0_squared(backend):
+    """The cobot joint: M = I_arm about the joint axis (its own inertia, its mass at its centre
+    of mass's distance from the axis) + i0^2 I_rotor: the wave generator's 2.0e-4 kg*m^2 seen
+    100^2 times, by hand from the file's numbers (the payload attached: + 3 kg at 0.4 m)."""
+    from gearcli import load_mechanism, mass_matrix
+    an = analyse(load_mechanism(MECHS / "cobot_joint.yaml"))
+    q = np.array([[0.0], [1.0]])
+    I_arm = 3.0e-2 + 2.0 * 0.2**2          # Iyy about the centre of mass + m r^2 (r = 0.2 m off the axis)
+    M = mass_matrix(an, q, backend=backend)
+    assert np.allclose(M[:, 0, 0], I_arm + 100.0**2 * 2.0e-4, rtol=1e-12)
+    M = mass_matrix(an, q, backend=backend, attach={"part": np.ones(2)})
+    assert np.allclose(M[:, 0, 0], I_arm + 3.0 * 0.4**2 + 100.0**2 * 2.0e-4, rtol=1e-12)
+
+
+def test_forward_dynamics_inverts_the_lossy_solve():
+    """forward_dynamics of the motor torques solve gives back the accelerations, through the
+    reducer's power-flow factor and no-load torque (forward and back-driven samples)."""
+    from gearcli import forward_dynamics, load_mechanism
+    an = analyse(load_mechanism(MECHS / "cobot_joint.yaml"))
+    rng = np.random.default_rng(4)
+    q, qd, qdd = rng.uniform(-1, 1, (50, 1)), rng.uniform(-2, 2, (50, 1)), rng.uniform(-6, 6, (50, 1))
+    res = solve(an, q, qd, qdd)
+    back = forward_dynamics(an, q, qd, res.motor)
+    assert np.max(np.abs(back - qdd)) < 1e-9 * (1 + np.abs(qdd).max())
+
+
+def test_simulate_runs_the_cobot_joint(run_cli, tmp_path):
+    """gearcli simulate drives the cobot joint with the motor torques of a planned motion
+    (solve, then simulate from the same start): the simulated angle follows the planned one.
+    The motion never reverses: at a reversal the power-flow factor jumps between 1/eta_f and
+    eta_b where a held state would be needed, which simulate does not model (README, Reducers)."""
+    from gearcli import load_mechanism
+    an = analyse(load_mechanism(MECHS / "cobot_joint.yaml"))
+    t = np.linspace(0.0, 2.0, 401)
+    from numpy import cos, pi, sin
+    q = 0.5 * t + 0.1 * sin(pi * t)
+    qd, qdd = 0.5 + 0.1 * pi * cos(pi * t), -0.1 * pi**2 * sin(pi * t)
+    res = solve(an, q[:, None], qd[:, None], qdd[:, None])
+    np.savetxt(tmp_path / "torque.csv", np.column_stack([t, res.motor[:, 0]]), delimiter=",",
+               header="t,motor:motor", comments="")
+    r = run_cli("simulate", MECHS / "cobot_joint.yaml", tmp_path / "torque.csv", "--q0", "0", "--qd0", repr(0.5 + 0.1 * pi),
+                "-o", tmp_path / "sim.csv")
+    assert r.exit_code == 0, r.stderr
+    sim = np.genfromtxt(tmp_path / "sim.csv", delimiter=",", names=True)
+    assert np.max(np.abs(np.interp(t, sim["t"], sim["qJ2"]) - q)) < 2e-3

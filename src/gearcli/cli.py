@@ -122,8 +122,9 @@ def check(mech: Path = typer.Argument(..., metavar="MECH", help=MECH_HELP, show_
     an = load_analysis(mech, strict)
     _check_ratings(an)
     m = an.mech
-    typer.echo(f"{mech}: OK ({an.dof} dof, {counted(len(m.links), 'link')}, {counted(len(an.circuits), 'gear pair')}, "
-               f"{counted(len(m.motors), 'motor')})")
+    reducers = sum(1 for c in an.circuits if m.gears[c.gear].reducer is not None)
+    pairs = counted(len(an.circuits) - reducers, 'gear pair') + (f", {counted(reducers, 'reducer')}" if reducers else "")
+    typer.echo(f"{mech}: OK ({an.dof} dof, {counted(len(m.links), 'link')}, {pairs}, {counted(len(m.motors), 'motor')})")
     for line in feature_notes(an) + sharing_notes(an):
         typer.echo(line)
 

@@ -207,8 +207,7 @@ class Solver:
         sig = self.llvm_kernel().solve(self.an, q, qd, qdd, values, jobs, chunk, arrays, work, losses)
         res = Result(**arrays) if out is None else out
         res.residual, res.backend, res.backend_note = None, how.path, how.note
-        fill_kernel_losses(res, arrays, losses)
-        fill_reducers(self.an, qd, res)
+        fill_kernel_losses(res, arrays, losses)      # (a reducer's input torque and loss: the kernel's)
         if verify:
             x_all = _unknowns(self.an, res)
             worst = 0.0

@@ -14,11 +14,28 @@ from ..model.mechanism import GearPair, Motor
 from ..model.validate import gear_pair_problems
 from .urdf_transmissions import KINDS as TRANSMISSION_KINDS
 from .urdf_transmissions import read_transmissions
+from .reducer_specs import reducer_spec
 from .urdf_xml import NS, floats, q
+from ..model.reducers import LIFE_BASES, REDUCER_KINDS
 
 GEAR_ATTRS = ("name", "j", "k", "kind", "ratio", "teeth", "carrier", "mesh_point", "pressure_angle",
               "pressure_angle_deg", "cone_angles", "cone_angles_deg", "helix_angle", "helix_angle_deg", "hand",
               "stiffness", "derived", "efficiency", "loss_factor")
+
+
+REDUCER_ATTRS = ("name", "kind", "input", "output", "housing", "ratio", "teeth", "efficiency_forward",
+                 "efficiency_backward", "no_load_torque", "torsional_stiffness_torque", "torsional_stiffness_rate")
+RATING_KEYS = ("rated_torque", "rated_input_speed", "rated_life", "life_basis", "life_exponent", "average_torque_limit",
+               "repeated_peak_torque", "max_input_speed", "average_input_speed_limit")
+
+
+def _attribute_path(path: str) -> str:
+    """A reducer key's path named by its URDF attribute (``.efficiency.forward[1]`` ->
+    ``.efficiency_forward``, ``.torsional_stiffness.rate`` -> ``.torsional_stiffness_rate``)."""
+    import re  # noqa: PLC0415
+    path = re.sub(r"\.efficiency\.(forward|backward)(\[\d+\])?", r".efficiency_\1", path)
+    path = re.sub(r"\.no_load_torque\[\d+\]", ".no_load_torque", path)
+    return re.sub(r"\.torsional_stiffness\.(torque|rate)", r".torsional_stiffness_\1", path)
 
 
 def _helix_deg(el, kw: dict) -> float | None:
@@ -36,7 +53,7 @@ class Extension:
     ``leader`` and ``chain_leader``."""
 
     def read_extension(self) -> dict:
-        ext = {"mechanism": None, "gears": [], "motors": [], "loads": [], "payloads": []}
+        ext = {"mechanism": None, "gears": [], "motors": [], "loads": [], "payloads": [], "reducers": []}
         for el in self.root:
             if not isinstance(el.tag, str) or etree.QName(el).namespace != NS:
                 continue
@@ -58,11 +75,13 @@ class Extension:
                 ext["loads"].append(el)
             elif local == "payload":
                 ext["payloads"].append(el)
+            elif local == "reducer":
+                ext["reducers"].append(el)
             elif local in ("motor_rating", "gear_rating", "motor_model"):
                 continue  # read by io.ratings_reader
             else:
                 self.add(f"gearcli:{local}", f"unknown gearcli element gearcli:{local} (expected gearcli:mechanism, "
-                         "gearcli:gear, gearcli:motor, gearcli:load or gearcli:payload)", el)
+                         "gearcli:gear, gearcli:reducer, gearcli:motor, gearcli:load or gearcli:payload)", el)
         return ext
 
     def unknown_attrs(self, el, allowed, path: str) -> None:
@@ -205,6 +224,104 @@ class Extension:
             if len(ends) == 2:
                 gears.append(GearPair(name, ends[0], ends[1], ratio=ratio, path=path, **kw))
         return gears
+
+    def extension_reducers(self, ext) -> list[GearPair]:
+        """The gearcli:reducer elements (a strain-wave or cycloidal reducer, README "Reducers"):
+        attributes name, kind, input, output, housing, ratio or teeth, efficiency_forward,
+        efficiency_backward and no_load_torque (a number, or a table "w1 v1 w2 v2 ..." over
+        |w_in| rad/s), torsional_stiffness_torque "T1 T2" and torsional_stiffness_rate "K1 K2
+        K3"; a child gearcli:rating with the catalogue keys.  Validated as the YAML keys are
+        (:func:`.reducer_specs.reducer_spec`)."""
+        out = []
+        for el in ext["reducers"]:
+            name = el.get("name") or f"{el.get('input')}-{el.get('output')}"
+            path = f"gearcli:reducer '{name}'"
+            self.lines[path] = el.sourceline
+            self.unknown_attrs(el, REDUCER_ATTRS, path)
+            spec = self._reducer_dict(el, path)
+            ends = []
+            for key in ("input", "output", "housing"):
+                ref = self.link_ref(el.get(key), path, el) if el.get(key) else None
+                if not el.get(key):
+                    self.add(path, f"gearcli:reducer needs attribute {key} (a link name)", el)
+                if ref is not None:
+                    ends.append(ref[0])
+            if spec is None or len(ends) < 3:
+                continue
+            if spec["kind"] not in REDUCER_KINDS:
+                self.add(path, f"kind must be one of {', '.join(REDUCER_KINDS)}, got '{spec['kind']}'", el)
+                continue
+            i0, red = reducer_spec(spec, path, lambda p, m, el=el: self.add(_attribute_path(p), m, el))
+            teeth = tuple(int(z) for z in spec["teeth"]) if "teeth" in spec else None
+            out.append(GearPair(name, ends[0], ends[1], spec["kind"], i0, teeth=teeth, carrier=ends[2], path=path,
+                                reducer=red))
+        return out
+
+    def _reducer_dict(self, el, path: str) -> dict | None:
+        """The reducer's attributes (and its gearcli:rating child) as the YAML mapping, or None
+        when a number is unreadable (reported)."""
+        spec: dict = {"kind": el.get("kind", "")}
+        ok = True
+
+        def numbers(attr, n=None):
+            nonlocal ok
+            text = el.get(attr)
+            v = floats(text, n)
+            if v is None or v.size == 0:
+                self.add(path, f"{attr}=\"{text}\" is not {'a list of' if n is None else n} finite number(s)", el)
+                ok = False
+            return v
+
+        def table(attr):
+            v = numbers(attr)
+            if v is None:
+                return None
+            if v.size == 1:
+                return float(v[0])
+            if v.size % 2:
+                self.add(path, f"{attr}: a table is pairs 'w_in value ...', got {v.size} numbers", el)
+                return None
+            return [[float(a), float(b)] for a, b in v.reshape(-1, 2)]
+        for attr, key in (("ratio", "ratio"), ("teeth", "teeth")):
+            if el.get(attr) is not None:
+                v = numbers(attr, 1 if attr == "ratio" else 2)
+                if v is not None:
+                    spec[key] = float(v[0]) if attr == "ratio" else [int(z) for z in v]
+        eff = {k: table(f"efficiency_{k}") for k in ("forward", "backward") if el.get(f"efficiency_{k}") is not None}
+        if eff:
+            if "forward" not in eff:
+                self.add(path, "efficiency_backward needs efficiency_forward", el)
+                return None
+            spec["efficiency"] = eff
+        if el.get("no_load_torque") is not None:
+            spec["no_load_torque"] = table("no_load_torque")
+        if el.get("torsional_stiffness_torque") is not None or el.get("torsional_stiffness_rate") is not None:
+            T, K = numbers("torsional_stiffness_torque", 2), numbers("torsional_stiffness_rate", 3)
+            if T is not None and K is not None:
+                spec["torsional_stiffness"] = {"torque": [float(v) for v in T], "rate": [float(v) for v in K]}
+        ratings = [c for c in el if isinstance(c.tag, str) and etree.QName(c).localname == "rating"]
+        if ratings:
+            r = ratings[0]
+            rating = {}
+            for k, v in r.attrib.items():
+                if k == "life_basis":
+                    rating[k] = v
+                    continue
+                x = floats(v, 1)
+                if x is None or not x[0] > 0:
+                    self.add(f"{path}.rating", f"{k}=\"{v}\" is not a positive number", r)
+                    ok = False
+                else:
+                    rating[k] = float(x[0])
+            missing = [k for k in ("rated_torque", "rated_input_speed", "rated_life", "life_basis") if k not in rating]
+            unknown = [k for k in rating if k not in RATING_KEYS]
+            if missing or unknown or rating.get("life_basis", "L10") not in LIFE_BASES:
+                self.add(f"{path}.rating", f"gearcli:rating needs {', '.join(RATING_KEYS[:4])} (life_basis L10 or L50)"
+                         + (f"; missing {', '.join(missing)}" if missing else "")
+                         + (f"; unknown {', '.join(unknown)}" if unknown else ""), r)
+                ok = False
+            spec["rating"] = rating
+        return spec if ok and all(v is not None for v in eff.values()) else None
 
     # -- motors ------------------------------------------------------------------------------------
     def motors(self, ext, has_gears: bool) -> list[Motor]:

@@ -331,7 +331,8 @@ def _reducer(spec: dict, col: Collector, links: _Names, names: _Names, path: str
         col.add(f"{path}.links", f"a reducer's input, output and housing must be three different links, got {[i, o, h]}")
     names.declare(spec.get("name", f"{i}-{o}"), path)
     i0, red = reducer_spec(spec, path, col.add)
-    return GearPair(spec.get("name", f"{i}-{o}"), i, o, spec["kind"], i0, carrier=h, path=path, reducer=red)
+    teeth = tuple(spec["teeth"]) if "teeth" in spec else None
+    return GearPair(spec.get("name", f"{i}-{o}"), i, o, spec["kind"], i0, teeth=teeth, carrier=h, path=path, reducer=red)
 
 
 def _stiffness(spec: dict, col: Collector, path: str) -> float | None:

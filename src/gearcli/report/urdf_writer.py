@@ -260,6 +260,9 @@ def _add_extension(an: Analysis, root, corr: dict) -> None:
     for gi, gp in enumerate(mech.gears):
         if gp.joints is not None:
             continue
+        if gp.reducer is not None:
+            _add_reducer(root, gp)
+            continue
         circ = next(c for c in an.circuits if c.gear == gi)
         carrier = tree.links[circ.carrier]
         g = etree.SubElement(root, q("gear"), name=gp.name, j=gp.j, k=gp.k, kind=gp.kind, carrier=carrier)
@@ -292,6 +295,37 @@ def _add_loads(mech: Mechanism, root, corr: dict) -> None:
             I = R.T @ ld.inertia @ R
             el.set("mass", _num(ld.mass))
             el.set("inertia", _vec([I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]]))
+
+
+def _table(tab) -> str:
+    """A reducer's speed table as an attribute: one number, or the pairs "w1 v1 w2 v2 ..."."""
+    if tab.is_constant:
+        return _num(tab.values[0])
+    return _vec([v for pair in zip(tab.speeds, tab.values) for v in pair])
+
+
+def _add_reducer(root, gp) -> None:
+    """One gearcli:reducer (with its gearcli:rating) of a strain-wave or cycloidal reducer."""
+    red = gp.reducer
+    el = etree.SubElement(root, q("reducer"), name=gp.name, kind=gp.kind, input=gp.j, output=gp.k, housing=gp.carrier)
+    if gp.teeth is not None:
+        el.set("teeth", f"{gp.teeth[0]} {gp.teeth[1]}")
+    else:
+        el.set("ratio", _num(gp.ratio))
+    el.set("efficiency_forward", _table(red.forward))
+    el.set("efficiency_backward", _table(red.backward))
+    if red.no_load_torque is not None:
+        el.set("no_load_torque", _table(red.no_load_torque))
+    if red.torsional_stiffness is not None:
+        el.set("torsional_stiffness_torque", _vec(red.torsional_stiffness[0]))
+        el.set("torsional_stiffness_rate", _vec(red.torsional_stiffness[1]))
+    r = red.rating
+    if r is not None:
+        rel = etree.SubElement(el, q("rating"), rated_torque=_num(r.rated_torque), rated_input_speed=_num(r.rated_input_speed),
+                               rated_life=_num(r.rated_life), life_basis=r.life_basis, life_exponent=_num(r.life_exponent))
+        for k in ("average_torque_limit", "repeated_peak_torque", "max_input_speed", "average_input_speed_limit"):
+            if getattr(r, k) is not None:
+                rel.set(k, _num(getattr(r, k)))
 
 
 def _gear_attrs(el, gp, mesh_point) -> None:

@@ -16,7 +16,7 @@ import llvmlite.ir as ir
 from . import losses as llvm_losses
 from .bearings import converge
 from .hot_pairs import HotLossyBlock
-from .build import I64, Emitter
+from .build import D, I64, Emitter
 from .links import Sample, floats
 from .signs import SignedBlock, resolve, signs_of, tolerance
 from .trig import sincos
@@ -113,6 +113,18 @@ def store(e: Emitter, s: Sample, rec, prog, x: list) -> None:
             s.sol[int(gcol[g0 + c0 + h + 1])] = e.sub(e.mul(cq, x1), e.mul(sq, x0))
 
 
+def _sign_free(e: Emitter, x: list, tcols: list, tol):
+    """(x, p) of a block whose matrix does not depend on its signs (a reducer's output block
+    in its link's axes, :func:`.program._sign_free`): the pattern the numpy search accepts,
+    every t positive but those below -tol (:func:`..signs.resolve_signs`: all positive is
+    tried first, then the solution's own signs)."""
+    p, m = ir.Constant(I64, 0), len(tcols)
+    for i, c in enumerate(tcols):
+        neg = e.b.zext(e.b.fcmp_ordered("<", e.const(x[c]), e.const(e.neg(tol))), I64)
+        p = e.b.or_(p, e.b.shl(neg, ir.Constant(I64, m - 1 - i)))
+    return x, p
+
+
 def _on_fail(e: Emitter, fail, n, b: int):
     """The code that records block b as sample n's first failing block (if none before)."""
     def emit():
@@ -131,7 +143,7 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row, search: bool
     depend on the pattern; ``n``, ``fail``, ``sg_row`` unused)."""
     rec = prog.blocks[b]
     F, lk0, B, nloc, m, t0, a0 = (int(v) for v in (rec.F, rec.link0, rec.nlinks, rec.n, rec.m, rec.t0, rec.ainv0))
-    p0, np_, k0, nt = int(rec.prop0), int(rec.nprop), int(rec.term0), int(rec.nterm)
+    p0, np_, k0, nt, local = int(rec.prop0), int(rec.nprop), int(rec.term0), int(rec.nterm), int(rec.local)
     blinks, tcol, ainv = prog.block_links, prog.t_col, prog.ainv
     nr = 6 * B
     links = [int(v) for v in blinks[lk0:lk0 + B]]
@@ -145,16 +157,20 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row, search: bool
     else:
         r = gather(e, s, F, links)
         maps = [ainv[a0 + k * nloc * nr:a0 + (k + 1) * nloc * nr].reshape(nloc, nr) for k in range(1 << m)]
-        blk = SignedBlock(e, maps, tcols, f"b{b}", prog.hot.get(b, ((),))[0]) if m and search else None
+        blk = SignedBlock(e, maps, tcols, f"b{b}", prog.hot.get(b, ((),))[0]) if m and search and not local else None
     lossy = prog.losses.blocks.get(b) if prog.losses is not None and search else None
     if lossy is not None and F < 0:
         blk.extra = llvm_losses.world_columns(prog.losses, lossy, s)
+    elif lossy is not None and local:     # solved in its link's axes: only reducers, none of whose
+        assert not lossy.positions and not any(rows for _, _, rows, _ in lossy.reducers)   # factors act on it
     elif lossy is not None:
         blk = llvm_losses.lossy_block(e, blk, lossy, s.sv, f"b{b}")
         if lossy.hot:                # (a LossyBlock) its hot pairs from their stored maps
             blk = HotLossyBlock(e, blk, lossy, s.sv)
 
     def solve(r, tag):              # (x, p) of right-hand side r; p None: pattern 0 without a search
+        if m and search and local:       # sign-free (program._sign_free): one map, the signs read off
+            return _sign_free(e, [e.dot(floats(maps[0][i]), r) for i in range(nloc)], tcols, tolerance(e, r))
         if m and search:
             return resolve(e, fn, blk, r, tolerance(e, r), _on_fail(e, fail, n, b), tag, first)
         if F < 0:
@@ -164,7 +180,7 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row, search: bool
         return [e.dot(floats(maps[0][i]), r) for i in range(nloc)], None
 
     def rows(p, idx, R, tag):       # rows idx of the solution with pattern p of each r of R (constant frame)
-        if m == 0:
+        if m == 0 or blk is None:                # (sign-free: every pattern's map is maps[0])
             return [[e.dot(floats(maps[0][i]), r) for i in idx] for r in R]
         X = blk.products(e, p, R) if hasattr(blk, "products") and all(isinstance(v, float) for r in R for v in r) else None
         if X is not None:
@@ -182,7 +198,7 @@ def block(e: Emitter, fn, s: Sample, prog, b: int, n, fail, sg_row, search: bool
     else:
         couples = llvm_losses.couples_F(e, s, lossy, x, tcols) if lossy is not None and F >= 0 else {}
         propagate(e, s, F, prog.props[p0:p0 + np_], prog, x, not search, couples)
-    if lossy is not None and F < 0:
+    if lossy is not None and (F < 0 or local):
         llvm_losses.propagate(e, s, prog.losses, lossy, x, tcols, sig)
     store(e, s, rec, prog, x)
     return p

@@ -59,7 +59,8 @@ def interp(e: Emitter, x, table):
 
 def reducer_terms(e: Emitter, s: Sample, red) -> list:
     """Per lossy reducer (:class:`.loss_program.ReducerLosses`): (s_a, A, B, z_I in world
-    axes) for the world-frame block columns (:func:`.losses.world_columns`), a = its rate row
+    axes, a, T0(|a|)) for the world-frame block columns (:func:`.losses.world_columns`) and
+    the outputs (:func:`write_losses`), a = its rate row
     . q'_ind (exactly 0 at rest); rhs -= its no-load torque -T0(|a|) s_a about z_I on the
     input (+ on the housing), a known load (:func:`..losses.subtract_reducer_drag`)."""
     out = []
@@ -72,10 +73,11 @@ def reducer_terms(e: Emitter, s: Sample, red) -> list:
         inv_f, eta_b = e.div(1.0, interp(e, speed, fwd)), interp(e, speed, bwd)
         A = e.const(e.sub(e.mul(0.5, e.add(inv_f, eta_b)), 1.0))
         B = e.const(e.mul(0.5, e.sub(eta_b, inv_f)))
-        out.append((sa, A, B, z))
+        T0 = 0.0 if t0 is None else e.const(interp(e, speed, t0))
+        out.append((sa, A, B, z, a, T0))
         if t0 is None:
             continue
-        tq = e.const(e.neg(e.mul(interp(e, speed, t0), sa)))
+        tq = e.const(e.neg(e.mul(T0, sa)))
         for L, sign in ((j, 1.0), (c, -1.0)):
             if L >= 0:
                 s.rhs[L] = s.rhs[L][:3] + tuple(e.sub(s.rhs[L][3 + h], e.mul(e.mul(sign, tq), z[h])) for h in range(3))
@@ -113,21 +115,39 @@ def joint_friction(e: Emitter, s: Sample, lp, rows: dict) -> dict:
     return own
 
 
-def write_losses(e: Emitter, s: Sample, lp, gear_col, rates: list, own: dict, rows: dict) -> None:
+def write_losses(e: Emitter, s: Sample, lp, gear_col, rates: list, own: dict, rows: dict) -> dict:
     """The sample's ``gear_loss`` (every circuit, 0 for an ideal pair), and the
     ``joint_friction`` and ``joint_loss`` of the joints with bearing friction (their own
-    friction ``own`` less the converged s_J Mb_J; :func:`joint_friction` wrote the others')."""
+    friction ``own`` less the converged s_J Mb_J; :func:`joint_friction` wrote the others').
+    Returns {circuit: the torque each lossy reducer exerts on its input} (``gear_sep``,
+    :func:`.outputs.write_outputs`)."""
     for k, ci in enumerate(lp.rate_meshes):
         c, rj = floats(lp.loss_flt[k])
         t = s.sol[int(gear_col[ci])]
         e.store(e.mul(e.mul(e.mul(c, e.call("fabs", t)), e.call("fabs", rates[k])), rj), rows["gear_loss"], ci)
-    for ci in set(range(len(gear_col))) - set(lp.rate_meshes):
+    inputs = _reducer_outputs(e, s, lp.reducers, gear_col, rows) if lp.reducers is not None else {}
+    for ci in set(range(len(gear_col))) - set(lp.rate_meshes) - set(inputs):
         e.store(0.0, rows["gear_loss"], ci)
     for ji in (int(v) for v in lp.bearing_joints):
         f = own.get(ji, 0.0)
         if ji in s.bearing:            # (0 - 0 = +0 at rest, as numpy's)
             f = e.b.fsub(e.const(f), s.bearing[ji], flags=FLAGS)
         _write_joint(e, s, ji, f, rows)
+    return inputs
+
+
+def _reducer_outputs(e: Emitter, s: Sample, red, gear_col, rows: dict) -> dict:
+    """Each lossy reducer's ``gear_loss`` -delta u a + T0 |a| (delta = c_r - 1 with sigma =
+    sign(u): u = 0 makes both terms' product 0) and its input torque (1 + delta) u - T0 s_a
+    (:func:`gearcli.model.reducers.reducer_loss`, :func:`~gearcli.model.reducers.input_torque`)."""
+    out = {}
+    for k, ci in enumerate(red.circuits):
+        sa, A, B, _, a, T0 = s.red[k]
+        u = s.sol[int(gear_col[ci])]
+        delta = e.add(e.mul(A, e.mul(sa, sa)), e.mul(B, e.mul(_sign(e, u), sa)))
+        e.store(e.add(e.neg(e.mul(e.mul(delta, u), a)), e.mul(T0, e.call("fabs", a))), rows["gear_loss"], ci)
+        out[ci] = e.const(e.sub(e.add(u, e.mul(delta, u)), e.mul(T0, sa)))
+    return out
 
 
 def _write_joint(e: Emitter, s: Sample, ji: int, f, rows: dict) -> None:

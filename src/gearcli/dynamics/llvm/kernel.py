@@ -87,9 +87,10 @@ def _sample(e: Emitter, fn, prog, loads, n, before: list) -> list:
         first = e.b.select(fresh, ir.Constant(I64, 0), next(before)) if _carries(prog.blocks[b]) else None
         p = block(e, fn, s, prog, b, n, a["fail"], signs, first=first)
         settled += [p] if first is not None else []
+    inputs = {}
     if lp is not None:
-        friction_terms.write_losses(e, s, lp, prog.gear_col, rates, own, rows)
-    write_outputs(e, s, prog, ind[1], {k: e.row(a[k], n, max(w[k], 1)) for k in OUTPUTS})
+        inputs = friction_terms.write_losses(e, s, lp, prog.gear_col, rates, own, rows)
+    write_outputs(e, s, prog, ind[1], {k: e.row(a[k], n, max(w[k], 1)) for k in OUTPUTS}, inputs)
     return settled
 
 

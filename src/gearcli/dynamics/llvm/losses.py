@@ -307,7 +307,7 @@ def world_columns(lp, bl, s: Sample):
 def _reducer_delta(e: Emitter, terms, sigma):
     """(delta, z_I): a reducer's power-flow change of its input column, delta = A |s_a| + B
     sigma s_a (:class:`.loss_program.ReducerLosses`), and its axis in world axes."""
-    sa, A, B, z = terms
+    sa, A, B, z = terms[:4]
     return e.add(e.mul(A, e.mul(sa, sa)), e.mul(B, e.mul(sigma, sa))), z
 
 

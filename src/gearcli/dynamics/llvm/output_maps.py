@@ -30,13 +30,14 @@ def gear_outputs(an) -> np.recarray:
     g = t (ut + a) + s us with s = |t| tan(phi_t) (-g on k), so each radial or axial
     component is t times the t coefficient plus s times the sep one (ut is perpendicular to
     both radial directions; zeros without gear geometry)."""
-    mflt = np.zeros((len(an.circuits), 10))
+    mflt = np.zeros((len(an.circuits), 11))
     for ci, c in enumerate(an.circuits):
         if c.geometry is None:
+            mflt[ci, 10] = float(an.mech.gears[c.gear].reducer is not None)
             continue
         gm, gp = c.geometry, an.mech.gears[c.gear]
         tan_t, a = helical_terms(gm, gp.pressure_angle, gp.helix_angle, gp.hand)
         ua = gm.ut + a
         mflt[ci] = [1.0, tan_t, ua @ gm.rad_j, gm.us @ gm.rad_j, ua @ gm.zj, gm.us @ gm.zj,
-                    ua @ gm.rad_k, gm.us @ gm.rad_k, ua @ gm.zk, gm.us @ gm.zk]
+                    ua @ gm.rad_k, gm.us @ gm.rad_k, ua @ gm.zk, gm.us @ gm.zk, 0.0]
     return records(map(tuple, mflt), GEAR_OUT)

@@ -31,24 +31,28 @@ def _joints(e: Emitter, s: Sample, jout, row) -> None:
             e.store(v, row, d + h)
 
 
-def _meshes(e: Emitter, s: Sample, gcol, gout, rows) -> None:
+def _meshes(e: Emitter, s: Sample, gcol, gout, rows, inputs: dict) -> None:
+    """gear_t, gear_sep (a reducer's: the torque on its input, ``inputs`` where lossy, else
+    its t), radial and axial components."""
     gear_t, sep, rad, ax = rows
     for c, f in enumerate(gout):
         t = s.sol[int(gcol[c])]
         sp = e.mul(e.call("fabs", t), float(f.tan_t)) if f.geometry == 1.0 else 0.0
         e.store(t, gear_t, c)
-        e.store(sp, sep, c)
+        e.store(inputs.get(c, t) if f.reducer == 1.0 else sp, sep, c)
         e.store(e.add(e.mul(t, float(f.t_rad_j)), e.mul(sp, float(f.sep_rad_j))), rad, 2 * c)
         e.store(e.add(e.mul(t, float(f.t_ax_j)), e.mul(sp, float(f.sep_ax_j))), ax, 2 * c)
         e.store(e.neg(e.add(e.mul(t, float(f.t_rad_k)), e.mul(sp, float(f.sep_rad_k)))), rad, 2 * c + 1)
         e.store(e.neg(e.add(e.mul(t, float(f.t_ax_k)), e.mul(sp, float(f.sep_ax_k)))), ax, 2 * c + 1)
 
 
-def write_outputs(e: Emitter, s: Sample, prog, qdi: list, rows: dict) -> None:
-    """Every output's row of this sample (``rows``: name -> double* to the row)."""
+def write_outputs(e: Emitter, s: Sample, prog, qdi: list, rows: dict, inputs: dict | None = None) -> None:
+    """Every output's row of this sample (``rows``: name -> double* to the row; ``inputs``:
+    {circuit: a lossy reducer's input torque}, :func:`.friction_terms.write_losses`)."""
     A = prog.A
     _joints(e, s, prog.joint_out, rows["joint"])
-    _meshes(e, s, prog.gear_col, prog.gear_out, [rows[k] for k in ("gear_t", "gear_sep", "gear_radial", "gear_axial")])
+    _meshes(e, s, prog.gear_col, prog.gear_out, [rows[k] for k in ("gear_t", "gear_sep", "gear_radial", "gear_axial")],
+            inputs or {})
     motor = [s.sol[int(c)] for c in prog.motor_col]
     for i, v in enumerate(motor):
         e.store(v, rows["motor"], i)

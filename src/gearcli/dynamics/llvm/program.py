@@ -23,6 +23,7 @@ import numpy as np
 
 from ...analysis.schedule import unknown_groups
 from ..blocks import primary_side
+from ..kinematics import forward
 from .basis import basis as _basis
 from .lossy_maps import hot_lossy_maps
 from .output_maps import output_constants
@@ -174,7 +175,7 @@ def _block(bd: _Builder, an, bi, p, offsets, terms, lowrank):
     term0, nterm = terms.get(bi, (0, 0))
     rec = dict(F=-1 if p.F is None else p.F, link0=len(bd.blinks), nlinks=len(p.links), n=n, col0=len(bd.gcol),
                m=len(p.signed), t0=len(bd.tcol), ainv0=sum(a.size for a in bd.ainv), prop0=len(bd.prec), nprop=0,
-               cb0=len(bd.cbrec), ncb=0, term0=term0, nterm=nterm)
+               cb0=len(bd.cbrec), ncb=0, term0=term0, nterm=nterm, local=0)
     bd.blinks += list(p.links)
     for g in p.groups:
         bd.gcol += range(offsets[(g.kind, g.index)][0], offsets[(g.kind, g.index)][0] + g.size)
@@ -198,14 +199,70 @@ def _block(bd: _Builder, an, bi, p, offsets, terms, lowrank):
     bd.brec.append(rec)
 
 
-def _local_frame(bd: _Builder, terms, values, p) -> None:
+def _local_frame(bd: _Builder, an, terms, values, p) -> None:
     """A world-frame block whose matrix is constant in its link's axes
     (:func:`.terms.local_inverse`) becomes a constant-frame block in that link
-    (F = the link, its inverse in ``ainv``) that keeps its terms for the propagation."""
+    (F = the link, its inverse in ``ainv``, once per sign pattern of its signed reducers: the
+    matrix does not depend on them, :func:`_sign_free`) that keeps its terms for the
+    propagation."""
     rec = bd.brec[-1]
     Ainv = local_inverse(terms, values, rec["term0"], rec["nterm"], p.links[0], rec["n"])
     if Ainv is not None:
-        rec["F"], rec["ainv0"] = p.links[0], bd.add_floats(bd.ainv, Ainv)
+        rec["F"], rec["ainv0"], rec["local"] = p.links[0], bd.add_floats(bd.ainv, Ainv), 1
+        for _ in range((1 << len(p.signed)) - 1):
+            bd.add_floats(bd.ainv, Ainv)
+        _term_props(bd, an, terms, values, rec)
+
+
+def _term_props(bd: _Builder, an, terms, values, rec) -> None:
+    """A local-frame block's propagation as :data:`.records.PROPAGATION` records, one per later
+    link (its wrench summed in F's axes, one rotation a sample) instead of a rotation per term,
+    when every later term's wrench is constant in F's axes about o_F: a force or moment in F
+    itself, or a moment along the axis about which its frame link turns relative to F (a
+    reducer's torques on its input and housing); checked at home and two other poses.  Else
+    the terms stay."""
+    F, k0, nt = int(rec["F"]), int(rec["term0"]), int(rec["nterm"])
+    later = [(t, v) for t, v in zip(terms[k0:k0 + nt], values[k0:k0 + nt]) if t.row < 0]
+    rng = np.random.default_rng(0)
+    poses = [np.zeros((1, len(an.mech.joints)))] + [rng.uniform(-3, 3, (1, len(an.mech.joints))) for _ in range(2)]
+    kins = [forward(an.mech, an.tree, q) for q in poses]
+    by_link: dict = {}
+    for t, v in later:
+        ws = []
+        for kin in kins:
+            RF, RX = kin.R[F][0], kin.R[int(t.frame)][0]
+            d = RF.T @ RX @ np.asarray(v.d, float)
+            if t.moment == 1:
+                ws.append(np.concatenate([np.zeros(3), v.coef * d]))
+            else:
+                P = RF.T @ (RX @ np.asarray(v.p, float) + kin.o[int(t.frame)][0] - kin.o[F][0])
+                ws.append(np.concatenate([v.coef * d, v.coef * np.cross(P, d)]))
+        if any(not np.allclose(w, ws[0], rtol=1e-12, atol=1e-12 * (1 + np.abs(ws[0]).max())) for w in ws[1:]):
+            return
+        by_link.setdefault(int(t.link), []).append((int(t.col), ws[0]))
+    rec["prop0"], rec["nprop"] = len(bd.prec), 0
+    for L, cols in by_link.items():
+        c0, c1 = min(c for c, _ in cols), max(c for c, _ in cols) + 1
+        C = np.zeros((6, c1 - c0))
+        for c, w in cols:
+            C[:, c - c0] += w
+        bd.prec.append(dict(col0=c0, ncols=c1 - c0, signed=0, cmat0=bd.add_floats(bd.cmat, C), primary=L,
+                            later0=len(bd.later), nlater=1))
+        bd.later.append(L)
+        rec["nprop"] += 1
+    rec["nterm"] = 0
+
+
+def _sign_free(an, p) -> bool:
+    """True when block plan ``p``'s matrix does not depend on the signs of its signed
+    unknowns: each is a reducer's (:mod:`gearcli.model.reducers`) whose input and housing,
+    the links its power-flow factor acts on, are not block links (the block holds its output)."""
+    for gi in p.signed:
+        g = p.groups[gi]
+        c = an.circuits[g.index] if g.kind == "mesh" else None
+        if c is None or an.mech.gears[c.gear].reducer is None or {c.j, c.carrier} & set(p.links):
+            return False
+    return True
 
 
 MAX_PATTERNS = 256
@@ -244,8 +301,8 @@ def build_program(an, plans) -> Program:
     bd = _Builder()
     for bi, p in enumerate(plans):
         _block(bd, an, bi, p, offsets, terms, lowrank)
-        if p.F is None and len(p.links) == 1 and not p.signed:
-            _local_frame(bd, trec, tflt, p)
+        if p.F is None and len(p.links) == 1 and (not p.signed or _sign_free(an, p)):
+            _local_frame(bd, an, trec, tflt, p)
     joints, poses = _joints(an)
     cat = (lambda xs: np.concatenate(xs) if xs else np.zeros(0))
     jout, mcol, gcol, gout = output_constants(an, offsets)

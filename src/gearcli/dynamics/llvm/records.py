@@ -23,11 +23,14 @@ POSE = np.dtype([("R_pj", F, (9,)), ("p_pj", F, (3,)), ("R_jc", F, (9,)), ("p_jc
 """A joint's fixed placements: joint frame in the parent (R_pj, p_pj), child in the joint frame (R_jc, p_jc)."""
 BODY = np.dtype([("mass", F), ("inertia", F, (9,)), ("com", F, (3,))])
 """A link: mass (kg), inertia about its centre of mass (link axes, kg m^2), centre of mass (link frame, m)."""
-BLOCK = _ints("F", "link0", "nlinks", "n", "col0", "m", "t0", "ainv0", "prop0", "nprop", "cb0", "ncb", "term0", "nterm")
+BLOCK = _ints("F", "link0", "nlinks", "n", "col0", "m", "t0", "ainv0", "prop0", "nprop", "cb0", "ncb", "term0", "nterm",
+              "local")
 """A block of the schedule: frame link F (-1: world axes), its links (``block_links[link0:]``),
 n unknowns (columns ``group_col[col0:]``), m signed meshes (``t_col[t0:]``, at ``t0`` in the signs row),
 its pattern maps at ``ainv[ainv0:]`` (-1: a :class:`..pattern_maps.LowRank`), propagation
-records ``props[prop0:]``, child-basis records ``child_basis[cb0:]``, column terms ``terms[term0:]``."""
+records ``props[prop0:]``, child-basis records ``child_basis[cb0:]``, column terms ``terms[term0:]``;
+``local`` 1: a world-frame block solved in its one link's axes (:func:`.program._local_frame`; its
+signed unknowns, a reducer's, do not change its matrix)."""
 PROPAGATION = _ints("col0", "ncols", "signed", "cmat0", "primary", "later0", "nlater")
 """A solved group passed on to later links: its block columns (``ncols`` from ``col0``), 1 if a signed mesh, C_plus (then
 C_sep) at ``cmat[cmat0:]``, the primary link, the later links ``later[later0:later0 + nlater]``."""
@@ -43,9 +46,10 @@ TERM_VALUE = np.dtype([("coef", F), ("d", F, (3,)), ("p", F, (3,))])
 JOINT_OUT = _ints("col0", "prismatic")
 """Where a joint's reaction starts in the solution row, 1 if prismatic."""
 GEAR_OUT = np.dtype([(n, F) for n in ("geometry", "tan_t", "t_rad_j", "sep_rad_j", "t_ax_j", "sep_ax_j",
-                                       "t_rad_k", "sep_rad_k", "t_ax_k", "sep_ax_k")])
+                                       "t_rad_k", "sep_rad_k", "t_ax_k", "sep_ax_k", "reducer")])
 """A mesh's output coefficients: 1 if it has gear geometry, tan(phi_t), and the t and
-|t| tan(phi_t) coefficients of the radial and axial components on gear j and on gear k."""
+|t| tan(phi_t) coefficients of the radial and axial components on gear j and on gear k; 1 for
+a reducer (its gear_sep is the torque on its input)."""
 
 
 def records(rows, dtype: np.dtype) -> np.recarray:

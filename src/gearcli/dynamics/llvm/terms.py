@@ -19,6 +19,8 @@ frame link X, signed-mesh position) with their :data:`.records.TERM_VALUE` (coef
 """
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 from ...model.gears import helical_terms
@@ -65,6 +67,26 @@ def _motor(an, mi, L):
     return [_axial(an, an.tree.parent_joint[x], L, 1.0, 1.0 if L == x else -1.0)]
 
 
+def _own_axis(an, x: int, c: int, z_c: np.ndarray) -> np.ndarray:
+    """The axis ``z_c`` (carrier c's axes) of gear x turning about it relative to c, in x's own
+    axes: constant, x's rotation relative to c being about that axis alone (its coaxial group),
+    so R_x^T R_c z_c is taken at home.  A term on x in x's own axes lets a block of x alone be
+    solved in x's frame (:func:`local_inverse`)."""
+    home = _home(an)
+    return home.R[x][0].T @ home.R[c][0] @ z_c
+
+
+def _home(an):
+    """The kinematics of ``an`` at home (every joint coordinate 0), made once per analysis."""
+    from ..kinematics import forward  # noqa: PLC0415
+    if an not in _HOMES:
+        _HOMES[an] = forward(an.mech, an.tree, np.zeros((1, len(an.mech.joints))))
+    return _HOMES[an]
+
+
+_HOMES: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
 def _mesh(an, ci, L, t_pos):
     c = an.circuits[ci]
     if c.joints is not None:
@@ -78,9 +100,9 @@ def _mesh(an, ci, L, t_pos):
         return [[(0, c.carrier, -1, s, gm.ut + ax, gm.P), (0, c.carrier, t_pos, s * tan_t, gm.us, gm.P)]]
     out = []
     if L == c.j:
-        out.append((1, c.carrier, -1, 1.0, c.zj, zero))
+        out.append((1, c.j, -1, 1.0, _own_axis(an, c.j, c.carrier, c.zj), zero))
     if L == c.k:
-        out.append((1, c.carrier, -1, -c.ratio, c.zk, zero))
+        out.append((1, c.k, -1, -c.ratio, _own_axis(an, c.k, c.carrier, c.zk), zero))
     if L == c.carrier:
         out += [(1, c.carrier, -1, -1.0, c.zj, zero), (1, c.carrier, -1, c.ratio, c.zk, zero)]
     return [out]
