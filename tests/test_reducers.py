@@ -247,12 +247,16 @@ def test_two_segment_duty_life_by_hand(run_cli, tmp_path):
     assert got[("reducer hd", "L50 life")]["passed"] is True
 
 
-def test_bundled_reducer_design_fails_on_the_reducer_life(run_cli):
-    """designs/cobot_joint_reducer.yaml: every check passes except the reducer's L50 life."""
-    r = run_cli("verify", DESIGNS / "cobot_joint_reducer.yaml")
+def test_bundled_reducer_design_fails_on_the_reducer_life(run_cli, tmp_path):
+    """designs/cobot_joint_reducer.yaml: every check passes except the reducer's L50 life; its
+    plot (|T| against the T_av the life needs, and the running life) and the tight average
+    torque's are written."""
+    r = run_cli("verify", DESIGNS / "cobot_joint_reducer.yaml", "--plots", tmp_path / "plots")
     assert r.exit_code == 1
     assert "FAILED pick_and_place: reducer hd: L50 life" in r.stdout
     assert r.stdout.count("FAILED") == 1
+    assert sorted(p.name for p in (tmp_path / "plots").iterdir()) == [
+        "pick_and_place__reducer_hd__L50_life.png", "pick_and_place__reducer_hd__average_torque_T_av.png"]
 
 
 # --- input errors ----------------------------------------------------------------------------------
@@ -399,3 +403,18 @@ def test_simulate_runs_the_cobot_joint(run_cli, tmp_path):
     assert r.exit_code == 0, r.stderr
     sim = np.genfromtxt(tmp_path / "sim.csv", delimiter=",", names=True)
     assert np.max(np.abs(np.interp(t, sim["t"], sim["qJ2"]) - q)) < 2e-3
+
+
+def test_a_reducer_that_never_turns_has_no_finite_life(run_cli, tmp_path):
+    """Holding a load without moving: n_av = 0, the catalogue life is infinite, reported with
+    its reason (JSON value null and value_note), and the check passes."""
+    rated = HOIST.format(i0=-100.0, extra="", kind="strain_wave", axis=1).replace(
+        "ratio: -100.0}", "ratio: -100.0,\n" + textwrap.indent(textwrap.dedent(RATED).strip(), "     ") + "}")
+    (tmp_path / "hoist.yaml").write_text(rated)
+    t = np.linspace(0.0, 1.0, 11)
+    np.savetxt(tmp_path / "hold.csv", np.column_stack([t, 0 * t, 0 * t, 0 * t]), delimiter=",",
+               header="t,q:Jd,qd:Jd,qdd:Jd", comments="")
+    doc = verify_json(run_cli, tmp_path, "cases:\n  - {name: c, mechanism: hoist.yaml, trajectories: [hold.csv],"
+                                         " reducer_life_h: 1000}\n")
+    life = checks(doc)[("reducer hd", "L50 life")]
+    assert life["value"] is None and life["passed"] is True and "does not turn" in life["value_note"]

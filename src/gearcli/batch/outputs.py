@@ -71,7 +71,8 @@ class Row:
 
 INFINITE_NOTES = {"fatigue": "no damage (below the endurance limit)",
                   "life": "no revolutions (the bearing does not turn)",
-                  "safety": "no load (a safety factor over a zero load)"}
+                  "safety": "no load (a safety factor over a zero load)",
+                  "reducer_life": "no load or no turning (the reducer's input does not turn, or carries no torque)"}
 """What an infinite value of a check kind means: the reports print it in place of "inf"."""
 
 

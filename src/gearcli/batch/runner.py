@@ -231,6 +231,16 @@ def profile_plot(result: CaseResult, verdict: Verdict, path, title: str):
     parts = [partials([ch], s, an.mech)[0] for s in samples]
     rates = profile_rates(case.shares or (None,) * len(samples), [p[6] for p in parts], case.req.cycles_per_hour,
                           case.req.service_life_h)
+    if ch.kind == "reducer_life":
+        from ..design.evaluate import reducer_duty  # noqa: PLC0415
+        from ..report.check_plots import plot_reducer_life  # noqa: PLC0415
+        row = np.asarray(ch.extra["row"])
+        traces = [(Path(tp).stem, s.t, signal(ch, s, an.mech), np.abs(s.rates @ row))
+                  for tp, s in zip(case.trajectories, samples)]
+        T_av, _ = reducer_duty(ch, parts, rates)
+        plot_reducer_life(traces, T_av, verdict.signal_limit, verdict.value, ch.limit, ch.extra["rating"].life_basis,
+                          ch.extra["rating"], path, title)
+        return path
     if ch.kind == "life":
         traces = [(Path(tp).stem, s.t, signal(ch, s, an.mech), p[5]) for tp, s, p in zip(case.trajectories, samples, parts)]
         plot_life(traces, profile_equivalent_load(ch, parts, rates), verdict.signal_limit, path, title)

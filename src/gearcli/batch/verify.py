@@ -99,7 +99,7 @@ def write_plots(results, directory: Path) -> list[Path]:
             ch = v.check
             path = directory / f"{_slug(r.case.name)}__{_slug(ch.component)}__{_slug(ch.quantity)}.png"
             status = "FAIL" if not v.passed else "tight"
-            if ch.kind in ("life", "fatigue"):
+            if ch.kind in ("life", "fatigue", "reducer_life"):
                 out.append(profile_plot(r, v, path, f"{r.case.name}: {ch.name} ({status}, margin {v.margin:.3g} %)"))
                 continue
             t, y = worst_samples(r, v)

@@ -66,3 +66,48 @@ def plot_sn(N: np.ndarray, S: np.ndarray, peaks: np.ndarray, cycles_in_life: flo
     ax.legend(fontsize="small", loc="best")
     fig.tight_layout()
     _save(fig, check_output_path(out))
+
+
+def plot_reducer_life(traces: list[tuple], T_av: float, T_req: float, life: float, required: float, basis: str,
+                      rating, out: str | Path, title: str) -> None:
+    """A reducer's life check (:mod:`gearcli.model.reducers`): above, |T| along every trajectory
+    of the profile one after another with the duty's speed-weighted T_av (solid) and the T_av
+    that just gives the required life (dashed red); below, the running life over the motion so
+    far, L_n (n_N / n_av(t)) (T_N / T_av(t))^p from the sums up to t (pauses between cycles
+    not counted), with the case's life (pauses counted) and the required one.
+
+    ``traces``: (name, t (N,), |T| (N,), |a| (N,)) per trajectory, s, N*m, rad/s.
+    """
+    from ..design.evaluate import _trapezoid_weights  # noqa: PLC0415
+    plt = _pyplot()
+    fig, (ax, bx) = plt.subplots(2, 1, figsize=(7.5, 5.6), sharex=True)
+    t0, num, den = 0.0, 0.0, 0.0
+    p = rating.life_exponent
+    for name, t, T, a in traces:
+        tt = t - t[0] + t0
+        ax.plot(tt, T, lw=1.0, label=f"|T|, {name}")
+        w = _trapezoid_weights(t)
+        n_run, d_run = num + np.cumsum(a * T ** p * w), den + np.cumsum(a * w)
+        elapsed = np.maximum(tt, 1e-300)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            T_run = (n_run / d_run) ** (1.0 / p)
+            L = rating.rated_life * (rating.rated_input_speed / (d_run / elapsed)) * (rating.rated_torque / T_run) ** p
+        L = np.where(np.isfinite(L) & (L > 0), L, np.nan)
+        bx.plot(tt, L, lw=1.0, label=f"running {basis} life, {name}")
+        num, den, t0 = n_run[-1], d_run[-1], tt[-1]
+    ax.axhline(T_av, color="black", lw=1.2, label=f"T_av of the duty: {T_av:.4g} N·m")
+    if np.isfinite(T_req):
+        ax.axhline(T_req, color="red", ls="--", lw=1.2, label=f"T_av giving the required life: {T_req:.4g} N·m")
+    ax.set_ylabel("|output torque T| [N·m]")
+    ax.set_title(title, fontsize="medium")
+    bx.axhline(required, color="red", ls="--", lw=1.2, label=f"required: {required:.4g} h")
+    if np.isfinite(life):
+        bx.axhline(life, color="black", lw=1.2, label=f"{basis} life of the duty (pauses counted): {life:.4g} h")
+    bx.set_yscale("log")
+    bx.set_xlabel("t [s] (trajectories one after another)")
+    bx.set_ylabel(f"{basis} life [h]")
+    for a_ in (ax, bx):
+        a_.grid(alpha=0.3)
+        a_.legend(fontsize="x-small", loc="best")
+    fig.tight_layout()
+    _save(fig, check_output_path(out))

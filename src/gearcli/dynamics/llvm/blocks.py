@@ -16,7 +16,7 @@ import llvmlite.ir as ir
 from . import losses as llvm_losses
 from .bearings import converge
 from .hot_pairs import HotLossyBlock
-from .build import D, I64, Emitter
+from .build import I64, Emitter
 from .links import Sample, floats
 from .signs import SignedBlock, resolve, signs_of, tolerance
 from .trig import sincos
