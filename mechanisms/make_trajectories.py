@@ -95,3 +95,12 @@ np.savetxt("mechanisms/cobot_6axis_traj.csv", np.column_stack([t6, q6, qd6, qdd6
 tr = np.linspace(0.0, 4.0, 4001)
 q, qd, qdd = quintic_moves(tr, [(0.0, 1.5, -np.pi / 2, np.pi / 2), (2.0, 3.5, np.pi / 2, -np.pi / 2)])
 write_trajectory("mechanisms/rv_turret_traj.csv", ["J1"], tr, q[:, None], qd[:, None], qdd[:, None])
+
+# screw_lift: the carriage Jz (m): lift the part 0.15 m in 1.2 s, dwell, place it (attach:part 0
+# from 1.4 s), lower empty in 1.2 s, dwell, pick the next (attach:part 1 from 3.0 s); 3.2 s.
+# 0.234 m/s at most: 295 rad/s (2810 rpm) of the screw, below its 314 rad/s critical speed
+ts = np.linspace(0.0, 3.2, 3201)
+q, qd, qdd = quintic_moves(ts, [(0.0, 1.2, 0.0, 0.15), (1.6, 2.8, 0.15, 0.0)])
+attach = ((ts < 1.4) | (ts >= 3.0)).astype(float)
+np.savetxt("mechanisms/screw_lift_traj.csv", np.column_stack([ts, q, qd, qdd, attach]), delimiter=",",
+           header="t,q:Jz,qd:Jz,qdd:Jz,attach:part", comments="", fmt="%.17g")

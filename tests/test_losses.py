@@ -102,6 +102,9 @@ def own_losses(an, q, qd, res):
         if gp.reducer is not None:
             parts.append(own_reducer_loss(an, kin, ci, res))
             continue
+        if gp.screw is not None:
+            parts.append(own_screw_loss(an, kin, ci, res))
+            continue
         if not gp.loss_factor:
             continue
         zj = np.einsum("nij,j->ni", kin.R[c.carrier], c.geometry.zj)
@@ -138,6 +141,25 @@ def own_reducer_loss(an, kin, ci, res):
     scale = 1.0 + np.abs(T)
     assert np.max(np.abs(cols[f"gear:{gp.name}:input_torque"] - tau_I * np.sum(zI * zO, axis=1)) / scale) < 1e-11
     return -(tau_I * a + T * b)
+
+
+def own_screw_loss(an, kin, ci, res):
+    """A screw's loss from the model statement (drive-elements.md B): u = z_S, a the screw's rate
+    relative to the carrier from the link angular velocities, h = +-lead/(2 pi) by hand, F the
+    printed gear:<s>:force; the torque on the nut h F / eta_f where F h a > 0 (the screw drives),
+    h F eta_b where F h a < 0; the loss is minus the power the element delivers to screw and
+    nut, -(F h a - tau_N a) (the nut does not turn relative to the carrier)."""
+    c, gp = an.circuits[ci], an.mech.gears[an.circuits[ci].gear]
+    sc = gp.screw
+    u = np.einsum("nij,j->ni", kin.R[c.carrier], c.zj)
+    a = np.sum((kin.w[c.j] - kin.w[c.carrier]) * u, axis=1)
+    h = (1.0 if sc.hand == "right" else -1.0) * sc.lead / (2 * np.pi)
+    F = named_columns(an, res)[f"gear:{gp.name}:force"]
+    eta_f = np.interp(np.abs(a), sc.forward.speeds, sc.forward.values)
+    eta_b = np.interp(np.abs(a), sc.backward.speeds, sc.backward.values)
+    flow = np.sign(F * h * a)
+    tau_N = h * F * np.where(flow > 0, 1 / eta_f, np.where(flow < 0, eta_b, 1.0))
+    return -(F * h * a - tau_N * a)
 
 
 def _load(name):

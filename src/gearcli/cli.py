@@ -123,7 +123,9 @@ def check(mech: Path = typer.Argument(..., metavar="MECH", help=MECH_HELP, show_
     _check_ratings(an)
     m = an.mech
     reducers = sum(1 for c in an.circuits if m.gears[c.gear].reducer is not None)
-    pairs = counted(len(an.circuits) - reducers, 'gear pair') + (f", {counted(reducers, 'reducer')}" if reducers else "")
+    screws = sum(1 for c in an.circuits if m.gears[c.gear].screw is not None)
+    pairs = counted(len(an.circuits) - reducers - screws, 'gear pair') + (
+        f", {counted(reducers, 'reducer')}" if reducers else "") + (f", {counted(screws, 'screw')}" if screws else "")
     typer.echo(f"{mech}: OK ({an.dof} dof, {counted(len(m.links), 'link')}, {pairs}, {counted(len(m.motors), 'motor')})")
     for line in feature_notes(an) + sharing_notes(an):
         typer.echo(line)
@@ -242,7 +244,8 @@ def _print_summary(console, report, verify: bool) -> None:
     """Peak/RMS table of a solve, ideal pairs, feature notes, the residual (``--verify``)."""
     an = report.analysis
     console.print(summary_table(report))
-    ideal = [an.mech.gears[c.gear].name for c in an.circuits if c.geometry is None and an.mech.gears[c.gear].reducer is None]
+    ideal = [an.mech.gears[c.gear].name for c in an.circuits if c.geometry is None and an.mech.gears[c.gear].reducer is None
+             and an.mech.gears[c.gear].screw is None]
     if ideal:
         console.print("Ideal pairs (no mesh geometry; mesh torque instead of tooth forces): " + ", ".join(ideal))
     for line in feature_notes(an) + sharing_notes(an) + [report.backend_line()]:

@@ -49,6 +49,8 @@ def gear_circuit(h: Home, groups, canon, gi: int, gp, j: int, k: int, col: Colle
     with the ratio e given or derived from the mesh geometry."""
     if gp.reducer is not None:
         return reducer_circuit(h, groups, canon, gi, gp, j, k, col)
+    if gp.screw is not None:
+        return screw_circuit(h, groups, canon, gi, gp, j, k, col)
     found = gear_carrier(h, groups, gp, j, k, col)
     if found is None:
         return None
@@ -96,6 +98,32 @@ def reducer_circuit(h: Home, groups, canon, gi: int, gp, j: int, k: int, col: Co
     Rc = h.kin.R[c]
     return Circuit(gi, j, k, c, ratio, row_j - ratio * row_k, Rc.T @ zj_w, Rc.T @ zk_w, None,
                    row_j=np.rint(row_j))
+
+
+def screw_circuit(h: Home, groups, canon, gi: int, gp, j: int, k: int, col: Collector) -> Circuit | None:
+    """Circuit of a screw (:mod:`gearcli.model.screws`): the screw j turning and the nut k
+    sliding relative to the carrier c on one line; theta_{j,c} = e x_{k,c}, e = (z_k . z_j) / h."""
+    types = [h.mech.joints[h.jin[x]].type for x in (j, k)]
+    for n, (name, got, need) in enumerate(zip((gp.j, gp.k), types, ("revolute", "prismatic"))):
+        if got != need:
+            col.add(f"{gp.path}.links[{n}]", f"'{name}' {'slides' if got == 'prismatic' else 'turns'} on its joint: "
+                    f"a screw's {'screw must turn on a revolute' if n == 0 else 'nut must slide on a prismatic'}"
+                    " joint (links: [screw, nut])")
+            return None
+    found = gear_carrier(h, groups, gp, j, k, col)
+    if found is None:
+        return None
+    c, gj, gk = found
+    if not h.collinear(h.jin[j], h.jin[k]):
+        col.add(f"{gp.path}.links", f"the screw '{gp.j}' and the nut '{gp.k}' are not on one line: the nut must slide "
+                "along the screw's axis (within 1e-9 rad and 1e-9 m)")
+        return None
+    row_j, zj_w = relative_rotation(h, canon, j, c, gj)
+    row_k, zk_w = relative_rotation(h, canon, k, c, gk)
+    ratio = float(zk_w @ zj_w) / gp.screw.h
+    Rc, oc = h.kin.R[c], h.kin.o[c]
+    return Circuit(gi, j, k, c, ratio, row_j - ratio * row_k, Rc.T @ zj_w, Rc.T @ zk_w, None,
+                   row_j=np.rint(row_j), axis_point=Rc.T @ (h.ow[h.jin[j]] - oc))
 
 
 def joint_types_fit(h: Home, gp, c: int, gj: CoaxialGroup, gk: CoaxialGroup, col: Collector) -> bool:

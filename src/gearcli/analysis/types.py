@@ -49,6 +49,8 @@ class Circuit:
     # relative to its carrier about z_j, the sum of the coaxial joints between them (each
     # coefficient an integer); None for a joint coupling
     row_j: np.ndarray | None = None
+    # a screw's (GearPair.screw) axis line: a point on it in the carrier frame (m); None otherwise
+    axis_point: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)

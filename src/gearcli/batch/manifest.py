@@ -26,7 +26,8 @@ from ..model.validate import MAX_ABS
 from ..dynamics.determinacy import load_analysed
 from ..io.schemas import packaged_schema
 
-REQUIREMENT_KEYS = ("cycles_per_hour", "service_life_h", "bearing_life_h", "gear_life_h", "reducer_life_h", "min_static_safety",
+REQUIREMENT_KEYS = ("cycles_per_hour", "service_life_h", "bearing_life_h", "gear_life_h", "reducer_life_h", "screw_life_h",
+                    "min_static_safety",
                     "min_bending_safety", "min_contact_safety")
 
 
@@ -313,6 +314,7 @@ def _prepare_case(spec: dict, where: str, base: Path, col: Collector, issues: li
 REQUIREMENT_CHECKS = {"bearing_life_h": ("L10 life", "joints[].bearings with C"),
                       "gear_life_h": ("bending fatigue life", "gears[].rating"),
                       "reducer_life_h": ("reducer life", "reducer (kind strain_wave or cycloidal) with a rating"),
+                      "screw_life_h": ("screw life", "screw (kind screw) with a rating"),
                       "min_static_safety": ("static safety s0", "joints[].bearings"),
                       "min_bending_safety": ("bending safety", "gears[].rating"),
                       "min_contact_safety": ("contact safety", "gears[].rating")}
@@ -324,6 +326,7 @@ def _unused_requirements(spec: dict, mechanism: str, where: str, checks, col: Co
     error, not a silent no-op."""
     quantities = {c.quantity for c in checks} | ({"L10 life"} if any(c.kind == "life" for c in checks) else set())
     quantities |= {"reducer life"} if any(c.kind == "reducer_life" for c in checks) else set()
+    quantities |= {"screw life"} if any(c.kind == "screw_life" for c in checks) else set()
     for key, (quantity, needs) in REQUIREMENT_CHECKS.items():
         if key in spec and quantity not in quantities:
             col.add(f"{where}.{key}", f"checks nothing: '{mechanism}' has no {needs} "

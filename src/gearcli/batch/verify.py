@@ -22,7 +22,8 @@ LIMIT_LABELS = {"peak": "limit", "rms": "RMS limit", "safety": "allowable / requ
                 "life": "P_eq giving the required life", "energy": "energy limit (integral over the cycle)",
                 "reducer_average": "average torque limit (T_av, speed-weighted)",
                 "reducer_speed_average": "average input speed limit (n_av)",
-                "reducer_life": "T_av giving the required life"}
+                "reducer_life": "T_av giving the required life",
+                "screw_life": "F_m (cubic mean, speed-weighted) giving the required life"}
 
 
 @dataclass

@@ -15,7 +15,9 @@ and how the samples of a duty cycle are reduced to the value compared with the l
 * ``energy``: the integral of the signal over each trajectory (a cycle), worst one <= limit;
 * ``reducer_average``, ``reducer_speed_average``, ``reducer_life``: a reducer's
   speed-weighted average torque T_av, average input speed n_av (<= limit) and catalogue life
-  (>= limit) over the duty cycle (:mod:`gearcli.model.reducers`).
+  (>= limit) over the duty cycle (:mod:`gearcli.model.reducers`);
+* ``screw_life``: a screw's ISO 3408-5 life from its speed-weighted cubic-mean axial load
+  (>= limit, :mod:`gearcli.model.screws`).
 
 Servo sizing (inertia ratio, torque-speed envelope, regenerative energy) is in :mod:`.sizing`.
 """
@@ -44,6 +46,7 @@ class Requirements:
     bearing_life_h: float | None = None
     gear_life_h: float | None = None
     reducer_life_h: float | None = None
+    screw_life_h: float | None = None
     min_static_safety: float = 1.0
     min_bending_safety: float = 1.0
     min_contact_safety: float = 1.0
@@ -74,8 +77,30 @@ class Check:
 def build_checks(an, req: Requirements, col: Collector) -> list[Check]:
     """Every check of the analysed mechanism ``an`` under ``req``; problems go to ``col``."""
     checks = _motor_checks(an) + sizing_checks(an, Check) + _bearing_checks(an, req, col) + _gear_checks(an, req, col)
-    checks += _reducer_checks(an, req) + _joint_limit_checks(an) + _column_checks(an, req, col)
+    checks += _reducer_checks(an, req) + _screw_checks(an, req) + _joint_limit_checks(an) + _column_checks(an, req, col)
     return checks
+
+
+def _screw_checks(an, req: Requirements) -> list[Check]:
+    """The ISO 3408-5 checks of every rated screw (:class:`~gearcli.model.screws.ScrewRating`):
+    static safety C_0a / max |F| >= ``min_static_safety``, the screw's speed (max |a|, with
+    ``max_speed``) and, with ``screw_life_h``, the life L_h = (C_a / F_m)^3 10^6 / (60 n_m)
+    from the speed-weighted cubic-mean axial load F_m."""
+    out = []
+    for c in an.circuits:
+        gp = an.mech.gears[c.gear]
+        r = gp.screw.rating if gp.screw is not None else None
+        if r is None:
+            continue
+        comp, F = f"screw {gp.name}", ("abs", f"gear:{gp.name}:force")
+        x = {"row": tuple(float(v) for v in c.row_j), "rating": r}
+        out.append(Check(comp, "static safety s0", "", req.min_static_safety, "safety", F, "N", rating=r.C_0a))
+        if r.max_speed is not None:
+            out.append(Check(comp, "speed", "rad/s", r.max_speed, "peak", ("reducer_speed", gp.name), "rad/s", extra=x))
+        if req.screw_life_h is not None:
+            out.append(Check(comp, "L10 life (ISO 3408-5)", "h", req.screw_life_h, "screw_life", F, "N",
+                             rating=r.C_a, exponent=3.0, extra=x))
+    return out
 
 
 def _reducer_checks(an, req: Requirements) -> list[Check]:

@@ -20,6 +20,7 @@ from .checks import Check
 from ..report.rms import running_rms, rms_of, square_integral
 from .gears import hertz_contact_stress, lewis_bending_stress
 from ..model.reducers import reducer_life
+from ..model.screws import screw_life_hours
 from ..model.shaft import split_two_bearings
 
 
@@ -161,7 +162,8 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
     return out
 
 
-REDUCER_KINDS = ("reducer_average", "reducer_speed_average", "reducer_life")
+REDUCER_KINDS = ("reducer_average", "reducer_speed_average", "reducer_life", "screw_life")
+"""Checks reduced by speed-weighted means over the duty cycle (:func:`_reducer_sums`)."""
 
 
 def _reducer_sums(ch: Check, s: Samples, x: np.ndarray) -> tuple[float, float, float]:
@@ -313,7 +315,8 @@ def combine(check: Check, parts: list[tuple], rates) -> Verdict:
 def _reducer_value(check: Check, parts: list[tuple], rates) -> tuple[float, float]:
     """(value, signal level that just meets the limit) of a reducer check: T_av and its limit;
     n_av and its limit; the life L = L_n (n_N/n_av) (T_N/T_av)^p (h) and the T_av that gives the
-    required life, T_N (L_n n_N / (n_av L_req))^(1/p)."""
+    required life, T_N (L_n n_N / (n_av L_req))^(1/p); a screw's life (ISO 3408-5) L_h =
+    (C_a / F_m)^3 10^6 / (60 n_m) and the F_m that gives the required life."""
     if not isinstance(rates, (list, tuple)):
         rates = [rates] * len(parts)
     T_av, n_av = reducer_duty(check, parts, rates)
@@ -322,6 +325,10 @@ def _reducer_value(check: Check, parts: list[tuple], rates) -> tuple[float, floa
     if check.kind == "reducer_speed_average":
         return n_av, check.limit
     r = check.extra["rating"]
+    if check.kind == "screw_life":           # T_av is F_m (p = 3), n_av the mean speed in rad/s
+        n_m = n_av * 60.0 / (2.0 * math.pi)
+        need = r.C_a * (1e6 / (60.0 * n_m * check.limit)) ** (1.0 / 3.0) if n_m > 0 else math.inf
+        return screw_life_hours(r.C_a, T_av, n_m), need
     life = reducer_life(r, T_av, n_av)
     need = (r.rated_torque * (r.rated_life * r.rated_input_speed / (n_av * check.limit)) ** (1.0 / r.life_exponent)
             if n_av > 0 else math.inf)

@@ -57,13 +57,18 @@ class BlockPlan:
 
 
 def _spread(an, g) -> bool:
-    """True when g's wrench is not one wrench applied +/- to two links: a motor acting on
-    several joints (a transmission) or an ideal coupling (torques on several links)."""
+    """True when g's wrench is not one wrench applied +/- to two links fixed in one frame: a
+    motor acting on several joints (a transmission), an ideal coupling or a reducer (torques
+    on several links), or a lossy screw (its torque's power-flow factor varies per sample)."""
     if g.kind == "motor":
         mj = an.motor_joints[g.index] if an.motor_joints else None
         return mj is not None and len(mj) > 1
     if g.kind == "mesh":
-        return an.circuits[g.index].geometry is None
+        c = an.circuits[g.index]
+        sc = an.mech.gears[c.gear].screw
+        if sc is not None:           # fixed in the carrier; lossy: its torque's factor per sample
+            return sc.power_flow_lossy
+        return c.geometry is None
     return False
 
 

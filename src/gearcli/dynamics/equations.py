@@ -24,6 +24,8 @@ the motors acting on it.  :meth:`Columns.balance` assembles the columns of one l
   the carrier taking the reaction;
 * reducer (:mod:`gearcli.model.reducers`: j the input, k the output, the carrier the
   housing): as an ideal coupling, the moment on j times the power-flow factor c_r(sigma, a);
+* screw (:mod:`gearcli.model.screws`: j the screw, k the nut): the axial force along the axis
+  u through a point on it and the torque h c_r u, on the nut, reversed on the screw;
 * mesh (joint coupling q_B = ratio q_A, GearPair.joints): a unit generalised force of joint
   B and -ratio times one of joint A, each on the joint's child and reversed on its parent
   (a moment about the axis of a revolute joint, a force along that of a prismatic one);
@@ -35,6 +37,7 @@ import numpy as np
 
 from ..model.gears import helical_terms
 from ..model.reducers import power_flow_factor
+from ..model.screws import screw_factor
 from ..spatial import cross, mv
 from .kinematics import Kinematics
 from .losses import mesh_friction_moment, relative_rate
@@ -85,6 +88,12 @@ class Columns:
             Rc, oc = kin.R[c.carrier], kin.o[c.carrier]
             if c.joints is not None:
                 continue  # joint coupling: see axial()
+            sc = an.mech.gears[c.gear].screw
+            if sc is not None:                   # the axis u = z_S through a point P on it
+                self.world[ci] = dict(u=mv(Rc, c.zj), P=oc + mv(Rc, c.axis_point), h=sc.h)
+                if sc.power_flow_lossy:
+                    self.world[ci].update(screw=sc, a=relative_rate(an, kin, ci))
+                continue
             if c.geometry is not None:
                 gm, gp = c.geometry, an.mech.gears[c.gear]
                 tan_t, a = helical_terms(gm, gp.pressure_angle, gp.helix_angle, gp.hand)
@@ -153,6 +162,12 @@ class Columns:
             return (self.axial(b, L) - c.ratio * self.axial(a, L))[:, :, None]
         wv = self.world[ci]
         o = self.kin.o[L]
+        if "h" in wv:                 # a screw: F u through P and the torque h c_r F u on the nut, minus on the screw
+            cr = 1.0 if "screw" not in wv else screw_factor(
+                wv["screw"], np.broadcast_to(np.asarray(sigma, float), wv["a"].shape), wv["a"])[:, None]
+            col = _force_at(wv["u"], wv["P"], o)
+            col[:, 3:] += (wv["h"] * cr) * wv["u"]
+            return ((1.0 if L == c.k else -1.0) * col)[:, :, None]
         if c.geometry is not None:
             sign = 1.0 if L == c.j else -1.0
             d = tooth_force_direction(wv["ut"], wv["us"], sigma, self.tan_phi[ci], wv["ax"])

@@ -16,15 +16,16 @@ from .signs import resolve_signs
 
 def is_geared(an, g: UnknownGroup) -> bool:
     """True for a signed unknown: the tangential force of a mesh with gear geometry (Eq. 14),
-    or the torque of a reducer whose efficiency depends on the power-flow direction
-    (:func:`gearcli.model.reducers.power_flow_factor`)."""
+    or the torque of a reducer or the force of a screw whose efficiency depends on the
+    power-flow direction (:mod:`gearcli.model.power_flow`)."""
     if g.kind != "mesh":
         return False
     c = an.circuits[g.index]
     if c.geometry is not None:
         return True
-    red = an.mech.gears[c.gear].reducer
-    return red is not None and red.power_flow_lossy
+    gp = an.mech.gears[c.gear]
+    el = gp.reducer if gp.reducer is not None else gp.screw
+    return el is not None and el.power_flow_lossy
 
 
 def mesh_names(an, groups, signed) -> list[str]:

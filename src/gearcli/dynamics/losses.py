@@ -36,6 +36,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.reducers import input_torque, no_load_torque, reducer_loss
+from ..model.screws import screw_loss
 from ..spatial import cross
 
 
@@ -100,12 +101,18 @@ def fill_reducers(an, qd_ind: np.ndarray, res) -> None:
     """A solved ``res``'s reducer fields, in place, from its unknowns u (``gear_t``) and the
     independent rates ``qd_ind``: ``gear_sep`` holds the torque each reducer exerts on its input
     about z_I, losses included (:func:`gearcli.model.reducers.input_torque`), and ``gear_loss``
-    (a lossy mechanism) its dissipated power (:func:`gearcli.model.reducers.reducer_loss`)."""
+    (a lossy mechanism) its dissipated power (:func:`gearcli.model.reducers.reducer_loss`); a
+    screw's ``gear_loss`` (:func:`gearcli.model.screws.screw_loss`)."""
     for ci, red in reducers(an):
         a, u = mesh_rate(an, qd_ind, ci), res.gear_t[:, ci]
         res.gear_sep[:, ci] = input_torque(red, u, a)
         if res.gear_loss is not None:
             res.gear_loss[:, ci] = reducer_loss(red, u, a)
+    if res.gear_loss is not None:
+        for ci, c in enumerate(an.circuits):
+            sc = an.mech.gears[c.gear].screw
+            if sc is not None:
+                res.gear_loss[:, ci] = screw_loss(sc, res.gear_t[:, ci], mesh_rate(an, qd_ind, ci))
 
 
 def mesh_loss(an, kin, ci: int, t: np.ndarray) -> np.ndarray:

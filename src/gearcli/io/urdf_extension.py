@@ -15,6 +15,7 @@ from ..model.validate import gear_pair_problems
 from .urdf_transmissions import KINDS as TRANSMISSION_KINDS
 from .urdf_transmissions import read_transmissions
 from .reducer_specs import reducer_spec
+from .screw_specs import screw_spec
 from .urdf_xml import NS, floats, q
 from ..model.reducers import LIFE_BASES, REDUCER_KINDS
 
@@ -25,6 +26,8 @@ GEAR_ATTRS = ("name", "j", "k", "kind", "ratio", "teeth", "carrier", "mesh_point
 
 REDUCER_ATTRS = ("name", "kind", "input", "output", "housing", "ratio", "teeth", "efficiency_forward",
                  "efficiency_backward", "no_load_torque", "torsional_stiffness_torque", "torsional_stiffness_rate")
+SCREW_ATTRS = ("name", "screw", "nut", "carrier", "lead", "hand", "efficiency_forward", "efficiency_backward",
+               "friction_coefficient", "diameter")
 RATING_KEYS = ("rated_torque", "rated_input_speed", "rated_life", "life_basis", "life_exponent", "average_torque_limit",
                "repeated_peak_torque", "max_input_speed", "average_input_speed_limit")
 
@@ -53,7 +56,7 @@ class Extension:
     ``leader`` and ``chain_leader``."""
 
     def read_extension(self) -> dict:
-        ext = {"mechanism": None, "gears": [], "motors": [], "loads": [], "payloads": [], "reducers": []}
+        ext = {"mechanism": None, "gears": [], "motors": [], "loads": [], "payloads": [], "reducers": [], "screws": []}
         for el in self.root:
             if not isinstance(el.tag, str) or etree.QName(el).namespace != NS:
                 continue
@@ -77,11 +80,13 @@ class Extension:
                 ext["payloads"].append(el)
             elif local == "reducer":
                 ext["reducers"].append(el)
+            elif local == "screw":
+                ext["screws"].append(el)
             elif local in ("motor_rating", "gear_rating", "motor_model"):
                 continue  # read by io.ratings_reader
             else:
                 self.add(f"gearcli:{local}", f"unknown gearcli element gearcli:{local} (expected gearcli:mechanism, "
-                         "gearcli:gear, gearcli:reducer, gearcli:motor, gearcli:load or gearcli:payload)", el)
+                         "gearcli:gear, gearcli:reducer, gearcli:screw, gearcli:motor, gearcli:load or gearcli:payload)", el)
         return ext
 
     def unknown_attrs(self, el, allowed, path: str) -> None:
@@ -256,6 +261,90 @@ class Extension:
             out.append(GearPair(name, ends[0], ends[1], spec["kind"], i0, teeth=teeth, carrier=ends[2], path=path,
                                 reducer=red))
         return out
+
+    def extension_screws(self, ext) -> list[GearPair]:
+        """The gearcli:screw elements (README "Screws"): attributes name, screw, nut, carrier
+        (links), lead (m/rev), hand, efficiency_forward and efficiency_backward (a number or a
+        table "w1 v1 ..." over the screw's speed, rad/s), or friction_coefficient and diameter;
+        a child gearcli:rating with C_a, C_0a, max_speed.  Validated as the YAML keys are
+        (:func:`.screw_specs.screw_spec`)."""
+        out = []
+        for el in ext["screws"]:
+            name = el.get("name") or f"{el.get('screw')}-{el.get('nut')}"
+            path = f"gearcli:screw '{name}'"
+            self.lines[path] = el.sourceline
+            self.unknown_attrs(el, SCREW_ATTRS, path)
+            ends = []
+            for key in ("screw", "nut"):
+                ref = self.link_ref(el.get(key), path, el) if el.get(key) else None
+                if not el.get(key):
+                    self.add(path, f"gearcli:screw needs attribute {key} (a link name)", el)
+                if ref is not None:
+                    ends.append(ref[0])
+            carrier = None
+            if el.get("carrier") is not None:
+                ref = self.link_ref(el.get("carrier"), path, el, "carrier link")
+                carrier = None if ref is None else ref[0]
+            spec = self._screw_dict(el, path)
+            if spec is None or len(ends) < 2:
+                continue
+            sc = screw_spec(spec, path, lambda p, m, el=el: self.add(_attribute_path(p), m, el))
+            out.append(GearPair(name, ends[0], ends[1], "screw", None, carrier=carrier, path=path, screw=sc))
+        return out
+
+    def _screw_dict(self, el, path: str) -> dict | None:
+        """The screw's attributes (and its gearcli:rating child) as the YAML mapping, or None
+        when one is missing or unreadable (reported)."""
+        spec: dict = {"kind": "screw"}
+        for key in ("lead", "hand"):
+            if el.get(key) is None:
+                self.add(path, f"gearcli:screw needs attribute {key}", el)
+                return None
+        v = floats(el.get("lead"), 1)
+        if v is None:
+            self.add(path, f"lead=\"{el.get('lead')}\" is not a finite number", el)
+            return None
+        spec["lead"], spec["hand"] = float(v[0]), el.get("hand")
+        if spec["hand"] not in ("right", "left"):
+            self.add(path, f"hand must be 'right' or 'left', got '{spec['hand']}'", el)
+            return None
+        eff = {}
+        for k in ("forward", "backward"):
+            text = el.get(f"efficiency_{k}")
+            if text is None:
+                continue
+            v = floats(text)
+            if v is None or v.size == 0 or (v.size > 1 and v.size % 2):
+                self.add(path, f"efficiency_{k}=\"{text}\" is not a number or a table of pairs 'w_in value ...'", el)
+                return None
+            eff[k] = float(v[0]) if v.size == 1 else [[float(a), float(b)] for a, b in v.reshape(-1, 2)]
+        if eff:
+            if "forward" not in eff:
+                self.add(path, "efficiency_backward needs efficiency_forward", el)
+                return None
+            spec["efficiency"] = eff
+        for key in ("friction_coefficient", "diameter"):
+            if el.get(key) is not None:
+                v = floats(el.get(key), 1)
+                if v is None:
+                    self.add(path, f"{key}=\"{el.get(key)}\" is not a finite number", el)
+                    return None
+                spec[key] = float(v[0])
+        ratings = [c for c in el if isinstance(c.tag, str) and etree.QName(c).localname == "rating"]
+        if ratings:
+            r, rating = ratings[0], {}
+            for k, text in r.attrib.items():
+                x = floats(text, 1)
+                if k not in ("C_a", "C_0a", "max_speed") or x is None or not x[0] > 0:
+                    self.add(f"{path}.rating", f"gearcli:rating of a screw takes C_a, C_0a and max_speed (positive "
+                             f"numbers), got {k}=\"{text}\"", r)
+                    return None
+                rating[k] = float(x[0])
+            if "C_a" not in rating or "C_0a" not in rating:
+                self.add(f"{path}.rating", "gearcli:rating of a screw needs C_a and C_0a", r)
+                return None
+            spec["rating"] = rating
+        return spec
 
     def _reducer_dict(self, el, path: str) -> dict | None:
         """The reducer's attributes (and its gearcli:rating child) as the YAML mapping, or None

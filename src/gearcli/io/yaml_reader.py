@@ -26,6 +26,7 @@ from ..model.geometry import dh_transform, origin_axis_transform
 from ..model.reducers import REDUCER_KINDS
 from ..model.validate import check_inertia, gear_pair_problems, inertia_matrix, number_problem
 from .reducer_specs import reducer_spec
+from .screw_specs import screw_spec
 from .schema_words import schema_messages
 from .yaml_safe import read_text, yaml_lines
 from .schemas import packaged_schema
@@ -295,6 +296,9 @@ def _gears(data: dict, col: Collector, links: _Names) -> list[GearPair]:
         if spec.get("kind") in REDUCER_KINDS:
             gears.append(_reducer(spec, col, links, names, path))
             continue
+        if spec.get("kind") == "screw":
+            gears.append(_screw(spec, col, links, names, path))
+            continue
         j, k = spec["links"]
         links.ref(j, f"{path}.links[0]")
         links.ref(k, f"{path}.links[1]")
@@ -333,6 +337,21 @@ def _reducer(spec: dict, col: Collector, links: _Names, names: _Names, path: str
     i0, red = reducer_spec(spec, path, col.add)
     teeth = tuple(spec["teeth"]) if "teeth" in spec else None
     return GearPair(spec.get("name", f"{i}-{o}"), i, o, spec["kind"], i0, teeth=teeth, carrier=h, path=path, reducer=red)
+
+
+def _screw(spec: dict, col: Collector, links: _Names, names: _Names, path: str) -> GearPair:
+    """A ball or lead screw (links: [screw, nut]) as a GearPair with j = screw, k = nut and the
+    ratio e from the geometry (:mod:`gearcli.model.screws`; the analysis derives it)."""
+    s, n = spec["links"]
+    links.ref(s, f"{path}.links[0]")
+    links.ref(n, f"{path}.links[1]")
+    if s == n:
+        col.add(f"{path}.links", "a screw needs two different links [screw, nut]")
+    if "carrier" in spec:
+        links.ref(spec["carrier"], f"{path}.carrier")
+    names.declare(spec.get("name", f"{s}-{n}"), path)
+    return GearPair(spec.get("name", f"{s}-{n}"), s, n, "screw", None, carrier=spec.get("carrier"), path=path,
+                    screw=screw_spec(spec, path, col.add))
 
 
 def _stiffness(spec: dict, col: Collector, path: str) -> float | None:

@@ -25,6 +25,7 @@ from .friction import JointFriction
 from .loads import Load, with_payloads
 from .ratings import BearingRating, GearRating, JointLimit, MotorModel, MotorRating
 from .reducers import Reducer
+from .screws import Screw
 
 
 @dataclass(frozen=True, eq=False)
@@ -111,6 +112,9 @@ class GearPair:
     # output, carrier its housing, ratio the basic ratio i0; its efficiency, no-load torque,
     # torsional stiffness and catalogue rating.  None for a gear pair.
     reducer: Reducer | None = None
+    # A ball or lead screw (kind screw, model.screws): j is the screw (revolute), k the nut
+    # (prismatic) on the same line relative to the carrier, ratio e = theta_j / x_k (rad/m).
+    screw: Screw | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -159,7 +163,8 @@ class Mechanism:
     def has_losses(self) -> bool:
         """True when any gear pair has a loss factor, any reducer an efficiency below 1 or a
         no-load torque, or any joint has friction of its own or in its bearings."""
-        return any(g.loss_factor or (g.reducer is not None and g.reducer.lossy) for g in self.gears) or any(
+        return any(g.loss_factor or (g.reducer is not None and g.reducer.lossy) or (g.screw is not None and g.screw.lossy)
+                   for g in self.gears) or any(
             (j.friction is not None and j.friction.active) or any(b.friction_arm for b in j.bearings or ())
             for j in self.joints)
 

@@ -37,32 +37,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .power_flow import SpeedTable, efficiency_factor
+
 REDUCER_KINDS = ("strain_wave", "cycloidal")
 
 LIFE_BASES = ("L10", "L50")
-
-
-@dataclass(frozen=True)
-class SpeedTable:
-    """A value that depends on |w_in| only: rows (w_in rad/s increasing from >= 0, value),
-    linear between rows, held beyond the ends; one row: a constant."""
-
-    speeds: tuple[float, ...]
-    values: tuple[float, ...]
-
-    @classmethod
-    def constant(cls, value: float) -> "SpeedTable":
-        """The table of one constant ``value``."""
-        return cls((0.0,), (float(value),))
-
-    def at(self, a) -> np.ndarray:
-        """The value at the input rates ``a`` (N,) (indexed by |a|)."""
-        return np.interp(np.abs(np.asarray(a, float)), self.speeds, self.values)
-
-    @property
-    def is_constant(self) -> bool:
-        """True for one row (the value does not depend on the speed)."""
-        return len(self.values) == 1
 
 
 @dataclass(frozen=True)
@@ -131,8 +110,7 @@ def power_flow_factor(red: Reducer, u, a) -> np.ndarray:
     1/eta_f where the input drives (u a < 0), eta_b where the output drives (u a > 0), 1 where
     u a = 0 (at rest: lossless).  ``u`` the lossless torque on I about z_I, ``a`` the input's
     rate relative to the housing about z_I (rad/s, from the joint rates)."""
-    s = np.sign(np.asarray(u, float)) * np.sign(np.asarray(a, float))
-    return np.where(s < 0, 1.0 / red.forward.at(a), np.where(s > 0, red.backward.at(a), 1.0))
+    return efficiency_factor(red.forward, red.backward, u, a, a)
 
 
 def no_load_torque(red: Reducer, a) -> np.ndarray:

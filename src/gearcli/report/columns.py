@@ -16,7 +16,8 @@ Columns, in order (units SI):
   the output torque T on the output about its joint axis), ``gear:<r>:input_torque`` (N*m,
   the torque the reducer exerts on its input about the input's joint axis, losses included)
   and, with a ``torsional_stiffness``, ``gear:<r>:windup`` (rad, the output's torsion angle
-  under T, odd in T; reported, not fed back);
+  under T, odd in T; reported, not fed back); per screw ``gear:<s>:force`` (N, the axial
+  force on the nut along the screw's axis z_S);
 * per real joint ``joint:<joint>:fx, fy, fz, mx, my, mz`` (N, N*m): reaction wrench the
   parent exerts on the child, in the joint frame, about its origin; then
   ``joint:<joint>:radial`` = hypot(fx, fy), ``axial`` = |fz|, ``bending`` = hypot(mx, my);
@@ -24,8 +25,8 @@ Columns, in order (units SI):
   rate A^T qd) and ``motor:<motor>:power`` (W, torque x speed, negative when braking),
   appended last so that the columns above keep their positions;
 * only for a mechanism with losses (``gears[].efficiency``, ``joints[].friction``), appended
-  after those: per gear pair with geometry and per reducer ``gear:<pair>:loss`` (W, mesh or
-  reducer power loss), then
+  after those: per gear pair with geometry, reducer and screw ``gear:<pair>:loss`` (W, mesh,
+  reducer or screw power loss), then
   per real joint ``joint:<joint>:friction`` (N*m, N for a prismatic joint: the friction on
   the child about (along) the axis; not included in ``mz``/``fz``) and ``joint:<joint>:loss``
   (W).
@@ -58,6 +59,9 @@ def column_names(an) -> list[str]:
             if gp.reducer.torsional_stiffness is not None:
                 cols.append(f"gear:{gp.name}:windup")
             continue
+        if gp.screw is not None:
+            cols.append(f"gear:{gp.name}:force")
+            continue
         if c.geometry is None:
             cols.append(f"gear:{gp.name}:torque")
             continue
@@ -77,8 +81,9 @@ def column_names(an) -> list[str]:
 
 def has_loss_column(an, c) -> bool:
     """True when circuit ``c`` has a ``gear:<pair>:loss`` column (a lossy mechanism's pairs with
-    tooth geometry and its reducers)."""
-    return c.geometry is not None or an.mech.gears[c.gear].reducer is not None
+    tooth geometry, its reducers and screws)."""
+    gp = an.mech.gears[c.gear]
+    return c.geometry is not None or gp.reducer is not None or gp.screw is not None
 
 
 TRANSPOSE_ROWS = 512
@@ -111,7 +116,7 @@ def column_sources(an, t: np.ndarray, res: Result) -> dict:
             if red.torsional_stiffness is not None:
                 put(lambda ci=ci, e=circ.ratio, red=red: windup(red, -e * res.gear_t[:, ci]))
             continue
-        put(lambda ci=ci: res.gear_t[:, ci])
+        put(lambda ci=ci: res.gear_t[:, ci])       # (a screw: its axial force F on the nut)
         if circ.geometry is not None:
             put(lambda ci=ci: res.gear_sep[:, ci])
             for side in (0, 1):
@@ -291,9 +296,9 @@ class Summary:
                 pick.append((i, f"motor {n.split(':')[1]} {last}", unit))
             elif kind == "motor":
                 pick.append((i, f"motor {n[6:]}", unit))
-            elif kind == "gear" and last in ("t", "torque"):
+            elif kind == "gear" and last in ("t", "torque", "force"):
                 pair = n[5:-len(last) - 1]
-                pick.append((i, f"gear {pair} {'tangential' if last == 't' else 'torque'}", unit))
+                pick.append((i, f"gear {pair} {'tangential' if last == 't' else last}", unit))
             elif kind == "joint" and last in ("radial", "axial", "bending"):
                 pick.append((i, f"bearing {n[6:-len(last) - 1]} {last}", unit))
         return cls([p[0] for p in pick], [Stat(p[1], p[2]) for p in pick])

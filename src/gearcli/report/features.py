@@ -79,6 +79,35 @@ def _reducer_line(d: dict) -> str:
     return text
 
 
+def screw_dicts(an: Analysis) -> list[dict]:
+    """Each screw (:mod:`gearcli.model.screws`): screw, nut, carrier, lead (m/rev), hand, h
+    (m/rad), efficiencies (constant ones; a table: its rows)."""
+    out = []
+    for c in an.circuits:
+        gp = an.mech.gears[c.gear]
+        sc = gp.screw
+        if sc is None:
+            continue
+
+        def value(tab):
+            return tab.values[0] if tab.is_constant else [list(r) for r in zip(tab.speeds, tab.values)]
+        out.append({"screw": gp.name, "screw_link": gp.j, "nut": gp.k, "carrier": an.names[c.carrier], "lead": sc.lead,
+                    "hand": sc.hand, "h": sc.h, "efficiency": {"forward": value(sc.forward), "backward": value(sc.backward)}})
+    return out
+
+
+def _screw_line(d: dict) -> str:
+    eff = d["efficiency"]
+    text = (f"screw '{d['screw']}': screw '{d['screw_link']}' drives nut '{d['nut']}' (carrier '{d['carrier']}'), lead "
+            f"{d['lead']:.6g} m/rev {d['hand']} hand: x_nut = {d['h']:.6g} m/rad * theta_screw; the axial force F on "
+            "the nut along the axis with the torque h F, the opposite on the screw")
+    if eff["forward"] != 1.0 or eff["backward"] != 1.0:
+        text += f"; efficiency forward {eff['forward']}, backward {eff['backward']}"
+        if not isinstance(eff["backward"], list) and eff["backward"] <= 0:
+            text += " (self-locking: it holds its load without a brake; lowering needs the motor)"
+    return text
+
+
 def feature_notes(an: Analysis) -> list[str]:
     """Human-readable lines: ``load 'tip' on link '2' (frame base): force [..] N, moment [..]
     N*m at [..] m``, ``payload 'box' on link 'arm': ...``, ``helical pair ...``, ``rack pair
@@ -98,4 +127,5 @@ def feature_notes(an: Analysis) -> list[str]:
             lines.append(f"rack pair '{d['pair']}': pinion '{d['pinion']}' (pitch radius {d['pitch_radius']:.6g} m) "
                          f"drives rack '{d['rack']}': x = {d['x_per_rad']:.6g} m/rad * theta")
     lines += [_reducer_line(d) for d in reducer_dicts(an)]
+    lines += [_screw_line(d) for d in screw_dicts(an)]
     return lines + loss_notes(an)

@@ -36,8 +36,8 @@ def lossless_twin(mech):
     bearing friction, reducers without losses (the ratings stay)."""
     def frictionless(bearings):
         return bearings and tuple(replace(b, friction_coefficient=None) for b in bearings)
-    return replace(mech, gears=tuple(replace(g, loss_factor=0.0, reducer=g.reducer and g.reducer.lossless())
-                                     for g in mech.gears),
+    return replace(mech, gears=tuple(replace(g, loss_factor=0.0, reducer=g.reducer and g.reducer.lossless(),
+                                             screw=g.screw and g.screw.lossless()) for g in mech.gears),
                    joints=tuple(replace(j, friction=None, bearings=frictionless(j.bearings)) for j in mech.joints))
 
 

@@ -263,6 +263,10 @@ def _add_extension(an: Analysis, root, corr: dict) -> None:
         if gp.reducer is not None:
             _add_reducer(root, gp)
             continue
+        if gp.screw is not None:
+            circ = next(c for c in an.circuits if c.gear == gi)
+            _add_screw(root, gp, tree.links[circ.carrier])
+            continue
         circ = next(c for c in an.circuits if c.gear == gi)
         carrier = tree.links[circ.carrier]
         g = etree.SubElement(root, q("gear"), name=gp.name, j=gp.j, k=gp.k, kind=gp.kind, carrier=carrier)
@@ -326,6 +330,20 @@ def _add_reducer(root, gp) -> None:
         for k in ("average_torque_limit", "repeated_peak_torque", "max_input_speed", "average_input_speed_limit"):
             if getattr(r, k) is not None:
                 rel.set(k, _num(getattr(r, k)))
+
+
+def _add_screw(root, gp, carrier: str) -> None:
+    """One gearcli:screw (with its gearcli:rating) of a ball or lead screw; its efficiencies
+    as numbers (those derived from a friction coefficient too)."""
+    sc = gp.screw
+    el = etree.SubElement(root, q("screw"), name=gp.name, screw=gp.j, nut=gp.k, carrier=carrier,
+                          lead=_num(sc.lead), hand=sc.hand, efficiency_forward=_table(sc.forward),
+                          efficiency_backward=_table(sc.backward))
+    r = sc.rating
+    if r is not None:
+        rel = etree.SubElement(el, q("rating"), C_a=_num(r.C_a), C_0a=_num(r.C_0a))
+        if r.max_speed is not None:
+            rel.set("max_speed", _num(r.max_speed))
 
 
 def _gear_attrs(el, gp, mesh_point) -> None:

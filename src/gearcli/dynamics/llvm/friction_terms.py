@@ -58,29 +58,28 @@ def interp(e: Emitter, x, table):
 
 
 def reducer_terms(e: Emitter, s: Sample, red) -> list:
-    """Per lossy reducer (:class:`.loss_program.ReducerLosses`): (s_a, A, B, z_I in world
-    axes, a, T0(|a|)) for the world-frame block columns (:func:`.losses.world_columns`) and
-    the outputs (:func:`write_losses`), a = its rate row
-    . q'_ind (exactly 0 at rest); rhs -= its no-load torque -T0(|a|) s_a about z_I on the
-    input (+ on the housing), a known load (:func:`..losses.subtract_reducer_drag`)."""
+    """Per lossy power-flow element (:class:`.loss_program.ReducerLosses`): (s_w, A, B, its axis
+    in world axes, w, T0(|a|), |a|) for the world-frame block columns
+    (:func:`.losses.world_columns`) and the outputs (:func:`write_losses`), w = its drive-rate
+    row . q'_ind (exactly 0 at rest); rhs -= a reducer's no-load torque -T0(|a|) s_w coef z on
+    its sides, a known load (:func:`..losses.subtract_reducer_drag`)."""
     out = []
     for k in range(len(red.circuits)):
-        a = e.const(e.dot(floats(red.rate_flt[k]), s.qdi))
-        sa, speed = _sign(e, a), e.call("fabs", a)
-        j, c, housing = (int(v) for v in red.links[k])
-        z = e.mv(s.R[housing], floats(red.axis[k]))
+        w = e.const(e.dot(floats(red.rate_flt[k]), s.qdi))
+        sw, speed = _sign(e, w), e.const(e.mul(red.scale[k], e.call("fabs", w)))
+        z = e.mv(s.R[int(red.carriers[k])], floats(red.axis[k]))
         fwd, bwd, t0 = red.tables[k]
         inv_f, eta_b = e.div(1.0, interp(e, speed, fwd)), interp(e, speed, bwd)
         A = e.const(e.sub(e.mul(0.5, e.add(inv_f, eta_b)), 1.0))
         B = e.const(e.mul(0.5, e.sub(eta_b, inv_f)))
         T0 = 0.0 if t0 is None else e.const(interp(e, speed, t0))
-        out.append((sa, A, B, z, a, T0))
+        out.append((sw, A, B, z, w, T0, speed))
         if t0 is None:
             continue
-        tq = e.const(e.neg(e.mul(T0, sa)))
-        for L, sign in ((j, 1.0), (c, -1.0)):
+        tq = e.const(e.neg(e.mul(T0, sw)))
+        for L, coef in red.sides[k]:
             if L >= 0:
-                s.rhs[L] = s.rhs[L][:3] + tuple(e.sub(s.rhs[L][3 + h], e.mul(e.mul(sign, tq), z[h])) for h in range(3))
+                s.rhs[L] = s.rhs[L][:3] + tuple(e.sub(s.rhs[L][3 + h], e.mul(e.mul(coef, tq), z[h])) for h in range(3))
     return out
 
 
@@ -126,7 +125,8 @@ def write_losses(e: Emitter, s: Sample, lp, gear_col, rates: list, own: dict, ro
         t = s.sol[int(gear_col[ci])]
         e.store(e.mul(e.mul(e.mul(c, e.call("fabs", t)), e.call("fabs", rates[k])), rj), rows["gear_loss"], ci)
     inputs = _reducer_outputs(e, s, lp.reducers, gear_col, rows) if lp.reducers is not None else {}
-    for ci in set(range(len(gear_col))) - set(lp.rate_meshes) - set(inputs):
+    done = set(lp.reducers.circuits) if lp.reducers is not None else set()
+    for ci in set(range(len(gear_col))) - set(lp.rate_meshes) - done:
         e.store(0.0, rows["gear_loss"], ci)
     for ji in (int(v) for v in lp.bearing_joints):
         f = own.get(ji, 0.0)
@@ -137,16 +137,19 @@ def write_losses(e: Emitter, s: Sample, lp, gear_col, rates: list, own: dict, ro
 
 
 def _reducer_outputs(e: Emitter, s: Sample, red, gear_col, rows: dict) -> dict:
-    """Each lossy reducer's ``gear_loss`` -delta u a + T0 |a| (delta = c_r - 1 with sigma =
-    sign(u): u = 0 makes both terms' product 0) and its input torque (1 + delta) u - T0 s_a
-    (:func:`gearcli.model.reducers.reducer_loss`, :func:`~gearcli.model.reducers.input_torque`)."""
+    """Each lossy power-flow element's ``gear_loss`` -delta u w + T0 |a| (delta = c_r - 1 with
+    sigma = sign(u): u = 0 makes both terms' product 0); returns each reducer's input torque
+    (1 + delta) u - T0 s_w (:func:`gearcli.model.reducers.reducer_loss`,
+    :func:`~gearcli.model.reducers.input_torque`, :func:`gearcli.model.screws.screw_loss`)."""
     out = {}
     for k, ci in enumerate(red.circuits):
-        sa, A, B, _, a, T0 = s.red[k]
+        sw, A, B, _, w, T0, speed = s.red[k]
         u = s.sol[int(gear_col[ci])]
-        delta = e.add(e.mul(A, e.mul(sa, sa)), e.mul(B, e.mul(_sign(e, u), sa)))
-        e.store(e.add(e.neg(e.mul(e.mul(delta, u), a)), e.mul(T0, e.call("fabs", a))), rows["gear_loss"], ci)
-        out[ci] = e.const(e.sub(e.add(u, e.mul(delta, u)), e.mul(T0, sa)))
+        delta = e.add(e.mul(A, e.mul(sw, sw)), e.mul(B, e.mul(_sign(e, u), sw)))
+        drag = e.const(e.mul(T0, speed))      # T0 |a| - delta u w: +0 at rest, as numpy's
+        e.store(e.b.fsub(drag, e.const(e.mul(e.mul(delta, u), w)), flags=FLAGS), rows["gear_loss"], ci)
+        if red.reducer[k]:
+            out[ci] = e.const(e.sub(e.add(u, e.mul(delta, u)), e.mul(T0, sw)))
     return out
 
 

@@ -67,36 +67,42 @@ class BlockLosses:
     rows: tuple = ()
     maps: tuple | None = None
     hot: tuple = ()
-    # the block's signed reducers (world frame): (position in its signed unknowns, index in
-    # ReducerLosses, ((block row, +1 input / -1 housing), ...), ((later link, sign), ...))
+    # the block's signed power-flow elements (world frame): (position in its signed unknowns,
+    # index in ReducerLosses, ((block row, coef), ...), ((later link, coef), ...))
     reducers: tuple = ()
 
 
 @dataclass(frozen=True, eq=False)
 class ReducerLosses:
-    """The lossy coaxial reducers (:mod:`gearcli.model.reducers`) for the kernel.
+    """The lossy power-flow elements for the kernel: coaxial reducers
+    (:mod:`gearcli.model.reducers`) and screws (:mod:`gearcli.model.screws`).
 
-    Per reducer: ``circuits`` its circuit; ``rate_flt`` (R, dof) its rate row (a = the input's
-    rate relative to the housing about z_I, from the independent rates); ``links`` (R, 3)
-    [input, housing] (-1 where not moving) and the housing; ``axis`` (R, 3) z_I in the housing's axes;
-    ``tables``: (eta_f, eta_b, T0 or None) each as (speeds, values) over |a| (linear between
-    rows, held beyond the ends); ``signed``: 1 when its efficiency is below 1 (its torque on
-    the input then depends on sign(u) sign(a)).  The kernel adds to the input's column
-    delta = A |s_a| + B sigma s_a times z_I (minus on the housing), A = (1/eta_f + eta_b)/2 - 1,
-    B = (eta_b - 1/eta_f)/2: c_r = 1 + delta is 1/eta_f where sigma s_a = -1, eta_b where +1,
-    1 at rest; and the no-load torque -T0 s_a about z_I on the input (the opposite on the
-    housing) as a known load."""
+    Per element: ``circuits`` its circuit; ``rate_flt`` (R, dof) the row of its drive rate w
+    over the independent rates (:mod:`gearcli.model.power_flow`: a reducer's a, the input's rate
+    relative to the housing; a screw's -h a); ``scale`` (R,) |a| / |w| (1; 1/|h|), the speed its
+    tables are read at; ``sides`` per element ((link or -1 where not moving, coef), ...) the
+    moments coef delta u z its power-flow change puts on its links (a reducer: +1 input, -1
+    housing; a screw: -h screw, +h nut); ``carriers`` (R,) the link whose axes ``axis`` (R, 3)
+    is given in (the housing, the carrier); ``tables``: (eta_f, eta_b, T0 or None) each as
+    (speeds, values) over |a|; ``signed``: 1 when its efficiency is below 1; ``reducer``: 1 for a
+    reducer (its input torque is an output).  The kernel adds delta = A |s_w| + B sigma s_w to
+    c_r = 1 + delta, A = (1/eta_f + eta_b)/2 - 1, B = (eta_b - 1/eta_f)/2: 1/eta_f where sigma
+    s_w = -1, eta_b where +1, 1 at rest; a reducer's no-load torque -T0 s_w coef z on its sides is
+    a known load."""
 
     circuits: tuple
     rate_flt: np.ndarray
-    links: np.ndarray
+    scale: tuple
+    sides: tuple
+    carriers: tuple
     axis: np.ndarray
     tables: tuple
     signed: tuple
+    reducer: tuple
 
     def parts(self) -> list:
-        return [self.circuits, self.rate_flt.tobytes(), self.links.tobytes(), self.axis.tobytes(), self.signed,
-                repr(self.tables).encode()]
+        return [self.circuits, self.rate_flt.tobytes(), self.scale, self.sides, self.carriers, self.axis.tobytes(),
+                self.signed, self.reducer, repr(self.tables).encode()]
 
 
 @dataclass(frozen=True, eq=False)
@@ -247,27 +253,36 @@ def build_loss_program(an, plans) -> LossProgram | None:
 
 
 def _reducer_losses(an) -> ReducerLosses | None:
-    """The :class:`ReducerLosses` of ``an``'s lossy reducers, None without one."""
+    """The :class:`ReducerLosses` of ``an``'s lossy reducers and screws, None without one."""
     gears, moving = an.mech.gears, set(an.tree.moving)
     circ = tuple(ci for ci, c in enumerate(an.circuits)
-                 if gears[c.gear].reducer is not None and gears[c.gear].reducer.lossy)
+                 if (gears[c.gear].reducer is not None and gears[c.gear].reducer.lossy)
+                 or (gears[c.gear].screw is not None and gears[c.gear].screw.lossy))
     if not circ:
         return None
-    tables, signed = [], []
+    rows, scale, sides, tables, signed, reducer = [], [], [], [], [], []
     for ci in circ:
-        r = gears[an.circuits[ci].gear].reducer
-        t0 = None if r.no_load_torque is None else (r.no_load_torque.speeds, r.no_load_torque.values)
-        tables.append(((r.forward.speeds, r.forward.values), (r.backward.speeds, r.backward.values), t0))
-        signed.append(int(r.power_flow_lossy))
-    links = [[c.j if c.j in moving else -1, c.carrier if c.carrier in moving else -1, c.carrier]
-             for c in (an.circuits[ci] for ci in circ)]
-    return ReducerLosses(circ, np.array(an.mesh_rate_rows[list(circ)], float).reshape(-1, an.dof),
-                         np.array(links, np.int64).reshape(-1, 3),
-                         np.array([an.circuits[ci].zj for ci in circ], float).reshape(-1, 3), tuple(tables), tuple(signed))
+        c, gp = an.circuits[ci], gears[an.circuits[ci].gear]
+        el = gp.reducer if gp.reducer is not None else gp.screw
+        k = 1.0 if gp.reducer is not None else -gp.screw.h       # w = k a
+        rows.append(k * np.asarray(an.mesh_rate_rows[ci], float))
+        scale.append(1.0 / abs(k))
+        coefs = ((c.j, 1.0), (c.carrier, -1.0)) if gp.reducer is not None else ((c.j, -gp.screw.h), (c.k, gp.screw.h))
+        sides.append(tuple((L if L in moving else -1, coef) for L, coef in coefs))
+        t0 = getattr(el, "no_load_torque", None)
+        tables.append(((el.forward.speeds, el.forward.values), (el.backward.speeds, el.backward.values),
+                       None if t0 is None else (t0.speeds, t0.values)))
+        signed.append(int(el.power_flow_lossy))
+        reducer.append(int(gp.reducer is not None))
+    return ReducerLosses(circ, np.array(rows, float).reshape(-1, an.dof), tuple(scale), tuple(sides),
+                         tuple(an.circuits[ci].carrier for ci in circ),
+                         np.array([an.circuits[ci].zj for ci in circ], float).reshape(-1, 3), tuple(tables),
+                         tuple(signed), tuple(reducer))
 
 
 def _block_reducers(an, p, bi: int, block_of: dict, red: ReducerLosses | None) -> tuple:
-    """:attr:`BlockLosses.reducers` of block plan ``p`` (index ``bi``)."""
+    """:attr:`BlockLosses.reducers` of block plan ``p`` (index ``bi``): per signed power-flow
+    element (position, index in ``red``, ((block row, coef), ...), ((later link, coef), ...))."""
     if red is None:
         return ()
     out = []
@@ -275,11 +290,11 @@ def _block_reducers(an, p, bi: int, block_of: dict, red: ReducerLosses | None) -
         g = p.groups[gi]
         if g.kind != "mesh" or g.index not in red.circuits:
             continue
-        c = an.circuits[g.index]
-        sides = ((c.j, 1), (c.carrier, -1))
-        rows = tuple((p.links.index(L), s) for L, s in sides if L in p.links)
-        later = tuple((L, s) for L, s in sides if L not in p.links and L in block_of and block_of[L] > bi)
-        out.append((n, red.circuits.index(g.index), rows, later))
+        r = red.circuits.index(g.index)
+        sides = [(L, coef) for L, coef in red.sides[r] if L >= 0]
+        rows = tuple((p.links.index(L), coef) for L, coef in sides if L in p.links)
+        later = tuple((L, coef) for L, coef in sides if L not in p.links and L in block_of and block_of[L] > bi)
+        out.append((n, r, rows, later))
     return tuple(out)
 
 

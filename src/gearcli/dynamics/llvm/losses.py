@@ -298,15 +298,15 @@ def world_columns(lp, bl, s: Sample):
                     A[6 * row + 3 + h][tcols[n]] = e.add(A[6 * row + 3 + h][tcols[n]], e.mul(coef, e.mul(float(sign), fr[h])))
         for n, k, rows, _ in bl.reducers:
             delta, z = _reducer_delta(e, s.red[k], sig[n])
-            for row, sign in rows:
+            for row, coef in rows:
                 for h in range(3):
-                    A[6 * row + 3 + h][tcols[n]] = e.add(A[6 * row + 3 + h][tcols[n]], e.mul(e.mul(float(sign), delta), z[h]))
+                    A[6 * row + 3 + h][tcols[n]] = e.add(A[6 * row + 3 + h][tcols[n]], e.mul(e.mul(float(coef), delta), z[h]))
     return add
 
 
 def _reducer_delta(e: Emitter, terms, sigma):
-    """(delta, z_I): a reducer's power-flow change of its input column, delta = A |s_a| + B
-    sigma s_a (:class:`.loss_program.ReducerLosses`), and its axis in world axes."""
+    """(delta, z): a power-flow element's change of its torque's factor, delta = A |s_w| + B
+    sigma s_w (:class:`.loss_program.ReducerLosses`), and its axis in world axes."""
     sa, A, B, z = terms[:4]
     return e.add(e.mul(A, e.mul(sa, sa)), e.mul(B, e.mul(sigma, sa))), z
 
@@ -334,9 +334,9 @@ def propagate(e: Emitter, s: Sample, lp, bl, x: list, tcols: list, sig: list) ->
         for L, sign in bl.later[a]:
             s.rhs[L] = s.rhs[L][:3] + tuple(e.sub(s.rhs[L][3 + h], e.mul(float(sign), e.mul(amount, m[h])))
                                             for h in range(3))
-    for n, k, _, later in bl.reducers:          # the power-flow change delta u z_I (+ input, - housing)
+    for n, k, _, later in bl.reducers:          # the power-flow change coef delta u z on its sides
         delta, z = _reducer_delta(e, s.red[k], sig[n])
         amount = e.mul(delta, x[tcols[n]])
-        for L, sign in later:
-            s.rhs[L] = s.rhs[L][:3] + tuple(e.sub(s.rhs[L][3 + h], e.mul(float(sign), e.mul(amount, z[h])))
+        for L, coef in later:
+            s.rhs[L] = s.rhs[L][:3] + tuple(e.sub(s.rhs[L][3 + h], e.mul(float(coef), e.mul(amount, z[h])))
                                             for h in range(3))

@@ -93,6 +93,10 @@ def _mesh(an, ci, L, t_pos):
         b, a = c.joints
         return [_axial(an, b, L, 1.0) + _axial(an, a, L, -c.ratio)]
     zero = np.zeros(3)
+    sc = an.mech.gears[c.gear].screw
+    if sc is not None:             # the axial force along z_S through the axis point, the torque h z_S
+        s = 1.0 if L == c.k else -1.0
+        return [[(0, c.carrier, -1, s, c.zj, c.axis_point), (1, c.carrier, -1, s * sc.h, c.zj, zero)]]
     if c.geometry is not None:
         gm, gp = c.geometry, an.mech.gears[c.gear]
         tan_t, ax = helical_terms(gm, gp.pressure_angle, gp.helix_angle, gp.hand)
