@@ -104,3 +104,10 @@ q, qd, qdd = quintic_moves(ts, [(0.0, 1.2, 0.0, 0.15), (1.6, 2.8, 0.15, 0.0)])
 attach = ((ts < 1.4) | (ts >= 3.0)).astype(float)
 np.savetxt("mechanisms/screw_lift_traj.csv", np.column_stack([ts, q, qd, qdd, attach]), delimiter=",",
            header="t,q:Jz,qd:Jz,qdd:Jz,attach:part", comments="", fmt="%.17g")
+
+# worm_lift: the drum Jd (rad): raise the load a turn and a half (0.47 m of rope) in 2 s, hold,
+# lower it back in 2 s (under power: the stage is self-locking), hold; 5 s.  Drum to 8.8 rad/s,
+# the worm to 353 rad/s (3380 rpm).
+tw = np.linspace(0.0, 5.0, 5001)
+q, qd, qdd = quintic_moves(tw, [(0.0, 2.0, 0.0, 3 * np.pi), (2.5, 4.5, 3 * np.pi, 0.0)])
+write_trajectory("mechanisms/worm_lift_traj.csv", ["Jd"], tw, q[:, None], qd[:, None], qdd[:, None])

@@ -105,6 +105,13 @@ def own_losses(an, q, qd, res):
         if gp.screw is not None:
             parts.append(own_screw_loss(an, kin, ci, res))
             continue
+        if gp.worm is not None:         # mu |N| |v_s|, the sliding speed from the links' velocities at P
+            P = np.einsum("nij,j->ni", kin.R[c.carrier], c.worm.P) + kin.o[c.carrier]
+            vel = forward(mech, tree, qa, np.zeros_like(qa), qda)
+            vw = vel.a[c.j] + np.cross(kin.w[c.j], P - kin.o[c.j])
+            vg = vel.a[c.k] + np.cross(kin.w[c.k], P - kin.o[c.k])
+            parts.append(gp.worm.mu * np.abs(res.gear_t[:, ci]) * np.linalg.norm(vw - vg, axis=1))
+            continue
         if not gp.loss_factor:
             continue
         zj = np.einsum("nij,j->ni", kin.R[c.carrier], c.geometry.zj)
@@ -203,7 +210,9 @@ def test_lossless_mechanism_outputs_unchanged_and_without_loss_columns(name):
                 return None
             return r.lossless() if mu is None else dataclasses.replace(
                 r.lossless(), no_load_torque=SpeedTable.constant(0.0))
-        return dataclasses.replace(m, gears=tuple(dataclasses.replace(g, loss_factor=0.0, reducer=red(g.reducer))
+        return dataclasses.replace(m, gears=tuple(dataclasses.replace(g, loss_factor=0.0, reducer=red(g.reducer),
+                                                                      screw=g.screw and g.screw.lossless(),
+                                                                      worm=g.worm and g.worm.lossless())
                                                   for g in m.gears),
                                    joints=tuple(dataclasses.replace(j, friction=fr, bearings=None if not j.bearings else
                                                 tuple(dataclasses.replace(b, friction_coefficient=mu) for b in j.bearings))

@@ -245,7 +245,7 @@ def _print_summary(console, report, verify: bool) -> None:
     an = report.analysis
     console.print(summary_table(report))
     ideal = [an.mech.gears[c.gear].name for c in an.circuits if c.geometry is None and an.mech.gears[c.gear].reducer is None
-             and an.mech.gears[c.gear].screw is None]
+             and an.mech.gears[c.gear].screw is None and an.mech.gears[c.gear].worm is None]
     if ideal:
         console.print("Ideal pairs (no mesh geometry; mesh torque instead of tooth forces): " + ", ".join(ideal))
     for line in feature_notes(an) + sharing_notes(an) + [report.backend_line()]:

@@ -51,6 +51,8 @@ class Circuit:
     row_j: np.ndarray | None = None
     # a screw's (GearPair.screw) axis line: a point on it in the carrier frame (m); None otherwise
     axis_point: np.ndarray | None = None
+    # a worm pair's (GearPair.worm) geometry in the carrier frame (model.worms.WormGeometry)
+    worm: object = None
 
 
 @dataclass(frozen=True, eq=False)

@@ -68,6 +68,8 @@ def _spread(an, g) -> bool:
         sc = an.mech.gears[c.gear].screw
         if sc is not None:           # fixed in the carrier; lossy: its torque's factor per sample
             return sc.power_flow_lossy
+        if an.mech.gears[c.gear].worm is not None:    # solved per sample (its friction's sign)
+            return True
         return c.geometry is None
     return False
 

@@ -26,6 +26,9 @@ the motors acting on it.  :meth:`Columns.balance` assembles the columns of one l
   housing): as an ideal coupling, the moment on j times the power-flow factor c_r(sigma, a);
 * screw (:mod:`gearcli.model.screws`: j the screw, k the nut): the axial force along the axis
   u through a point on it and the torque h c_r u, on the nut, reversed on the screw;
+* worm pair (:mod:`gearcli.model.worms`: j the worm, k the wheel): the flank load's force at
+  the contact point, cos(a_n) e + sigma sin(a_n) n_c + sigma s_v mu h per unit N on the wheel,
+  reversed on the worm (s_v the sign of the worm's rate);
 * mesh (joint coupling q_B = ratio q_A, GearPair.joints): a unit generalised force of joint
   B and -ratio times one of joint A, each on the joint's child and reversed on its parent
   (a moment about the axis of a revolute joint, a force along that of a prismatic one);
@@ -88,6 +91,13 @@ class Columns:
             Rc, oc = kin.R[c.carrier], kin.o[c.carrier]
             if c.joints is not None:
                 continue  # joint coupling: see axial()
+            wm = an.mech.gears[c.gear].worm
+            if wm is not None:                   # a worm pair: the flank load's directions at P
+                geo = c.worm
+                self.world[ci] = dict(P=oc + mv(Rc, geo.P), e=mv(Rc, geo.e_hat), n=mv(Rc, geo.n_c),
+                                      hh=mv(Rc, geo.h_hat), worm=wm,
+                                      sv=np.sign(relative_rate(an, kin, ci)) if wm.mu else None)
+                continue
             sc = an.mech.gears[c.gear].screw
             if sc is not None:                   # the axis u = z_S through a point P on it
                 self.world[ci] = dict(u=mv(Rc, c.zj), P=oc + mv(Rc, c.axis_point), h=sc.h)
@@ -162,6 +172,12 @@ class Columns:
             return (self.axial(b, L) - c.ratio * self.axial(a, L))[:, :, None]
         wv = self.world[ci]
         o = self.kin.o[L]
+        if "worm" in wv:              # the force on the wheel per unit N, minus on the worm (model.worms)
+            wm, sg = wv["worm"], np.asarray(sigma, float).reshape(-1, 1)
+            d = np.cos(wm.pressure_angle) * wv["e"] + sg * (np.sin(wm.pressure_angle) * wv["n"])
+            if wv["sv"] is not None:
+                d = d + (sg * wv["sv"][:, None] * wm.mu) * wv["hh"]
+            return ((1.0 if L == c.k else -1.0) * _force_at(d, wv["P"], o))[:, :, None]
         if "h" in wv:                 # a screw: F u through P and the torque h c_r F u on the nut, minus on the screw
             cr = 1.0 if "screw" not in wv else screw_factor(
                 wv["screw"], np.broadcast_to(np.asarray(sigma, float), wv["a"].shape), wv["a"])[:, None]

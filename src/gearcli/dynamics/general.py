@@ -24,6 +24,8 @@ def is_geared(an, g: UnknownGroup) -> bool:
     if c.geometry is not None:
         return True
     gp = an.mech.gears[c.gear]
+    if gp.worm is not None:          # its separating force |N| sin(a_n): always signed
+        return True
     el = gp.reducer if gp.reducer is not None else gp.screw
     return el is not None and el.power_flow_lossy
 

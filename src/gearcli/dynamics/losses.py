@@ -37,6 +37,7 @@ import numpy as np
 
 from ..model.reducers import input_torque, no_load_torque, reducer_loss
 from ..model.screws import screw_loss
+from ..model.worms import worm_force
 from ..spatial import cross
 
 
@@ -95,6 +96,25 @@ def subtract_reducer_drag(an, kin, b: dict) -> None:
         for L, sign in ((c.j, 1.0), (c.carrier, -1.0)):
             if L in moving:
                 b[L] -= sign * w
+
+
+def fill_worms(an, qd_ind: np.ndarray, res) -> None:
+    """A solved ``res``'s worm-pair fields, in place (:mod:`gearcli.model.worms`), from the flank
+    loads N (``gear_t``) and the independent rates: ``gear_sep`` the wheel's tangential force
+    F . t_G, ``gear_axial[:, ci, 0]`` the force on the worm along its axis (-F . z_w), and
+    ``gear_loss`` (a lossy mechanism) mu |N| |v_s|, |v_s| = |w_W| d1 / (2 cos(gamma))."""
+    for ci, c in enumerate(an.circuits):
+        wm = an.mech.gears[c.gear].worm
+        if wm is None:
+            continue
+        rate = mesh_rate(an, qd_ind, ci)
+        F = worm_force(c.worm, wm, res.gear_t[:, ci], np.sign(rate))
+        res.gear_sep[:, ci] = F @ c.worm.t_g
+        res.gear_axial[:, ci, 0] = -(F @ c.worm.z_w)
+        res.gear_radial[:, ci, :] = 0.0
+        res.gear_axial[:, ci, 1] = 0.0
+        if res.gear_loss is not None:
+            res.gear_loss[:, ci] = wm.mu * np.abs(res.gear_t[:, ci]) * np.abs(rate) * wm.d1 / (2 * np.cos(wm.lead_angle))
 
 
 def fill_reducers(an, qd_ind: np.ndarray, res) -> None:

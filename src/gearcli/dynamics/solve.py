@@ -37,7 +37,7 @@ from .llvm.output_maps import gear_outputs
 from .llvm.program import MAX_SIGNED, build_program
 from .kinematics import forward
 from .bearing_friction import solve_with_bearing_friction, subtract_bearing_friction
-from .losses import (LOSS_FIELDS, fill_kernel_losses, fill_losses, fill_reducers, subtract_joint_friction,
+from .losses import (LOSS_FIELDS, fill_kernel_losses, fill_losses, fill_reducers, fill_worms, subtract_joint_friction,
                      subtract_reducer_drag)
 from .result_arrays import check_out, copy_into, result_arrays, work_arrays
 from .signs import SignError, sign_violation
@@ -194,6 +194,7 @@ class Solver:
                 return self._by_kernel(how, q, qd, qdd, values, jobs, chunk, verify, out)
             res = self._by_numpy(q, qd, qdd, method, chunk, verify, values)
         fill_reducers(self.an, qd, res)
+        fill_worms(self.an, qd, res)
         res.motor_speed = qd @ self.an.A
         if out is not None:
             copy_into(out, res)
@@ -208,6 +209,7 @@ class Solver:
         res = Result(**arrays) if out is None else out
         res.residual, res.backend, res.backend_note = None, how.path, how.note
         fill_kernel_losses(res, arrays, losses)      # (a reducer's input torque and loss: the kernel's)
+        fill_worms(self.an, qd, res)                  # a worm pair's outputs from N (numpy, both paths)
         if verify:
             x_all = _unknowns(self.an, res)
             worst = 0.0

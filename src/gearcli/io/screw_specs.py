@@ -46,3 +46,39 @@ def screw_spec(spec: dict, path: str, add) -> Screw | None:
         kw["rating"] = ScrewRating(float(r["C_a"]), float(r["C_0a"]),
                                    float(r["max_speed"]) if "max_speed" in r else None, path=f"{path}.rating")
     return Screw(lead, spec["hand"], **kw) if ok else None
+
+
+def worm_spec(spec: dict, path: str, add):
+    """The :class:`~gearcli.model.worms.Worm` of a schema-valid worm declaration; None with a
+    problem (negative or zero sizes, module and lead angle both or neither, mu < 0)."""
+    import math  # noqa: PLC0415
+
+    from ..model.worms import Worm  # noqa: PLC0415
+    z1, z2 = spec["teeth"]
+    d1 = float(spec["reference_diameter"])
+    ok = True
+    if not d1 > 0:
+        add(f"{path}.reference_diameter", f"the worm's reference diameter must be positive (m), got {d1:g}")
+        ok = False
+    if ("module" in spec) == ("lead_angle_deg" in spec):
+        add(path, "a worm pair needs its axial module or its lead_angle_deg (one of them)")
+        return None
+    if "module" in spec:
+        m = float(spec["module"])
+        if not m > 0:
+            add(f"{path}.module", f"the axial module must be positive (m), got {m:g}")
+            return None
+        gamma = math.atan(z1 * m / d1) if d1 > 0 else 0.0
+    else:
+        g = float(spec["lead_angle_deg"])
+        if not 0 < g <= 45:
+            add(f"{path}.lead_angle_deg", f"the lead angle must be in (0, 45] degrees, got {g:g}")
+            return None
+        gamma = math.radians(g)
+        m = d1 * math.tan(gamma) / z1
+    mu = float(spec.get("friction_coefficient", 0.0))
+    if not mu >= 0:
+        add(f"{path}.friction_coefficient", f"friction coefficient must be >= 0, got {mu:g}")
+        ok = False
+    alpha = math.radians(float(spec.get("pressure_angle_deg", 20.0)))
+    return Worm(int(z1), int(z2), d1, m, gamma, alpha, mu, spec["hand"], path) if ok else None

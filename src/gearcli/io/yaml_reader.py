@@ -26,7 +26,7 @@ from ..model.geometry import dh_transform, origin_axis_transform
 from ..model.reducers import REDUCER_KINDS
 from ..model.validate import check_inertia, gear_pair_problems, inertia_matrix, number_problem
 from .reducer_specs import reducer_spec
-from .screw_specs import screw_spec
+from .screw_specs import screw_spec, worm_spec
 from .schema_words import schema_messages
 from .yaml_safe import read_text, yaml_lines
 from .schemas import packaged_schema
@@ -299,6 +299,9 @@ def _gears(data: dict, col: Collector, links: _Names) -> list[GearPair]:
         if spec.get("kind") == "screw":
             gears.append(_screw(spec, col, links, names, path))
             continue
+        if spec.get("kind") == "worm":
+            gears.append(_worm(spec, col, links, names, path))
+            continue
         j, k = spec["links"]
         links.ref(j, f"{path}.links[0]")
         links.ref(k, f"{path}.links[1]")
@@ -352,6 +355,21 @@ def _screw(spec: dict, col: Collector, links: _Names, names: _Names, path: str) 
     names.declare(spec.get("name", f"{s}-{n}"), path)
     return GearPair(spec.get("name", f"{s}-{n}"), s, n, "screw", None, carrier=spec.get("carrier"), path=path,
                     screw=screw_spec(spec, path, col.add))
+
+
+def _worm(spec: dict, col: Collector, links: _Names, names: _Names, path: str) -> GearPair:
+    """A worm pair (links: [worm, wheel]) as a GearPair with j = worm, k = wheel, the ratio from
+    the geometry (:mod:`gearcli.model.worms`; the analysis derives it)."""
+    w, g = spec["links"]
+    links.ref(w, f"{path}.links[0]")
+    links.ref(g, f"{path}.links[1]")
+    if w == g:
+        col.add(f"{path}.links", "a worm pair needs two different links [worm, wheel]")
+    if "carrier" in spec:
+        links.ref(spec["carrier"], f"{path}.carrier")
+    names.declare(spec.get("name", f"{w}-{g}"), path)
+    return GearPair(spec.get("name", f"{w}-{g}"), w, g, "worm", None, teeth=tuple(spec["teeth"]),
+                    carrier=spec.get("carrier"), path=path, worm=worm_spec(spec, path, col.add))
 
 
 def _stiffness(spec: dict, col: Collector, path: str) -> float | None:

@@ -26,6 +26,7 @@ from .loads import Load, with_payloads
 from .ratings import BearingRating, GearRating, JointLimit, MotorModel, MotorRating
 from .reducers import Reducer
 from .screws import Screw
+from .worms import Worm
 
 
 @dataclass(frozen=True, eq=False)
@@ -115,6 +116,8 @@ class GearPair:
     # A ball or lead screw (kind screw, model.screws): j is the screw (revolute), k the nut
     # (prismatic) on the same line relative to the carrier, ratio e = theta_j / x_k (rad/m).
     screw: Screw | None = None
+    # A worm pair (kind worm, model.worms): j is the worm, k the wheel; ratio from the geometry.
+    worm: Worm | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -164,7 +167,7 @@ class Mechanism:
         """True when any gear pair has a loss factor, any reducer an efficiency below 1 or a
         no-load torque, or any joint has friction of its own or in its bearings."""
         return any(g.loss_factor or (g.reducer is not None and g.reducer.lossy) or (g.screw is not None and g.screw.lossy)
-                   for g in self.gears) or any(
+                   or (g.worm is not None and g.worm.lossy) for g in self.gears) or any(
             (j.friction is not None and j.friction.active) or any(b.friction_arm for b in j.bearings or ())
             for j in self.joints)
 

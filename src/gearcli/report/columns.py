@@ -17,7 +17,9 @@ Columns, in order (units SI):
   the torque the reducer exerts on its input about the input's joint axis, losses included)
   and, with a ``torsional_stiffness``, ``gear:<r>:windup`` (rad, the output's torsion angle
   under T, odd in T; reported, not fed back); per screw ``gear:<s>:force`` (N, the axial
-  force on the nut along the screw's axis z_S);
+  force on the nut along the screw's axis z_S); per worm pair ``gear:<w>:t`` (N, the wheel's
+  tangential force F . t_G, positive when the flank load drives the wheel positively about its
+  axis) and ``gear:<w>:axial`` (N, the force on the worm along its axis: its thrust);
 * per real joint ``joint:<joint>:fx, fy, fz, mx, my, mz`` (N, N*m): reaction wrench the
   parent exerts on the child, in the joint frame, about its origin; then
   ``joint:<joint>:radial`` = hypot(fx, fy), ``axial`` = |fz|, ``bending`` = hypot(mx, my);
@@ -62,6 +64,9 @@ def column_names(an) -> list[str]:
         if gp.screw is not None:
             cols.append(f"gear:{gp.name}:force")
             continue
+        if gp.worm is not None:
+            cols += [f"gear:{gp.name}:t", f"gear:{gp.name}:axial"]
+            continue
         if c.geometry is None:
             cols.append(f"gear:{gp.name}:torque")
             continue
@@ -83,7 +88,7 @@ def has_loss_column(an, c) -> bool:
     """True when circuit ``c`` has a ``gear:<pair>:loss`` column (a lossy mechanism's pairs with
     tooth geometry, its reducers and screws)."""
     gp = an.mech.gears[c.gear]
-    return c.geometry is not None or gp.reducer is not None or gp.screw is not None
+    return c.geometry is not None or gp.reducer is not None or gp.screw is not None or gp.worm is not None
 
 
 TRANSPOSE_ROWS = 512
@@ -115,6 +120,10 @@ def column_sources(an, t: np.ndarray, res: Result) -> dict:
             put(lambda ci=ci: res.gear_sep[:, ci])
             if red.torsional_stiffness is not None:
                 put(lambda ci=ci, e=circ.ratio, red=red: windup(red, -e * res.gear_t[:, ci]))
+            continue
+        if an.mech.gears[circ.gear].worm is not None:   # the wheel's tangential force, the worm's thrust
+            put(lambda ci=ci: res.gear_sep[:, ci])
+            put(lambda ci=ci: res.gear_axial[:, ci, 0])
             continue
         put(lambda ci=ci: res.gear_t[:, ci])       # (a screw: its axial force F on the nut)
         if circ.geometry is not None:

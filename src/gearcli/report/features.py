@@ -108,6 +108,35 @@ def _screw_line(d: dict) -> str:
     return text
 
 
+def worm_dicts(an: Analysis) -> list[dict]:
+    """Each worm pair (:mod:`gearcli.model.worms`): worm, wheel, teeth, lead angle and normal
+    pressure angle (deg), mu, hand, the ratio e and the efficiencies from the geometry."""
+    from ..model.worms import self_locking, worm_efficiencies  # noqa: PLC0415
+    out = []
+    for c in an.circuits:
+        gp = an.mech.gears[c.gear]
+        wm = gp.worm
+        if wm is None:
+            continue
+        f, b = worm_efficiencies(wm.lead_angle, wm.pressure_angle, wm.mu)
+        out.append({"pair": gp.name, "worm": gp.j, "wheel": gp.k, "teeth": [wm.z1, wm.z2],
+                    "lead_angle_deg": math.degrees(wm.lead_angle), "pressure_angle_deg": math.degrees(wm.pressure_angle),
+                    "friction_coefficient": wm.mu, "hand": wm.hand, "ratio": c.ratio, "efficiency": {"forward": f, "backward": b},
+                    "self_locking": self_locking(wm.lead_angle, wm.pressure_angle, wm.mu)})
+    return out
+
+
+def _worm_line(d: dict) -> str:
+    text = (f"worm pair '{d['pair']}': worm '{d['worm']}' ({d['teeth'][0]} start(s), {d['hand']} hand, lead angle "
+            f"{d['lead_angle_deg']:.4g} deg) drives wheel '{d['wheel']}' ({d['teeth'][1]} teeth), theta_worm = "
+            f"{d['ratio']:.6g} * theta_wheel; normal pressure angle {d['pressure_angle_deg']:.4g} deg, mu "
+            f"{d['friction_coefficient']:g}: efficiency forward {d['efficiency']['forward']:.4f}, backward "
+            f"{d['efficiency']['backward']:.4f}")
+    if d["self_locking"]:
+        text += " (self-locking: it holds a load without a brake; lowering needs the motor)"
+    return text
+
+
 def feature_notes(an: Analysis) -> list[str]:
     """Human-readable lines: ``load 'tip' on link '2' (frame base): force [..] N, moment [..]
     N*m at [..] m``, ``payload 'box' on link 'arm': ...``, ``helical pair ...``, ``rack pair
@@ -128,4 +157,5 @@ def feature_notes(an: Analysis) -> list[str]:
                          f"drives rack '{d['rack']}': x = {d['x_per_rad']:.6g} m/rad * theta")
     lines += [_reducer_line(d) for d in reducer_dicts(an)]
     lines += [_screw_line(d) for d in screw_dicts(an)]
+    lines += [_worm_line(d) for d in worm_dicts(an)]
     return lines + loss_notes(an)

@@ -57,6 +57,12 @@ def interp(e: Emitter, x, table):
     return e.b.select(e.b.fcmp_ordered(">=", x, ir.Constant(D, xs[-1])), ir.Constant(D, ys[-1]), y)
 
 
+def worm_signs(e: Emitter, s: Sample, worms) -> list:
+    """s_v of each lossy worm pair: the sign of its worm's rate relative to the carrier
+    (:class:`.loss_program.WormLosses`; exactly 0 at rest)."""
+    return [_sign(e, e.const(e.dot(floats(worms.rate_flt[k]), s.qdi))) for k in range(len(worms.circuits))]
+
+
 def reducer_terms(e: Emitter, s: Sample, red) -> list:
     """Per lossy power-flow element (:class:`.loss_program.ReducerLosses`): (s_w, A, B, its axis
     in world axes, w, T0(|a|), |a|) for the world-frame block columns

@@ -79,6 +79,8 @@ def _sample(e: Emitter, fn, prog, loads, n, before: list) -> list:
         rates, s.sv = friction_terms.mesh_rates(e, s, lp)
         if lp.reducers is not None:
             s.red = friction_terms.reducer_terms(e, s, lp.reducers)
+        if lp.worms is not None:
+            s.worm_sv = friction_terms.worm_signs(e, s, lp.worms)
         own = friction_terms.joint_friction(e, s, lp, rows)
     signs = e.row(a["signs"], n, max(w["signs"], 1))
     fresh = e.b.icmp_signed("==", e.b.srem(n, ir.Constant(I64, WARM)), ir.Constant(I64, 0))

@@ -47,6 +47,7 @@ class Sample:
     frames: dict = field(default_factory=dict)
     qdi: list = field(default_factory=list)    # (dof,) the independent joint rates (mesh rates: :mod:`.friction_terms`)
     red: list = field(default_factory=list)    # per lossy reducer (s_a, A, B, z_I world) (:func:`.friction_terms.reducer_terms`)
+    worm_sv: list = field(default_factory=list)   # per lossy worm pair, the sign of the worm's rate
 
 
 def floats(row) -> tuple:

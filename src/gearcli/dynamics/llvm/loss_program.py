@@ -70,6 +70,28 @@ class BlockLosses:
     # the block's signed power-flow elements (world frame): (position in its signed unknowns,
     # index in ReducerLosses, ((block row, coef), ...), ((later link, coef), ...))
     reducers: tuple = ()
+    # the block's lossy worm pairs (world frame): (position, index in WormLosses, ((block row,
+    # link, +1 wheel / -1 worm), ...), ((later link, sign), ...))
+    worms: tuple = ()
+
+
+@dataclass(frozen=True, eq=False)
+class WormLosses:
+    """The lossy worm pairs (:mod:`gearcli.model.worms`) for the kernel: per pair its
+    ``circuits``, ``rate_flt`` (W, dof) the worm's rate row (s_v = its sign), ``carriers``,
+    ``point`` (W, 3) the contact point P and ``h_hat`` (W, 3) the thread tangent in the
+    carrier's axes, ``mu``.  Their friction adds sigma s_v mu h_hat, a force at P, to the flank
+    load's column on the wheel (minus on the worm)."""
+
+    circuits: tuple
+    rate_flt: np.ndarray
+    carriers: tuple
+    point: np.ndarray
+    h_hat: np.ndarray
+    mu: tuple
+
+    def parts(self) -> list:
+        return [self.circuits, self.rate_flt.tobytes(), self.carriers, self.point.tobytes(), self.h_hat.tobytes(), self.mu]
 
 
 @dataclass(frozen=True, eq=False)
@@ -138,7 +160,8 @@ class LossProgram:
     bearing_flt: np.ndarray | None = None         # (K, 6) [z1, z2, locating 1, 2, arm 1, 2] (bearing_layout)
     bearing_single: tuple = field(default=())     # (K,) 1: the joint has one bearing
     bearing_blocks: dict = field(default_factory=dict)   # block -> BearingBlock
-    reducers: ReducerLosses | None = None                # the lossy reducers
+    reducers: ReducerLosses | None = None                # the lossy reducers and screws
+    worms: WormLosses | None = None                      # the lossy worm pairs
 
     @property
     def out_width(self) -> int:
@@ -158,9 +181,11 @@ class LossProgram:
             out += [b, bb.joints, bb.cols, b"" if bb.wF is None else bb.wF.tobytes()]
         if self.reducers is not None:
             out += self.reducers.parts()
+        if self.worms is not None:
+            out += self.worms.parts()
         for b in sorted(self.blocks):
             bl = self.blocks[b]
-            out += [b, bl.positions, bl.rates, bl.circuits, bl.later, bl.rows, bl.reducers]
+            out += [b, bl.positions, bl.rates, bl.circuits, bl.later, bl.rows, bl.reducers, bl.worms]
             out += [a.tobytes() for a in (bl.phi, bl.couple_F) + (bl.maps or ()) if a is not None]
             out += [v for key, L in bl.hot for v in (key, L.tobytes())]
         return out
@@ -206,15 +231,15 @@ def build_loss_program(an, plans) -> LossProgram | None:
     rate_int = np.array([[an.circuits[ci].j, an.circuits[ci].carrier] for ci in rate_meshes], np.int64).reshape(-1, 2)
     rate_flt = np.array(an.mesh_rate_rows[list(rate_meshes)], float).reshape(-1, an.dof)
     block_of = {L: i for i, p in enumerate(plans) for L in p.links}
-    red = _reducer_losses(an)
+    red, worms = _reducer_losses(an), _worm_losses(an)
     blocks = {}
     for bi, p in enumerate(plans):
         pos = [n for n, gi in enumerate(p.signed) if p.groups[gi].kind == "mesh" and p.groups[gi].index in couple]
-        reds = _block_reducers(an, p, bi, block_of, red)
-        if reds:
-            assert p.F is None, "a reducer's unknown is solved in world axes"
+        reds, wms = _block_reducers(an, p, bi, block_of, red), _block_worms(an, p, bi, block_of, worms)
+        if reds or wms:
+            assert p.F is None, "a reducer's, screw's or worm's lossy unknown is solved in world axes"
             if not pos:
-                blocks[bi] = BlockLosses((), (), (), None, None, (), (), reducers=reds)
+                blocks[bi] = BlockLosses((), (), (), None, None, (), (), reducers=reds, worms=wms)
                 continue
         if not pos:
             continue
@@ -225,7 +250,7 @@ def build_loss_program(an, plans) -> LossProgram | None:
         if p.F is None:
             rows = tuple(tuple((p.links.index(L), 1 if L == an.circuits[ci].j else -1)
                                for L in p.groups[p.signed[n]].links if L in p.links) for n, ci in zip(pos, circ))
-            blocks[bi] = BlockLosses(tuple(pos), rates, circ, None, None, later, rows, reducers=reds)
+            blocks[bi] = BlockLosses(tuple(pos), rates, circ, None, None, later, rows, reducers=reds, worms=wms)
         else:
             assert p.fric is not None and all(p.signed[n] in p.fric_C for n in pos)
             assert all(primary_side(an, p.groups[p.signed[n]]) == an.circuits[ci].j for n, ci in zip(pos, circ))
@@ -249,7 +274,37 @@ def build_loss_program(an, plans) -> LossProgram | None:
     bflt = np.ascontiguousarray(np.column_stack([z1, z2, loc, arm]).reshape(-1, 6), float)
     return LossProgram(rate_meshes, rate_int, rate_flt, couple, blocks, np.array(jrec, np.int64).reshape(-1, 5),
                        np.array(jflt, float).reshape(-1, 8), loss_flt, tuple(bj), bflt, tuple(int(v) for v in single),
-                       _bearing_blocks(an, plans, bj), red)
+                       _bearing_blocks(an, plans, bj), red, worms)
+
+
+def _worm_losses(an) -> WormLosses | None:
+    """The :class:`WormLosses` of ``an``'s worm pairs with friction, None without one."""
+    gears = an.mech.gears
+    circ = tuple(ci for ci, c in enumerate(an.circuits) if gears[c.gear].worm is not None and gears[c.gear].worm.lossy)
+    if not circ:
+        return None
+    cs = [an.circuits[ci] for ci in circ]
+    return WormLosses(circ, np.array(an.mesh_rate_rows[list(circ)], float).reshape(-1, an.dof),
+                      tuple(c.carrier for c in cs), np.array([c.worm.P for c in cs], float).reshape(-1, 3),
+                      np.array([c.worm.h_hat for c in cs], float).reshape(-1, 3),
+                      tuple(gears[c.gear].worm.mu for c in cs))
+
+
+def _block_worms(an, p, bi: int, block_of: dict, worms: WormLosses | None) -> tuple:
+    """:attr:`BlockLosses.worms` of block plan ``p`` (index ``bi``)."""
+    if worms is None:
+        return ()
+    out = []
+    for n, gi in enumerate(p.signed):
+        g = p.groups[gi]
+        if g.kind != "mesh" or g.index not in worms.circuits:
+            continue
+        c = an.circuits[g.index]
+        sides = [(L, s) for L, s in ((c.k, 1.0), (c.j, -1.0)) if L in an.tree.moving]
+        rows = tuple((p.links.index(L), L, s) for L, s in sides if L in p.links)
+        later = tuple((L, s) for L, s in sides if L not in p.links and L in block_of and block_of[L] > bi)
+        out.append((n, worms.circuits.index(g.index), rows, later))
+    return tuple(out)
 
 
 def _reducer_losses(an) -> ReducerLosses | None:

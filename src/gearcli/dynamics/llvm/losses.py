@@ -296,12 +296,28 @@ def world_columns(lp, bl, s: Sample):
             for row, sign in rows:
                 for h in range(3):
                     A[6 * row + 3 + h][tcols[n]] = e.add(A[6 * row + 3 + h][tcols[n]], e.mul(coef, e.mul(float(sign), fr[h])))
+        for n, k, rows, _ in bl.worms:               # friction sigma s_v mu h_hat, a force at P
+            f, P = _worm_friction(e, s, lp.worms, k, sig[n])
+            for row, L, sign in rows:
+                m = e.cx(e.vsub(P, s.o[L]), f)
+                for h in range(3):
+                    A[6 * row + h][tcols[n]] = e.add(A[6 * row + h][tcols[n]], e.mul(sign, f[h]))
+                    A[6 * row + 3 + h][tcols[n]] = e.add(A[6 * row + 3 + h][tcols[n]], e.mul(sign, m[h]))
         for n, k, rows, _ in bl.reducers:
             delta, z = _reducer_delta(e, s.red[k], sig[n])
             for row, coef in rows:
                 for h in range(3):
                     A[6 * row + 3 + h][tcols[n]] = e.add(A[6 * row + 3 + h][tcols[n]], e.mul(e.mul(float(coef), delta), z[h]))
     return add
+
+
+def _worm_friction(e: Emitter, s: Sample, worms, k: int, sigma):
+    """(f, P): a worm pair's friction force on the wheel per unit N, sigma s_v mu h_hat, and its
+    contact point, in world axes."""
+    c = int(worms.carriers[k])
+    coef = e.mul(e.mul(sigma, s.worm_sv[k]), float(worms.mu[k]))
+    f = e.scale(e.mv(s.R[c], floats(worms.h_hat[k])), coef)
+    return f, e.vadd(s.o[c], e.mv(s.R[c], floats(worms.point[k])))
 
 
 def _reducer_delta(e: Emitter, terms, sigma):
@@ -334,6 +350,12 @@ def propagate(e: Emitter, s: Sample, lp, bl, x: list, tcols: list, sig: list) ->
         for L, sign in bl.later[a]:
             s.rhs[L] = s.rhs[L][:3] + tuple(e.sub(s.rhs[L][3 + h], e.mul(float(sign), e.mul(amount, m[h])))
                                             for h in range(3))
+    for n, k, _, later in bl.worms:             # the worm's friction force on the later links
+        f, P = _worm_friction(e, s, lp.worms, k, sig[n])
+        f = e.scale(f, x[tcols[n]])
+        for L, sign in later:
+            w = f + e.cx(e.vsub(P, s.o[L]), f)
+            s.rhs[L] = tuple(e.sub(s.rhs[L][h], e.mul(sign, w[h])) for h in range(6))
     for n, k, _, later in bl.reducers:          # the power-flow change coef delta u z on its sides
         delta, z = _reducer_delta(e, s.red[k], sig[n])
         amount = e.mul(delta, x[tcols[n]])

@@ -93,6 +93,11 @@ def _mesh(an, ci, L, t_pos):
         b, a = c.joints
         return [_axial(an, b, L, 1.0) + _axial(an, a, L, -c.ratio)]
     zero = np.zeros(3)
+    wm = an.mech.gears[c.gear].worm
+    if wm is not None:             # the flank load on the wheel at P: cos(a_n) e + sigma sin(a_n) n_c (friction: .losses)
+        s, geo = (1.0 if L == c.k else -1.0), c.worm
+        return [[(0, c.carrier, -1, s * np.cos(wm.pressure_angle), geo.e_hat, geo.P),
+                 (0, c.carrier, t_pos, s * np.sin(wm.pressure_angle), geo.n_c, geo.P)]]
     sc = an.mech.gears[c.gear].screw
     if sc is not None:             # the axial force along z_S through the axis point, the torque h z_S
         s = 1.0 if L == c.k else -1.0

@@ -1,0 +1,165 @@
+"""Worm pairs (issue 36, ``kind: worm``): hand cases from the model statement
+(``../shared/drive-elements.md`` D, README "Worm pairs"), written here without the solver's code:
+the efficiencies' closed forms, self-locking and back-driving, the deliberate bug they catch,
+the energy balance of the bundled worm lift and located input errors."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gearcli import analyse, load_mechanism, parse_mechanism, solve
+from gearcli.report.columns import named_columns
+
+pytestmark = pytest.mark.physics
+MECHS = Path(__file__).resolve().parents[1] / "mechanisms"
+ALPHA, MU, D1, Z2 = math.radians(20.0), 0.1, 0.02, 40
+
+WORM = """
+name: worm
+gravity: [0, 0, 0]
+base: frame
+end_effector: drum
+links:
+  - {{name: frame}}
+  - {{name: worm, mass: 0.2, inertia: [2.0e-5, 1.0e-4, 1.0e-4]}}
+  - {{name: drum, mass: 1.0, inertia: [1.0e-3, 2.0e-3, 1.0e-3]}}
+joints:
+  - {{name: Jw, parent: frame, child: worm, origin: {{xyz: [0, 0, 0]}}, axis: [1, 0, 0]}}
+  - {{name: Jd, parent: frame, child: drum, origin: {{xyz: [0, 0, {a!r}]}}, axis: [0, 1, 0]}}
+gears:
+  - {{name: wp, kind: worm, links: [worm, drum], teeth: [1, {z2}], reference_diameter: {d1}, lead_angle_deg: {gamma},
+     pressure_angle_deg: 20, friction_coefficient: {mu}, hand: {hand}}}
+motors:
+  - {{name: m, link: worm}}
+loads:
+  - {{name: rope, link: drum, point: [0, 0, 0], frame: base, moment: [0, -10, 0]}}
+"""
+
+
+def worm(gamma_deg, mu=MU, hand="right"):
+    """A one-start worm of lead angle gamma against a 40-tooth wheel: the axial module
+    d1 tan(gamma) and the centre distance d1/2 + Z2 m_x / 2 that the geometry requires."""
+    m = D1 * math.tan(math.radians(gamma_deg))
+    return analyse(parse_mechanism(WORM.format(a=D1 / 2 + Z2 * m / 2, z2=Z2, d1=D1, gamma=gamma_deg, mu=mu, hand=hand)))
+
+
+def at_speed(an, w):
+    """The drum at constant rates w (rad/s about +y), one sample each."""
+    w = np.asarray(w, float)[:, None]
+    return named_columns(an, solve(an, np.zeros_like(w), w, np.zeros_like(w), verify=True))
+
+
+def closed_forms(gamma_deg, mu=MU):
+    g = math.radians(gamma_deg)
+    c = math.cos(ALPHA)
+    return (c - mu * math.tan(g)) / (c + mu / math.tan(g)), (c - mu / math.tan(g)) / (c + mu * math.tan(g))
+
+
+def test_self_locking_worm_at_5_degrees():
+    """gamma = 5 deg, alpha_n = 20 deg, mu = 0.1: tan(gamma) = 0.0875 <= mu / cos(alpha_n) = 0.106,
+    self-locking.  Lifting (the drum turning +y against the rope's -10 N*m): the motor's power is
+    the load's 10 W / eta_f, eta_f = (cos an - mu tan g) / (cos an + mu cot g).  Lowering: the
+    motor must still deliver power, the load's 10 W times -eta_b (eta_b < 0)."""
+    eta_f, eta_b = closed_forms(5.0)
+    assert eta_b < 0 and math.tan(math.radians(5)) <= MU / math.cos(ALPHA)
+    c = at_speed(worm(5.0), [0.0, 1.0, -1.0])
+    P = c["motor:m:power"]
+    assert P[0] == 0.0 and P[1] == pytest.approx(10.0 / eta_f, rel=1e-12)
+    assert P[2] > 0 and P[2] == pytest.approx(-10.0 * eta_b, rel=1e-12)
+    assert c["motor:m"][0] == pytest.approx(10.0 / Z2, rel=1e-12)          # holding: lossless
+    assert np.allclose(c["gear:wp:loss"], [0.0, 10.0 / eta_f - 10.0, 10.0 - 10.0 * eta_b], rtol=1e-12, atol=1e-15)
+
+
+def test_back_drivable_worm_at_25_degrees():
+    """gamma = 25 deg: the wheel back-drives the worm; lowering, the motor receives the load's
+    10 W times eta_b = (cos an - mu cot g) / (cos an + mu tan g) > 0."""
+    eta_f, eta_b = closed_forms(25.0)
+    assert eta_b > 0
+    c = at_speed(worm(25.0), [1.0, -1.0])
+    assert c["motor:m:power"][0] == pytest.approx(10.0 / eta_f, rel=1e-12)
+    assert c["motor:m:power"][1] == pytest.approx(-10.0 * eta_b, rel=1e-12)
+
+
+def test_wheel_tangential_force_and_worm_thrust():
+    """At rest the flank load's tangential part on the wheel is the drum's torque over the wheel's
+    pitch radius, 10 / r2; the worm's thrust along its axis equals it (t_G is along z_w)."""
+    an = worm(5.0)
+    r2 = Z2 * D1 * math.tan(math.radians(5.0)) / 2
+    c = at_speed(an, [0.0])
+    assert c["gear:wp:t"][0] == pytest.approx(10.0 / r2, rel=1e-12)
+    assert abs(c["gear:wp:axial"][0]) == pytest.approx(10.0 / r2, rel=1e-12)
+
+
+def test_left_hand_reverses_the_worm():
+    """A left-hand worm turns the other way for the same drum motion (the ratio's sign), with the
+    same efficiencies."""
+    right, left = worm(5.0), worm(5.0, hand="left")
+    assert left.circuits[0].ratio == -right.circuits[0].ratio
+    cr, cl = at_speed(right, [1.0]), at_speed(left, [1.0])
+    assert cl["motor:m"][0] == pytest.approx(-cr["motor:m"][0], rel=1e-12)
+    assert cl["motor:m:power"][0] == pytest.approx(cr["motor:m:power"][0], rel=1e-12)
+
+
+def test_the_hand_case_catches_friction_along_the_wrong_direction(monkeypatch):
+    """A deliberate bug, the friction along -h_hat instead of the sliding direction: friction then
+    feeds power in, and lifting takes less than the load's power."""
+    from gearcli.model import worms
+    good = worms.worm_geometry
+
+    def flipped(*args, **kw):
+        geo, problems = good(*args, **kw)
+        from dataclasses import replace
+        return (replace(geo, h_hat=-geo.h_hat) if geo is not None else None), problems
+    import gearcli.analysis.circuits as circuits
+    monkeypatch.setattr(circuits, "worm_geometry", flipped)
+    eta_f, _ = closed_forms(5.0)
+    c = at_speed(worm(5.0), [1.0])
+    assert c["motor:m:power"][0] != pytest.approx(10.0 / eta_f, rel=1e-3)
+
+
+def test_bundled_worm_lift_balances_power_and_lowers_under_power():
+    """mechanisms/worm_lift.yaml along its duty: the motor's power = dT/dt - P_gravity - P_loads +
+    mu |N| |v_s| (the loss from the model, the sliding speed from the link velocities at the
+    contact point) to 1e-9 per sample; lowering (drum rate < 0) the motor delivers power."""
+    from test_losses import energy_terms
+    from gearcli.dynamics.kinematics import forward
+    from gearcli.io.trajectory import read_trajectory
+    an = analyse(load_mechanism(MECHS / "worm_lift.yaml"))
+    tr = read_trajectory(MECHS / "worm_lift_traj.csv", an.independent_names)
+    res = solve(an, tr.q, tr.qd, tr.qdd)
+    cols = named_columns(an, res, tr.t)
+    dT, Pg, Pe = energy_terms(an, tr.q, tr.qd, tr.qdd)
+    c = an.circuits[0]
+    kin = forward(an.mech, an.tree, tr.q @ an.S.T, tr.qd @ an.S.T)
+    P = c.worm.P                                   # the carrier is the (fixed) frame: base axes
+    vw = np.cross(kin.w[c.j], P - kin.o[c.j][0])   # the worm's and the wheel's material points at P
+    vg = np.cross(kin.w[c.k], P - kin.o[c.k][0])
+    loss = an.mech.gears[0].worm.mu * np.abs(res.gear_t[:, 0]) * np.linalg.norm(vw - vg, axis=1)
+    P_motor = cols["motor:motor:power"]
+    scale = 1.0 + np.abs(P_motor) + np.abs(dT) + np.abs(Pg) + np.abs(Pe) + loss
+    assert np.max(np.abs(P_motor - (dT - Pg - Pe + loss)) / scale) < 1e-9
+    assert np.max(np.abs(cols["gear:stage:loss"] - loss) / scale) < 1e-11
+    lowering = (tr.qd[:, 0] < -0.5) & (np.abs(tr.qdd[:, 0]) < 1.0)
+    assert lowering.any() and np.all(P_motor[lowering] > 0)
+
+
+@pytest.mark.parametrize("old, new, place, message", [
+    ("axis: [0, 1, 0]", "axis: [0.1, 1, 0]", "gears[0].links", "not perpendicular"),
+    ("reference_diameter: 0.02", "reference_diameter: 0.021", "gears[0].reference_diameter", "disagree"),
+    ("friction_coefficient: 0.1", "friction_coefficient: -0.1", "gears[0].friction_coefficient", ">= 0"),
+    ("lead_angle_deg: 5.0", "lead_angle_deg: 50", "gears[0].lead_angle_deg", "(0, 45]"),
+    ("lead_angle_deg: 5.0", "module: 0.002, lead_angle_deg: 5.0", "gears[0]", "axial module or its lead_angle_deg"),
+])
+def test_worm_input_problems_are_located(run_cli, tmp_path, old, new, place, message):
+    """Each bad worm declaration: one located line naming the key, exit 2, no traceback."""
+    m = D1 * math.tan(math.radians(5.0))
+    text = WORM.format(a=D1 / 2 + Z2 * m / 2, z2=Z2, d1=D1, gamma=5.0, mu=MU, hand="right")
+    assert old in text
+    (tmp_path / "m.yaml").write_text(text.replace(old, new, 1))
+    r = run_cli("check", tmp_path / "m.yaml")
+    assert r.exit_code == 2 and "Traceback" not in r.stderr
+    line = next((ln for ln in r.stderr.splitlines() if place + ":" in ln or place + "." in ln), "")
+    assert message in line, r.stderr
