@@ -358,6 +358,8 @@ def verify(
                              progress=lambda: progress.update(advance=1))
     stdout_console().print(rich_table(outcome.rows))
     typer.echo("".join(f"Backend of {case}: {backend}\n" for case, backend in backends(outcome.rows).items()), nl=False)
+    for line in _worm_lines(manifest):
+        typer.echo(line)
     failed = [r for r in outcome.rows if not r.passed]
     for r in failed:
         typer.echo(f"FAILED {r.case}: {r.name}: worst {with_unit(r.value, r.unit)} against limit {with_unit(r.limit, r.unit)}")
@@ -366,6 +368,22 @@ def verify(
                (f"; load spectra of {counted(len(outcome.spectra) // 2, 'case')} in {spectra}" if spectra else ""))
     if failed:
         raise typer.Exit(EXIT_CHECK_FAILED)
+
+
+def _worm_lines(manifest) -> list[str]:
+    """One line per worm pair of each case: its efficiencies from the geometry and, when
+    self-locking, that it holds a load without a brake (README, Worm pairs)."""
+    from .batch.manifest import case_analysis  # noqa: PLC0415
+    from .report.features import worm_dicts  # noqa: PLC0415
+
+    out = []
+    for case in manifest.cases:
+        for d in worm_dicts(case_analysis(case.mechanism)):
+            eff = d["efficiency"]
+            out.append(f"Worm pair {d['pair']} of {case.name}: efficiency forward {eff['forward']:.4f}, backward "
+                       f"{eff['backward']:.4f}" + ("; self-locking: it holds a load without a brake, and lowering "
+                                                   "needs motor power" if d["self_locking"] else "; back-drivable"))
+    return out
 
 
 def _case_mechanism_warnings(manifest, strict: bool) -> None:

@@ -15,7 +15,7 @@ from ..model.validate import gear_pair_problems
 from .urdf_transmissions import KINDS as TRANSMISSION_KINDS
 from .urdf_transmissions import read_transmissions
 from .reducer_specs import reducer_spec
-from .screw_specs import screw_spec
+from .screw_specs import screw_spec, worm_spec
 from .urdf_xml import NS, floats, q
 from ..model.reducers import LIFE_BASES, REDUCER_KINDS
 
@@ -26,6 +26,8 @@ GEAR_ATTRS = ("name", "j", "k", "kind", "ratio", "teeth", "carrier", "mesh_point
 
 REDUCER_ATTRS = ("name", "kind", "input", "output", "housing", "ratio", "teeth", "efficiency_forward",
                  "efficiency_backward", "no_load_torque", "torsional_stiffness_torque", "torsional_stiffness_rate")
+WORM_ATTRS = ("name", "worm", "wheel", "carrier", "teeth", "reference_diameter", "module", "lead_angle", "lead_angle_deg",
+              "pressure_angle", "pressure_angle_deg", "friction_coefficient", "hand")
 SCREW_ATTRS = ("name", "screw", "nut", "carrier", "lead", "hand", "efficiency_forward", "efficiency_backward",
                "friction_coefficient", "diameter")
 RATING_KEYS = ("rated_torque", "rated_input_speed", "rated_life", "life_basis", "life_exponent", "average_torque_limit",
@@ -56,7 +58,7 @@ class Extension:
     ``leader`` and ``chain_leader``."""
 
     def read_extension(self) -> dict:
-        ext = {"mechanism": None, "gears": [], "motors": [], "loads": [], "payloads": [], "reducers": [], "screws": []}
+        ext = {"mechanism": None, "gears": [], "motors": [], "loads": [], "payloads": [], "reducers": [], "screws": [], "worms": []}
         for el in self.root:
             if not isinstance(el.tag, str) or etree.QName(el).namespace != NS:
                 continue
@@ -82,11 +84,13 @@ class Extension:
                 ext["reducers"].append(el)
             elif local == "screw":
                 ext["screws"].append(el)
+            elif local == "worm":
+                ext["worms"].append(el)
             elif local in ("motor_rating", "gear_rating", "motor_model"):
                 continue  # read by io.ratings_reader
             else:
                 self.add(f"gearcli:{local}", f"unknown gearcli element gearcli:{local} (expected gearcli:mechanism, "
-                         "gearcli:gear, gearcli:reducer, gearcli:screw, gearcli:motor, gearcli:load or gearcli:payload)", el)
+                         "gearcli:gear, gearcli:reducer, gearcli:screw, gearcli:worm, gearcli:motor, gearcli:load or gearcli:payload)", el)
         return ext
 
     def unknown_attrs(self, el, allowed, path: str) -> None:
@@ -290,6 +294,51 @@ class Extension:
                 continue
             sc = screw_spec(spec, path, lambda p, m, el=el: self.add(_attribute_path(p), m, el))
             out.append(GearPair(name, ends[0], ends[1], "screw", None, carrier=carrier, path=path, screw=sc))
+        return out
+
+    def extension_worms(self, ext) -> list[GearPair]:
+        """The gearcli:worm elements (README "Worm pairs"): attributes name, worm, wheel, carrier
+        (links), teeth "z1 Z2", reference_diameter (m), module (m) and/or lead_angle (rad; both as
+        gearcli export writes them: taken as given) or lead_angle_deg, pressure_angle (rad) or
+        pressure_angle_deg, friction_coefficient, hand."""
+        from ..model.worms import Worm  # noqa: PLC0415
+        out = []
+        for el in ext["worms"]:
+            name = el.get("name") or f"{el.get('worm')}-{el.get('wheel')}"
+            path = f"gearcli:worm '{name}'"
+            self.lines[path] = el.sourceline
+            self.unknown_attrs(el, WORM_ATTRS, path)
+            ends = [ref[0] for key in ("worm", "wheel")
+                    if (ref := self.link_ref(el.get(key), path, el) if el.get(key) else None) is not None]
+            for key in ("worm", "wheel", "teeth", "reference_diameter", "hand"):
+                if el.get(key) is None:
+                    self.add(path, f"gearcli:worm needs attribute {key}", el)
+            carrier = None
+            if el.get("carrier") is not None:
+                ref = self.link_ref(el.get("carrier"), path, el, "carrier link")
+                carrier = None if ref is None else ref[0]
+            nums = {k: self.vector(el, k, path, n=2 if k == "teeth" else 1) for k in
+                    ("teeth", "reference_diameter", "module", "lead_angle", "lead_angle_deg", "pressure_angle",
+                     "pressure_angle_deg", "friction_coefficient")}
+            if len(ends) < 2 or nums["teeth"] is None or nums["reference_diameter"] is None or el.get("hand") is None:
+                continue
+            if nums["module"] is not None and nums["lead_angle"] is not None:      # as exported: exact
+                t = nums["teeth"]
+                pa = nums["pressure_angle"]
+                wm = Worm(int(t[0]), int(t[1]), float(nums["reference_diameter"][0]), float(nums["module"][0]),
+                          float(nums["lead_angle"][0]),
+                          float(pa[0]) if pa is not None else math.radians(20.0),
+                          float(nums["friction_coefficient"][0]) if nums["friction_coefficient"] is not None else 0.0,
+                          el.get("hand"), path)
+            else:
+                spec = {"teeth": [int(v) for v in nums["teeth"]], "reference_diameter": float(nums["reference_diameter"][0]),
+                        "hand": el.get("hand")}
+                for k in ("module", "lead_angle_deg", "pressure_angle_deg", "friction_coefficient"):
+                    if nums[k] is not None:
+                        spec[k] = float(nums[k][0])
+                wm = worm_spec(spec, path, lambda p, m, el=el: self.add(p, m, el))
+            out.append(GearPair(name, ends[0], ends[1], "worm", None, teeth=(wm.z1, wm.z2) if wm else None,
+                                carrier=carrier, path=path, worm=wm))
         return out
 
     def _screw_dict(self, el, path: str) -> dict | None:

@@ -127,7 +127,8 @@ class _Reader(StructureChecks, Mimics, Extension, UrdfLoads):
         ext = self.read_extension()
         joints = self.movable_joints()
         self.col.raise_if_any()
-        gears = self.couplings() + self.extension_gears(ext) + self.extension_reducers(ext) + self.extension_screws(ext)
+        gears = (self.couplings() + self.extension_gears(ext) + self.extension_reducers(ext) + self.extension_screws(ext)
+                 + self.extension_worms(ext))
         bad_pairs = bool(self.col.issues)   # go on to list the transmissions' problems too, with
         if bad_pairs:                       # no joint following another and no direct drive made up
             self.leader = {}

@@ -267,6 +267,13 @@ def _add_extension(an: Analysis, root, corr: dict) -> None:
             circ = next(c for c in an.circuits if c.gear == gi)
             _add_screw(root, gp, tree.links[circ.carrier])
             continue
+        if gp.worm is not None:
+            wm, circ = gp.worm, next(c for c in an.circuits if c.gear == gi)
+            etree.SubElement(root, q("worm"), name=gp.name, worm=gp.j, wheel=gp.k, carrier=tree.links[circ.carrier],
+                             teeth=f"{wm.z1} {wm.z2}", reference_diameter=_num(wm.d1), module=_num(wm.module),
+                             lead_angle=_num(wm.lead_angle), pressure_angle=_num(wm.pressure_angle),
+                             friction_coefficient=_num(wm.mu), hand=wm.hand)
+            continue
         circ = next(c for c in an.circuits if c.gear == gi)
         carrier = tree.links[circ.carrier]
         g = etree.SubElement(root, q("gear"), name=gp.name, j=gp.j, k=gp.k, kind=gp.kind, carrier=carrier)

@@ -1,6 +1,6 @@
-"""Speed of mechanisms with strain-wave reducers (issue 35); prints figures, not a test.
+"""Speed of mechanisms with drive elements (issues 35, 36); prints figures, not a test.
 
-    python benchmarks/bench_reducers.py [--samples 20000] [--rounds 5]
+    python benchmarks/bench_drive_elements.py [--samples 20000] [--rounds 5]
 
 The generated kernel (backend llvm, one thread) on random states of
 
@@ -8,8 +8,11 @@ The generated kernel (backend llvm, one thread) on random states of
   power-flow sign, the no-load torque, a crossed-roller joint),
 * mechanisms/cobot_6axis.yaml (six lossy strain-wave reducers, 13 links),
 * their lossless twins (efficiencies 1, no no-load torque),
+* mechanisms/screw_lift.yaml (a lossy ball screw: a world-frame block with its power-flow sign)
+  and mechanisms/worm_lift.yaml (a self-locking worm pair: its friction force at the contact),
 * mechanisms/bendix_wrist.yaml, the reference point (issue 35's target: each reducer
-  mechanism at least 0.5x its samples/s in the same run),
+  mechanism at least 0.5x its samples/s in the same run; issue 36's the same for the worm
+  joint),
 
 rows interleaved round by round so that load drift hits all alike, medians of --rounds of the
 median of 3 calls, with the load average.  The kernels are compiled (or loaded from the disk
@@ -35,17 +38,21 @@ def lossless(mech):
         dataclasses.replace(g, reducer=g.reducer.lossless()) if g.reducer is not None else g for g in mech.gears))
 
 
+NAMES = ("bendix_wrist", "cobot_joint", "cobot_6axis", "screw_lift", "worm_lift")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--samples", type=int, default=20000)
     ap.add_argument("--rounds", type=int, default=5)
     args = ap.parse_args()
     mechs = {name: load_mechanism(ROOT / "mechanisms" / f"{name}.yaml")
-             for name in ("bendix_wrist", "cobot_joint", "cobot_6axis")}
+             for name in NAMES}
     rows = {"bendix_wrist": mechs["bendix_wrist"]}
     for name in ("cobot_joint", "cobot_6axis"):
         rows[name] = mechs[name]
         rows[f"{name} (lossless)"] = lossless(mechs[name])
+    rows["screw_lift"], rows["worm_lift"] = mechs["screw_lift"], mechs["worm_lift"]
     rng = np.random.default_rng(0)
     cases = {}
     for name, mech in rows.items():
