@@ -338,7 +338,7 @@ def test_verify_with_the_kernel(backend):
 # --- the comparison catches a wrong program ----------------------------------------------------
 BENDIX = "loaded:bendix_wrist.yaml"
 MUTATIONS = [(BENDIX, "poses", 10), (BENDIX, "bodies", None), (BENDIX, "ainv", 7), (BENDIX, "cmat", 3),
-             ("geared_arm.urdf", "term_values", 2), ("planetary_3p.yaml", "ainv", "t row")]
+             ("servo_joint.yaml", "term_values", 2), ("planetary_3p.yaml", "ainv", "t row")]
 
 
 def _t_row(prog) -> np.ndarray:

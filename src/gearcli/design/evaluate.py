@@ -17,7 +17,7 @@ from . import fatigue as F
 from . import iso281
 from . import sizing
 from .checks import Check
-from ..report.rms import running_rms, rms_of, square_integral
+from ..report.rms import running_rms, rms_of, square_integral, trapezoid_weights
 from .gears import hertz_contact_stress, lewis_bending_stress
 from ..model.reducers import reducer_life
 from ..model.screws import screw_life_hours
@@ -169,23 +169,13 @@ REDUCER_KINDS = ("reducer_average", "reducer_speed_average", "reducer_life", "sc
 def _reducer_sums(ch: Check, s: Samples, x: np.ndarray) -> tuple[float, float, float]:
     """A reducer check's sums over one trajectory (trapezoid weights dt_k): T_av and the life,
     (sum |a| |T|^p dt, sum |a| dt, span); n_av, (sum |a| dt, span, span)."""
-    dt = _trapezoid_weights(s.t)
+    dt = trapezoid_weights(s.t)
     a = np.abs(s.rates @ np.asarray(ch.extra["row"]))
     span = float(s.t[-1] - s.t[0]) if s.t.size else 0.0
     turned = float(np.sum(a * dt))
     if ch.kind == "reducer_speed_average":
         return turned, span, span
     return float(np.sum(a * x ** ch.exponent * dt)), turned, span
-
-
-def _trapezoid_weights(t: np.ndarray) -> np.ndarray:
-    """dt_k of the trapezoid rule on the samples t (N,): sum_k y_k dt_k = the integral of y."""
-    w = np.zeros_like(t)
-    if t.size > 1:
-        d = np.diff(t)
-        w[:-1] += d / 2
-        w[1:] += d / 2
-    return w
 
 
 def reducer_duty(check: Check, parts: list[tuple], rates) -> tuple[float, float]:

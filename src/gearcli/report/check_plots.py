@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from .plots import _pyplot, _save, check_output_path
+from .rms import trapezoid_weights
 
 
 def plot_life(traces: list[tuple], P_eq: float, P_req: float, out: str | Path, title: str) -> None:
@@ -78,7 +79,6 @@ def plot_reducer_life(traces: list[tuple], T_av: float, T_req: float, life: floa
 
     ``traces``: (name, t (N,), |T| (N,), |a| (N,)) per trajectory, s, N*m, rad/s.
     """
-    from ..design.evaluate import _trapezoid_weights  # noqa: PLC0415
     plt = _pyplot()
     fig, (ax, bx) = plt.subplots(2, 1, figsize=(7.5, 5.6), sharex=True)
     t0, num, den = 0.0, 0.0, 0.0
@@ -86,7 +86,7 @@ def plot_reducer_life(traces: list[tuple], T_av: float, T_req: float, life: floa
     for name, t, T, a in traces:
         tt = t - t[0] + t0
         ax.plot(tt, T, lw=1.0, label=f"|T|, {name}")
-        w = _trapezoid_weights(t)
+        w = trapezoid_weights(t)
         n_run, d_run = num + np.cumsum(a * T ** p * w), den + np.cumsum(a * w)
         elapsed = np.maximum(tt, 1e-300)
         with np.errstate(divide="ignore", invalid="ignore"):

@@ -253,6 +253,19 @@ def _term_props(bd: _Builder, an, terms, values, rec) -> None:
     rec["nterm"] = 0
 
 
+def _live_terms(bd: _Builder, trec, tflt):
+    """The term records the kernel reads (those of the blocks that still propagate or solve by
+    terms: a local-frame block whose propagation became records drops its own), the blocks'
+    ``term0`` renumbered."""
+    live = np.zeros(len(trec), bool)
+    for rec in bd.brec:
+        live[rec["term0"]:rec["term0"] + rec["nterm"]] = True
+    first = np.cumsum(live) - live
+    for rec in bd.brec:
+        rec["term0"] = int(first[rec["term0"]]) if rec["nterm"] else 0
+    return trec[live], tflt[live]
+
+
 def _sign_free(an, p) -> bool:
     """True when block plan ``p``'s matrix does not depend on the signs of its signed
     unknowns: each is a reducer's (:mod:`gearcli.model.reducers`) whose input and housing,
@@ -303,6 +316,7 @@ def build_program(an, plans) -> Program:
         _block(bd, an, bi, p, offsets, terms, lowrank)
         if p.F is None and len(p.links) == 1 and (not p.signed or _sign_free(an, p)):
             _local_frame(bd, an, trec, tflt, p)
+    trec, tflt = _live_terms(bd, trec, tflt)
     joints, poses = _joints(an)
     cat = (lambda xs: np.concatenate(xs) if xs else np.zeros(0))
     jout, mcol, gcol, gout = output_constants(an, offsets)
