@@ -111,3 +111,17 @@ np.savetxt("mechanisms/screw_lift_traj.csv", np.column_stack([ts, q, qd, qdd, at
 tw = np.linspace(0.0, 5.0, 5001)
 q, qd, qdd = quintic_moves(tw, [(0.0, 2.0, 0.0, 3 * np.pi), (2.5, 4.5, 3 * np.pi, 0.0)])
 write_trajectory("mechanisms/worm_lift_traj.csv", ["Jd"], tw, q[:, None], qd[:, None], qdd[:, None])
+
+# scara: J1, J2 (rad) and the quill Jz (m, + up): pick a part (quill down 80 mm and up, the part
+# attached from 0.3 s), swing to the place (1 s), place it (down and up, detached from 2.0 s),
+# swing back; 3.4 s at 1 kHz.  J1 and J2 to 3.75 rad/s (motor 1: 18.75 rad/s, the wave
+# generator 188 rad/s), the quill to 0.5 m/s (the screw: 157 rad/s).
+tsc = np.linspace(0.0, 3.4, 3401)
+j1 = quintic_moves(tsc, [(0.65, 1.65, -1.0, 1.0), (2.3, 3.3, 1.0, -1.0)])
+j2 = quintic_moves(tsc, [(0.65, 1.65, 1.2, -0.8), (2.3, 3.3, -0.8, 1.2)])
+jz = quintic_moves(tsc, [(0.0, 0.3, 0.0, -0.08), (0.35, 0.65, -0.08, 0.0), (1.65, 1.95, 0.0, -0.08),
+                         (2.0, 2.3, -0.08, 0.0)])
+attach = ((tsc >= 0.3) & (tsc < 2.0)).astype(float)
+cols = [tsc] + [np.asarray(x) for k in range(3) for x in (j1[k], j2[k], jz[k])] + [attach]
+np.savetxt("mechanisms/scara_traj.csv", np.column_stack(cols), delimiter=",",
+           header="t,q:J1,q:J2,q:Jz,qd:J1,qd:J2,qd:Jz,qdd:J1,qdd:J2,qdd:Jz,attach:part", comments="", fmt="%.17g")

@@ -119,7 +119,7 @@ def test_auto_backend_cases_are_all_there():
     """The mechanisms issue 18 names are in the list above (a renamed file fails here)."""
     assert {"servo_joint.yaml", "planetary_5p.yaml", "bendix_wrist.yaml", "geared_arm.urdf"} <= set(BUNDLED)
     assert LOSSY == ["cobot_6axis.yaml", "cobot_joint.yaml", "cobot_joint_csf14.yaml", "planetary_3p_rated.yaml",
-                     "rv_turret.yaml", "screw_lift.yaml", "servo_joint_rated.yaml", "turntable_dwell.yaml",
+                     "rv_turret.yaml", "scara.yaml", "screw_lift.yaml", "servo_joint_rated.yaml", "turntable_dwell.yaml",
                      "worm_lift.yaml"]
 
 

@@ -105,6 +105,9 @@ def own_losses(an, q, qd, res):
         if gp.screw is not None:
             parts.append(own_screw_loss(an, kin, ci, res))
             continue
+        if gp.belt is not None:
+            parts.append(own_belt_loss(an, kin, ci, res))
+            continue
         if gp.worm is not None:         # mu |N| |v_s|, the sliding speed from the links' velocities at P
             P = np.einsum("nij,j->ni", kin.R[c.carrier], c.worm.P) + kin.o[c.carrier]
             vel = forward(mech, tree, qa, np.zeros_like(qa), qda)
@@ -148,6 +151,27 @@ def own_reducer_loss(an, kin, ci, res):
     scale = 1.0 + np.abs(T)
     assert np.max(np.abs(cols[f"gear:{gp.name}:input_torque"] - tau_I * np.sum(zI * zO, axis=1)) / scale) < 1e-11
     return -(tau_I * a + T * b)
+
+
+def own_belt_loss(an, kin, ci, res):
+    """A belt's loss from the model statement (drive-elements.md C): the pulleys' rates relative
+    to the carrier about z from the link angular velocities, the torque of the spans' pull E on
+    each pulley (E/2 along e_A at its span-A point, -E/2 along e_B at its span-B point on j, the
+    opposites on k) about its centre; power flows j -> k where E's power on k is > 0: the loss is
+    (1 - eta_f) |E's torque on k| |omega_k|, else (1 - eta_b) |E's torque on j| |omega_j|."""
+    c, gp = an.circuits[ci], an.mech.gears[an.circuits[ci].gear]
+    bt, g = gp.belt, c.belt
+    z = np.einsum("nij,j->ni", kin.R[c.carrier], c.zj)
+    wj = np.sum((kin.w[c.j] - kin.w[c.carrier]) * z, axis=1)
+    wk = np.sum((kin.w[c.k] - kin.w[c.carrier]) * z, axis=1)
+    E = named_columns(an, res)[f"gear:{gp.name}:effective_pull"]
+    tj = (np.cross(g.X[0, 0] - g.C_j, 0.5 * g.e[0]) + np.cross(g.X[1, 0] - g.C_j, -0.5 * g.e[1])) @ g.z
+    tk = (np.cross(g.X[0, 1] - g.C_k, -0.5 * g.e[0]) + np.cross(g.X[1, 1] - g.C_k, 0.5 * g.e[1])) @ g.z
+    speed = np.abs(wj)
+    eta_f = np.interp(speed, bt.forward.speeds, bt.forward.values)
+    eta_b = np.interp(speed, bt.backward.speeds, bt.backward.values)
+    on_k = E * tk * wk
+    return np.where(on_k > 0, (1 - eta_f) * np.abs(E * tk * wk), np.where(on_k < 0, (1 - eta_b) * np.abs(E * tj * wj), 0.0))
 
 
 def own_screw_loss(an, kin, ci, res):
@@ -212,7 +236,8 @@ def test_lossless_mechanism_outputs_unchanged_and_without_loss_columns(name):
                 r.lossless(), no_load_torque=SpeedTable.constant(0.0))
         return dataclasses.replace(m, gears=tuple(dataclasses.replace(g, loss_factor=0.0, reducer=red(g.reducer),
                                                                       screw=g.screw and g.screw.lossless(),
-                                                                      worm=g.worm and g.worm.lossless())
+                                                                      worm=g.worm and g.worm.lossless(),
+                                                                      belt=g.belt and g.belt.lossless())
                                                   for g in m.gears),
                                    joints=tuple(dataclasses.replace(j, friction=fr, bearings=None if not j.bearings else
                                                 tuple(dataclasses.replace(b, friction_coefficient=mu) for b in j.bearings))

@@ -122,10 +122,10 @@ def check(mech: Path = typer.Argument(..., metavar="MECH", help=MECH_HELP, show_
     an = load_analysis(mech, strict)
     _check_ratings(an)
     m = an.mech
-    reducers = sum(1 for c in an.circuits if m.gears[c.gear].reducer is not None)
-    screws = sum(1 for c in an.circuits if m.gears[c.gear].screw is not None)
-    pairs = counted(len(an.circuits) - reducers - screws, 'gear pair') + (
-        f", {counted(reducers, 'reducer')}" if reducers else "") + (f", {counted(screws, 'screw')}" if screws else "")
+    kinds = {"reducer": "reducer", "screw": "screw", "belt": "belt"}
+    count = {k: sum(1 for c in an.circuits if getattr(m.gears[c.gear], k) is not None) for k in kinds}
+    pairs = counted(len(an.circuits) - sum(count.values()), 'gear pair') + "".join(
+        f", {counted(n, kinds[k])}" for k, n in count.items() if n)
     typer.echo(f"{mech}: OK ({an.dof} dof, {counted(len(m.links), 'link')}, {pairs}, {counted(len(m.motors), 'motor')})")
     for line in feature_notes(an) + sharing_notes(an):
         typer.echo(line)
@@ -245,7 +245,8 @@ def _print_summary(console, report, verify: bool) -> None:
     an = report.analysis
     console.print(summary_table(report))
     ideal = [an.mech.gears[c.gear].name for c in an.circuits if c.geometry is None and an.mech.gears[c.gear].reducer is None
-             and an.mech.gears[c.gear].screw is None and an.mech.gears[c.gear].worm is None]
+             and an.mech.gears[c.gear].screw is None and an.mech.gears[c.gear].worm is None
+             and an.mech.gears[c.gear].belt is None]
     if ideal:
         console.print("Ideal pairs (no mesh geometry; mesh torque instead of tooth forces): " + ", ".join(ideal))
     for line in feature_notes(an) + sharing_notes(an) + [report.backend_line()]:

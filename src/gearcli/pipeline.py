@@ -22,6 +22,7 @@ from .dynamics.backends import BACKENDS, Choice
 from .dynamics.solve import solve, solver_for
 from .analysis.graph import Analysis
 from .dynamics.bearing_friction import BearingFrictionError
+from .dynamics.losses import SlackError, check_belts
 from .dynamics.determinacy import analyse, load_analysed
 from .dynamics.signs import SignError
 from . import __version__
@@ -140,6 +141,7 @@ def solve_file(mech_path, traj_path, out_path=None, *, degrees: bool = False, me
                         res = solve(an, sub.q, sub.qd, sub.qdd, method=method, chunk=chunk, verify=verify,
                                     loads=sub.loads, backend=how.path, jobs=jobs, check_finite=False,  # read checked
                                     attach=sub.attach)
+                        check_belts(an, res)
                         tabs.append(table(an, sub.t, res))
                         if losses is not None:
                             losses.add(an, sub.t, res, lossless_motor(twin, sub, method, chunk, backend, jobs))
@@ -329,7 +331,7 @@ def at_samples(file: str, part):
     a chunk alone would name a row counted from the chunk's start."""
     try:
         yield
-    except (SignError, BearingFrictionError) as exc:
+    except (SignError, BearingFrictionError, SlackError) as exc:
         i, text = exc.sample, exc.lines()[0]
         text = text.removeprefix(f"sample {i}: ")
         line = None if part.line is None else int(part.line[i])

@@ -6,6 +6,7 @@ import numpy as np
 from ..errors import Collector
 from ..model.gears import GearGeometry, gear_geometry
 from ..model.worms import worm_geometry
+from ..model.belts import belt_geometry
 from ..model.mechanism import Mechanism
 from .context import Home
 from .tree import Tree
@@ -54,6 +55,8 @@ def gear_circuit(h: Home, groups, canon, gi: int, gp, j: int, k: int, col: Colle
         return screw_circuit(h, groups, canon, gi, gp, j, k, col)
     if gp.worm is not None:
         return worm_circuit(h, groups, canon, gi, gp, j, k, col)
+    if gp.belt is not None:
+        return belt_circuit(h, groups, canon, gi, gp, j, k, col)
     found = gear_carrier(h, groups, gp, j, k, col)
     if found is None:
         return None
@@ -151,6 +154,29 @@ def worm_circuit(h: Home, groups, canon, gi: int, gp, j: int, k: int, col: Colle
         return None
     return Circuit(gi, j, k, c, geo.ratio, row_j - geo.ratio * row_k, Rc.T @ zj_w, Rc.T @ zk_w, None,
                    row_j=np.rint(row_j), worm=geo)
+
+
+def belt_circuit(h: Home, groups, canon, gi: int, gp, j: int, k: int, col: Collector) -> Circuit | None:
+    """Circuit of a timing belt (:mod:`gearcli.model.belts`): pulleys j and k turning about
+    parallel axes fixed in the carrier; theta_{j,c} = e theta_{k,c}, e = (r_k / r_j)(z_k . z_j)."""
+    found = gear_carrier(h, groups, gp, j, k, col)
+    if found is None:
+        return None
+    c, gj, gk = found
+    if not joint_types_fit(h, gp, c, gj, gk, col):
+        return None
+    row_j, zj_w = relative_rotation(h, canon, j, c, gj)
+    row_k, zk_w = relative_rotation(h, canon, k, c, gk)
+    Rc, oc = h.kin.R[c], h.kin.o[c]
+    pj = h.ow[h.jin[j]] if j != gj.carrier else h.ow[h.jin[c]]
+    pk = h.ow[h.jin[k]] if k != gk.carrier else h.ow[h.jin[c]]
+    geo, problems = belt_geometry(gp.belt, Rc.T @ (pj - oc), Rc.T @ zj_w, Rc.T @ (pk - oc), Rc.T @ zk_w, (gp.j, gp.k))
+    for fld, msg in problems:
+        col.add(f"{gp.path}.{fld}", msg)
+    if geo is None:
+        return None
+    return Circuit(gi, j, k, c, geo.ratio, row_j - geo.ratio * row_k, Rc.T @ zj_w, Rc.T @ zk_w, None,
+                   row_j=np.rint(row_j), belt=geo)
 
 
 def joint_types_fit(h: Home, gp, c: int, gj: CoaxialGroup, gk: CoaxialGroup, col: Collector) -> bool:

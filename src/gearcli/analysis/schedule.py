@@ -35,6 +35,17 @@ class UnknownGroup:
     links: tuple[int, ...]
 
 
+def _loads_carrier(gp) -> bool:
+    """True when a pair's unknown puts a wrench on its carrier: an ideal coupling's or a
+    reducer's reaction torque, a lossy belt's loss couple; a screw's or a worm pair's forces,
+    and a lossless belt's, act on its two members only."""
+    if gp.screw is not None or gp.worm is not None:
+        return False
+    if gp.belt is not None:
+        return gp.belt.lossy
+    return True
+
+
 def unknown_groups(an) -> list[UnknownGroup]:
     """The unknowns of the load equations, grouped: 5 per revolute joint reaction (3 forces,
     2 moments), 1 per gear mesh (the tangential force t), 1 per motor; each with the moving
@@ -49,7 +60,7 @@ def unknown_groups(an) -> list[UnknownGroup]:
         if c.joints is not None:  # joint coupling: both joints' children and parents
             links = _joint_links(mech, tree, c.joints)
         else:
-            links = (c.j, c.k) if c.geometry is not None else (c.j, c.k, c.carrier)
+            links = (c.j, c.k) if c.geometry is not None or not _loads_carrier(mech.gears[c.gear]) else (c.j, c.k, c.carrier)
         out.append(UnknownGroup("mesh", ci, 1, tuple(x for x in links if x != b)))
     for mi, (x, s) in enumerate(zip(an.motor_links, an.motor_stators)):
         mj = an.motor_joints[mi] if an.motor_joints else None

@@ -53,6 +53,8 @@ class Circuit:
     axis_point: np.ndarray | None = None
     # a worm pair's (GearPair.worm) geometry in the carrier frame (model.worms.WormGeometry)
     worm: object = None
+    # a belt's (GearPair.belt) geometry in the carrier frame (model.belts.BeltGeometry)
+    belt: object = None
 
 
 @dataclass(frozen=True, eq=False)

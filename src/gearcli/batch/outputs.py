@@ -73,7 +73,8 @@ INFINITE_NOTES = {"fatigue": "no damage (below the endurance limit)",
                   "life": "no revolutions (the bearing does not turn)",
                   "safety": "no load (a safety factor over a zero load)",
                   "reducer_life": "no load or no turning (the reducer's input does not turn, or carries no torque)",
-                  "screw_life": "no load or no turning (the screw does not turn, or carries no axial load)"}
+                  "screw_life": "no load or no turning (the screw does not turn, or carries no axial load)",
+                  "slack": "no effective pull (both spans at the pretension)"}
 """What an infinite value of a check kind means: the reports print it in place of "inf"."""
 
 

@@ -21,6 +21,7 @@ from ..design.sizing import inertia_columns
 from ..dynamics.solve import solve
 from ..errors import Collector, GearcliError
 from ..io.trajectory import count_rows, forget_rows, read_trajectory
+from ..dynamics.losses import check_belts
 from ..pipeline import at_samples
 from ..report.columns import LazyColumns
 from .heap import keep_freed_memory
@@ -61,6 +62,7 @@ def solve_samples(an, traj_path, degrees: bool, threads: int | None = None, back
     with at_samples(traj_path, tr):
         res = solve(an, tr.q, tr.qd, tr.qdd, loads=tr.loads, jobs=threads, check_finite=False,   # read checked them
                     attach=tr.attach, backend=backend)
+        check_belts(an, res)
     cols = LazyColumns(an, res, tr.t)
     cols.update(inertia_columns(an, tr.q, tr.attach))     # servo sizing: inertia at the rated motors
     return Samples(tr.t, cols, tr.qd @ an.S.T, backend_text(res))
@@ -75,6 +77,7 @@ def _streamed(an, traj_path, tr, threads, backend, checks) -> Samples:
         with at_samples(traj_path, part):
             res = solve(an, part.q, part.qd, part.qdd, loads=part.loads, jobs=threads, check_finite=False,
                         attach=part.attach, backend=backend)
+            check_belts(an, res)
         cols = LazyColumns(an, res, part.t)
         cols.update(inertia_columns(an, part.q, part.attach))
         if kept is None:

@@ -23,7 +23,8 @@ LIMIT_LABELS = {"peak": "limit", "rms": "RMS limit", "safety": "allowable / requ
                 "reducer_average": "average torque limit (T_av, speed-weighted)",
                 "reducer_speed_average": "average input speed limit (n_av)",
                 "reducer_life": "T_av giving the required life",
-                "screw_life": "F_m (cubic mean, speed-weighted) giving the required life"}
+                "screw_life": "F_m (cubic mean, speed-weighted) giving the required life",
+                "slack": "|E| at the least slack ratio: T_i / (ratio + 1/2)"}
 
 
 @dataclass

@@ -16,6 +16,7 @@ and how the samples of a duty cycle are reduced to the value compared with the l
 * ``reducer_average``, ``reducer_speed_average``, ``reducer_life``: a reducer's
   speed-weighted average torque T_av, average input speed n_av (<= limit) and catalogue life
   (>= limit) over the duty cycle (:mod:`gearcli.model.reducers`);
+* ``slack``: a belt's least slack-span tension over |E|, ``rating`` (T_i) / max |E| - 1/2 >= limit;
 * ``screw_life``: a screw's ISO 3408-5 life from its speed-weighted cubic-mean axial load
   (>= limit, :mod:`gearcli.model.screws`).
 
@@ -77,8 +78,27 @@ class Check:
 def build_checks(an, req: Requirements, col: Collector) -> list[Check]:
     """Every check of the analysed mechanism ``an`` under ``req``; problems go to ``col``."""
     checks = _motor_checks(an) + sizing_checks(an, Check) + _bearing_checks(an, req, col) + _gear_checks(an, req, col)
-    checks += _reducer_checks(an, req) + _screw_checks(an, req) + _joint_limit_checks(an) + _column_checks(an, req, col)
+    checks += _reducer_checks(an, req) + _screw_checks(an, req) + _belt_checks(an)
+    checks += _joint_limit_checks(an) + _column_checks(an, req, col)
     return checks
+
+
+def _belt_checks(an) -> list[Check]:
+    """A rated belt's checks (:class:`~gearcli.model.belts.BeltRating`): max |E| <=
+    ``max_effective_pull``; the least slack-span tension over |E|, T_i / max|E| - 1/2, >=
+    ``min_slack_ratio``."""
+    out = []
+    for c in an.circuits:
+        gp = an.mech.gears[c.gear]
+        r = gp.belt.rating if gp.belt is not None else None
+        if r is None:
+            continue
+        comp, E = f"belt {gp.name}", ("abs", f"gear:{gp.name}:effective_pull")
+        if r.max_effective_pull is not None:
+            out.append(Check(comp, "effective pull", "N", r.max_effective_pull, "peak", E, "N"))
+        if r.min_slack_ratio is not None:
+            out.append(Check(comp, "slack ratio", "", r.min_slack_ratio, "slack", E, "N", rating=gp.belt.pretension))
+    return out
 
 
 def _screw_checks(an, req: Requirements) -> list[Check]:

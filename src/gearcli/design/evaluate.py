@@ -283,6 +283,9 @@ def combine(check: Check, parts: list[tuple], rates) -> Verdict:
     elif check.kind == "safety":
         value = B.static_safety(check.rating, peak)
         sig_lim = check.rating / check.limit
+    elif check.kind == "slack":                    # T_i / max|E| - 1/2 >= limit: |E| <= T_i / (limit + 1/2)
+        value = check.rating / peak - 0.5 if peak > 0 else math.inf
+        sig_lim = check.rating / (check.limit + 0.5)
     elif check.kind in REDUCER_KINDS:
         value, sig_lim = _reducer_value(check, parts, rates)
     elif check.kind == "fatigue":

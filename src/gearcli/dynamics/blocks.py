@@ -68,8 +68,8 @@ def _spread(an, g) -> bool:
         sc = an.mech.gears[c.gear].screw
         if sc is not None:           # fixed in the carrier; lossy: its torque's factor per sample
             return sc.power_flow_lossy
-        if an.mech.gears[c.gear].worm is not None:    # solved per sample (its friction's sign)
-            return True
+        if an.mech.gears[c.gear].worm is not None or an.mech.gears[c.gear].belt is not None:
+            return True               # per sample (a worm's friction; a belt's forces at four points)
         return c.geometry is None
     return False
 

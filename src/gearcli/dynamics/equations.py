@@ -26,6 +26,9 @@ the motors acting on it.  :meth:`Columns.balance` assembles the columns of one l
   housing): as an ideal coupling, the moment on j times the power-flow factor c_r(sigma, a);
 * screw (:mod:`gearcli.model.screws`: j the screw, k the nut): the axial force along the axis
   u through a point on it and the torque h c_r u, on the nut, reversed on the screw;
+* belt (:mod:`gearcli.model.belts`: j the input pulley, k the other): the spans' forces per
+  unit of the effective pull E at their tangent points, a lossy belt's loss couple on the
+  driven pulley (the carrier taking the reaction);
 * worm pair (:mod:`gearcli.model.worms`: j the worm, k the wheel): the flank load's force at
   the contact point, cos(a_n) e + sigma sin(a_n) n_c + sigma s_v mu h per unit N on the wheel,
   reversed on the worm (s_v the sign of the worm's rate);
@@ -41,6 +44,7 @@ import numpy as np
 from ..model.gears import helical_terms
 from ..model.reducers import power_flow_factor
 from ..model.screws import screw_factor
+from ..model.belts import belt_arms, loss_couples
 from ..spatial import cross, mv
 from .kinematics import Kinematics
 from .losses import mesh_friction_moment, relative_rate
@@ -91,6 +95,14 @@ class Columns:
             Rc, oc = kin.R[c.carrier], kin.o[c.carrier]
             if c.joints is not None:
                 continue  # joint coupling: see axial()
+            bt = an.mech.gears[c.gear].belt
+            if bt is not None:                   # a belt: the spans' tangent points and directions
+                geo = c.belt
+                self.world[ci] = dict(belt=bt, X=[[oc + mv(Rc, geo.X[s, p]) for p in (0, 1)] for s in (0, 1)],
+                                      es=[mv(Rc, geo.e[s]) for s in (0, 1)], z=mv(Rc, geo.z))
+                if bt.lossy:
+                    self.world[ci].update(rate=relative_rate(an, kin, ci), **belt_arms(geo))
+                continue
             wm = an.mech.gears[c.gear].worm
             if wm is not None:                   # a worm pair: the flank load's directions at P
                 geo = c.worm
@@ -172,18 +184,20 @@ class Columns:
             return (self.axial(b, L) - c.ratio * self.axial(a, L))[:, :, None]
         wv = self.world[ci]
         o = self.kin.o[L]
+        if "belt" in wv:              # +E/2 on span A, -E/2 on span B: on j along e_S, on k against
+            return self._belt(ci, wv, L, sigma)[:, :, None]
         if "worm" in wv:              # the force on the wheel per unit N, minus on the worm (model.worms)
             wm, sg = wv["worm"], np.asarray(sigma, float).reshape(-1, 1)
             d = np.cos(wm.pressure_angle) * wv["e"] + sg * (np.sin(wm.pressure_angle) * wv["n"])
             if wv["sv"] is not None:
                 d = d + (sg * wv["sv"][:, None] * wm.mu) * wv["hh"]
-            return ((1.0 if L == c.k else -1.0) * _force_at(d, wv["P"], o))[:, :, None]
+            return ((float(L == c.k) - float(L == c.j)) * _force_at(d, wv["P"], o))[:, :, None]
         if "h" in wv:                 # a screw: F u through P and the torque h c_r F u on the nut, minus on the screw
             cr = 1.0 if "screw" not in wv else screw_factor(
                 wv["screw"], np.broadcast_to(np.asarray(sigma, float), wv["a"].shape), wv["a"])[:, None]
             col = _force_at(wv["u"], wv["P"], o)
             col[:, 3:] += (wv["h"] * cr) * wv["u"]
-            return ((1.0 if L == c.k else -1.0) * col)[:, :, None]
+            return ((float(L == c.k) - float(L == c.j)) * col)[:, :, None]
         if c.geometry is not None:
             sign = 1.0 if L == c.j else -1.0
             d = tooth_force_direction(wv["ut"], wv["us"], sigma, self.tan_phi[ci], wv["ax"])
@@ -203,6 +217,27 @@ class Columns:
         if L == c.carrier:
             col = col - cr * _moment(wv["zj"]) + c.ratio * _moment(wv["zk"])
         return col[:, :, None]
+
+    def _belt(self, ci: int, wv: dict, L: int, sigma) -> np.ndarray:
+        """(N, 6) column of a belt's effective pull E on link L (:mod:`gearcli.model.belts`): on
+        pulley j +1/2 e_A at X_jA and -1/2 e_B at X_jB, on k the opposites at X_kA, X_kB; a
+        lossy belt adds its loss couple on the driven pulley, the carrier taking the reaction
+        (:func:`gearcli.model.belts.loss_couples`)."""
+        c, o = self.an.circuits[ci], self.kin.o[L]
+        col = np.zeros((self.kin.n, 6))
+        for side, link in ((0, c.j), (1, c.k)):
+            if L == link:
+                sign = 1.0 if side == 0 else -1.0
+                col += sign * (0.5 * _force_at(wv["es"][0], wv["X"][0][side], o) - 0.5 * _force_at(wv["es"][1], wv["X"][1][side], o))
+        if "rate" in wv:
+            on_j, on_k = loss_couples(wv["belt"], wv["tj"], wv["tk"], wv["rk"], wv["rate"],
+                                      np.broadcast_to(np.asarray(sigma, float), wv["rate"].shape))
+            for link, cp in ((c.j, on_j), (c.k, on_k)):
+                if L == link:
+                    col[:, 3:] += cp[:, None] * wv["z"]
+                if L == c.carrier:
+                    col[:, 3:] -= cp[:, None] * wv["z"]
+        return col
 
     def group(self, g, L: int, sigma=1.0) -> np.ndarray:
         """(N, 6, g.size) columns of unknown group ``g`` on link L (sigma: sign of t)."""

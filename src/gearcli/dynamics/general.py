@@ -26,6 +26,8 @@ def is_geared(an, g: UnknownGroup) -> bool:
     gp = an.mech.gears[c.gear]
     if gp.worm is not None:          # its separating force |N| sin(a_n): always signed
         return True
+    if gp.belt is not None:          # a lossy belt's loss couple follows sign(E)
+        return gp.belt.lossy
     el = gp.reducer if gp.reducer is not None else gp.screw
     return el is not None and el.power_flow_lossy
 

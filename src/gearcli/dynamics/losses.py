@@ -38,6 +38,8 @@ import numpy as np
 from ..model.reducers import input_torque, no_load_torque, reducer_loss
 from ..model.screws import screw_loss
 from ..model.worms import worm_force
+from ..model.belts import belt_arms, belt_loss, slack_problem
+from ..errors import GearcliError
 from ..spatial import cross
 
 
@@ -96,6 +98,62 @@ def subtract_reducer_drag(an, kin, b: dict) -> None:
         for L, sign in ((c.j, 1.0), (c.carrier, -1.0)):
             if L in moving:
                 b[L] -= sign * w
+
+
+def subtract_belt_pretension(an, kin, b: dict) -> None:
+    """b_L -= the belts' pretension forces (:mod:`gearcli.model.belts`), in place: on pulley j
+    T_i e_A at X_jA and T_i e_B at X_jB, on k the opposites at X_kA, X_kB (a known load)."""
+    moving = set(an.tree.moving)
+    for c in an.circuits:
+        bt = an.mech.gears[c.gear].belt
+        if bt is None or not bt.pretension:
+            continue
+        Rc, oc = kin.R[c.carrier], kin.o[c.carrier]
+        for side, L, sign in ((0, c.j, 1.0), (1, c.k, -1.0)):
+            if L not in moving:
+                continue
+            for s in (0, 1):
+                d = np.einsum("nij,j->ni", Rc, c.belt.e[s])
+                P = oc + np.einsum("nij,j->ni", Rc, c.belt.X[s, side])
+                b[L] -= sign * bt.pretension * np.concatenate([d, cross(P - kin.o[L], d)], axis=1)
+
+
+class SlackError(GearcliError):
+    """A belt's slack span would have a negative tension at a sample: |E|/2 > T_i."""
+
+    def __init__(self, sample: int, belt: str, pretension: float, half: float):
+        super().__init__()
+        self.sample, self.belt, self.pretension, self.half = sample, belt, pretension, half
+
+    def lines(self) -> list[str]:
+        return [f"sample {self.sample}: belt '{self.belt}' goes slack: pretension T_i = {self.pretension:g} N < "
+                f"|E|/2 = {self.half:.6g} N (raise the pretension, or lower the load)"]
+
+
+def check_belts(an, res) -> None:
+    """SlackError at the first sample of ``res`` where a belt's slack span would go below zero
+    tension, |E|/2 > T_i (the commands call it on what they read from a file: the library's
+    solve returns the tensions, negative ones included)."""
+    for ci, c in enumerate(an.circuits):
+        bt = an.mech.gears[c.gear].belt
+        if bt is None:
+            continue
+        E = res.gear_t[:, ci]
+        bad = slack_problem(bt, E)
+        if bad is not None:
+            raise SlackError(bad, an.mech.gears[c.gear].name, bt.pretension, abs(float(E[bad])) / 2)
+
+
+def fill_belts(an, qd_ind: np.ndarray, res) -> None:
+    """A solved ``res``'s belt fields, in place: ``gear_loss`` (a lossy mechanism) the loss of a
+    lossy belt (:func:`gearcli.model.belts.belt_loss`)."""
+    for ci, c in enumerate(an.circuits):
+        bt = an.mech.gears[c.gear].belt
+        if bt is None:
+            continue
+        E = res.gear_t[:, ci]
+        if res.gear_loss is not None:
+            res.gear_loss[:, ci] = belt_loss(bt, **belt_arms(c.belt), rate=mesh_rate(an, qd_ind, ci), E=E) if bt.lossy else 0.0
 
 
 def fill_worms(an, qd_ind: np.ndarray, res) -> None:

@@ -147,12 +147,13 @@ def _accelerations(ss, mode, q, qd, T, backend, t):
     an acceleration with losses that does not settle, a sign search or bearing friction
     that fails (named by its time), an integration that diverged."""
     from .bearing_friction import BearingFrictionError  # noqa: PLC0415
+    from .losses import SlackError  # noqa: PLC0415
     from .signs import SignError                        # noqa: PLC0415
     when = f"t = {t:.9g} s" if np.ndim(t) == 0 else f"t = {t[0]:.9g} to {t[-1]:.9g} s"
     first = float(t) if np.ndim(t) == 0 else float(t[0])
     try:
         return ss.accelerations(mode, np.atleast_2d(q), np.atleast_2d(qd), np.atleast_2d(T), backend)
-    except (SignError, BearingFrictionError) as exc:     # its "sample i" counts this call's states
+    except (SignError, BearingFrictionError, SlackError) as exc:     # its "sample i" counts this call's states
         at = t if np.ndim(t) == 0 else t[min(exc.sample, len(t) - 1)]
         raise SimulationError(f"t = {at:.9g} s: {exc.lines()[0].removeprefix(f'sample {exc.sample}: ')}",
                               float(at)) from None

@@ -37,8 +37,8 @@ from .llvm.output_maps import gear_outputs
 from .llvm.program import MAX_SIGNED, build_program
 from .kinematics import forward
 from .bearing_friction import solve_with_bearing_friction, subtract_bearing_friction
-from .losses import (LOSS_FIELDS, fill_kernel_losses, fill_losses, fill_reducers, fill_worms, subtract_joint_friction,
-                     subtract_reducer_drag)
+from .losses import (LOSS_FIELDS, fill_belts, fill_kernel_losses, fill_losses, fill_reducers, fill_worms,
+                     subtract_belt_pretension, subtract_joint_friction, subtract_reducer_drag)
 from .result_arrays import check_out, copy_into, result_arrays, work_arrays
 from .signs import SignError, sign_violation
 
@@ -195,6 +195,7 @@ class Solver:
             res = self._by_numpy(q, qd, qdd, method, chunk, verify, values)
         fill_reducers(self.an, qd, res)
         fill_worms(self.an, qd, res)
+        fill_belts(self.an, qd, res)
         res.motor_speed = qd @ self.an.A
         if out is not None:
             copy_into(out, res)
@@ -210,6 +211,7 @@ class Solver:
         res.residual, res.backend, res.backend_note = None, how.path, how.note
         fill_kernel_losses(res, arrays, losses)      # (a reducer's input torque and loss: the kernel's)
         fill_worms(self.an, qd, res)                  # a worm pair's outputs from N (numpy, both paths)
+        fill_belts(self.an, qd, res)                  # a belt's slack check and loss (numpy, both paths)
         if verify:
             x_all = _unknowns(self.an, res)
             worst = 0.0
@@ -250,6 +252,7 @@ class Solver:
         subtract_external(b, external_wrenches(an, kin, values))
         subtract_joint_friction(an, kin, b, qd)
         subtract_reducer_drag(an, kin, b)
+        subtract_belt_pretension(an, kin, b)
         return q, qd, kin, b
 
     def _chunk(self, q_ind, qd_ind, qdd_ind, method, verify, values) -> Result:

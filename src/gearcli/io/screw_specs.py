@@ -1,6 +1,7 @@
-"""Reading a screw's declaration (``gears[]`` with ``kind: screw``), whatever file it comes
-from: a schema-valid mapping (YAML, or a URDF extension element's attributes) -> the
-:class:`~gearcli.model.screws.Screw`.  Problems go to ``add(path, message)`` at their key."""
+"""Reading the declarations of screws, worm pairs and belts (``gears[]`` with ``kind: screw |
+worm | belt``), whatever file they come from: a schema-valid mapping (YAML, or a URDF extension
+element's attributes) -> the model's element.  Problems go to ``add(path, message)`` at their
+key."""
 from __future__ import annotations
 
 from ..model.power_flow import SpeedTable
@@ -82,3 +83,47 @@ def worm_spec(spec: dict, path: str, add):
         ok = False
     alpha = math.radians(float(spec.get("pressure_angle_deg", 20.0)))
     return Worm(int(z1), int(z2), d1, m, gamma, alpha, mu, spec["hand"], path) if ok else None
+
+
+def belt_spec(spec: dict, path: str, add):
+    """The :class:`~gearcli.model.belts.Belt` of a schema-valid belt declaration; None with a
+    problem (radii or teeth with pitch, positive sizes, pretension >= 0, efficiencies in (0, 1])."""
+    import math  # noqa: PLC0415
+
+    import numpy as np  # noqa: PLC0415
+
+    from ..model.belts import Belt, BeltRating  # noqa: PLC0415
+    ok = True
+    if "radii" in spec and ("teeth" in spec or "pitch" in spec):
+        add(f"{path}.radii", "give radii, or teeth and pitch, not both")
+        return None
+    if "radii" in spec:
+        r_j, r_k = (float(v) for v in spec["radii"])
+    elif "teeth" in spec and "pitch" in spec:
+        p = float(spec["pitch"])
+        if not p > 0:
+            add(f"{path}.pitch", f"belt pitch must be positive (m), got {p:g}")
+            return None
+        r_j, r_k = (p * z / (2 * math.pi) for z in spec["teeth"])
+    else:
+        add(path, "a belt needs its pulleys' pitch radii (radii), or teeth and pitch")
+        return None
+    if not (r_j > 0 and r_k > 0):
+        add(f"{path}.radii", f"pitch radii must be positive (m), got [{r_j:g}, {r_k:g}]")
+        ok = False
+    T_i = float(spec["pretension"])
+    if not T_i >= 0:
+        add(f"{path}.pretension", f"pretension must be >= 0 (N), got {T_i:g}")
+        ok = False
+    kw = {}
+    if "efficiency" in spec:
+        eff = spec["efficiency"]
+        fwd = speed_table(eff["forward"], f"{path}.efficiency.forward", add, "forward efficiency eta_f", 0.0, 1.0, True)
+        bwd = speed_table(eff.get("backward", eff["forward"]), f"{path}.efficiency.backward", add,
+                          "backward efficiency eta_b", 0.0, 1.0, True)
+        ok = ok and fwd is not None and bwd is not None
+        kw.update(forward=fwd, backward=bwd)
+    if "rating" in spec:
+        r = spec["rating"]
+        kw["rating"] = BeltRating(r.get("max_effective_pull"), r.get("min_slack_ratio"), path=f"{path}.rating")
+    return Belt(r_j, r_k, T_i, np.asarray(spec["belt_point"], float), **kw) if ok else None

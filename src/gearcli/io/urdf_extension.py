@@ -15,7 +15,7 @@ from ..model.validate import gear_pair_problems
 from .urdf_transmissions import KINDS as TRANSMISSION_KINDS
 from .urdf_transmissions import read_transmissions
 from .reducer_specs import reducer_spec
-from .screw_specs import screw_spec, worm_spec
+from .screw_specs import belt_spec, screw_spec, worm_spec
 from .urdf_xml import NS, floats, q
 from ..model.reducers import LIFE_BASES, REDUCER_KINDS
 
@@ -26,6 +26,8 @@ GEAR_ATTRS = ("name", "j", "k", "kind", "ratio", "teeth", "carrier", "mesh_point
 
 REDUCER_ATTRS = ("name", "kind", "input", "output", "housing", "ratio", "teeth", "efficiency_forward",
                  "efficiency_backward", "no_load_torque", "torsional_stiffness_torque", "torsional_stiffness_rate")
+BELT_ATTRS = ("name", "j", "k", "carrier", "radii", "pretension", "belt_point", "efficiency_forward", "efficiency_backward",
+              "max_effective_pull", "min_slack_ratio")
 WORM_ATTRS = ("name", "worm", "wheel", "carrier", "teeth", "reference_diameter", "module", "lead_angle", "lead_angle_deg",
               "pressure_angle", "pressure_angle_deg", "friction_coefficient", "hand")
 SCREW_ATTRS = ("name", "screw", "nut", "carrier", "lead", "hand", "efficiency_forward", "efficiency_backward",
@@ -58,7 +60,7 @@ class Extension:
     ``leader`` and ``chain_leader``."""
 
     def read_extension(self) -> dict:
-        ext = {"mechanism": None, "gears": [], "motors": [], "loads": [], "payloads": [], "reducers": [], "screws": [], "worms": []}
+        ext = {"mechanism": None, "gears": [], "motors": [], "loads": [], "payloads": [], "reducers": [], "screws": [], "worms": [], "belts": []}
         for el in self.root:
             if not isinstance(el.tag, str) or etree.QName(el).namespace != NS:
                 continue
@@ -86,11 +88,14 @@ class Extension:
                 ext["screws"].append(el)
             elif local == "worm":
                 ext["worms"].append(el)
+            elif local == "belt":
+                ext["belts"].append(el)
             elif local in ("motor_rating", "gear_rating", "motor_model"):
                 continue  # read by io.ratings_reader
             else:
                 self.add(f"gearcli:{local}", f"unknown gearcli element gearcli:{local} (expected gearcli:mechanism, "
-                         "gearcli:gear, gearcli:reducer, gearcli:screw, gearcli:worm, gearcli:motor, gearcli:load or gearcli:payload)", el)
+                         "gearcli:gear, gearcli:reducer, gearcli:screw, gearcli:worm, gearcli:belt, gearcli:motor, gearcli:load or "
+                         "gearcli:payload)", el)
         return ext
 
     def unknown_attrs(self, el, allowed, path: str) -> None:
@@ -339,6 +344,45 @@ class Extension:
                 wm = worm_spec(spec, path, lambda p, m, el=el: self.add(p, m, el))
             out.append(GearPair(name, ends[0], ends[1], "worm", None, teeth=(wm.z1, wm.z2) if wm else None,
                                 carrier=carrier, path=path, worm=wm))
+        return out
+
+    def extension_belts(self, ext) -> list[GearPair]:
+        """The gearcli:belt elements (README "Timing belts"): attributes name, j, k, carrier (links),
+        radii "r_j r_k" (m), pretension (N), belt_point "x y z" (the carrier link's URDF frame),
+        efficiency_forward, efficiency_backward (numbers or tables "w1 v1 ..."), max_effective_pull,
+        min_slack_ratio.  Validated as the YAML keys are (:func:`.screw_specs.belt_spec`)."""
+        out = []
+        for el in ext["belts"]:
+            name = el.get("name") or f"{el.get('j')}-{el.get('k')}"
+            path = f"gearcli:belt '{name}'"
+            self.lines[path] = el.sourceline
+            self.unknown_attrs(el, BELT_ATTRS, path)
+            ends = [ref[0] for key in ("j", "k") if (ref := self.link_ref(el.get(key), path, el) if el.get(key) else None)]
+            carrier = self.link_ref(el.get("carrier"), path, el, "carrier link") if el.get("carrier") else None
+            missing = [k for k in ("j", "k", "radii", "pretension", "belt_point") if el.get(k) is None]
+            if missing:
+                self.add(path, f"gearcli:belt needs attribute(s) {', '.join(missing)}", el)
+                continue
+            radii, T, P = self.vector(el, "radii", path, n=2), self.vector(el, "pretension", path, n=1), self.vector(el, "belt_point", path)
+            if len(ends) < 2 or radii is None or T is None or P is None:
+                continue
+            if carrier is not None:              # the point is in the carrier link's URDF frame
+                P = carrier[1][:3, :3] @ P + carrier[1][:3, 3]
+            spec = {"radii": [float(v) for v in radii], "pretension": float(T[0]), "belt_point": list(P)}
+            eff = {}
+            for k in ("forward", "backward"):
+                v = self.vector(el, f"efficiency_{k}", path, n=None)
+                if v is not None:
+                    eff[k] = float(v[0]) if v.size == 1 else [[float(a), float(b)] for a, b in v.reshape(-1, 2)]
+            if eff:
+                spec["efficiency"] = eff if "forward" in eff else {"forward": eff["backward"], **eff}
+            rating = {k: float(v[0]) for k in ("max_effective_pull", "min_slack_ratio")
+                      if (v := self.vector(el, k, path, n=1)) is not None}
+            if rating:
+                spec["rating"] = rating
+            bt = belt_spec(spec, path, lambda p, m, el=el: self.add(_attribute_path(p), m, el))
+            out.append(GearPair(name, ends[0], ends[1], "belt", None, carrier=None if carrier is None else carrier[0],
+                                path=path, belt=bt))
         return out
 
     def _screw_dict(self, el, path: str) -> dict | None:

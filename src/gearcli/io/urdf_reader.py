@@ -127,8 +127,9 @@ class _Reader(StructureChecks, Mimics, Extension, UrdfLoads):
         ext = self.read_extension()
         joints = self.movable_joints()
         self.col.raise_if_any()
-        gears = (self.couplings() + self.extension_gears(ext) + self.extension_reducers(ext) + self.extension_screws(ext)
-                 + self.extension_worms(ext))
+        elements = (self.extension_gears(ext) + self.extension_reducers(ext) + self.extension_screws(ext)
+                    + self.extension_worms(ext) + self.extension_belts(ext))
+        gears = self.couplings() + sorted(elements, key=lambda g: self.lines.get(g.path, 0))   # document order
         bad_pairs = bool(self.col.issues)   # go on to list the transmissions' problems too, with
         if bad_pairs:                       # no joint following another and no direct drive made up
             self.leader = {}

@@ -26,7 +26,7 @@ from ..model.geometry import dh_transform, origin_axis_transform
 from ..model.reducers import REDUCER_KINDS
 from ..model.validate import check_inertia, gear_pair_problems, inertia_matrix, number_problem
 from .reducer_specs import reducer_spec
-from .screw_specs import screw_spec, worm_spec
+from .screw_specs import belt_spec, screw_spec, worm_spec
 from .schema_words import schema_messages
 from .yaml_safe import read_text, yaml_lines
 from .schemas import packaged_schema
@@ -302,6 +302,9 @@ def _gears(data: dict, col: Collector, links: _Names) -> list[GearPair]:
         if spec.get("kind") == "worm":
             gears.append(_worm(spec, col, links, names, path))
             continue
+        if spec.get("kind") == "belt":
+            gears.append(_belt(spec, col, links, names, path))
+            continue
         j, k = spec["links"]
         links.ref(j, f"{path}.links[0]")
         links.ref(k, f"{path}.links[1]")
@@ -370,6 +373,21 @@ def _worm(spec: dict, col: Collector, links: _Names, names: _Names, path: str) -
     names.declare(spec.get("name", f"{w}-{g}"), path)
     return GearPair(spec.get("name", f"{w}-{g}"), w, g, "worm", None, teeth=tuple(spec["teeth"]),
                     carrier=spec.get("carrier"), path=path, worm=worm_spec(spec, path, col.add))
+
+
+def _belt(spec: dict, col: Collector, links: _Names, names: _Names, path: str) -> GearPair:
+    """A timing belt (links: [input pulley, output pulley]) as a GearPair, the ratio from the
+    geometry (:mod:`gearcli.model.belts`; the analysis derives it)."""
+    j, k = spec["links"]
+    links.ref(j, f"{path}.links[0]")
+    links.ref(k, f"{path}.links[1]")
+    if j == k:
+        col.add(f"{path}.links", "a belt needs two different pulleys [input, output]")
+    if "carrier" in spec:
+        links.ref(spec["carrier"], f"{path}.carrier")
+    names.declare(spec.get("name", f"{j}-{k}"), path)
+    return GearPair(spec.get("name", f"{j}-{k}"), j, k, "belt", None, carrier=spec.get("carrier"), path=path,
+                    belt=belt_spec(spec, path, col.add))
 
 
 def _stiffness(spec: dict, col: Collector, path: str) -> float | None:

@@ -27,6 +27,7 @@ from .ratings import BearingRating, GearRating, JointLimit, MotorModel, MotorRat
 from .reducers import Reducer
 from .screws import Screw
 from .worms import Worm
+from .belts import Belt
 
 
 @dataclass(frozen=True, eq=False)
@@ -118,6 +119,8 @@ class GearPair:
     screw: Screw | None = None
     # A worm pair (kind worm, model.worms): j is the worm, k the wheel; ratio from the geometry.
     worm: Worm | None = None
+    # A timing belt (kind belt, model.belts): j the input pulley, k the output; ratio from the geometry.
+    belt: Belt | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -167,7 +170,8 @@ class Mechanism:
         """True when any gear pair has a loss factor, any reducer an efficiency below 1 or a
         no-load torque, or any joint has friction of its own or in its bearings."""
         return any(g.loss_factor or (g.reducer is not None and g.reducer.lossy) or (g.screw is not None and g.screw.lossy)
-                   or (g.worm is not None and g.worm.lossy) for g in self.gears) or any(
+                   or (g.worm is not None and g.worm.lossy) or (g.belt is not None and g.belt.lossy)
+                   for g in self.gears) or any(
             (j.friction is not None and j.friction.active) or any(b.friction_arm for b in j.bearings or ())
             for j in self.joints)
 

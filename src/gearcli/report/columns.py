@@ -19,7 +19,9 @@ Columns, in order (units SI):
   under T, odd in T; reported, not fed back); per screw ``gear:<s>:force`` (N, the axial
   force on the nut along the screw's axis z_S); per worm pair ``gear:<w>:t`` (N, the wheel's
   tangential force F . t_G, positive when the flank load drives the wheel positively about its
-  axis) and ``gear:<w>:axial`` (N, the force on the worm along its axis: its thrust);
+  axis) and ``gear:<w>:axial`` (N, the force on the worm along its axis: its thrust); per belt
+  ``gear:<b>:tension_a``, ``gear:<b>:tension_b`` (N, the span tensions T_i +- E/2) and
+  ``gear:<b>:effective_pull`` (N, E);
 * per real joint ``joint:<joint>:fx, fy, fz, mx, my, mz`` (N, N*m): reaction wrench the
   parent exerts on the child, in the joint frame, about its origin; then
   ``joint:<joint>:radial`` = hypot(fx, fy), ``axial`` = |fz|, ``bending`` = hypot(mx, my);
@@ -67,6 +69,9 @@ def column_names(an) -> list[str]:
         if gp.worm is not None:
             cols += [f"gear:{gp.name}:t", f"gear:{gp.name}:axial"]
             continue
+        if gp.belt is not None:
+            cols += [f"gear:{gp.name}:{k}" for k in ("tension_a", "tension_b", "effective_pull")]
+            continue
         if c.geometry is None:
             cols.append(f"gear:{gp.name}:torque")
             continue
@@ -88,7 +93,8 @@ def has_loss_column(an, c) -> bool:
     """True when circuit ``c`` has a ``gear:<pair>:loss`` column (a lossy mechanism's pairs with
     tooth geometry, its reducers and screws)."""
     gp = an.mech.gears[c.gear]
-    return c.geometry is not None or gp.reducer is not None or gp.screw is not None or gp.worm is not None
+    return (c.geometry is not None or gp.reducer is not None or gp.screw is not None or gp.worm is not None
+            or gp.belt is not None)
 
 
 TRANSPOSE_ROWS = 512
@@ -120,6 +126,12 @@ def column_sources(an, t: np.ndarray, res: Result) -> dict:
             put(lambda ci=ci: res.gear_sep[:, ci])
             if red.torsional_stiffness is not None:
                 put(lambda ci=ci, e=circ.ratio, red=red: windup(red, -e * res.gear_t[:, ci]))
+            continue
+        bt = an.mech.gears[circ.gear].belt
+        if bt is not None:                               # span tensions T_i +- E/2 and E
+            put(lambda ci=ci, T=bt.pretension: T + 0.5 * res.gear_t[:, ci])
+            put(lambda ci=ci, T=bt.pretension: T - 0.5 * res.gear_t[:, ci])
+            put(lambda ci=ci: res.gear_t[:, ci])
             continue
         if an.mech.gears[circ.gear].worm is not None:   # the wheel's tangential force, the worm's thrust
             put(lambda ci=ci: res.gear_sep[:, ci])
@@ -305,7 +317,7 @@ class Summary:
                 pick.append((i, f"motor {n.split(':')[1]} {last}", unit))
             elif kind == "motor":
                 pick.append((i, f"motor {n[6:]}", unit))
-            elif kind == "gear" and last in ("t", "torque", "force"):
+            elif kind == "gear" and last in ("t", "torque", "force", "effective_pull"):
                 pair = n[5:-len(last) - 1]
                 pick.append((i, f"gear {pair} {'tangential' if last == 't' else last}", unit))
             elif kind == "joint" and last in ("radial", "axial", "bending"):

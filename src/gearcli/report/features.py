@@ -137,6 +137,28 @@ def _worm_line(d: dict) -> str:
     return text
 
 
+def belt_dicts(an: Analysis) -> list[dict]:
+    """Each timing belt (:mod:`gearcli.model.belts`): pulleys, pitch radii (m), pretension (N), the
+    pull between the shafts at rest 2 T_i cos(alpha) (N) and the ratio e."""
+    out = []
+    for c in an.circuits:
+        gp = an.mech.gears[c.gear]
+        bt = gp.belt
+        if bt is None:
+            continue
+        out.append({"belt": gp.name, "pulleys": [gp.j, gp.k], "radii": [bt.r_j, bt.r_k], "pretension": bt.pretension,
+                    "shaft_pull_at_rest": 2 * bt.pretension * math.cos(c.belt.alpha), "ratio": c.ratio,
+                    "efficiency": {"forward": bt.forward.values[0] if bt.forward.is_constant else "table",
+                                   "backward": bt.backward.values[0] if bt.backward.is_constant else "table"}})
+    return out
+
+
+def _belt_line(d: dict) -> str:
+    return (f"belt '{d['belt']}': pulley '{d['pulleys'][0]}' (r = {d['radii'][0]:.6g} m) drives '{d['pulleys'][1]}' "
+            f"(r = {d['radii'][1]:.6g} m), theta_j = {d['ratio']:.6g} * theta_k; pretension {d['pretension']:.6g} N per "
+            f"span: the shafts are pulled together by {d['shaft_pull_at_rest']:.6g} N at rest; spans T_i +- E/2")
+
+
 def feature_notes(an: Analysis) -> list[str]:
     """Human-readable lines: ``load 'tip' on link '2' (frame base): force [..] N, moment [..]
     N*m at [..] m``, ``payload 'box' on link 'arm': ...``, ``helical pair ...``, ``rack pair
@@ -158,4 +180,5 @@ def feature_notes(an: Analysis) -> list[str]:
     lines += [_reducer_line(d) for d in reducer_dicts(an)]
     lines += [_screw_line(d) for d in screw_dicts(an)]
     lines += [_worm_line(d) for d in worm_dicts(an)]
+    lines += [_belt_line(d) for d in belt_dicts(an)]
     return lines + loss_notes(an)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from ..analysis.graph import Analysis, Circuit
 from ..model.mechanism import Mechanism
-from .features import load_dicts, pair_dicts, payload_dicts, reducer_dicts, screw_dicts, worm_dicts
+from .features import load_dicts, pair_dicts, payload_dicts, reducer_dicts, screw_dicts, worm_dicts, belt_dicts
 from .loss_notes import loss_dicts
 from .sharing import sharing_sets
 
@@ -50,6 +50,7 @@ def analysis_dict(an: Analysis) -> dict:
         "reducers": reducer_dicts(an),
         "screws": screw_dicts(an),
         "worms": worm_dicts(an),
+        "belts": belt_dicts(an),
         "losses": loss_dicts(an),
     } | ({"open_loop": "tree"} if an.open_loop == "tree" else {})
 

@@ -37,7 +37,8 @@ def lossless_twin(mech):
     def frictionless(bearings):
         return bearings and tuple(replace(b, friction_coefficient=None) for b in bearings)
     return replace(mech, gears=tuple(replace(g, loss_factor=0.0, reducer=g.reducer and g.reducer.lossless(),
-                                             screw=g.screw and g.screw.lossless(), worm=g.worm and g.worm.lossless())
+                                             screw=g.screw and g.screw.lossless(), worm=g.worm and g.worm.lossless(),
+                                             belt=g.belt and g.belt.lossless())
                                      for g in mech.gears),
                    joints=tuple(replace(j, friction=None, bearings=frictionless(j.bearings)) for j in mech.joints))
 

@@ -267,6 +267,18 @@ def _add_extension(an: Analysis, root, corr: dict) -> None:
             circ = next(c for c in an.circuits if c.gear == gi)
             _add_screw(root, gp, tree.links[circ.carrier])
             continue
+        if gp.belt is not None:
+            bt, circ = gp.belt, next(c for c in an.circuits if c.gear == gi)
+            carrier = tree.links[circ.carrier]
+            el = etree.SubElement(root, q("belt"), name=gp.name, j=gp.j, k=gp.k, carrier=carrier,
+                                  radii=_vec([bt.r_j, bt.r_k]), pretension=_num(bt.pretension),
+                                  belt_point=_vec(_to_urdf(corr, carrier, bt.belt_point)),
+                                  efficiency_forward=_table(bt.forward), efficiency_backward=_table(bt.backward))
+            if bt.rating is not None:
+                for k in ("max_effective_pull", "min_slack_ratio"):
+                    if getattr(bt.rating, k) is not None:
+                        el.set(k, _num(getattr(bt.rating, k)))
+            continue
         if gp.worm is not None:
             wm, circ = gp.worm, next(c for c in an.circuits if c.gear == gi)
             etree.SubElement(root, q("worm"), name=gp.name, worm=gp.j, wheel=gp.k, carrier=tree.links[circ.carrier],

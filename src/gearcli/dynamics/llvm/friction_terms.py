@@ -75,9 +75,17 @@ def reducer_terms(e: Emitter, s: Sample, red) -> list:
         sw, speed = _sign(e, w), e.const(e.mul(red.scale[k], e.call("fabs", w)))
         z = e.mv(s.R[int(red.carriers[k])], floats(red.axis[k]))
         fwd, bwd, t0 = red.tables[k]
-        inv_f, eta_b = e.div(1.0, interp(e, speed, fwd)), interp(e, speed, bwd)
-        A = e.const(e.sub(e.mul(0.5, e.add(inv_f, eta_b)), 1.0))
-        B = e.const(e.mul(0.5, e.sub(eta_b, inv_f)))
+        mode = red.mode[k] if red.mode else 0
+        if mode == 0:          # c_r = 1/eta_f forward, eta_b backward
+            inv_f, eta_b = e.div(1.0, interp(e, speed, fwd)), interp(e, speed, bwd)
+            A = e.const(e.sub(e.mul(0.5, e.add(inv_f, eta_b)), 1.0))
+            B = e.const(e.mul(0.5, e.sub(eta_b, inv_f)))
+        elif mode == 1:        # a belt's loss couple on its driven pulley k, forward only
+            A = e.const(e.mul(0.5, e.sub(1.0, interp(e, speed, fwd))))
+            B = e.neg(A)
+        else:                  # ... on j, backward only
+            A = e.const(e.mul(-0.5, e.sub(1.0, interp(e, speed, bwd))))
+            B = A
         T0 = 0.0 if t0 is None else e.const(interp(e, speed, t0))
         out.append((sw, A, B, z, w, T0, speed))
         if t0 is None:
@@ -149,6 +157,8 @@ def _reducer_outputs(e: Emitter, s: Sample, red, gear_col, rows: dict) -> dict:
     :func:`~gearcli.model.reducers.input_torque`, :func:`gearcli.model.screws.screw_loss`)."""
     out = {}
     for k, ci in enumerate(red.circuits):
+        if red.mode and red.mode[k]:        # a belt's loss: :func:`..losses.fill_belts`, both paths
+            continue
         sw, A, B, _, w, T0, speed = s.red[k]
         u = s.sol[int(gear_col[ci])]
         delta = e.add(e.mul(A, e.mul(sw, sw)), e.mul(B, e.mul(_sign(e, u), sw)))

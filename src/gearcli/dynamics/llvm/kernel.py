@@ -25,13 +25,14 @@ samples failed (the caller checks a sum, not ``fail``).  Compiled by :mod:`.driv
 from __future__ import annotations
 
 import llvmlite.ir as ir
+import numpy as np
 
 from . import friction_terms
 from ..signs import MAX_EXHAUSTIVE
 from .blocks import block
 from .signs import WARM
 from .build import DP, I64, I64P, ConstantPool, Emitter
-from .links import at_rest, external, inertia, joint, joint_space, load_groups
+from .links import at_rest, external, floats, inertia, joint, joint_space, load_groups
 from .outputs import OUTPUTS, widths, write_outputs
 
 LOSS_OUTPUTS = ("gear_loss", "joint_friction", "joint_loss")
@@ -73,6 +74,7 @@ def _sample(e: Emitter, fn, prog, loads, n, before: list) -> list:
     for L in prog.moving:
         inertia(e, s, int(L), prog.bodies[L], prog.gravity)
     external(e, s, fn, [L for L, _, _ in load_groups(loads)[1]], n, a["vals"], a["ldrow"], a["ldpt"], a["ldgrp"])
+    belt_pretension(e, s, prog)
     lp, w = prog.losses, widths(prog)
     if lp is not None:
         rows = {k: e.row(a[k], n, max(w[k], 1)) for k in LOSS_OUTPUTS}
@@ -94,6 +96,23 @@ def _sample(e: Emitter, fn, prog, loads, n, before: list) -> list:
         inputs = friction_terms.write_losses(e, s, lp, prog.gear_col, rates, own, rows)
     write_outputs(e, s, prog, ind[1], {k: e.row(a[k], n, max(w[k], 1)) for k in OUTPUTS}, inputs)
     return settled
+
+
+def belt_pretension(e: Emitter, s, prog) -> None:
+    """rhs[L] -= each belt's pretension forces (:func:`..losses.subtract_belt_pretension`): on
+    pulley j T_i e_S at X_jS, on k the opposites at X_kS, the points and directions in the
+    carrier's axes."""
+    for ints, f in zip(prog.belt_int, prog.belt_flt):
+        j, k, c = (int(v) for v in ints)
+        T, X, es = float(f[0]), np.asarray(f[1:13]).reshape(2, 2, 3), np.asarray(f[13:19]).reshape(2, 3)
+        for side, L, sign in ((0, j, 1.0), (1, k, -1.0)):
+            if L < 0:
+                continue
+            for sp in (0, 1):
+                d = e.mv(s.R[c], floats(es[sp]))
+                P = e.vadd(s.o[c], e.mv(s.R[c], floats(X[sp, side])))
+                w = e.scale(d, sign * T) + e.scale(e.cx(e.vsub(P, s.o[L]), d), sign * T)
+                s.rhs[L] = tuple(e.sub(s.rhs[L][h], w[h]) for h in range(6))
 
 
 def build_module(prog, loads) -> ir.Module:

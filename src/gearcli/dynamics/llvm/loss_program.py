@@ -37,6 +37,7 @@ from ..blocks import primary_side
 from ..kinematics import forward
 from ..losses import mesh_friction_moment
 from ..pattern_maps import PatternMaps
+from ...model.belts import belt_arms
 from ...model.friction import JointFriction
 
 
@@ -121,10 +122,15 @@ class ReducerLosses:
     tables: tuple
     signed: tuple
     reducer: tuple
+    # per element how A, B follow from the efficiencies: 0 a reducer's or screw's factor c_r on
+    # its torque; 1 a belt's loss couple on the driven pulley k where power flows j -> k,
+    # A = -B = (1 - eta_f)/2; 2 the same on j where it flows k -> j, A = B = -(1 - eta_b)/2
+    # (model.belts.loss_couples; a belt is two elements of one circuit)
+    mode: tuple = ()
 
     def parts(self) -> list:
         return [self.circuits, self.rate_flt.tobytes(), self.scale, self.sides, self.carriers, self.axis.tobytes(),
-                self.signed, self.reducer, repr(self.tables).encode()]
+                self.signed, self.reducer, self.mode, repr(self.tables).encode()]
 
 
 @dataclass(frozen=True, eq=False)
@@ -310,29 +316,40 @@ def _block_worms(an, p, bi: int, block_of: dict, worms: WormLosses | None) -> tu
 def _reducer_losses(an) -> ReducerLosses | None:
     """The :class:`ReducerLosses` of ``an``'s lossy reducers and screws, None without one."""
     gears, moving = an.mech.gears, set(an.tree.moving)
-    circ = tuple(ci for ci, c in enumerate(an.circuits)
-                 if (gears[c.gear].reducer is not None and gears[c.gear].reducer.lossy)
-                 or (gears[c.gear].screw is not None and gears[c.gear].screw.lossy))
-    if not circ:
+    circ0 = tuple(ci for ci, c in enumerate(an.circuits)
+                  if (gears[c.gear].reducer is not None and gears[c.gear].reducer.lossy)
+                  or (gears[c.gear].screw is not None and gears[c.gear].screw.lossy)
+                  or (gears[c.gear].belt is not None and gears[c.gear].belt.lossy))
+    if not circ0:
         return None
-    rows, scale, sides, tables, signed, reducer = [], [], [], [], [], []
-    for ci in circ:
+    circ, rows, scale, sides, tables, signed, reducer, mode = [], [], [], [], [], [], [], []
+    for ci in circ0:
         c, gp = an.circuits[ci], gears[an.circuits[ci].gear]
-        el = gp.reducer if gp.reducer is not None else gp.screw
-        k = 1.0 if gp.reducer is not None else -gp.screw.h       # w = k a
-        rows.append(k * np.asarray(an.mesh_rate_rows[ci], float))
-        scale.append(1.0 / abs(k))
-        coefs = ((c.j, 1.0), (c.carrier, -1.0)) if gp.reducer is not None else ((c.j, -gp.screw.h), (c.k, gp.screw.h))
-        sides.append(tuple((L if L in moving else -1, coef) for L, coef in coefs))
+        el = gp.reducer or gp.screw or gp.belt
         t0 = getattr(el, "no_load_torque", None)
-        tables.append(((el.forward.speeds, el.forward.values), (el.backward.speeds, el.backward.values),
-                       None if t0 is None else (t0.speeds, t0.values)))
-        signed.append(int(el.power_flow_lossy))
-        reducer.append(int(gp.reducer is not None))
-    return ReducerLosses(circ, np.array(rows, float).reshape(-1, an.dof), tuple(scale), tuple(sides),
+        table = ((el.forward.speeds, el.forward.values), (el.backward.speeds, el.backward.values),
+                 None if t0 is None else (t0.speeds, t0.values))
+        if gp.belt is not None:         # w = -tk omega_k = tj omega_j: the power of E on k per unit E, negated
+            arms = belt_arms(c.belt)
+            k, parts = arms["tj"], (((c.k, -arms["tk"]), (c.carrier, arms["tk"])), ((c.j, arms["tj"]), (c.carrier, -arms["tj"])))
+            modes = (1, 2)
+        else:
+            k = 1.0 if gp.reducer is not None else -gp.screw.h       # w = k a
+            parts = (((c.j, 1.0), (c.carrier, -1.0)) if gp.reducer is not None else ((c.j, -gp.screw.h), (c.k, gp.screw.h)),)
+            modes = (0,)
+        for coefs, m in zip(parts, modes):
+            circ.append(ci)
+            rows.append(k * np.asarray(an.mesh_rate_rows[ci], float))
+            scale.append(1.0 / abs(k))
+            sides.append(tuple((L if L in moving else -1, coef) for L, coef in coefs))
+            tables.append(table)
+            signed.append(int(el.power_flow_lossy))
+            reducer.append(int(gp.reducer is not None))
+            mode.append(m)
+    return ReducerLosses(tuple(circ), np.array(rows, float).reshape(-1, an.dof), tuple(scale), tuple(sides),
                          tuple(an.circuits[ci].carrier for ci in circ),
                          np.array([an.circuits[ci].zj for ci in circ], float).reshape(-1, 3), tuple(tables),
-                         tuple(signed), tuple(reducer))
+                         tuple(signed), tuple(reducer), tuple(mode))
 
 
 def _block_reducers(an, p, bi: int, block_of: dict, red: ReducerLosses | None) -> tuple:
@@ -343,13 +360,11 @@ def _block_reducers(an, p, bi: int, block_of: dict, red: ReducerLosses | None) -
     out = []
     for n, gi in enumerate(p.signed):
         g = p.groups[gi]
-        if g.kind != "mesh" or g.index not in red.circuits:
-            continue
-        r = red.circuits.index(g.index)
-        sides = [(L, coef) for L, coef in red.sides[r] if L >= 0]
-        rows = tuple((p.links.index(L), coef) for L, coef in sides if L in p.links)
-        later = tuple((L, coef) for L, coef in sides if L not in p.links and L in block_of and block_of[L] > bi)
-        out.append((n, r, rows, later))
+        for r in (r for r, ci in enumerate(red.circuits) if g.kind == "mesh" and ci == g.index):
+            sides = [(L, coef) for L, coef in red.sides[r] if L >= 0]
+            rows = tuple((p.links.index(L), coef) for L, coef in sides if L in p.links)
+            later = tuple((L, coef) for L, coef in sides if L not in p.links and L in block_of and block_of[L] > bi)
+            out.append((n, r, rows, later))
     return tuple(out)
 
 

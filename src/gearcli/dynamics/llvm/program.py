@@ -82,6 +82,10 @@ class Program:
     weights: dict = field(default_factory=dict)   # redundant world-frame block -> sharing.mesh_weights
     free: dict = field(default_factory=dict)      # redundant world-frame block -> (free columns, row order, swaps) (basis.py)
     losses: object = None                         # loss_program.LossProgram of a lossy mechanism
+    # belts' pretension (a known load, model.belts): per belt [pulley j, pulley k (-1: not
+    # moving), carrier] and [T_i, the tangent points X (2 spans x 2 pulleys x 3), e_A, e_B]
+    belt_int: np.ndarray = _arr()
+    belt_flt: np.ndarray = _arr()
 
     def arrays(self) -> list:
         """(name, array) of every array field, in field order (the disk cache's fingerprint)."""
@@ -253,6 +257,18 @@ def _term_props(bd: _Builder, an, terms, values, rec) -> None:
     rec["nterm"] = 0
 
 
+def _belts(an) -> dict:
+    """``belt_int`` and ``belt_flt`` of the belts with a pretension (:class:`Program`)."""
+    moving, ints, flts = set(an.tree.moving), [], []
+    for c in an.circuits:
+        bt = an.mech.gears[c.gear].belt
+        if bt is None or not bt.pretension:
+            continue
+        ints.append([c.j if c.j in moving else -1, c.k if c.k in moving else -1, c.carrier])
+        flts.append(np.concatenate([[bt.pretension], np.ravel(c.belt.X), np.ravel(c.belt.e)]))
+    return {"belt_int": np.array(ints, I64).reshape(-1, 3), "belt_flt": np.array(flts, float).reshape(-1, 19)}
+
+
 def _live_terms(bd: _Builder, trec, tflt):
     """The term records the kernel reads (those of the blocks that still propagate or solve by
     terms: a local-frame block whose propagation became records drops its own), the blocks'
@@ -337,7 +353,7 @@ def build_program(an, plans) -> Program:
                    props=records(bd.prec, PROPAGATION), cmat=cat(bd.cmat), later=ints(bd.later),
                    child_basis=records(bd.cbrec, CHILD_BASIS), turns=np.array(bd.turns, float), terms=trec,
                    term_values=tflt, joint_out=jout, motor_col=mcol, gear_col=gcol, gear_out=gout, hashed=hashed,
-                   lowrank=lowrank, hot=hot, weights=weights, free=free,
+                   lowrank=lowrank, hot=hot, weights=weights, free=free, **_belts(an),
                    losses=_hot_lossy(an, plans, build_loss_program(an, plans), study))
 
 

@@ -93,13 +93,24 @@ def _mesh(an, ci, L, t_pos):
         b, a = c.joints
         return [_axial(an, b, L, 1.0) + _axial(an, a, L, -c.ratio)]
     zero = np.zeros(3)
+    if an.mech.gears[c.gear].belt is not None:     # +-E/2 along the spans at their tangent points
+        if L not in (c.j, c.k):
+            return [[]]                            # (a lossy belt's couple on the carrier: .losses)
+        geo, side = c.belt, (0 if L == c.j else 1)
+        s = 1.0 if side == 0 else -1.0
+        return [[(0, c.carrier, -1, 0.5 * s, geo.e[0], geo.X[0, side]),
+                 (0, c.carrier, -1, -0.5 * s, geo.e[1], geo.X[1, side])]]
     wm = an.mech.gears[c.gear].worm
     if wm is not None:             # the flank load on the wheel at P: cos(a_n) e + sigma sin(a_n) n_c (friction: .losses)
+        if L not in (c.j, c.k):
+            return [[]]
         s, geo = (1.0 if L == c.k else -1.0), c.worm
         return [[(0, c.carrier, -1, s * np.cos(wm.pressure_angle), geo.e_hat, geo.P),
                  (0, c.carrier, t_pos, s * np.sin(wm.pressure_angle), geo.n_c, geo.P)]]
     sc = an.mech.gears[c.gear].screw
     if sc is not None:             # the axial force along z_S through the axis point, the torque h z_S
+        if L not in (c.j, c.k):
+            return [[]]
         s = 1.0 if L == c.k else -1.0
         return [[(0, c.carrier, -1, s, c.zj, c.axis_point), (1, c.carrier, -1, s * sc.h, c.zj, zero)]]
     if c.geometry is not None:
