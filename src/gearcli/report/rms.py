@@ -86,13 +86,3 @@ def cumulative_rms(x, t) -> np.ndarray:
     out = np.abs(x).copy()
     out[1:] = np.sqrt(cum[1:] / np.where(span[1:] > 0, span[1:], 1.0))
     return out
-
-
-def trapezoid_weights(t: np.ndarray) -> np.ndarray:
-    """dt_k of the trapezoid rule on the samples t (N,): sum_k y_k dt_k = the integral of y."""
-    w = np.zeros_like(t)
-    if t.size > 1:
-        d = np.diff(t)
-        w[:-1] += d / 2
-        w[1:] += d / 2
-    return w
