@@ -154,3 +154,13 @@ def test_scara_urdf_round_trip_solves_bit_identically(run_cli, tmp_path):
     q, qd, qdd = (rng.uniform(-1, 1, (100, 3)) for _ in range(3))
     ca, cb = (named_columns(x, solve(x, q, qd, qdd)) for x in (a, b))
     assert list(ca) == list(cb) and all(np.array_equal(ca[k], cb[k]) for k in ca)
+
+
+@pytest.mark.parametrize("name, unit", [("gear:b:tension_a", "N"), ("gear:b:tension_b", "N"), ("gear:b:effective_pull", "N"),
+                                        ("gear:s:force", "N"), ("gear:w:axial", "N"), ("gear:r:input_torque", "N·m"),
+                                        ("gear:r:windup", "rad")])
+def test_plot_reads_the_drive_elements_units_from_a_csv(name, unit):
+    """gearcli plot groups a CSV's columns by the unit their names give (a CSV carries none): the
+    drive elements' columns have theirs (they were drawn on a unit-less 'value' axis)."""
+    from gearcli.report.loads_files import csv_unit
+    assert csv_unit(name) == unit

@@ -312,6 +312,8 @@ def csv_unit(name: str) -> str:
     return column_unit(name) if OUTPUT_COLUMN.fullmatch(name) else ""
 
 
-OUTPUT_COLUMN = re.compile(r"t|tau:[^:]+|motor:[^:]+(:speed|:power)?|gear:[^:]+:(t|sep|torque|loss)"
+OUTPUT_COLUMN = re.compile(r"t|tau:[^:]+|motor:[^:]+(:speed|:power)?"
+                           r"|gear:[^:]+:(t|sep|torque|loss|input_torque|windup|force|axial|tension_a|tension_b"
+                           r"|effective_pull)"
                            r"|gear:[^:]+:[^:]+:(radial|axial)"
                            r"|joint:[^:]+:(fx|fy|fz|mx|my|mz|radial|axial|bending|friction|loss)")
