@@ -326,6 +326,9 @@ def verify(
     junit: str = typer.Option(None, "--junit", metavar="FILE", help="Write JUnit XML (one testcase per check)."),
     json_out: str = typer.Option(None, "--json", metavar="FILE", help="Write the checks as JSON."),
     markdown: str = typer.Option(None, "--markdown", metavar="FILE", help="Write a Markdown table (CI job summary)."),
+    html_out: str = typer.Option(None, "--html", metavar="REPORT.html", help="Write a self-contained HTML report "
+                                 "(summary, sortable checks, each check's plot, the mechanisms' graphs, versions; "
+                                 "no network needed: a CI artefact)."),
     plots: str = typer.Option(None, "--plots", metavar="DIR", help="Write a PNG of each failing or tight "
                                "(< 10 % margin) check along its worst trajectory."),
     spectra: str = typer.Option(None, "--spectra", metavar="DIR", help="Write each case's load spectra (time "
@@ -356,6 +359,7 @@ def verify(
         progress.update(total=count_jobs(manifest))
         outcome = run_verify(design, jobs=jobs, dask_address=dask, junit=junit, json_path=json_out,
                              markdown_path=markdown, plots_dir=plots, manifest=manifest, spectra_dir=spectra,
+                             html_path=html_out,
                              progress=lambda: progress.update(advance=1))
     stdout_console().print(rich_table(outcome.rows))
     typer.echo("".join(f"Backend of {case}: {backend}\n" for case, backend in backends(outcome.rows).items()), nl=False)

@@ -45,7 +45,7 @@ def count_jobs(manifest) -> int:
 
 def run_verify(manifest_path, *, jobs: int | None = None, dask_address: str | None = None, junit=None,
                json_path=None, markdown_path=None, plots_dir=None, progress=None, manifest=None,
-               spectra_dir=None) -> VerifyOutcome:
+               spectra_dir=None, html_path=None) -> VerifyOutcome:
     """Run a manifest (already loaded with :func:`load_manifest` when ``manifest`` is given)
     and write the requested reports (``spectra_dir``: the load spectra, :mod:`.spectra`);
     ``progress(total=..)`` once, then ``progress()`` per job.
@@ -53,7 +53,7 @@ def run_verify(manifest_path, *, jobs: int | None = None, dask_address: str | No
     if jobs is not None and dask_address is not None:
         raise GearcliError("verify: give -j/--jobs or --dask, not both (a Dask cluster has its own workers)")
     manifest = manifest or load_manifest(manifest_path)
-    check_outputs(manifest, {"--junit": junit, "--json": json_path, "--markdown": markdown_path})
+    check_outputs(manifest, {"--junit": junit, "--json": json_path, "--markdown": markdown_path, "--html": html_path})
     for d, option in ((plots_dir, "--plots"), (spectra_dir, "--spectra")):
         if d is not None and not str(d).strip():
             raise OutputError(option, "empty directory name (give a directory for the files)", place="")
@@ -70,7 +70,26 @@ def run_verify(manifest_path, *, jobs: int | None = None, dask_address: str | No
         write_markdown(rows, markdown_path, str(manifest_path))
     plots = write_plots(results, Path(plots_dir)) if plots_dir is not None else []
     spectra = write_spectra(results, Path(spectra_dir)) if spectra_dir is not None else []
+    if html_path:
+        write_html(rows, results, html_path, str(manifest_path))
     return VerifyOutcome(rows, results, plots, spectra)
+
+
+def write_html(rows, results, path, manifest: str) -> None:
+    """The self-contained HTML report (:mod:`.html_report`): every check's plot made in a
+    temporary folder and inlined, each case's graph as SVG; written atomically."""
+    import tempfile  # noqa: PLC0415
+
+    from ..io.output import write_text  # noqa: PLC0415
+    from ..report.graph_svg import graph_svg  # noqa: PLC0415
+    from .html_report import html_report  # noqa: PLC0415
+    from .manifest import case_analysis  # noqa: PLC0415
+    with tempfile.TemporaryDirectory() as tmp:
+        made = write_plots(results, Path(tmp), every=True)
+        keys = [(r.case.name, v.check.component, v.check.quantity) for r in results for v in r.verdicts]
+        plots = dict(zip(keys, made))
+        graphs = {r.case.name: graph_svg(case_analysis(r.case.mechanism)) for r in results}
+        write_text(path, html_report(rows, results, manifest, plots, graphs))
 
 
 def check_outputs(manifest, paths: dict) -> None:
@@ -90,17 +109,19 @@ def make_plot_dir(directory: Path, option: str = "--plots") -> None:
         raise GearcliError(f"{directory}: {option}: cannot create the directory: {exc.strerror}") from None
 
 
-def write_plots(results, directory: Path) -> list[Path]:
-    """One PNG per failing or tight (< 10 % margin) check: its quantity along the worst
-    trajectory with the level that just meets the limit."""
+def write_plots(results, directory: Path, every: bool = False) -> list[Path]:
+    """One PNG per failing or tight (< 10 % margin) check (``every``: per check, in the order
+    of the cases' verdicts): its quantity along the worst trajectory with the level that just
+    meets the limit."""
     out = []
     for r in results:
-        for v in r.verdicts:
-            if v.passed and v.margin >= WARN_MARGIN:
+        for n, v in enumerate(r.verdicts):
+            if v.passed and v.margin >= WARN_MARGIN and not every:
                 continue
             ch = v.check
-            path = directory / f"{_slug(r.case.name)}__{_slug(ch.component)}__{_slug(ch.quantity)}.png"
-            status = "FAIL" if not v.passed else "tight"
+            stem = f"{_slug(r.case.name)}__{_slug(ch.component)}__{_slug(ch.quantity)}"
+            path = directory / (f"{stem}__{n}.png" if every else f"{stem}.png")
+            status = "FAIL" if not v.passed else ("tight" if v.margin < WARN_MARGIN else "ok")
             if ch.kind in ("life", "fatigue", "reducer_life"):
                 out.append(profile_plot(r, v, path, f"{r.case.name}: {ch.name} ({status}, margin {v.margin:.3g} %)"))
                 continue
