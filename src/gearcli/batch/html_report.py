@@ -74,7 +74,7 @@ def _png(path: Path) -> str:
 def _versions() -> str:
     import numpy  # noqa: PLC0415
 
-    from .. import __version__  # noqa: PLC0415
+    from ..pipeline import __version__  # noqa: PLC0415  (the package version, as the loads files record it)
     parts = [f"gearcli {__version__}", f"Python {platform.python_version()}", f"numpy {numpy.__version__}"]
     try:
         import llvmlite  # noqa: PLC0415
