@@ -164,3 +164,43 @@ def test_plot_reads_the_drive_elements_units_from_a_csv(name, unit):
     drive elements' columns have theirs (they were drawn on a unit-less 'value' axis)."""
     from gearcli.report.loads_files import csv_unit
     assert csv_unit(name) == unit
+
+
+CARRIED = """name: carried
+gravity: [0, -3, -9.81]
+base: frame
+end_effector: big
+links:
+  - {name: frame}
+  - {name: table, mass: 5.0, com: [0.05, 0.02, 0.1], inertia: [0.05, 0.06, 0.08]}
+  - {name: small, mass: 0.1, inertia: [1.0e-5, 1.0e-5, 2.0e-5]}
+  - {name: big, mass: 0.5, com: [0.02, 0, 0], inertia: [1.0e-4, 1.0e-4, 2.0e-4]}
+joints:
+  - {name: Jt, parent: frame, child: table, origin: {xyz: [0, 0, 0]}, axis: [0, 0, 1]}
+  - {name: Js, parent: table, child: small, origin: {xyz: [-0.1, 0, 0.1]}, axis: [0, 0, 1]}
+  - {name: Jb, parent: table, child: big, origin: {xyz: [-0.1, 0.2, 0.1]}, axis: [0, 0, 1]}
+gears:
+  - {name: belt, kind: belt, links: [small, big], radii: [0.02, 0.04], pretension: 2000, belt_point: [0, 0, 0.1], efficiency: {forward: 0.95, backward: 0.9}}
+motors:
+  - {name: mt, link: table}
+  - {name: ms, link: small}
+"""
+
+
+@pytest.mark.parametrize("backend", ["numpy", "llvm"])
+def test_belt_on_a_turning_carrier_balances_power(backend):
+    """The belt drive carried by a turntable that turns and accelerates under gravity (the carrier
+    moves): the motors' power = dT/dt - P_gravity + the losses (from the model statement,
+    tests/test_losses.py), every loss >= 0, to 1e-9; the reported loss is that one."""
+    from test_losses import energy_terms, own_losses
+    an = analyse(parse_mechanism(CARRIED))
+    rng = np.random.default_rng(5)
+    q, qd, qdd = (rng.uniform(-2, 2, (200, an.dof)), rng.uniform(-2, 2, (200, an.dof)), rng.uniform(-3, 3, (200, an.dof)))
+    res = solve(an, q, qd, qdd, backend=backend)
+    dT, Pg, Pe = energy_terms(an, q, qd, qdd)
+    total, parts = own_losses(an, q, qd, res)
+    P = np.sum(res.motor * res.motor_speed, axis=1)
+    scale = 1 + np.abs(P) + np.abs(dT) + np.abs(Pg) + total
+    assert np.max(np.abs(P - (dT - Pg - Pe + total)) / scale) < 1e-9
+    assert all(np.all(p >= 0) for p in parts) and np.max(total) > 0
+    assert np.max(np.abs(res.gear_loss.sum(axis=1) - total) / scale) < 1e-11

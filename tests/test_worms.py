@@ -189,3 +189,43 @@ def test_verify_says_a_self_locking_worm_holds_without_a_brake(run_cli, tmp_path
     assert r.exit_code == 0, r.stderr
     line = next(ln for ln in r.stdout.splitlines() if ln.startswith("Worm pair stage of lift"))
     assert "self-locking: it holds a load without a brake" in line and "backward -0.1907" in line
+
+
+CARRIED = """name: carried
+gravity: [0, -3, -9.81]
+base: frame
+end_effector: drum
+links:
+  - {name: frame}
+  - {name: table, mass: 5.0, com: [0.05, 0.02, 0.1], inertia: [0.05, 0.06, 0.08]}
+  - {name: worm, mass: 0.2, inertia: [2.0e-5, 1.0e-4, 1.0e-4]}
+  - {name: drum, mass: 1.0, com: [0.01, 0, 0.02], inertia: [1.0e-3, 2.0e-3, 1.0e-3]}
+joints:
+  - {name: Jt, parent: frame, child: table, origin: {xyz: [0, 0, 0]}, axis: [0, 0, 1]}
+  - {name: Jw, parent: table, child: worm, origin: {xyz: [0.1, 0, 0.2]}, axis: [1, 0, 0]}
+  - {name: Jd, parent: table, child: drum, origin: {xyz: [0.1, 0, 0.25]}, axis: [0, 1, 0]}
+gears:
+  - {name: wp, kind: worm, links: [worm, drum], teeth: [2, 20], reference_diameter: 0.02, module: 0.004, friction_coefficient: 0.05, hand: left}
+motors:
+  - {name: mt, link: table}
+  - {name: mw, link: worm}
+"""
+
+
+@pytest.mark.parametrize("backend", ["numpy", "llvm"])
+def test_worm_pair_on_a_turning_carrier_balances_power(backend):
+    """The worm pair carried by a turntable that turns and accelerates under gravity (the carrier
+    moves): the motors' power = dT/dt - P_gravity + the losses (from the model statement,
+    tests/test_losses.py), every loss >= 0, to 1e-9; the reported loss is that one."""
+    from test_losses import energy_terms, own_losses
+    an = analyse(parse_mechanism(CARRIED))
+    rng = np.random.default_rng(5)
+    q, qd, qdd = (rng.uniform(-2, 2, (200, an.dof)), rng.uniform(-2, 2, (200, an.dof)), rng.uniform(-3, 3, (200, an.dof)))
+    res = solve(an, q, qd, qdd, backend=backend)
+    dT, Pg, Pe = energy_terms(an, q, qd, qdd)
+    total, parts = own_losses(an, q, qd, res)
+    P = np.sum(res.motor * res.motor_speed, axis=1)
+    scale = 1 + np.abs(P) + np.abs(dT) + np.abs(Pg) + total
+    assert np.max(np.abs(P - (dT - Pg - Pe + total)) / scale) < 1e-9
+    assert all(np.all(p >= 0) for p in parts) and np.max(total) > 0
+    assert np.max(np.abs(res.gear_loss.sum(axis=1) - total) / scale) < 1e-11
