@@ -418,3 +418,18 @@ def test_a_reducer_that_never_turns_has_no_finite_life(run_cli, tmp_path):
                                          " reducer_life_h: 1000}\n")
     life = checks(doc)[("reducer hd", "L50 life")]
     assert life["value"] is None and life["passed"] is True and "does not turn" in life["value_note"]
+
+
+def test_check_states_both_graph_views_of_the_reducer(run_cli):
+    """gearcli check describes the reducer in one line: i0 relative to the housing, and the
+    planetary view (the input as carrier) theta_O,I = (1 - 1/i0) theta_H,I, which the joint
+    rates obey (the wave generator at -100 rad/s relative to the housing per rad/s of the arm)."""
+    r = run_cli("check", MECHS / "cobot_joint.yaml")
+    assert r.exit_code == 0
+    line = next(ln for ln in r.stdout.splitlines() if ln.startswith("strain-wave reducer 'hd'"))
+    assert "i0 = -100" in line and "theta_O,I = 1.01 * theta_H,I" in line
+    an = analyse(parse_mechanism((MECHS / "cobot_joint.yaml").read_text()))
+    rates = an.S @ np.array([1.0])                    # every real joint's rate per unit of J2's
+    names = [j.name for j in an.mech.joints]
+    a, b = rates[names.index("Jm")], rates[names.index("J2")]  # input and output relative to the housing (the base)
+    assert a == pytest.approx(-100.0) and (b - a) == pytest.approx(1.01 * (0.0 - a))

@@ -71,7 +71,8 @@ def _reducer_line(d: dict) -> str:
     text = (f"{d['kind'].replace('_', '-')} reducer '{d['reducer']}': input '{d['input']}', output '{d['output']}', "
             f"housing '{d['housing']}', i0 = {i0:.6g} (input : output relative to the housing); pure torques, "
             f"T on the output, -T/i0 on the input, -T(1 - 1/i0) = {-(1 - 1 / i0):.6g} T on the housing "
-            f"(a heavy edge input-output whose carrier is the housing)")
+            f"(a heavy edge input-output whose carrier is the housing; in the planetary view, the edge "
+            f"output-housing with the input as carrier: theta_O,I = {1 - 1 / i0:.6g} * theta_H,I)")
     if eff["forward"] != 1.0 or eff["backward"] != 1.0:
         text += f"; efficiency forward {eff['forward']}, backward {eff['backward']}"
     if d["no_load_torque"] is not None:
