@@ -204,3 +204,16 @@ def test_belt_on_a_turning_carrier_balances_power(backend):
     assert np.max(np.abs(P - (dT - Pg - Pe + total)) / scale) < 1e-9
     assert all(np.all(p >= 0) for p in parts) and np.max(total) > 0
     assert np.max(np.abs(res.gear_loss.sum(axis=1) - total) / scale) < 1e-11
+
+
+def test_urdf_belt_with_an_odd_efficiency_table_is_a_located_error(run_cli, tmp_path):
+    """efficiency_forward="0 0.9 10" (an odd count) on a gearcli:belt: one line naming the
+    element and the attribute, exit 2, no traceback (it raised a numpy reshape error)."""
+    (tmp_path / "m.yaml").write_text(BELT.format(T=100.0, M=-4.0, extra=", efficiency: {forward: 0.95}"))
+    assert run_cli("export", tmp_path / "m.yaml", "-o", tmp_path / "m.urdf").exit_code == 0
+    text = (tmp_path / "m.urdf").read_text()
+    assert 'efficiency_forward="0.95"' in text
+    (tmp_path / "m.urdf").write_text(text.replace('efficiency_forward="0.95"', 'efficiency_forward="0 0.9 10"'))
+    r = run_cli("check", tmp_path / "m.urdf")
+    assert r.exit_code == 2 and "Traceback" not in r.stderr
+    assert "gearcli:belt 'belt': efficiency_forward: a table is pairs 'w_in value ...', got 3 numbers" in r.stderr

@@ -175,6 +175,7 @@ def test_urdf_round_trip_solves_bit_identically(run_cli, tmp_path, extra, backen
     ("type: prismatic, ", "", "gears[0].links[1]", "nut must slide on a prismatic"),
     ("origin: {xyz: [0, 0, 0.1]}", "origin: {xyz: [0.002, 0, 0.1]}", "gears[0].links", "not on one line"),
     ("hand: right", "hand: up", "gears[0].hand", "right"),
+    ("links: [screw, carriage]", "links: [screw, screw]", "gears[0].links", "a screw needs two different links [screw, nut]"),
 ])
 def test_screw_input_problems_are_located(run_cli, tmp_path, old, new, place, message):
     """Each bad screw declaration: one located line naming the key, exit 2, no traceback."""

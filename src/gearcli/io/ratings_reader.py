@@ -185,7 +185,7 @@ def attach_yaml_ratings(mech: Mechanism, data: dict, col: Collector) -> Mechanis
             col.add(f"joints[{i}].bearings", PRISMATIC_BEARINGS)
     gears = []
     for i, (g, s) in enumerate(zip(mech.gears, data.get("gears", []))):
-        if "rating" in s and g.reducer is None and g.screw is None and g.worm is None and g.belt is None:   # theirs: io.reducer_specs, io.screw_specs
+        if "rating" in s and g.reducer is None and g.screw is None and g.worm is None and g.belt is None:   # theirs: io.reducer_specs, io.element_specs
             path = f"{item_path(data, 'gears', i)}.rating"   # a planet copy: its original's path
             if g.mesh_point is None:
                 col.add(path, "a gear rating needs the mesh geometry (mesh_point)")

@@ -15,7 +15,7 @@ from ..model.validate import gear_pair_problems
 from .urdf_transmissions import KINDS as TRANSMISSION_KINDS
 from .urdf_transmissions import read_transmissions
 from .reducer_specs import reducer_spec
-from .screw_specs import belt_spec, screw_spec, worm_spec
+from .element_specs import belt_spec, screw_spec, worm_spec
 from .urdf_xml import NS, floats, q
 from ..model.reducers import LIFE_BASES, REDUCER_KINDS
 
@@ -239,6 +239,35 @@ class Extension:
                 gears.append(GearPair(name, ends[0], ends[1], ratio=ratio, path=path, **kw))
         return gears
 
+    def table_attr(self, el, attr: str, path: str):
+        """A drive element's number-or-table attribute (``efficiency_forward``,
+        ``no_load_torque``, ...) as the YAML value: a float, or [[w_in, value], ...] from
+        "w1 v1 w2 v2 ..."; None with a problem (reported)."""
+        text = el.get(attr)
+        v = floats(text)
+        if v is None or v.size == 0:
+            self.add(path, f"{attr}=\"{text}\" is not a number or a table of pairs 'w_in value ...'", el)
+            return None
+        if v.size > 1 and v.size % 2:
+            self.add(path, f"{attr}: a table is pairs 'w_in value ...', got {v.size} numbers", el)
+            return None
+        return float(v[0]) if v.size == 1 else [[float(a), float(b)] for a, b in v.reshape(-1, 2)]
+
+    def efficiency_attrs(self, el, path: str) -> dict | None:
+        """{"forward": ..., "backward": ...} of a drive element's ``efficiency_forward`` and
+        ``efficiency_backward`` ({} without them; backward alone is refused), None with a problem."""
+        eff = {}
+        for k in ("forward", "backward"):
+            if el.get(f"efficiency_{k}") is not None:
+                v = self.table_attr(el, f"efficiency_{k}", path)
+                if v is None:
+                    return None
+                eff[k] = v
+        if eff and "forward" not in eff:
+            self.add(path, "efficiency_backward needs efficiency_forward", el)
+            return None
+        return eff
+
     def extension_reducers(self, ext) -> list[GearPair]:
         """The gearcli:reducer elements (a strain-wave or cycloidal reducer, README "Reducers"):
         attributes name, kind, input, output, housing, ratio or teeth, efficiency_forward,
@@ -276,7 +305,7 @@ class Extension:
         (links), lead (m/rev), hand, efficiency_forward and efficiency_backward (a number or a
         table "w1 v1 ..." over the screw's speed, rad/s), or friction_coefficient and diameter;
         a child gearcli:rating with C_a, C_0a, max_speed.  Validated as the YAML keys are
-        (:func:`.screw_specs.screw_spec`)."""
+        (:func:`.element_specs.screw_spec`)."""
         out = []
         for el in ext["screws"]:
             name = el.get("name") or f"{el.get('screw')}-{el.get('nut')}"
@@ -350,7 +379,7 @@ class Extension:
         """The gearcli:belt elements (README "Timing belts"): attributes name, j, k, carrier (links),
         radii "r_j r_k" (m), pretension (N), belt_point "x y z" (the carrier link's URDF frame),
         efficiency_forward, efficiency_backward (numbers or tables "w1 v1 ..."), max_effective_pull,
-        min_slack_ratio.  Validated as the YAML keys are (:func:`.screw_specs.belt_spec`)."""
+        min_slack_ratio.  Validated as the YAML keys are (:func:`.element_specs.belt_spec`)."""
         out = []
         for el in ext["belts"]:
             name = el.get("name") or f"{el.get('j')}-{el.get('k')}"
@@ -369,13 +398,11 @@ class Extension:
             if carrier is not None:              # the point is in the carrier link's URDF frame
                 P = carrier[1][:3, :3] @ P + carrier[1][:3, 3]
             spec = {"radii": [float(v) for v in radii], "pretension": float(T[0]), "belt_point": list(P)}
-            eff = {}
-            for k in ("forward", "backward"):
-                v = self.vector(el, f"efficiency_{k}", path, n=None)
-                if v is not None:
-                    eff[k] = float(v[0]) if v.size == 1 else [[float(a), float(b)] for a, b in v.reshape(-1, 2)]
+            eff = self.efficiency_attrs(el, path)
+            if eff is None:
+                continue
             if eff:
-                spec["efficiency"] = eff if "forward" in eff else {"forward": eff["backward"], **eff}
+                spec["efficiency"] = eff
             rating = {k: float(v[0]) for k in ("max_effective_pull", "min_slack_ratio")
                       if (v := self.vector(el, k, path, n=1)) is not None}
             if rating:
@@ -401,20 +428,10 @@ class Extension:
         if spec["hand"] not in ("right", "left"):
             self.add(path, f"hand must be 'right' or 'left', got '{spec['hand']}'", el)
             return None
-        eff = {}
-        for k in ("forward", "backward"):
-            text = el.get(f"efficiency_{k}")
-            if text is None:
-                continue
-            v = floats(text)
-            if v is None or v.size == 0 or (v.size > 1 and v.size % 2):
-                self.add(path, f"efficiency_{k}=\"{text}\" is not a number or a table of pairs 'w_in value ...'", el)
-                return None
-            eff[k] = float(v[0]) if v.size == 1 else [[float(a), float(b)] for a, b in v.reshape(-1, 2)]
+        eff = self.efficiency_attrs(el, path)
+        if eff is None:
+            return None
         if eff:
-            if "forward" not in eff:
-                self.add(path, "efficiency_backward needs efficiency_forward", el)
-                return None
             spec["efficiency"] = eff
         for key in ("friction_coefficient", "diameter"):
             if el.get(key) is not None:
@@ -454,29 +471,19 @@ class Extension:
                 ok = False
             return v
 
-        def table(attr):
-            v = numbers(attr)
-            if v is None:
-                return None
-            if v.size == 1:
-                return float(v[0])
-            if v.size % 2:
-                self.add(path, f"{attr}: a table is pairs 'w_in value ...', got {v.size} numbers", el)
-                return None
-            return [[float(a), float(b)] for a, b in v.reshape(-1, 2)]
         for attr, key in (("ratio", "ratio"), ("teeth", "teeth")):
             if el.get(attr) is not None:
                 v = numbers(attr, 1 if attr == "ratio" else 2)
                 if v is not None:
                     spec[key] = float(v[0]) if attr == "ratio" else [int(z) for z in v]
-        eff = {k: table(f"efficiency_{k}") for k in ("forward", "backward") if el.get(f"efficiency_{k}") is not None}
+        eff = self.efficiency_attrs(el, path)
+        if eff is None:
+            return None
         if eff:
-            if "forward" not in eff:
-                self.add(path, "efficiency_backward needs efficiency_forward", el)
-                return None
             spec["efficiency"] = eff
         if el.get("no_load_torque") is not None:
-            spec["no_load_torque"] = table("no_load_torque")
+            spec["no_load_torque"] = self.table_attr(el, "no_load_torque", path)
+            ok = ok and spec["no_load_torque"] is not None
         if el.get("torsional_stiffness_torque") is not None or el.get("torsional_stiffness_rate") is not None:
             T, K = numbers("torsional_stiffness_torque", 2), numbers("torsional_stiffness_rate", 3)
             if T is not None and K is not None:
@@ -503,7 +510,7 @@ class Extension:
                          + (f"; unknown {', '.join(unknown)}" if unknown else ""), r)
                 ok = False
             spec["rating"] = rating
-        return spec if ok and all(v is not None for v in eff.values()) else None
+        return spec if ok else None
 
     # -- motors ------------------------------------------------------------------------------------
     def motors(self, ext, has_gears: bool) -> list[Motor]:

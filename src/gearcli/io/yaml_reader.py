@@ -26,7 +26,7 @@ from ..model.geometry import dh_transform, origin_axis_transform
 from ..model.reducers import REDUCER_KINDS
 from ..model.validate import check_inertia, gear_pair_problems, inertia_matrix, number_problem
 from .reducer_specs import reducer_spec
-from .screw_specs import belt_spec, screw_spec, worm_spec
+from .element_specs import belt_spec, screw_spec, worm_spec
 from .schema_words import schema_messages
 from .yaml_safe import read_text, yaml_lines
 from .schemas import packaged_schema
@@ -296,14 +296,8 @@ def _gears(data: dict, col: Collector, links: _Names) -> list[GearPair]:
         if spec.get("kind") in REDUCER_KINDS:
             gears.append(_reducer(spec, col, links, names, path))
             continue
-        if spec.get("kind") == "screw":
-            gears.append(_screw(spec, col, links, names, path))
-            continue
-        if spec.get("kind") == "worm":
-            gears.append(_worm(spec, col, links, names, path))
-            continue
-        if spec.get("kind") == "belt":
-            gears.append(_belt(spec, col, links, names, path))
+        if spec.get("kind") in ELEMENTS:
+            gears.append(_element(spec, col, links, names, path))
             continue
         j, k = spec["links"]
         links.ref(j, f"{path}.links[0]")
@@ -345,49 +339,29 @@ def _reducer(spec: dict, col: Collector, links: _Names, names: _Names, path: str
     return GearPair(spec.get("name", f"{i}-{o}"), i, o, spec["kind"], i0, teeth=teeth, carrier=h, path=path, reducer=red)
 
 
-def _screw(spec: dict, col: Collector, links: _Names, names: _Names, path: str) -> GearPair:
-    """A ball or lead screw (links: [screw, nut]) as a GearPair with j = screw, k = nut and the
-    ratio e from the geometry (:mod:`gearcli.model.screws`; the analysis derives it)."""
-    s, n = spec["links"]
-    links.ref(s, f"{path}.links[0]")
-    links.ref(n, f"{path}.links[1]")
-    if s == n:
-        col.add(f"{path}.links", "a screw needs two different links [screw, nut]")
-    if "carrier" in spec:
-        links.ref(spec["carrier"], f"{path}.carrier")
-    names.declare(spec.get("name", f"{s}-{n}"), path)
-    return GearPair(spec.get("name", f"{s}-{n}"), s, n, "screw", None, carrier=spec.get("carrier"), path=path,
-                    screw=screw_spec(spec, path, col.add))
+ELEMENTS = {"screw": (screw_spec, "[screw, nut]"), "worm": (worm_spec, "[worm, wheel]"),
+            "belt": (belt_spec, "[input pulley, output pulley]")}
+"""The two-member drive elements: kind -> (the reader of its keys, its links' roles)."""
 
 
-def _worm(spec: dict, col: Collector, links: _Names, names: _Names, path: str) -> GearPair:
-    """A worm pair (links: [worm, wheel]) as a GearPair with j = worm, k = wheel, the ratio from
-    the geometry (:mod:`gearcli.model.worms`; the analysis derives it)."""
-    w, g = spec["links"]
-    links.ref(w, f"{path}.links[0]")
-    links.ref(g, f"{path}.links[1]")
-    if w == g:
-        col.add(f"{path}.links", "a worm pair needs two different links [worm, wheel]")
-    if "carrier" in spec:
-        links.ref(spec["carrier"], f"{path}.carrier")
-    names.declare(spec.get("name", f"{w}-{g}"), path)
-    return GearPair(spec.get("name", f"{w}-{g}"), w, g, "worm", None, teeth=tuple(spec["teeth"]),
-                    carrier=spec.get("carrier"), path=path, worm=worm_spec(spec, path, col.add))
-
-
-def _belt(spec: dict, col: Collector, links: _Names, names: _Names, path: str) -> GearPair:
-    """A timing belt (links: [input pulley, output pulley]) as a GearPair, the ratio from the
-    geometry (:mod:`gearcli.model.belts`; the analysis derives it)."""
+def _element(spec: dict, col: Collector, links: _Names, names: _Names, path: str) -> GearPair:
+    """A screw, worm pair or timing belt (links: [j, k]) as a GearPair carrying its model
+    element (:mod:`gearcli.model.screws`, :mod:`~gearcli.model.worms`,
+    :mod:`~gearcli.model.belts`); the ratio comes from the geometry (the analysis derives it)."""
+    kind = spec["kind"]
+    parse, roles = ELEMENTS[kind]
     j, k = spec["links"]
-    links.ref(j, f"{path}.links[0]")
-    links.ref(k, f"{path}.links[1]")
+    for n, name in enumerate((j, k)):
+        links.ref(name, f"{path}.links[{n}]")
     if j == k:
-        col.add(f"{path}.links", "a belt needs two different pulleys [input, output]")
+        col.add(f"{path}.links", f"a {kind} needs two different links {roles}")
     if "carrier" in spec:
         links.ref(spec["carrier"], f"{path}.carrier")
-    names.declare(spec.get("name", f"{j}-{k}"), path)
-    return GearPair(spec.get("name", f"{j}-{k}"), j, k, "belt", None, carrier=spec.get("carrier"), path=path,
-                    belt=belt_spec(spec, path, col.add))
+    name = spec.get("name", f"{j}-{k}")
+    names.declare(name, path)
+    teeth = tuple(spec["teeth"]) if kind == "worm" else None
+    return GearPair(name, j, k, kind, None, teeth=teeth, carrier=spec.get("carrier"), path=path,
+                    **{kind: parse(spec, path, col.add)})
 
 
 def _stiffness(spec: dict, col: Collector, path: str) -> float | None:

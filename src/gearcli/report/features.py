@@ -47,6 +47,12 @@ def pair_dicts(an: Analysis) -> list[dict]:
     return out
 
 
+def _table_value(tab):
+    """A drive element's efficiency or no-load torque as the file wrote it: a number, or its
+    table's rows [[w_in, value], ...]."""
+    return tab.values[0] if tab.is_constant else [list(r) for r in zip(tab.speeds, tab.values)]
+
+
 def reducer_dicts(an: Analysis) -> list[dict]:
     """Each coaxial reducer (:mod:`gearcli.model.reducers`): kind, input, output, housing, the
     basic ratio i0, efficiencies (constant ones; a table: its rows), no-load torque (N*m)."""
@@ -57,11 +63,9 @@ def reducer_dicts(an: Analysis) -> list[dict]:
         if red is None:
             continue
 
-        def value(tab):
-            return tab.values[0] if tab.is_constant else [list(r) for r in zip(tab.speeds, tab.values)]
         out.append({"reducer": gp.name, "kind": gp.kind, "input": gp.j, "output": gp.k, "housing": gp.carrier,
-                    "ratio": gp.ratio, "efficiency": {"forward": value(red.forward), "backward": value(red.backward)},
-                    "no_load_torque": None if red.no_load_torque is None else value(red.no_load_torque)})
+                    "ratio": gp.ratio, "efficiency": {"forward": _table_value(red.forward), "backward": _table_value(red.backward)},
+                    "no_load_torque": None if red.no_load_torque is None else _table_value(red.no_load_torque)})
     return out
 
 
@@ -90,10 +94,8 @@ def screw_dicts(an: Analysis) -> list[dict]:
         if sc is None:
             continue
 
-        def value(tab):
-            return tab.values[0] if tab.is_constant else [list(r) for r in zip(tab.speeds, tab.values)]
         out.append({"screw": gp.name, "screw_link": gp.j, "nut": gp.k, "carrier": an.names[c.carrier], "lead": sc.lead,
-                    "hand": sc.hand, "h": sc.h, "efficiency": {"forward": value(sc.forward), "backward": value(sc.backward)}})
+                    "hand": sc.hand, "h": sc.h, "efficiency": {"forward": _table_value(sc.forward), "backward": _table_value(sc.backward)}})
     return out
 
 
@@ -149,8 +151,7 @@ def belt_dicts(an: Analysis) -> list[dict]:
             continue
         out.append({"belt": gp.name, "pulleys": [gp.j, gp.k], "radii": [bt.r_j, bt.r_k], "pretension": bt.pretension,
                     "shaft_pull_at_rest": 2 * bt.pretension * math.cos(c.belt.alpha), "ratio": c.ratio,
-                    "efficiency": {"forward": bt.forward.values[0] if bt.forward.is_constant else "table",
-                                   "backward": bt.backward.values[0] if bt.backward.is_constant else "table"}})
+                    "efficiency": {"forward": _table_value(bt.forward), "backward": _table_value(bt.backward)}})
     return out
 
 
