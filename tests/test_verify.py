@@ -152,7 +152,8 @@ def test_bad_manifest_lists_every_problem_before_running(run_cli, tmp_path):
     lines = r.stderr.strip().splitlines()
     # one round: the schema's problem (an unknown key) and those of the valid parts together
     assert f"{man}:9: cases[1].speed: unknown key 'speed' (allowed: name, mechanism, trajectories, service_life_h, " \
-           "degrees, cycles_per_hour, bearing_life_h, gear_life_h, reducer_life_h, screw_life_h, min_static_safety, " \
+           "degrees, cycles_per_hour, bearing_life_h, gear_life_h, reducer_life_h, screw_life_h, min_worm_efficiency, " \
+           "min_static_safety, " \
            "min_bending_safety, min_contact_safety, limits)" in lines
     assert f"{man}:3: cases[0].trajectories[0]: no trajectory file matches 'missing_*.csv' (relative to {tmp_path})" \
         in lines

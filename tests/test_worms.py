@@ -191,6 +191,59 @@ def test_verify_says_a_self_locking_worm_holds_without_a_brake(run_cli, tmp_path
     assert "self-locking: it holds a load without a brake" in line and "backward -0.1907" in line
 
 
+
+def _lift_manifest(tmp_path, extra: str, mech=MECHS / "worm_lift.yaml") -> Path:
+    (tmp_path / "d.yaml").write_text(
+        f"cases:\n  - {{name: lift, mechanism: {mech}, trajectories: [{MECHS / 'worm_lift_traj.csv'}], {extra}}}\n")
+    return tmp_path / "d.yaml"
+
+
+def test_verify_checks_the_worm_pairs_efficiency_over_the_duty_cycle(run_cli, tmp_path):
+    """``min_worm_efficiency``: the value verify reports is 1 - E_loss / E_in over the bundled
+    lift's duty (lift, hold, lower), computed here from the drum's own equation alone: the
+    mesh delivers P_G = (I_yy qdd - M_rope) qd to the drum; lifting (P_G > 0) the worm puts in
+    P_G / eta_f, lowering the self-locking stage (P_G < 0) both members put in, all of it lost,
+    (1 - eta_b) |P_G|; eta_f, eta_b from the model statement's closed forms.  Its plot is
+    written.  Deliberate bug caught: the power in without the loss (P_in = |P_G|)."""
+    import json
+    import csv
+    rows = np.array([[float(v) for v in r.values()] for r in csv.DictReader(open(MECHS / "worm_lift_traj.csv"))])
+    t, qd, qdd = rows[:, 0], rows[:, 2], rows[:, 3]
+    P_G = (4.0e-3 * qdd + 5.886) * qd               # the rope's moment about +y is -5.886 N*m
+    g, a, mu = math.atan(0.002 / 0.028), ALPHA, 0.08
+    eta_f = (math.cos(a) - mu * math.tan(g)) / (math.cos(a) + mu / math.tan(g))
+    eta_b = (math.cos(a) - mu / math.tan(g)) / (math.cos(a) + mu * math.tan(g))
+    assert eta_b < 0
+    E_in = np.where(P_G > 0, P_G / eta_f, (1 - eta_b) * -P_G)
+    E_loss = np.where(P_G > 0, P_G * (1 / eta_f - 1), (1 - eta_b) * -P_G)
+    trap = lambda x: float(np.sum(0.5 * (x[1:] + x[:-1]) * np.diff(t)))  # noqa: E731
+    want = 1.0 - trap(E_loss) / trap(E_in)
+    assert 0.2 < want < eta_f - 0.1                 # the lowering's losses count
+    r = run_cli("verify", _lift_manifest(tmp_path, "min_worm_efficiency: 0.25"), "-j", "1",
+                "--json", tmp_path / "r.json", "--html", tmp_path / "r.html")
+    assert r.exit_code == 0, r.stderr
+    (check,) = json.loads((tmp_path / "r.json").read_text())["checks"]
+    assert check["component"] == "worm pair stage" and check["quantity"] == "efficiency over the duty cycle"
+    assert check["value"] == pytest.approx(want, rel=1e-9) and check["passed"]
+    assert "efficiency over the duty cycle" in (tmp_path / "r.html").read_text() and "data:image/png" in (tmp_path / "r.html").read_text()
+    r = run_cli("verify", _lift_manifest(tmp_path, f"min_worm_efficiency: {want + 0.01:.6f}"), "-j", "1")
+    assert r.exit_code == 1 and "FAILED lift: worm pair stage: efficiency over the duty cycle" in r.stdout
+
+
+@pytest.mark.parametrize("extra, message", [
+    ("min_worm_efficiency: 0", "min_worm_efficiency"),
+    ("min_worm_efficiency: 1.5", "min_worm_efficiency"),
+])
+def test_bad_worm_efficiency_requirement_is_located(run_cli, tmp_path, extra, message):
+    r = run_cli("verify", _lift_manifest(tmp_path, extra), "-j", "1", "--json", tmp_path / "r.json")
+    assert r.exit_code == 2 and "Traceback" not in r.stderr and not (tmp_path / "r.json").exists()
+    assert f"d.yaml:2: cases[0].{message}:" in r.stderr, r.stderr
+
+
+def test_worm_efficiency_requirement_without_a_worm_is_an_error(run_cli, tmp_path):
+    r = run_cli("verify", _lift_manifest(tmp_path, "min_worm_efficiency: 0.3", MECHS / "screw_lift.yaml"), "-j", "1")
+    assert r.exit_code == 2 and "cases[0].min_worm_efficiency: checks nothing" in r.stderr, r.stderr
+
 CARRIED = """name: carried
 gravity: [0, -3, -9.81]
 base: frame

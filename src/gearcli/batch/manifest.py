@@ -27,7 +27,7 @@ from ..dynamics.determinacy import load_analysed
 from ..io.schemas import packaged_schema
 
 REQUIREMENT_KEYS = ("cycles_per_hour", "service_life_h", "bearing_life_h", "gear_life_h", "reducer_life_h", "screw_life_h",
-                    "min_static_safety",
+                    "min_worm_efficiency", "min_static_safety",
                     "min_bending_safety", "min_contact_safety")
 
 
@@ -315,6 +315,7 @@ REQUIREMENT_CHECKS = {"bearing_life_h": ("L10 life", "joints[].bearings with C")
                       "gear_life_h": ("bending fatigue life", "gears[].rating"),
                       "reducer_life_h": ("reducer life", "reducer (kind strain_wave or cycloidal) with a rating"),
                       "screw_life_h": ("screw life", "screw (kind screw) with a rating"),
+                      "min_worm_efficiency": ("efficiency over the duty cycle", "worm pair (kind worm)"),
                       "min_static_safety": ("static safety s0", "joints[].bearings"),
                       "min_bending_safety": ("bending safety", "gears[].rating"),
                       "min_contact_safety": ("contact safety", "gears[].rating")}

@@ -74,7 +74,8 @@ INFINITE_NOTES = {"fatigue": "no damage (below the endurance limit)",
                   "safety": "no load (a safety factor over a zero load)",
                   "reducer_life": "no load or no turning (the reducer's input does not turn, or carries no torque)",
                   "screw_life": "no load or no turning (the screw does not turn, or carries no axial load)",
-                  "slack": "no effective pull (both spans at the pretension)"}
+                  "slack": "no effective pull (both spans at the pretension)",
+                  "worm_efficiency": "no power flows (the pair does not turn, or carries no load)"}
 """What an infinite value of a check kind means: the reports print it in place of "inf"."""
 
 

@@ -1,6 +1,7 @@
 """``gearcli verify``: manifest in, verdicts and reports out (the CLI is a thin layer on it)."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,14 +18,16 @@ SIGNAL_LABELS = {"abs": "|{}|", "col": "RMS of {} from the start", "rate": "|joi
                  "bearing_P0": "static equivalent load P0", "bending": "Lewis root bending stress",
                  "contact": "Hertz contact stress", "inertia_ratio": "load-to-rotor inertia ratio",
                  "envelope": "|T| / T_max(speed)", "regen_power": "regenerative power",
-                 "reducer_speed": "|input speed relative to the housing|"}
+                 "reducer_speed": "|input speed relative to the housing|",
+                 "worm_efficiency": "efficiency 1 - loss / power in"}
 LIMIT_LABELS = {"peak": "limit", "rms": "RMS limit", "safety": "allowable / required safety",
                 "life": "P_eq giving the required life", "energy": "energy limit (integral over the cycle)",
                 "reducer_average": "average torque limit (T_av, speed-weighted)",
                 "reducer_speed_average": "average input speed limit (n_av)",
                 "reducer_life": "T_av giving the required life",
                 "screw_life": "F_m (cubic mean, speed-weighted) giving the required life",
-                "slack": "|E| at the least slack ratio: T_i / (ratio + 1/2)"}
+                "slack": "|E| at the least slack ratio: T_i / (ratio + 1/2)",
+                "worm_efficiency": "required efficiency over the duty cycle"}
 
 
 @dataclass
@@ -132,6 +135,8 @@ def write_plots(results, directory: Path, every: bool = False) -> list[Path]:
             title = (f"{r.case.name}: {ch.name} ({status}, margin {v.margin:.3g} %)\n"
                      f"worst trajectory {Path(r.case.trajectories[v.trajectory]).name}")
             ylabel = f"{label} [{ch.signal_unit}]" if ch.signal_unit else f"{label} (dimensionless)"
-            plot_check(t, y, v.signal_limit, path, title, ylabel, LIMIT_LABELS[ch.kind])
+            levels = ((v.value, f"efficiency over the duty cycle: {v.value:.4g}"),) \
+                if ch.kind == "worm_efficiency" and math.isfinite(v.value) else ()
+            plot_check(t, y, v.signal_limit, path, title, ylabel, LIMIT_LABELS[ch.kind], levels)
             out.append(path)
     return out

@@ -19,6 +19,8 @@ and how the samples of a duty cycle are reduced to the value compared with the l
 * ``slack``: a belt's least slack-span tension over |E|, ``rating`` (T_i) / max |E| - 1/2 >= limit;
 * ``screw_life``: a screw's ISO 3408-5 life from its speed-weighted cubic-mean axial load
   (>= limit, :mod:`gearcli.model.screws`).
+* ``worm_efficiency``: a worm pair's efficiency over the duty cycle, 1 - (energy lost) / (energy
+  its members put in), >= limit (:func:`gearcli.design.evaluate.worm_powers`).
 
 Servo sizing (inertia ratio, torque-speed envelope, regenerative energy) is in :mod:`.sizing`.
 """
@@ -48,6 +50,7 @@ class Requirements:
     gear_life_h: float | None = None
     reducer_life_h: float | None = None
     screw_life_h: float | None = None
+    min_worm_efficiency: float | None = None
     min_static_safety: float = 1.0
     min_bending_safety: float = 1.0
     min_contact_safety: float = 1.0
@@ -78,7 +81,7 @@ class Check:
 def build_checks(an, req: Requirements, col: Collector) -> list[Check]:
     """Every check of the analysed mechanism ``an`` under ``req``; problems go to ``col``."""
     checks = _motor_checks(an) + sizing_checks(an, Check) + _bearing_checks(an, req, col) + _gear_checks(an, req, col)
-    checks += _reducer_checks(an, req) + _screw_checks(an, req) + _belt_checks(an)
+    checks += _reducer_checks(an, req) + _screw_checks(an, req) + _belt_checks(an) + _worm_checks(an, req)
     checks += _joint_limit_checks(an) + _column_checks(an, req, col)
     return checks
 
@@ -98,6 +101,24 @@ def _belt_checks(an) -> list[Check]:
             out.append(Check(comp, "effective pull", "N", r.max_effective_pull, "peak", E, "N"))
         if r.min_slack_ratio is not None:
             out.append(Check(comp, "slack ratio", "", r.min_slack_ratio, "slack", E, "N", rating=gp.belt.pretension))
+    return out
+
+
+def _worm_checks(an, req: Requirements) -> list[Check]:
+    """With the case's ``min_worm_efficiency``, every worm pair's efficiency over the duty
+    cycle (energies, so a self-locking pair lowered by its motor counts at 0) >= the limit.
+    ``extra``: the worm's rate row over the joint rates relative to the carrier, the ratio e
+    (theta_W = e theta_G) and the wheel's pitch radius r2 (:mod:`gearcli.model.worms`)."""
+    if req.min_worm_efficiency is None:
+        return []
+    out = []
+    for c in an.circuits:
+        gp = an.mech.gears[c.gear]
+        if gp.worm is None:
+            continue
+        x = {"row": tuple(float(v) for v in c.row_j), "ratio": float(c.ratio), "r2": float(c.worm.r2)}
+        out.append(Check(f"worm pair {gp.name}", "efficiency over the duty cycle", "", req.min_worm_efficiency,
+                         "worm_efficiency", ("worm_efficiency", gp.name), "", extra=x))
     return out
 
 

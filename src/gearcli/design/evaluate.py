@@ -78,6 +78,12 @@ def _signal(check: Check, s: Samples, mech, cache: dict) -> np.ndarray:
         return np.abs(s.rates @ np.asarray(check.extra["row"]))
     if kind in sizing.SIGNALS:
         return sizing.signal(check, s.cols)
+    if kind == "worm_efficiency":       # 1 - loss / power in; NaN where no power flows (a gap in plots)
+        P_in, loss = worm_powers(check, s)
+        out = np.full(P_in.shape, np.nan)
+        flows = P_in > 0.0
+        out[flows] = 1.0 - loss[flows] / P_in[flows]
+        return out
     if kind in ("bearing_P", "bearing_P0"):
         jt = mech.joints[check.signal[1]]
         b = jt.bearings[check.signal[2]]
@@ -100,6 +106,23 @@ def _signal(check: Check, s: Samples, mech, cache: dict) -> np.ndarray:
         return hertz_contact_stress(ft, x["d1"], x["b"], x["u"], x["alpha"], x["ZE"], x["K"], x["internal"],
                                     x.get("beta", 0.0))
     raise ValueError(f"unknown signal {check.signal!r}")
+
+
+def worm_powers(check: Check, s: Samples) -> tuple[np.ndarray, np.ndarray]:
+    """(P_in, loss), W, of a worm pair at each sample: the power its two members put into the
+    mesh, relative to the carrier, and the power it dissipates (``gear:<w>:loss``).
+
+    The flank load delivers P_G = r2 t w_G to the wheel (t = ``gear:<w>:t``, its moment r2 t
+    about the wheel's axis; w_G = w_W / e, w_W the worm's rate relative to the carrier from
+    ``extra["row"]``) and the worm puts in P_W = P_G + loss, so P_in = max(P_W, 0) +
+    max(-P_G, 0): P_W when the worm drives (efficiency P_G / P_W = eta_f), -P_G when the
+    wheel drives and the worm receives power (1 - loss / P_in = eta_b), and loss itself when
+    the wheel pushes a self-locking worm that the motor also pushes (efficiency 0)."""
+    x, name = check.extra, check.signal[1]
+    w_G = (s.rates @ np.asarray(x["row"])) / x["ratio"]
+    P_G = x["r2"] * s.cols[f"gear:{name}:t"] * w_G
+    loss = s.cols[f"gear:{name}:loss"]
+    return np.maximum(P_G + loss, 0.0) + np.maximum(-P_G, 0.0), loss
 
 
 def bearing_of(check: Check, mech):
@@ -128,11 +151,20 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
         if ch.component != component:
             cache.clear()
             component = ch.component
+        total = wsum = revs = 0.0
+        counts = None
+        if ch.kind == "worm_efficiency":   # energies lost and put in; the least efficiency and its time
+            P_in, loss = worm_powers(ch, s)
+            total, wsum = sizing.cycle_integral(loss, s.t), sizing.cycle_integral(P_in, s.t)
+            x = signal(ch, s, mech, cache)
+            k = int(np.nanargmin(x)) if np.any(P_in > 0.0) else 0
+            peak, tp = (float(x[k]), float(s.t[k])) if x.size and P_in[k] > 0.0 else (math.inf, math.nan)
+            out[i] = (peak, tp, total, wsum, revs, total / wsum if wsum > 0.0 else 0.0, span, counts)
+            continue
         x = signal(ch, s, mech, cache)
         k = _peak_index(cache, ch, x)
         peak, tp = (float(np.abs(x[k])), float(s.t[k])) if x.size else (0.0, math.nan)
-        total = wsum = revs = 0.0
-        score, counts = peak, None
+        score = peak
         if ch.kind == "rms":
             total, wsum = float(square_integral(x, s.t)), span
             score = rms_of(total, wsum, peak)
@@ -288,6 +320,10 @@ def combine(check: Check, parts: list[tuple], rates) -> Verdict:
         sig_lim = check.rating / (check.limit + 0.5)
     elif check.kind in REDUCER_KINDS:
         value, sig_lim = _reducer_value(check, parts, rates)
+    elif check.kind == "worm_efficiency":           # 1 - E_loss / E_in, each trajectory weighted
+        E_in = sum(r * p[3] for r, p in zip(w, parts))
+        value = 1.0 - sum(r * p[2] for r, p in zip(w, parts)) / E_in if E_in > 0.0 else math.inf
+        sig_lim = check.limit
     elif check.kind == "fatigue":
         value = F.life_hours(sum(r * p[2] for r, p in zip(per_hour, parts)))
         cycles = check.limit * sum(r * p[4] for r, p in zip(per_hour, parts))

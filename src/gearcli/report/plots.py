@@ -162,8 +162,9 @@ def plot_columns(t: np.ndarray, series: dict, units: dict, out: str | Path, titl
 
 
 def plot_check(t: np.ndarray, y: np.ndarray, limit: float, out: str | Path, title: str, ylabel: str,
-               limit_label: str) -> None:
-    """A check's quantity ``y`` over ``t`` (its worst trajectory) and the level ``limit``."""
+               limit_label: str, levels: tuple = ()) -> None:
+    """A check's quantity ``y`` over ``t`` (its worst trajectory) and the level ``limit``;
+    ``levels``: more (level, label) lines, dotted (the value a duty-cycle check compares)."""
     plt = _pyplot()
     with warnings.catch_warnings():     # matplotlib's (a glyph missing from the font) are not gearcli's
         warnings.simplefilter("ignore")
@@ -171,6 +172,8 @@ def plot_check(t: np.ndarray, y: np.ndarray, limit: float, out: str | Path, titl
         ax.plot(t, y, lw=1.2, label="value")
         if np.isfinite(limit):
             ax.axhline(limit, color="red", ls="--", lw=1.2, label=limit_label)
+        for level, label in levels:
+            ax.axhline(level, color="black", ls=":", lw=1.2, label=label)
         ax.set_xlabel("t [s]")
         ax.set_ylabel(ylabel)
         ax.set_title(title, fontsize="medium")
