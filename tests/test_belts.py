@@ -217,3 +217,37 @@ def test_urdf_belt_with_an_odd_efficiency_table_is_a_located_error(run_cli, tmp_
     r = run_cli("check", tmp_path / "m.urdf")
     assert r.exit_code == 2 and "Traceback" not in r.stderr
     assert "gearcli:belt 'belt': efficiency_forward: a table is pairs 'w_in value ...', got 3 numbers" in r.stderr
+
+
+def test_simulate_stops_where_a_span_goes_slack(run_cli, tmp_path):
+    """simulate, without --loads: a motor torque ramped 0 -> 5 N*m over 1 s accelerates the pulleys
+    (no load).  By hand, alpha_s = tau / (I_s + I_b (r_s/r_b)^2) and the big pulley takes
+    E r_b = I_b alpha_s r_s / r_b: E = 2.5e-3 alpha_s = 35.714 tau, so the 41 N pretension's slack
+    span reaches zero at tau = 2.296 N*m, t = 0.45920 s.  The run stops at the first output
+    sample past it (0.460 s), names the belt and that time, keeps the rows before it, exit 1."""
+    (tmp_path / "m.yaml").write_text(BELT.format(T=41.0, M=0.0, extra=""))
+    t = np.array([0.0, 1.0])
+    np.savetxt(tmp_path / "u.csv", np.column_stack([t, 5.0 * t]), delimiter=",", header="t,motor:m", comments="")
+    r = run_cli("simulate", tmp_path / "m.yaml", tmp_path / "u.csv", "-o", tmp_path / "o.csv", "--rtol", "1e-10")
+    I_s, I_b, r_s, r_b = 2.0e-5, 2.0e-4, 0.02, 0.04
+    tau_star = 2 * 41.0 / (I_b * r_s / r_b**2 / (I_s + I_b * (r_s / r_b) ** 2))
+    t_star = tau_star / 5.0
+    assert t_star == pytest.approx(0.4592, abs=1e-4)
+    first = math.ceil(t_star * 1000) / 1000
+    assert r.exit_code == 1, r.stderr
+    assert f"belt 'belt' goes slack at t = {first:.9g} s: pretension T_i = 41 N < |E|/2 = " in r.stderr
+    rows = np.loadtxt(tmp_path / "o.csv", delimiter=",", skiprows=1)
+    assert rows[-1, 0] == pytest.approx(first - 1e-3, abs=1e-12) and len(rows) == round(first * 1000)
+    # the rows written are the motion by hand: qd = tau(t) t / 2 / I_eff ... of the small pulley's joint
+    qd_b = 5.0 * rows[:, 0] ** 2 / 2 / (I_s + I_b * (r_s / r_b) ** 2) * (r_s / r_b)
+    assert np.allclose(rows[:, 2], qd_b, rtol=1e-7, atol=1e-9)
+
+
+def test_simulate_without_slack_runs_to_the_end(run_cli, tmp_path):
+    """The same ramp with 100 N of pretension (E/2 <= 89.3 N): no stop, every row written, exit 0."""
+    (tmp_path / "m.yaml").write_text(BELT.format(T=100.0, M=0.0, extra=""))
+    t = np.array([0.0, 1.0])
+    np.savetxt(tmp_path / "u.csv", np.column_stack([t, 5.0 * t]), delimiter=",", header="t,motor:m", comments="")
+    r = run_cli("simulate", tmp_path / "m.yaml", tmp_path / "u.csv", "-o", tmp_path / "o.csv")
+    assert r.exit_code == 0, r.stderr
+    assert len(np.loadtxt(tmp_path / "o.csv", delimiter=",", skiprows=1)) == 1001

@@ -13,7 +13,10 @@ The accelerations are :func:`~.forward.forward_dynamics` (exact, every gear and 
 integrated by :func:`scipy.integrate.solve_ivp` row interval by row interval of the input
 (:func:`row_intervals`: its values are linear between rows, their slope may jump at one).  Joints with position limits (YAML
 ``joints[].limits``, a URDF ``<limit lower upper>``) stop the integration when they reach
-one (a terminal event); the stop is reported, with the samples up to it.
+one (a terminal event); the stop is reported, with the samples up to it.  A timing belt
+whose slack span would go below zero tension at an output sample (|E|/2 > T_i, E from the
+inverse dynamics of the samples integrated, as ``--loads`` solves them) stops it too, with
+the samples before that one (:meth:`_Kept.append`).
 """
 from __future__ import annotations
 
@@ -254,8 +257,8 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
                 x, a = xe, te
                 if a >= b:
                     break
-    except _Stopped:
-        pass
+    except _Stopped as why:
+        stop = why.reason or stop
     except SimulationError as exc:       # the motion up to the failure is kept (and written)
         if not segments:
             raise
@@ -281,8 +284,20 @@ class _Kept(list):
         super().__init__()
         self.sink, self.d, self.dof, self.backend = sink, d, dof, backend
         self.rows, self.ends = 0, []
+        self.belts = any(d.an.mech.gears[c.gear].belt is not None for c in d.an.circuits)
 
     def append(self, segment) -> None:
+        """Keep ``segment``; with a belt whose span goes slack at one of its samples, keep the
+        samples before that one and raise :class:`_Stopped` naming the belt and the time."""
+        slack = _slack(self.d, segment, self.dof, self.backend) if self.belts else None
+        if slack is not None:
+            k, reason = slack
+            if k:
+                self._add((segment[0][:k], segment[1][:k], segment[2]))
+            raise _Stopped(reason)
+        self._add(segment)
+
+    def _add(self, segment) -> None:
         if self.sink is None:
             super().append(segment)
             self.rows += len(segment[0])
@@ -294,6 +309,23 @@ class _Kept(list):
 
     def __bool__(self) -> bool:
         return self.rows > 0
+
+
+def _slack(d, segment, dof, backend) -> tuple[int, str] | None:
+    """(index, reason) of the first sample of ``segment`` where a belt's slack span would go
+    below zero tension (:func:`~.losses.check_belts` on the inverse dynamics of its samples,
+    the payloads it carries attached), else None."""
+    from .losses import SlackError, check_belts  # noqa: PLC0415
+    from .solve import solve  # noqa: PLC0415
+    sim = _samples(d, [segment], None, 0, dof, backend)
+    an = segment[2][1].an           # the mechanism carrying this segment's payloads
+    res = solve(an, sim.q, sim.qd, sim.qdd, backend=backend)
+    try:
+        check_belts(an, res)
+    except SlackError as exc:
+        return exc.sample, (f"belt '{exc.belt}' goes slack at t = {sim.t[exc.sample]:.9g} s: pretension T_i = "
+                            f"{exc.pretension:g} N < |E|/2 = {exc.half:.6g} N (raise the pretension, or lower the load)")
+    return None
 
 
 def _limit_events(an) -> list:
@@ -323,7 +355,12 @@ def _after_switch(ss, mode, switch, xe, d, te, dof, backend, dynamics):
 
 
 class _Stopped(Exception):
-    """A joint limit ended the integration."""
+    """A joint limit or a slack belt ended the integration (``reason``: the belt's, else None:
+    the caller has set the joint limit's)."""
+
+    def __init__(self, reason: str | None = None):
+        super().__init__(reason)
+        self.reason = reason
 
 
 def _integrate(solve_ivp, rhs, a, b, x, wanted, method, rtol, atol, events, segments, mode):
