@@ -2,7 +2,9 @@
 
 No network: the styles and the table-sorting script are inline, every plot is an inline PNG
 (a ``data:`` URI) and each case's graph an inline SVG.  The report holds the pass/fail
-summary, every check (value, limit, margin; the table sorts by any column), per check the
+summary with the plot of the tightest check (the failing one of least margin, else the
+passing one of least margin: what a reader opens first), every check (value, limit, margin;
+the table sorts by any column), per check the
 plot of its quantity against its limit along the duty cycle (:func:`gearcli.batch.verify.write_plots`),
 each case's mechanism graph (canonical thin edges by level, heavy edges for the gear pairs and
 drive elements) and the backend and versions that ran it.
@@ -84,6 +86,19 @@ def _versions() -> str:
     return ", ".join(parts) + f"; {platform.machine()} {platform.system()}"
 
 
+def _tightest(rows, plots: dict) -> list[str]:
+    """The summary's figure: the plot of the failing check of least margin, else of the passing
+    one of least margin (none without a plot)."""
+    drawn = [r for r in rows if (r.case, r.component, r.quantity) in plots]
+    if not drawn:
+        return []
+    r = min(drawn, key=lambda r: (r.passed, r.margin))
+    p = plots[(r.case, r.component, r.quantity)]
+    return [f'<h2 id="tightest">{"Failing" if not r.passed else "Tightest"} check: {html.escape(r.case)}: '
+            f"{html.escape(r.name)} (margin {html.escape(fmt(r.margin))} %)</h2>",
+            f'<img class="tightest" alt="{html.escape(r.name)}" src="{_png(p)}">']
+
+
 def html_report(rows, results, manifest: str, plots: dict, graphs: dict) -> str:
     """The report's HTML (a string).  ``plots``: {(case, component, quantity): PNG path};
     ``graphs``: {case: inline SVG of its mechanism's graph}."""
@@ -97,7 +112,7 @@ def html_report(rows, results, manifest: str, plots: dict, graphs: dict) -> str:
            f"<h1>Design checks: {html.escape(manifest)}</h1>", verdict,
            f"<p>{len(rows) - failed} passed ({tight} with less than {WARN_MARGIN:g} % margin), {failed} failed.</p>",
            f"<p class=meta>Solver backend per case:</p><ul class=meta>{backends}</ul>",
-           f"<p class=meta>Ran with {html.escape(_versions())}.</p>",
+           f"<p class=meta>Ran with {html.escape(_versions())}.</p>", *_tightest(rows, plots),
            "<h2>Checks</h2><p class=meta>Click a column's header to sort by it.</p>",
            '<table class="sortable"><thead><tr>' + "".join(f"<th>{html.escape(c)}</th>" for c in COLUMNS)
            + "</tr></thead><tbody>", *(_row(r) for r in rows), "</tbody></table>",
