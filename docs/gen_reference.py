@@ -1,5 +1,6 @@
-"""Write docs/reference/mechanism.md from schemas/mechanism.schema.json: the schema is the
-one source of the mechanism file's keys (tests/test_docs.py fails when the page differs).
+"""Write docs/reference/mechanism.md from schemas/mechanism.schema.json and
+docs/reference/design-manifest.md from schemas/design.schema.json: each schema is the one
+source of its file's keys (tests/test_docs.py fails when a page differs).
 
     python docs/gen_reference.py
 """
@@ -9,8 +10,10 @@ import json
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-SCHEMA = ROOT / "schemas" / "mechanism.schema.json"
-PAGE = ROOT / "docs" / "reference" / "mechanism.md"
+PAGES = {   # kind: (schema, page, title)
+    "mechanism": ("mechanism.schema.json", "mechanism.md", "Mechanism file (YAML)"),
+    "design": ("design.schema.json", "design-manifest.md", "Design manifest (YAML, gearcli verify)"),
+}
 
 
 def _type(spec: dict) -> str:
@@ -31,18 +34,46 @@ def _cell(text: str) -> str:
     return text.replace("|", "\\|").replace("\n", " ")
 
 
-def _table(props: dict, required=()) -> list[str]:
-    out = ["| key | type | description |", "|---|---|---|"]
+def _inline(spec: dict) -> list[dict]:
+    """The inline object schemas of a property (itself, its items, its oneOf/anyOf branches,
+    its if/then/else), whose keys the table lists under the property's dotted name."""
+    found = []
+    if "properties" in spec:
+        found.append(spec)
+    for k in ("items", "then", "else"):
+        if isinstance(spec.get(k), dict):
+            found += _inline(spec[k])
+    for k in ("oneOf", "anyOf"):
+        for branch in spec.get(k, []):
+            found += _inline(branch)
+    return found
+
+
+def _rows(props: dict, required=(), prefix: str = "") -> list[str]:
+    out = []
     for key, spec in props.items():
-        name = f"`{key}`" + (" (required)" if key in required else "")
+        name = f"`{prefix}{key}`" + (" (required)" if key in required else "")
         out.append(f"| {name} | {_cell(_type(spec))} | {_cell(spec.get('description', ''))} |")
+        seen = set()
+        for sub in _inline(spec):
+            props_new = {k: v for k, v in sub["properties"].items() if k not in seen}
+            seen |= set(props_new)
+            out += _rows(props_new, sub.get("required", ()), f"{prefix}{key}.")
     return out
 
 
-def page() -> str:
-    schema = json.loads(SCHEMA.read_text())
-    lines = ["# Mechanism file (YAML)", "",
-             "Generated from `schemas/mechanism.schema.json` by `docs/gen_reference.py`: the schema is",
+def _table(props: dict, required=()) -> list[str]:
+    """The keys of ``props`` (an object's properties) with their type and description; the keys
+    of an inline object (a rating, an inertia given as a mapping) follow their parent's row
+    under a dotted name (``rating.rated_torque``)."""
+    return ["| key | type | description |", "|---|---|---|"] + _rows(props, required)
+
+
+def page(kind: str = "mechanism") -> str:
+    schema_name, _, title = PAGES[kind]
+    schema = json.loads((ROOT / "schemas" / schema_name).read_text())
+    lines = [f"# {title}", "",
+             f"Generated from `schemas/{schema_name}` by `docs/gen_reference.py`: the schema is",
              "the one source of these keys (a test fails when this page differs from it). SI units.", "",
              schema.get("description", ""), "", "## Top level", ""]
     lines += _table(schema["properties"], schema.get("required", ()))
@@ -55,5 +86,7 @@ def page() -> str:
 
 
 if __name__ == "__main__":
-    PAGE.write_text(page())
-    print(f"wrote {PAGE}")
+    for kind, (_, name, _) in PAGES.items():
+        path = ROOT / "docs" / "reference" / name
+        path.write_text(page(kind))
+        print(f"wrote {path}")

@@ -1,4 +1,4 @@
-"""Every key a JSON Schema defines (properties, $defs, oneOf branches), for README checks."""
+"""Every key a JSON Schema defines (properties, $defs, oneOf branches), for the reference pages' checks."""
 from __future__ import annotations
 
 

@@ -10,6 +10,7 @@ import textwrap
 from pathlib import Path
 
 import pytest
+import yaml
 
 SPUR = """\
 name: spur_lossy
@@ -301,8 +302,8 @@ def test_csv_loss_columns_are_drawn_with_their_units(run_cli, tmp_path, monkeypa
 
 
 def _readme_example() -> tuple[str, list[str]]:
-    """The YAML and the console lines of the README's losses example (indented 2 spaces)."""
-    text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    """The YAML and the console lines of the loss model page's example (indented 2 spaces)."""
+    text = (Path(__file__).resolve().parents[1] / "docs" / "concepts" / "losses.md").read_text()
     part = text[text.index("* **Example** (a 15/60 mm spur pair"):]
     blocks = re.findall(r"\n  ```(yaml|console)\n(.*?)\n  ```\n", part, re.S)[:2]
     assert [b[0] for b in blocks] == ["yaml", "console"]
@@ -314,7 +315,9 @@ def test_readme_loss_example_runs_as_written(run_cli, tmp_path, monkeypatch):
     yaml_text, console = _readme_example()
     monkeypatch.chdir(tmp_path)
     Path("spur_lossy.yaml").write_text(yaml_text)
-    printf = console[0]
+    assert yaml.safe_load(yaml_text) == yaml.safe_load((Path(__file__).resolve().parents[1] / "docs" / "examples" / "spur_lossy.yaml").read_text())
+    assert console[0].startswith("$ cp docs/examples/spur_lossy.yaml .")
+    printf = console[1]
     assert printf.startswith("$ printf '") and printf.endswith("' > spur_traj.csv")
     Path("spur_traj.csv").write_text(printf[len("$ printf '"):-len("' > spur_traj.csv")].replace("\\n", "\n"))
     i_check = console.index("$ gearcli check spur_lossy.yaml")

@@ -143,7 +143,7 @@ def test_verify_plot_of_a_joint_rate_says_it_draws_its_magnitude(monkeypatch, me
     import gearcli.batch.verify as bv
 
     drawn = []
-    monkeypatch.setattr(bv, "plot_check", lambda t, y, limit, path, title, ylabel, limit_label:
+    monkeypatch.setattr(bv, "plot_check", lambda t, y, limit, path, title, ylabel, limit_label, levels=():
                         drawn.append((np.asarray(y), limit, ylabel)))
     design = tmp_path / "arm.yaml"    # geared_arm's elbow reaches 2.83 of its 3 rad/s: tight
     design.write_text(f"name: arm\ncases:\n  - mechanism: {mech_dir / 'geared_arm.urdf'}\n"

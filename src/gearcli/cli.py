@@ -84,7 +84,7 @@ def report_mechanism_warnings(an: Analysis, strict: bool) -> None:
 
 
 STRICT_OPTION = typer.Option(False, "--strict", help="Warnings are errors (exit 2): implausible values "
-                             "(a mechanism in mm, a trajectory in degrees read as rad; README, Plausibility "
+                             "(a mechanism in mm, a trajectory in degrees read as rad; docs/reference/mechanism-files.md, Plausibility "
                              "warnings) and input the reader worked around.")
 
 
@@ -211,7 +211,7 @@ def solve(
 ) -> None:
     """Motor torques (N*m), bearing reaction wrenches (N, N*m, parent on child, joint frame)
     and gear tooth forces (N) at every sample of a trajectory.  Writes a table (CSV, Parquet,
-    Feather or NPZ; columns in the README) and prints, for every motor, gear mesh and bearing, the peak, RMS and time of
+    Feather or NPZ; columns in docs/reference/outputs.md) and prints, for every motor, gear mesh and bearing, the peak, RMS and time of
     the peak.  A mechanism with losses (gears[].efficiency or loss_factor, joints[].friction,
     bearings' friction_coefficient and bore) has them in the motor torques, adds the columns
     gear:<pair>:loss (W), joint:<joint>:friction (N*m; N if prismatic) and joint:<joint>:loss
@@ -377,7 +377,7 @@ def verify(
 
 def _worm_lines(manifest) -> list[str]:
     """One line per worm pair of each case: its efficiencies from the geometry and, when
-    self-locking, that it holds a load without a brake (README, Worm pairs)."""
+    self-locking, that it holds a load without a brake (docs/concepts/drive-elements.md, Worm pairs)."""
     from .batch.manifest import case_analysis  # noqa: PLC0415
     from .report.features import worm_dicts  # noqa: PLC0415
 

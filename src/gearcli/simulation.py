@@ -56,7 +56,7 @@ class StallWatch:
 
     def hint(self) -> str:
         hints = ["a gear's rate reverses at 0 where its mesh or bearing friction would hold it (they hold nothing "
-                 "at rest: README, Losses)"] if self.an.mech.has_losses else []
+                 "at rest: docs/concepts/losses.md)"] if self.an.mech.has_losses else []
         tau = [m.model.inductance / m.model.resistance for m in self.an.mech.motors
                if m.model is not None and m.model.inductance]
         if self.method in ("RK45", "RK23", "DOP853") and (tau or not hints):

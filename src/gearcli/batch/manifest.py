@@ -159,7 +159,7 @@ def load_manifest(path: str | Path) -> Manifest:
         col.add("", "a design manifest must be a YAML mapping with a list of cases")
     elif "links" in data and "cases" not in data:
         col.add("", "this is a mechanism file, not a design manifest: a manifest lists cases, each naming "
-                    "a mechanism and its trajectories (README, Design checks in CI)")
+                    "a mechanism and its trajectories (docs/reference/manifest.md)")
     col.raise_if_any()
     number_issues(data, col)
     _schema_issues(data, col, {i.path for i in col.issues})

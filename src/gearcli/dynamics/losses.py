@@ -1,4 +1,4 @@
-"""Power losses of a drive: mesh friction and joint friction (README, "Losses").
+"""Power losses of a drive: mesh friction and joint friction (docs/concepts/losses.md).
 
 Mesh friction of pair p (gears j, k, carrier c; any kind with tooth geometry)
 -----------------------------------------------------------------------------

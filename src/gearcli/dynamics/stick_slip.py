@@ -33,7 +33,7 @@ along it for a prismatic joint), reversed on its parent, so that a rate of exact
 the direction it starts in and the tooth forces (and so the mesh friction) are those of
 the friction where it is.  A held joint's friction enters as C^T Q on the independent
 joints (its row s_J of q = S q_ind).  Viscous, mesh and bearing friction stay in the twin:
-a mesh or bearing at rest has no couple (sign 0), and holds nothing (README, Losses).
+a mesh or bearing at rest has no couple (sign 0), and holds nothing (docs/concepts/losses.md).
 """
 from __future__ import annotations
 

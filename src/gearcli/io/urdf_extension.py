@@ -269,7 +269,7 @@ class Extension:
         return eff
 
     def extension_reducers(self, ext) -> list[GearPair]:
-        """The gearcli:reducer elements (a strain-wave or cycloidal reducer, README "Reducers"):
+        """The gearcli:reducer elements (a strain-wave or cycloidal reducer, docs/concepts/drive-elements.md "Reducers"):
         attributes name, kind, input, output, housing, ratio or teeth, efficiency_forward,
         efficiency_backward and no_load_torque (a number, or a table "w1 v1 w2 v2 ..." over
         |w_in| rad/s), torsional_stiffness_torque "T1 T2" and torsional_stiffness_rate "K1 K2
@@ -301,7 +301,7 @@ class Extension:
         return out
 
     def extension_screws(self, ext) -> list[GearPair]:
-        """The gearcli:screw elements (README "Screws"): attributes name, screw, nut, carrier
+        """The gearcli:screw elements (docs/concepts/drive-elements.md "Screws"): attributes name, screw, nut, carrier
         (links), lead (m/rev), hand, efficiency_forward and efficiency_backward (a number or a
         table "w1 v1 ..." over the screw's speed, rad/s), or friction_coefficient and diameter;
         a child gearcli:rating with C_a, C_0a, max_speed.  Validated as the YAML keys are
@@ -331,7 +331,7 @@ class Extension:
         return out
 
     def extension_worms(self, ext) -> list[GearPair]:
-        """The gearcli:worm elements (README "Worm pairs"): attributes name, worm, wheel, carrier
+        """The gearcli:worm elements (docs/concepts/drive-elements.md "Worm pairs"): attributes name, worm, wheel, carrier
         (links), teeth "z1 Z2", reference_diameter (m), module (m) and/or lead_angle (rad; both as
         gearcli export writes them: taken as given) or lead_angle_deg, pressure_angle (rad) or
         pressure_angle_deg, friction_coefficient, hand."""
@@ -376,7 +376,7 @@ class Extension:
         return out
 
     def extension_belts(self, ext) -> list[GearPair]:
-        """The gearcli:belt elements (README "Timing belts"): attributes name, j, k, carrier (links),
+        """The gearcli:belt elements (docs/concepts/drive-elements.md "Timing belts"): attributes name, j, k, carrier (links),
         radii "r_j r_k" (m), pretension (N), belt_point "x y z" (the carrier link's URDF frame),
         efficiency_forward, efficiency_backward (numbers or tables "w1 v1 ..."), max_effective_pull,
         min_slack_ratio.  Validated as the YAML keys are (:func:`.element_specs.belt_spec`)."""

@@ -1,6 +1,6 @@
 """URDF robot descriptions -> :class:`~gearcli.model.mechanism.Mechanism`.
 
-What each URDF element becomes (README, "URDF in and out", has the table with examples):
+What each URDF element becomes (docs/reference/urdf.md has the table with examples):
 
 * the **root link** is the fixed base; every other link hangs from it by one joint;
 * ``revolute`` and ``continuous`` joints -> revolute joints, ``prismatic`` -> prismatic

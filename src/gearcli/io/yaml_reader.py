@@ -93,7 +93,7 @@ def number_issues(data, col: Collector, path: str = "") -> None:
 
 
 def parse_mechanism(text: str, file: str = "<string>") -> Mechanism:
-    """Parse the YAML text of a mechanism file (see the README for the format)."""
+    """Parse the YAML text of a mechanism file (see docs/reference/mechanism-files.md for the format)."""
     data, lines = yaml_lines(text, file)
     col = Collector(file, lines)
     if not isinstance(data, dict):

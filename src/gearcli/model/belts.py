@@ -1,5 +1,5 @@
 """Timing belts: an open drive of two pulleys (``gears[].kind: belt``;
-``../shared/drive-elements.md`` C, README "Timing belts").
+``../shared/drive-elements.md`` C, docs/concepts/drive-elements.md "Timing belts").
 
 Geometry (carrier frame, fixed for the whole motion)
 ----------------------------------------------------

@@ -5,7 +5,7 @@ input: every value is finite and every check of the geometry passes.  These chec
 for values that no real mechanism has and return findings, which the command line prints
 as warnings (``--strict``: errors).  Each check is one function; the bounds are generous
 (the bundled mechanisms, and the robots of example-robot-data, pass by a wide margin) and
-stated in the README ("Plausibility warnings").
+stated in docs/reference/mechanism-files.md ("Plausibility warnings").
 
 Mechanism checks take the model (:mod:`gearcli.model.mechanism`) and return
 :class:`Finding` (YAML path or URDF element, message).  Trajectory checks take sample

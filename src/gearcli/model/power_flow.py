@@ -1,5 +1,5 @@
 """Catalogue power-flow efficiency, shared by the drive elements (reducers, screws;
-``../shared/drive-elements.md``, "Power-flow efficiency"; README "Reducers", "Screws").
+``../shared/drive-elements.md``, "Power-flow efficiency"; docs/concepts/drive-elements.md).
 
 Catalogues give efficiency as a power ratio in a flow direction: eta_f = P_out / P_in when the
 input member drives, eta_b when the output member drives (eta_b <= 0: self-locking).  An

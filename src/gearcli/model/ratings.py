@@ -25,7 +25,7 @@ BEARING_FACTOR_DEFAULTS = {
     # equivalent radial load); X, Y, e unused
     "crossed_roller": {"X": 1.0, "Y": 0.45, "e": 1.5, "X0": 1.0, "Y0": 0.44},
 }
-"""Default ISO 281 (X, Y, e) and ISO 76 (X0, Y0) factors by rolling-element type (README,
+"""Default ISO 281 (X, Y, e) and ISO 76 (X0, Y0) factors by rolling-element type (docs/reference/mechanism-files.md,
 "Bearings"); None: from ISO 281 Table 3 at each sample's f0 Fa/C0
 (:func:`gearcli.design.iso281.ball_factors`).  Deep-groove ball: X = 0.56 with the table's
 e and Y, ISO 76 X0 = 0.6, Y0 = 0.5.  Cylindrical roller (contact angle 0): no axial load

@@ -1,5 +1,5 @@
 """Coaxial reducers: strain-wave (harmonic) and cycloidal (RV) gears (``gears[].kind:
-strain_wave | cycloidal``; ``../shared/drive-elements.md`` section A, README "Reducers").
+strain_wave | cycloidal``; ``../shared/drive-elements.md`` section A, docs/concepts/drive-elements.md "Reducers").
 
 Members and ratio
 -----------------

@@ -1,4 +1,4 @@
-"""Ball and lead screws (``gears[].kind: screw``; ``../shared/drive-elements.md`` B, README
+"""Ball and lead screws (``gears[].kind: screw``; ``../shared/drive-elements.md`` B, docs/concepts/drive-elements.md
 "Screws").
 
 Members and constraint

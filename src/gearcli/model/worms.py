@@ -1,5 +1,5 @@
 """Worm pairs: a cylindrical worm driving a wheel on crossed axes at 90 deg (``gears[].kind:
-worm``; ``../shared/drive-elements.md`` D, README "Worm pairs").
+worm``; ``../shared/drive-elements.md`` D, docs/concepts/drive-elements.md "Worm pairs").
 
 Geometry (carrier frame, fixed for the whole motion)
 ----------------------------------------------------

@@ -49,7 +49,7 @@ from ..errors import counted
 
 
 def column_names(an) -> list[str]:
-    """Names of the output columns of ``an``, in the stable order of the CSV (README,
+    """Names of the output columns of ``an``, in the stable order of the CSV (docs/reference/mechanism-files.md,
     "Output columns"): t, motors, equivalent joint torques, gear meshes, joint reactions,
     then the appended motor speed and power columns."""
     mech = an.mech
@@ -219,7 +219,7 @@ def named_columns(an, res: Result, t: np.ndarray | None = None) -> dict[str, np.
 
 
 def column_unit(name: str) -> str:
-    """SI unit of an output column from its name alone (the README's column table; a
+    """SI unit of an output column from its name alone (docs/reference/outputs.md's column table; a
     prismatic input or joint changes some: :func:`column_units`)."""
     last = name.rsplit(":", 1)[-1]
     if name.startswith("motor:"):

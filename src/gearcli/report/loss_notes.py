@@ -1,6 +1,6 @@
 """One-line notes on a mechanism's losses (``check``, ``graph``, the ``solve`` summary) and
 their plain-data form (``graph --json`` ``losses``): each lossy gear pair and each joint with
-friction, as the file gave them (README, "Losses").
+friction, as the file gave them (docs/concepts/losses.md).
 
 * A pair: efficiency eta and loss factor c = 1 - eta, and its friction arm rho (m): the
   couple is C = c |t| rho, rho = r_j / |u0| with u0 = z_j - z_k / e the gears' relative

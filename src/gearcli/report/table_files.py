@@ -31,7 +31,7 @@ FORMATS = {".csv": "csv", ".parquet": "parquet", ".feather": "feather", ".npz": 
 CONVENTIONS = ("SI units (s, N, N*m, rad/s, W); joint:<j>:* = wrench of the parent on the child in the "
                "joint frame about its origin; motor:<m> = torque on the input link about its positive joint "
                "axis; gear:<pair>:t = tangential tooth force on gear j by gear k, positive turning j "
-               "positively; columns as in the README, Output columns")
+               "positively; columns as in docs/reference/outputs.md")
 """One line on the frames and sign conventions, stored in binary files' metadata."""
 
 COMPILED_MIN_VALUES = 2_000_000
