@@ -199,3 +199,12 @@ def test_the_readme_is_a_landing_page():
 def test_the_benchmarks_the_pages_name_exist():
     named = {m for page in PAGES for m in re.findall(r"benchmarks/\w+\.py", page.read_text())}
     assert named and all((ROOT / m).is_file() for m in named), named
+
+
+def test_the_tutorials_graph_picture_is_what_graph_svg_draws():
+    """The picture the tutorial shows is gearcli's drawing of its mechanism, not a stale copy
+    (regenerate: gearcli graph docs/examples/geared_joint.yaml --svg docs/images/geared_joint_graph.svg)."""
+    from gearcli import analyse, load_mechanism
+    from gearcli.report.graph_svg import graph_svg
+    drawn = graph_svg(analyse(load_mechanism(DOCS / "examples" / "geared_joint.yaml")))
+    assert (DOCS / "images" / "geared_joint_graph.svg").read_text() == drawn

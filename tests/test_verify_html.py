@@ -4,6 +4,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import lxml.etree
 import lxml.html
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -46,3 +47,23 @@ def test_html_report_never_overwrites_an_input(run_cli, tmp_path):
     man.write_text(text)
     r = run_cli("verify", man, "--html", man)
     assert r.exit_code == 2 and "--html" in r.stderr and man.read_text() == text
+
+
+def test_graph_svg_writes_the_drawing_of_the_report(run_cli, tmp_path):
+    """gearcli graph --svg FILE: the canonical graph as the HTML report draws it (every link
+    and pair named), the tables still on stdout; '-' and an input file are refused, exit 2,
+    nothing written."""
+    from gearcli import analyse, load_mechanism
+    from gearcli.report.graph_svg import graph_svg
+    mech = ROOT / "mechanisms" / "bendix_wrist.yaml"
+    out = tmp_path / "g.svg"
+    r = run_cli("graph", mech, "--svg", out)
+    assert r.exit_code == 0 and "Structure matrix" in r.stdout
+    text = out.read_text()
+    assert text == graph_svg(analyse(load_mechanism(mech)))
+    svg = lxml.etree.fromstring(text.encode())
+    assert {"0", "3", "5-6", "7-8"} <= set(svg.itertext())
+    for bad in ("-", str(mech)):
+        r = run_cli("graph", mech, "--svg", bad)
+        assert r.exit_code == 2 and "--svg" in r.stderr and r.stderr.count("\n") == 1
+    assert mech.read_text().startswith(("#", "name")) and sorted(tmp_path.iterdir()) == [out]

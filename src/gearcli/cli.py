@@ -155,6 +155,9 @@ def graph(
                                 "(render with: dot -Tsvg)."),
     real_joints: bool = typer.Option(False, "--real-joints", help="With --dot: draw the real "
                                      "joints (bearings) instead of the canonical thin edges."),
+    svg: str = typer.Option(None, "--svg", metavar="GRAPH.svg", help="Also draw the canonical graph as SVG "
+                            "(a column per level; heavy edges for the gear pairs and drive elements), as the "
+                            "verify --html report does."),
     strict: bool = STRICT_OPTION,
 ) -> None:
     """Show the graph analysis: links with level, primary/secondary, carrier and axis label;
@@ -165,7 +168,17 @@ def graph(
         raise GearcliError("graph: give at most one of --json and --dot")
     if real_joints and not as_dot:
         raise GearcliError("graph: --real-joints only applies to --dot")
+    if svg is not None:
+        from .io.output import atomic_output, output_target  # noqa: PLC0415
+        if svg == "-":
+            raise GearcliError("--svg: expected a file name, got '-' (the graph's tables go to stdout)")
+        output_target(svg, (mech,), "--svg")
     an = load_analysis(mech, strict)
+    if svg is not None:
+        from .report.graph_svg import graph_svg  # noqa: PLC0415
+
+        with atomic_output(svg, (mech,)) as f:
+            f.write(graph_svg(an))
     if as_json:
         from .report.graph_json import analysis_dict  # noqa: PLC0415
 
