@@ -388,6 +388,77 @@ def verify(
         raise typer.Exit(EXIT_CHECK_FAILED)
 
 
+@app.command()
+@reports_bad_input
+def sweep(
+    design: Path = typer.Argument(..., metavar="DESIGN.yaml", show_default=False,
+                                  help="Design manifest, as gearcli verify reads it."),
+    vary: list[str] = typer.Option(..., "--vary", metavar="PATH=VALUES", help="A number of the cases' YAML "
+                                   "mechanism files and its values: links.payload.mass=0.5,1,2 (a list), "
+                                   "gears.g1.ratio=50:120:8 (a:b:n, n values), log:a:b:n (evenly in log); "
+                                   "CASE:PATH for one case's mechanism.  Repeat for a grid."),
+    output: str = typer.Option(None, "-o", "--output", metavar="TABLE.csv|parquet|feather",
+                               help="Write one row per variant: the varied values, every check's value, limit and "
+                                    "margin %, the worst margin and its check."),
+    plot: str = typer.Option(None, "--plot", metavar="FIG.png|svg|pdf", help="Draw the worst margin over one or "
+                             "two varied values."),
+    samples: int = typer.Option(None, "--samples", metavar="N", help="Verify N variants drawn at random from the "
+                                "grid (seed --seed) instead of the whole grid."),
+    seed: int = typer.Option(0, "--seed", metavar="S", help="Seed of --samples."),
+    jobs: int = typer.Option(1, "-j", "--jobs", min=1, metavar="N", help="Worker processes."),
+    dask: str = typer.Option(None, "--dask", metavar="ADDRESS", help="Run on an existing dask.distributed "
+                             "cluster (scheduler address)."),
+) -> None:
+    """Verify a design over a grid of mechanism values: every check of the manifest on every variant (the
+    mechanism files with the --vary numbers replaced), with a table and a plot of the worst margin.  Paths and
+    values are checked before anything runs.  Exit 0 when the sweep ran (failing variants are rows of the table),
+    2 on bad input."""
+    from rich.progress import BarColumn, Progress, TextColumn  # noqa: PLC0415
+
+    from .batch.manifest import load_manifest  # noqa: PLC0415
+    from .batch.sweep import parse_vary, plan_sweep, plot_sweep, run_sweep, table, write_table  # noqa: PLC0415
+    from .io.output import output_target  # noqa: PLC0415
+    from .report.progress import LateProgress  # noqa: PLC0415
+    from .report.table_files import format_of  # noqa: PLC0415
+
+    if jobs > 1 and dask is not None:
+        raise GearcliError("sweep: give -j/--jobs or --dask, not both (a Dask cluster has its own workers)")
+    varies = [parse_vary(v) for v in vary]
+    manifest = load_manifest(design)
+    inputs = [design] + [c.mechanism for c in manifest.cases] + [t for c in manifest.cases for t in c.trajectories]
+    if output is not None:
+        if output == "-" or format_of(output) not in ("csv", "parquet", "feather"):
+            raise GearcliError(f"-o: expected a .csv, .parquet or .feather file name, got '{output}'")
+        output_target(output, inputs)
+    if plot is not None:
+        if plot == "-" or Path(plot).suffix.lower() not in (".png", ".svg", ".pdf"):
+            raise GearcliError(f"--plot: expected a .png, .svg or .pdf file name, got '{plot}'")
+        if len(varies) > 2:
+            raise GearcliError(f"--plot: draws the worst margin over one or two varied values, {len(varies)} vary")
+        output_target(plot, inputs, "--plot")
+    plan = plan_sweep(manifest, varies, samples, seed)
+    err = stderr_console()
+    bar = Progress(TextColumn("sweeping"), BarColumn(), TextColumn("{task.completed}/{task.total} variants"),
+                   console=err, transient=True, disable=not err.is_terminal)
+    with LateProgress(bar, "sweep") as progress:
+        progress.update(total=len(plan.variants))
+        results = run_sweep(plan, jobs=jobs, dask_address=dask, progress=lambda n: progress.update(advance=n))
+    cols = table(plan, results)
+    if output is not None:
+        write_table(cols, output, inputs)
+    if plot is not None:
+        plot_sweep(plan, cols, plot, inputs)
+    names = list(cols)[:len(varies)]
+    passed = sum(cols["passed"])
+    typer.echo(f"{counted(len(plan.variants), 'variant')} of {design}: {passed} pass every check")
+    best = max(range(len(plan.variants)), key=lambda i: cols["worst_margin_%"][i])
+    said = ", ".join(f"{n} = {cols[n][best]:g}" for n in names)
+    typer.echo(f"best: {said}: worst margin {cols['worst_margin_%'][best]:.4g} % ({cols['worst_check'][best]})")
+    for path, what in ((output, "table"), (plot, "plot")):
+        if path is not None:
+            typer.echo(f"Wrote the {what} to {path}")
+
+
 def _worm_lines(manifest) -> list[str]:
     """One line per worm pair of each case: its efficiencies from the geometry and, when
     self-locking, that it holds a load without a brake (docs/concepts/drive-elements.md, Worm pairs)."""

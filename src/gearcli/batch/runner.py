@@ -47,16 +47,18 @@ the results are those of one call): of each part only the columns its checks rea
 
 
 def solve_samples(an, traj_path, degrees: bool, threads: int | None = None, backend: str = "auto",
-                  checks=None) -> Samples:
+                  checks=None, tr=None) -> Samples:
     """Solve a trajectory file: times, every output column (each computed when a check
     first reads it: :class:`~gearcli.report.columns.LazyColumns`), and every real joint's
     rate; ``threads``: the solver's threads (None: every core).  With ``checks``, a long
     trajectory is solved :data:`STREAM` samples at a time and only the columns the checks
     read are kept (found on the first part; with the checks evaluated a component at a time,
     :func:`~gearcli.design.evaluate.partials`, 1e6 samples of the rated arm peak at 0.65 GB
-    where they took 1.48 GB; its solve takes 0.26 GB)."""
-    tr = read_trajectory(traj_path, an.independent_names, degrees=degrees, linear=an.prismatic_independent,
-                         loads=an.mech.loads, payloads=[p.name for p in an.mech.payloads])
+    where they took 1.48 GB; its solve takes 0.26 GB).  ``tr``: the trajectory already read
+    (a sweep solves the same one for every variant)."""
+    if tr is None:
+        tr = read_trajectory(traj_path, an.independent_names, degrees=degrees, linear=an.prismatic_independent,
+                             loads=an.mech.loads, payloads=[p.name for p in an.mech.payloads])
     if checks is not None and len(tr.t) > STREAM:
         return _streamed(an, traj_path, tr, threads, backend, checks)
     with at_samples(traj_path, tr):

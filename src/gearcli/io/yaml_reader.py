@@ -102,8 +102,20 @@ def parse_mechanism(text: str, file: str = "<string>") -> Mechanism:
     elif "cases" in data and "links" not in data:
         col.add("", "this is a design manifest (it lists cases), not a mechanism file: run gearcli verify on it")
     col.raise_if_any()
+    return mechanism_from_data(data, file, lines)
+
+
+def mechanism_from_data(data: dict, file: str = "<string>", lines: dict | None = None,
+                        schema: bool = True) -> Mechanism:
+    """The mechanism of a mechanism file's parsed YAML mapping ``data`` (``lines``: YAML path
+    -> line, for the problems' places); ``schema=False`` skips the JSON Schema's checks, for
+    data whose every value has passed them before (a sweep's variant, each of its values
+    tried alone: :func:`gearcli.batch.sweep.plan_sweep`); the model's own checks still run."""
+    lines = lines or {}
+    col = Collector(file, lines)
     number_issues(data, col)
-    _schema_issues(data, col, {i.path for i in col.issues})
+    if schema:
+        _schema_issues(data, col, {i.path for i in col.issues})
     col.raise_if_any()
     later = Collector(file, lines)       # problems that leave the mechanism buildable (planet assembly)
     data = expand_planets(data, joint_geometry, col, later)

@@ -1,0 +1,68 @@
+"""Speed of gearcli sweep (issue 37's target: 1,000 mass/inertia/ratio/payload variants of the
+rated Bendix wrist over a 10,000-sample duty cycle, every check, at >= 50 variants/s with one
+compile in all); prints figures, not a test.
+
+    python benchmarks/bench_sweep.py [--variants 40] [--jobs 1]
+
+The duty cycle is the bundled Bendix motion resampled to 10,000 samples (a temporary file),
+verified with designs/ci_example.yaml's checks; the variants vary the tool flange's mass and
+its inertia about its axis.  Each variant is solved by the numpy path (no kernel compile: a
+compiled kernel holds the masses as constants, so each variant would compile its own);
+the script prints the variants per second, the kernel compiles counted in the run, and the
+load average.
+"""
+from __future__ import annotations
+
+import argparse
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from timing import load_line  # noqa: E402 (benchmarks/timing.py)
+
+from gearcli.batch.manifest import load_manifest
+from gearcli.batch.sweep import parse_vary, plan_sweep, run_sweep
+from gearcli.dynamics.llvm import driver
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--variants", type=int, default=40)
+    ap.add_argument("--jobs", type=int, default=1)
+    args = ap.parse_args()
+    src = ROOT / "mechanisms" / "bendix_wrist_traj.csv"
+    head = src.read_text().splitlines()[0]
+    d = np.loadtxt(src, delimiter=",", skiprows=1)
+    t = np.linspace(d[0, 0], d[-1, 0], 10_000)
+    q = np.column_stack([np.interp(t, d[:, 0], d[:, k]) for k in range(1, d.shape[1])])
+    tmp = Path(tempfile.mkdtemp())
+    np.savetxt(tmp / "traj.csv", np.column_stack([t, q]), delimiter=",", header=head, comments="", fmt="%.17g")
+    design = (ROOT / "designs" / "ci_example.yaml").read_text()
+    design = design.replace("../mechanisms/bendix_wrist_rated.yaml", str(ROOT / "mechanisms" / "bendix_wrist_rated.yaml"))
+    design = design.replace("../mechanisms/bendix_wrist_traj.csv", str(tmp / "traj.csv"))
+    (tmp / "d.yaml").write_text(design)
+    n_mass = max(1, args.variants // 2)
+    varies = [parse_vary(f"links.3.mass=0.6:1.2:{n_mass}"), parse_vary("links.3.inertia.izz=0.0011,0.0015")]
+    compiles = []
+    real = driver.Jit.__init__
+
+    def counted(self, *a, **k):                # every kernel the run builds (compiled or from the disk cache)
+        compiles.append(1)
+        real(self, *a, **k)
+    driver.Jit.__init__ = counted
+    plan = plan_sweep(load_manifest(tmp / "d.yaml"), varies)
+    t0 = time.perf_counter()
+    rows = run_sweep(plan, jobs=args.jobs)
+    dt = time.perf_counter() - t0
+    n = len(plan.variants)
+    print(f"gearcli sweep, rated Bendix wrist, 10,000 samples, {len(rows[0])} checks a variant, -j {args.jobs}:")
+    print(f"  {n} variants in {dt:.2f} s: {n / dt:.2f} variants/s ({dt / n * 1e3:.0f} ms a variant); "
+          f"kernels built: {len(compiles)} (numpy path)")
+    print(f"  {load_line()}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,425 @@
+"""``gearcli sweep``: a design manifest verified over a grid of mechanism values.
+
+A ``--vary PATH=VALUES`` names one number of a case's YAML mechanism file in the file's own
+terms and the values it takes:
+
+* PATH: dot-separated keys from the top of the mechanism file; in a list of named items
+  (``links``, ``joints``, ``gears``, ``motors``, ``loads``, ``payloads``, a joint's
+  ``bearings``) the next key is the item's ``name``; ``[i]`` picks element i of a list
+  (0-based).  ``links.payload.mass``, ``gears.hd1.ratio``,
+  ``motors.m1.rating.rotor_inertia``, ``loads.tip.force[2]``.  ``CASE:PATH`` varies the
+  mechanism of that case alone; without it, every case's mechanism (each must have PATH).
+* VALUES: ``1,2,5`` (a list), ``a:b:n`` (n values from a to b, evenly spaced) or
+  ``log:a:b:n`` (n values from a to b, evenly spaced in log); SI units, as the file.
+
+The variants are the full grid of the values (or, with ``samples``, that many grid points
+drawn at random with a fixed seed).  Each variant's mechanism files are the originals with
+the varied numbers replaced, checked as ``gearcli check`` would (a value the file would not
+accept is a located error before anything runs: every value is tried alone first), then every
+check of the manifest is run on them as ``gearcli verify`` runs it.  One row per variant:
+the varied values, every check's value, limit and margin (%), the worst margin and its
+check.  Rows come back in variant order whichever way they ran (this process, local
+processes, a Dask cluster), so the table is the same bytes.
+"""
+from __future__ import annotations
+
+import copy
+import math
+import re
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+from ..errors import GearcliError, MechanismError
+
+NAMED_LISTS = ("links", "joints", "gears", "motors", "loads", "payloads", "bearings")
+"""Lists whose items are picked by their ``name`` in a --vary path."""
+
+MAX_VARIANTS = 1_000_000
+"""A grid larger than this is refused (give --samples)."""
+
+
+@dataclass(frozen=True)
+class Vary:
+    """One ``--vary``: ``case`` (None: every case), the path's ``steps`` (a key, a name in a
+    named list, or an int index), its text and its values."""
+
+    text: str
+    case: str | None
+    path: str
+    steps: tuple
+    values: tuple[float, ...]
+
+
+def _number(text: str, where: str) -> float:
+    try:
+        x = float(text)
+    except ValueError:
+        raise GearcliError(f"{where}: expected a number, got '{text}'") from None
+    if not math.isfinite(x):
+        raise GearcliError(f"{where}: expected a finite number, got '{text}'")
+    return x
+
+
+def values_of(text: str, where: str) -> tuple[float, ...]:
+    """The values of a VALUES text: ``1,2,5``, ``a:b:n`` or ``log:a:b:n``."""
+    text = text.strip()
+    log = text.startswith("log:")
+    if log or ":" in text:
+        parts = text[4:].split(":") if log else text.split(":")
+        if len(parts) != 3:
+            raise GearcliError(f"{where}: expected {'log:' if log else ''}a:b:n (from a to b in n values), got '{text}'")
+        a, b = _number(parts[0], where), _number(parts[1], where)
+        try:
+            n = int(parts[2])
+        except ValueError:
+            raise GearcliError(f"{where}: expected a whole number of values n >= 1 in a:b:n, got '{parts[2]}'") from None
+        if n < 1 or n > MAX_VARIANTS:
+            raise GearcliError(f"{where}: expected 1 <= n <= {MAX_VARIANTS:,} values in a:b:n, got {n}")
+        if log:
+            if a <= 0 or b <= 0:
+                raise GearcliError(f"{where}: a log range needs a > 0 and b > 0, got {a:g} and {b:g}")
+            return tuple(float(v) for v in np.geomspace(a, b, n))
+        return tuple(float(v) for v in np.linspace(a, b, n))
+    items = [s for s in text.split(",")]
+    if not text or any(not s.strip() for s in items):
+        raise GearcliError(f"{where}: expected numbers separated by commas, a:b:n or log:a:b:n, got '{text}'")
+    return tuple(_number(s.strip(), where) for s in items)
+
+
+def _steps(path: str, where: str) -> tuple:
+    steps = []
+    for part in path.split("."):
+        m = re.fullmatch(r"([^\[\]]+)((?:\[\d+\])*)", part)
+        if not m:
+            raise GearcliError(f"{where}: '{part}' is not a key, a name or key[i] (path '{path}')")
+        steps.append(m.group(1))
+        steps += [int(i) for i in re.findall(r"\[(\d+)\]", m.group(2))]
+    return tuple(steps)
+
+
+def parse_vary(text: str) -> Vary:
+    """A ``--vary PATH=VALUES`` option's text, checked for its form (not yet against a file)."""
+    where = f"--vary '{text}'"
+    if "=" not in text:
+        raise GearcliError(f"{where}: expected PATH=VALUES (e.g. links.payload.mass=0.5,1,2)")
+    lhs, rhs = text.split("=", 1)
+    case, path = (lhs.split(":", 1) if ":" in lhs else (None, lhs))
+    path = path.strip()
+    if not path:
+        raise GearcliError(f"{where}: the path before '=' is empty")
+    return Vary(text, case.strip() if case is not None else None, path, _steps(path, where),
+                values_of(rhs, where))
+
+
+def locate(data, steps: tuple, path: str):
+    """(container, key) of the number ``steps`` name in the YAML ``data``; a GearcliError
+    (without its place: the caller adds it) when a step does not exist or the target is not
+    a number."""
+    node, at = data, []
+    for k, step in enumerate(steps):
+        last = k == len(steps) - 1
+        if isinstance(step, int):
+            if not isinstance(node, list):
+                raise GearcliError(f"{'.'.join(map(str, at)) or 'the file'} is not a list (path '{path}')")
+            if step >= len(node):
+                raise GearcliError(f"{'.'.join(map(str, at))} has {len(node)} elements, no [{step}] (path '{path}')")
+            container, key = node, step
+        elif isinstance(node, list) and at and at[-1] in NAMED_LISTS:
+            names = [item.get("name") for item in node if isinstance(item, dict)]
+            if step not in names:
+                raise GearcliError(f"no {at[-1][:-1] if at[-1] != 'bearings' else 'bearing'} named '{step}' "
+                                   f"(the file has {', '.join(map(str, names)) or 'none'}; path '{path}')")
+            container, key = node, names.index(step)
+        elif isinstance(node, dict):
+            if step not in node:
+                raise GearcliError(f"no key '{step}' in {'.'.join(map(str, at)) or 'the file'} "
+                                   f"(it has {', '.join(map(str, node)) or 'none'}; path '{path}')")
+            container, key = node, step
+        else:
+            raise GearcliError(f"{'.'.join(map(str, at))} has no key '{step}' (it is a value; path '{path}')")
+        at.append(step)
+        node = container[key]
+        if last:
+            if isinstance(node, bool) or not isinstance(node, (int, float)):
+                kind = "a list" if isinstance(node, list) else "a mapping" if isinstance(node, dict) else f"'{node}'"
+                raise GearcliError(f"is {kind} in the file, not a number (path '{path}')")
+            return container, key
+    raise GearcliError(f"empty path '{path}'")
+
+
+def _set(data, steps: tuple, path: str, value: float) -> None:
+    container, key = locate(data, steps, path)
+    old = container[key]
+    container[key] = int(value) if isinstance(old, int) and float(value).is_integer() else float(value)
+
+
+@dataclass(frozen=True)
+class Plan:
+    """What a sweep runs: the manifest, its ``varies`` and the variants (per variant one
+    value per vary)."""
+
+    manifest_path: str
+    varies: tuple[Vary, ...]
+    variants: tuple[tuple[float, ...], ...]
+
+
+@lru_cache(maxsize=8)
+def _base(mech_path: str) -> dict:
+    from ..io.yaml_safe import read_text, yaml_lines  # noqa: PLC0415
+    return yaml_lines(read_text(mech_path), mech_path)[0]
+
+
+def _data(manifest, varies, values) -> dict[str, dict]:
+    """{case name: its mechanism file's YAML data with the variant's values}."""
+    out = {}
+    for case in manifest.cases:
+        data = copy.deepcopy(_base(str(case.mechanism)))
+        for v, x in zip(varies, values):
+            if v.case is None or v.case == case.name:
+                _set(data, v.steps, v.path, x)
+        out[case.name] = data
+    return out
+
+
+def plan_sweep(manifest, varies: list[Vary], samples: int | None = None, seed: int = 0) -> Plan:
+    """The variants of ``varies`` over ``manifest``'s cases, every path and value checked
+    before anything runs: a case name that is not the manifest's, a path a case's mechanism
+    lacks, a mechanism that is not YAML, a value the file would not accept (each value tried
+    alone, the others at the file's own values)."""
+    from ..io.yaml_reader import mechanism_from_data  # noqa: PLC0415
+    if not varies:
+        raise GearcliError("sweep: give at least one --vary PATH=VALUES")
+    names = [c.name for c in manifest.cases]
+    paths = [v.path if v.case is None else f"{v.case}:{v.path}" for v in varies]
+    for p in paths:
+        if paths.count(p) > 1:
+            raise GearcliError(f"--vary {p}: given twice")
+    for v in varies:
+        where = f"--vary '{v.text}'"
+        if v.case is not None and v.case not in names:
+            raise GearcliError(f"{where}: no case named '{v.case}' in {manifest.path} (cases: {', '.join(names)})")
+        for case in manifest.cases:
+            if v.case is not None and v.case != case.name:
+                continue
+            if Path(case.mechanism).suffix.lower() not in (".yaml", ".yml"):
+                raise GearcliError(f"{where}: case '{case.name}': sweep varies YAML mechanism files, "
+                                   f"{case.mechanism} is not one (gearcli export writes a URDF; write the YAML by hand)")
+            try:
+                locate(_base(str(case.mechanism)), v.steps, v.path)
+            except GearcliError as exc:
+                raise GearcliError(f"{where}: case '{case.name}' ({case.mechanism}): {exc}") from None
+            for x in dict.fromkeys(v.values):
+                data = _data(manifest, [v], [x])[case.name]
+                try:
+                    mechanism_from_data(data, str(case.mechanism))
+                except MechanismError as exc:
+                    i = exc.issues[0]
+                    said = f"{i.path}: {i.message}" if i.path else i.message
+                    raise GearcliError(f"{where}: case '{case.name}': the value {x:g}: {said}") from None
+    sizes = [len(v.values) for v in varies]
+    total = math.prod(sizes)
+    if samples is None:
+        if total > MAX_VARIANTS:
+            raise GearcliError(f"sweep: the grid has {total:,} variants, more than {MAX_VARIANTS:,}: give --samples N")
+        grid = np.indices(sizes).reshape(len(sizes), -1).T
+    else:
+        if samples < 1:
+            raise GearcliError(f"--samples: expected at least 1, got {samples}")
+        grid = np.random.default_rng(seed).integers(0, sizes, size=(samples, len(sizes)))
+    variants = tuple(tuple(v.values[i] for v, i in zip(varies, row)) for row in grid)
+    return Plan(str(manifest.path), tuple(varies), variants)
+
+
+@lru_cache(maxsize=4)
+def _manifest(path: str):
+    from .manifest import load_manifest  # noqa: PLC0415
+    return load_manifest(path)
+
+
+@lru_cache(maxsize=64)
+def _trajectory(path: str, names: tuple, degrees: bool, linear: tuple, loads: tuple, payloads: tuple):
+    from ..io.trajectory import read_trajectory  # noqa: PLC0415
+    return read_trajectory(path, list(names), degrees=degrees, linear=np.asarray(linear, bool), loads=loads,
+                           payloads=list(payloads))
+
+
+def run_variant(manifest_path: str, varies: tuple[Vary, ...], values: tuple[float, ...]) -> list[tuple]:
+    """Every check of the manifest on one variant: [(case, component, quantity, unit, value,
+    limit, margin %, passed)] in the manifest's order of cases and checks (picklable in and
+    out: a local process or a Dask worker runs it the same)."""
+    from ..design.checks import build_checks  # noqa: PLC0415
+    from ..design.evaluate import combine, partials, profile_rates  # noqa: PLC0415
+    from ..dynamics.determinacy import analyse  # noqa: PLC0415
+    from ..errors import Collector  # noqa: PLC0415
+    from ..io.yaml_reader import mechanism_from_data  # noqa: PLC0415
+    from .runner import solve_samples  # noqa: PLC0415
+
+    manifest = _manifest(manifest_path)
+    datas = _data(manifest, varies, values)
+    out = []
+    for case in manifest.cases:
+        # every value passed the schema alone (plan_sweep): the model's checks run here
+        an = analyse(mechanism_from_data(datas[case.name], str(case.mechanism), schema=False))
+        checks = build_checks(an, case.req, Collector(str(case.mechanism)))
+        parts = []
+        for tp in case.trajectories:
+            tr = _trajectory(str(tp), tuple(an.independent_names), case.degrees,
+                             tuple(bool(x) for x in an.prismatic_independent), tuple(an.mech.loads),
+                             tuple(p.name for p in an.mech.payloads))
+            samples = solve_samples(an, tp, case.degrees, threads=1, backend="numpy", checks=checks, tr=tr)
+            parts.append(partials(checks, samples, an.mech))
+        spans = [p[0][6] if p else 0.0 for p in parts]
+        rates = profile_rates(case.shares or (None,) * len(parts), spans, case.req.cycles_per_hour,
+                              case.req.service_life_h)
+        for k, ch in enumerate(checks):
+            v = combine(ch, [p[k] for p in parts], rates)
+            out.append((case.name, ch.component, ch.quantity, ch.unit, float(v.value), float(ch.limit),
+                        float(v.margin), bool(v.passed)))
+    return out
+
+
+def _chunks(n: int, size: int) -> list[range]:
+    return [range(a, min(a + size, n)) for a in range(0, n, size)]
+
+
+def _run_chunk(manifest_path: str, varies, variants) -> list[list[tuple]]:
+    return [run_variant(manifest_path, varies, values) for values in variants]
+
+
+def run_sweep(plan: Plan, jobs: int = 1, dask_address: str | None = None, progress=None) -> list[list[tuple]]:
+    """Every variant's checks (:func:`run_variant`), in variant order; ``jobs`` local
+    processes or the Dask scheduler at ``dask_address``; ``progress(n)`` after each n
+    variants."""
+    n = len(plan.variants)
+    size = max(1, min(64, n // (8 * max(jobs, 1)) or 1))
+    parts = _chunks(n, size)
+    results: dict[int, list] = {}
+    if dask_address is not None:
+        from dask.distributed import as_completed as dask_completed  # noqa: PLC0415 (optional)
+
+        from .runner import _dask_client  # noqa: PLC0415
+        with _dask_client(dask_address) as client:
+            futures = {client.submit(_run_chunk, plan.manifest_path, plan.varies,
+                                     plan.variants[r.start:r.stop], pure=False): r for r in parts}
+            for fut in dask_completed(list(futures), loop=client.loop):
+                r = futures[fut]
+                results[r.start] = fut.result()
+                if progress:
+                    progress(len(r))
+    elif jobs <= 1 or len(parts) <= 1:
+        for r in parts:
+            results[r.start] = _run_chunk(plan.manifest_path, plan.varies, plan.variants[r.start:r.stop])
+            if progress:
+                progress(len(r))
+    else:
+        from concurrent.futures import ProcessPoolExecutor, as_completed  # noqa: PLC0415
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            futures = {pool.submit(_run_chunk, plan.manifest_path, plan.varies, plan.variants[r.start:r.stop]): r
+                       for r in parts}
+            for fut in as_completed(futures):
+                r = futures[fut]
+                results[r.start] = fut.result()
+                if progress:
+                    progress(len(r))
+    return [row for r in parts for row in results[r.start]]
+
+
+def table(plan: Plan, results: list[list[tuple]]) -> dict[str, list]:
+    """The sweep's table, {column: values} in order: the varied values (named by their
+    paths), then per check ``CASE: COMPONENT: QUANTITY`` value, limit and margin %, then
+    ``worst_margin_%``, ``worst_check`` and ``passed``."""
+    cols: dict[str, list] = {}
+    for k, v in enumerate(plan.varies):
+        name = v.path if v.case is None else f"{v.case}:{v.path}"
+        cols[name] = [values[k] for values in plan.variants]
+    checks = [f"{c[0]}: {c[1]}: {c[2]}" for c in results[0]] if results else []
+    for j, name in enumerate(checks):
+        unit = results[0][j][3]
+        u = f" [{unit}]" if unit else ""
+        cols[f"{name}: value{u}"] = [r[j][4] for r in results]
+        cols[f"{name}: limit{u}"] = [r[j][5] for r in results]
+        cols[f"{name}: margin %"] = [r[j][6] for r in results]
+    worst = [min(range(len(r)), key=lambda j: (r[j][7], r[j][6])) if r else None for r in results]
+    cols["worst_margin_%"] = [r[w][6] if w is not None else math.nan for r, w in zip(results, worst)]
+    cols["worst_check"] = [checks[w] if w is not None else "" for w in worst]
+    cols["passed"] = [all(c[7] for c in r) for r in results]
+    return cols
+
+
+def write_table(cols: dict[str, list], path: str, inputs=()) -> None:
+    """CSV (9 significant digits, as the loads files), Parquet or Feather by the extension,
+    written atomically."""
+    from ..io.output import atomic_output  # noqa: PLC0415
+    ext = Path(path).suffix.lower()
+    if ext in (".parquet", ".feather"):
+        import pyarrow as pa  # noqa: PLC0415
+        t = pa.table(cols)
+        with atomic_output(path, inputs, binary=True) as f:
+            if ext == ".parquet":
+                import pyarrow.parquet as pq  # noqa: PLC0415
+                pq.write_table(t, f)
+            else:
+                import pyarrow.feather as feather  # noqa: PLC0415
+                feather.write_feather(t, f, compression="uncompressed")
+        return
+    import csv  # noqa: PLC0415
+
+    def cell(x):
+        if isinstance(x, bool):
+            return "true" if x else "false"
+        if isinstance(x, float):
+            return "inf" if x == math.inf else "-inf" if x == -math.inf else f"{x:.9g}"
+        return x
+    with atomic_output(path, inputs) as f:
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(list(cols))
+        for row in zip(*cols.values()):
+            w.writerow([cell(x) for x in row])
+
+
+def plot_sweep(plan: Plan, cols: dict[str, list], path: str, inputs=()) -> None:
+    """The worst margin (%) of each variant over one varied value (a line, the points marked)
+    or two (each variant a square of the grid coloured by its margin, the 0 % contour where
+    the design starts to fail; random samples: a scatter); the 0 % line is the pass/fail
+    boundary.  Written atomically (PNG, SVG or PDF by the extension)."""
+    import matplotlib  # noqa: PLC0415
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    from ..io.output import atomic_output  # noqa: PLC0415
+    names = list(cols)[:len(plan.varies)]
+    worst = np.asarray(cols["worst_margin_%"], float)
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    if len(names) == 1:
+        x = np.asarray(cols[names[0]], float)
+        order = np.argsort(x, kind="stable")
+        ax.plot(x[order], worst[order], "o-", label="worst margin of the variant")
+        ax.axhline(0.0, color="red", linestyle="--", label="0 %: a check fails below")
+        ax.set_xlabel(names[0])
+        ax.set_ylabel("worst margin [%]")
+        ax.legend(fontsize=8)
+    else:
+        x, y = (np.asarray(cols[n], float) for n in names)
+        lim = max(float(np.nanmax(np.abs(worst[np.isfinite(worst)]))) if np.isfinite(worst).any() else 1.0, 1e-9)
+        xs, ys = np.unique(x), np.unique(y)
+        full = len(xs) * len(ys) == len(x) and len(set(zip(x, y))) == len(x)
+        if full:
+            Z = np.full((len(ys), len(xs)), np.nan)
+            Z[np.searchsorted(ys, y), np.searchsorted(xs, x)] = worst
+            mesh = ax.pcolormesh(xs, ys, Z, cmap="RdYlGn", vmin=-lim, vmax=lim, shading="nearest")
+            if len(xs) > 1 and len(ys) > 1 and np.nanmin(Z) < 0 < np.nanmax(Z):
+                ax.contour(xs, ys, Z, levels=[0.0], colors="black", linewidths=1.2)
+        else:
+            mesh = ax.scatter(x, y, c=worst, cmap="RdYlGn", vmin=-lim, vmax=lim, edgecolors="k", linewidths=0.3)
+        fig.colorbar(mesh, ax=ax, label="worst margin [%] (below 0: a check fails)")
+        ax.set_xlabel(names[0])
+        ax.set_ylabel(names[1])
+    ax.set_title(f"{Path(plan.manifest_path).name}: worst margin of {len(worst)} variants", fontsize=10)
+    ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    fmt = Path(path).suffix.lower().lstrip(".")
+    with atomic_output(path, inputs, binary=True) as f:
+        fig.savefig(f, format=fmt, dpi=110)
+    plt.close(fig)

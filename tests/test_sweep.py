@@ -1,0 +1,141 @@
+"""gearcli sweep (issue 37): a design manifest verified over a grid of mechanism values.
+
+Each variant's checks are those plain ``gearcli verify`` reports on the mechanism file edited
+by hand (text replacement, not the sweep's YAML editing); the table is the same bytes with
+local processes or on a Dask cluster; bad paths and values are located errors before
+anything runs, nothing written."""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+DESIGN = ROOT / "designs" / "paper_arm_duty.yaml"
+MECH = ROOT / "mechanisms" / "paper_2dof_rated.yaml"
+TRAJ = ROOT / "mechanisms" / "paper_2dof_traj.csv"
+FOREARM = '  - name: "2"                     # forearm; frame at the wrist\n    mass: 2.5\n'
+
+
+def _read_csv(path: Path) -> tuple[list[str], list[list[str]]]:
+    lines = path.read_text().splitlines()
+    import csv
+    rows = list(csv.reader(lines))
+    return rows[0], rows[1:]
+
+
+def _design(tmp_path: Path, mech_text: str, name: str = "d.yaml") -> Path:
+    (tmp_path / "m.yaml").write_text(mech_text)
+    d = tmp_path / name
+    d.write_text(DESIGN.read_text().replace("../mechanisms/paper_2dof_rated.yaml", str(tmp_path / "m.yaml"))
+                 .replace("../mechanisms/paper_2dof_traj.csv", str(TRAJ)))
+    return d
+
+
+def test_each_variant_is_what_verify_says_of_the_edited_file(run_cli, tmp_path):
+    """Three forearm masses: every check's value, limit and margin in the sweep's table equal
+    those of gearcli verify --json on the mechanism file with the mass edited by hand (the
+    table's 9 digits), the worst margin is the least margin of the row and 'passed' is verify's
+    exit status."""
+    text = MECH.read_text()
+    assert FOREARM in text
+    design = _design(tmp_path, text)
+    out = tmp_path / "sweep.csv"
+    r = run_cli("sweep", design, "--vary", "links.2.mass=2.5,3.4,4", "-o", out)
+    assert r.exit_code == 0, r.stderr
+    header, rows = _read_csv(out)
+    assert header[0] == "links.2.mass" and [float(row[0]) for row in rows] == [2.5, 3.4, 4.0]
+    for row, mass in zip(rows, ("2.5", "3.4", "4")):
+        edited = tmp_path / f"e{mass}"
+        edited.mkdir()
+        d = _design(edited, text.replace(FOREARM, FOREARM.replace("mass: 2.5", f"mass: {mass}")))
+        js = edited / "r.json"
+        v = run_cli("verify", d, "--json", js, "-j", "1")
+        checks = json.loads(js.read_text())["checks"]
+        assert len(header) == 1 + 3 * len(checks) + 3
+        cells = dict(zip(header, row))
+        for c in checks:
+            name = f"{c['case']}: {c['component']}: {c['quantity']}"
+            unit = f" [{c['unit']}]" if c["unit"] else ""
+            for key, field in (("value", f"value{unit}"), ("limit", f"limit{unit}"), ("margin_pct", "margin %")):
+                want = c[key] if c[key] is not None else math.inf
+                assert float(cells[f"{name}: {field}"]) == pytest.approx(want, rel=1e-8), (name, key)
+        margins = [c["margin_pct"] for c in checks]
+        assert float(cells["worst_margin_%"]) == pytest.approx(min(margins), rel=1e-8)
+        assert cells["passed"] == ("true" if v.exit_code == 0 else "false")
+    assert [r[-1] for r in rows] == ["true", "false", "false"]   # 3.4 kg fails, as verify says
+
+
+def test_the_grid_its_order_and_ranges(run_cli, tmp_path):
+    """a:b:n and log:a:b:n give their n values, the grid runs the last --vary fastest, and a
+    value-by-value edit of one case's mechanism (CASE:PATH) leaves the file's other numbers."""
+    from gearcli.batch.sweep import values_of
+    assert values_of("1:2:3", "x") == (1.0, 1.5, 2.0)
+    assert np.allclose(values_of("log:1:100:3", "x"), (1.0, 10.0, 100.0), rtol=1e-15)
+    assert values_of("-0.2, 0.5", "x") == (-0.2, 0.5)
+    out = tmp_path / "s.parquet"
+    r = run_cli("sweep", DESIGN, "--vary", "pick_and_place:links.2.mass=2:3:2", "--vary", "links.2.com[0]=-0.2,-0.15",
+                "-o", out)
+    assert r.exit_code == 0, r.stderr
+    t = pq.read_table(out).to_pydict()
+    assert t["pick_and_place:links.2.mass"] == [2.0, 2.0, 3.0, 3.0]
+    assert t["links.2.com[0]"] == [-0.2, -0.15, -0.2, -0.15]
+    assert "4 variants" in r.stdout and "Wrote the table" in r.stdout
+
+
+def test_local_processes_and_dask_give_the_same_bytes(run_cli, tmp_path):
+    from dask.distributed import LocalCluster
+    args = ["sweep", DESIGN, "--vary", "links.2.mass=2:4:6"]
+    one, two, dsk = (tmp_path / f"{n}.csv" for n in ("one", "two", "dask"))
+    assert run_cli(*args, "-o", one).exit_code == 0
+    assert run_cli(*args, "-o", two, "-j", "2").exit_code == 0
+    with LocalCluster(n_workers=2, processes=False, threads_per_worker=1, dashboard_address=None) as cluster:
+        r = run_cli(*args, "-o", dsk, "--dask", cluster.scheduler_address)
+    assert r.exit_code == 0, r.stderr
+    assert one.read_bytes() == two.read_bytes() == dsk.read_bytes()
+
+
+def test_the_plot_of_one_and_two_values(run_cli, tmp_path):
+    for varies in (["--vary", "links.2.mass=2:4:3"], ["--vary", "links.2.mass=2:4:3", "--vary", "links.2.com[0]=-0.2,-0.1"]):
+        fig = tmp_path / f"p{len(varies)}.png"
+        r = run_cli("sweep", DESIGN, *varies, "--plot", fig)
+        assert r.exit_code == 0, r.stderr
+        assert fig.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("vary, said", [
+    ("links.arm.mass=1,2", "no link named 'arm' (the file has 0, 1, 2, 3, 4, 5"),
+    ("links.2.inertia=1,2", "is a list in the file, not a number"),
+    ("links.2.inertia[7]=1", "has 3 elements, no [7]"),
+    ("links.2.colour=1", "no key 'colour' in links.2"),
+    ("links.2.mass=-1,2", "the value -1: links[2].mass"),
+    ("links.2.mass=a,b", "expected a number, got 'a'"),
+    ("links.2.mass=1:2", "expected a:b:n"),
+    ("links.2.mass=log:0:1:3", "a log range needs a > 0"),
+    ("links.2.mass=1:2:0", "expected 1 <= n"),
+    ("links.2.mass", "expected PATH=VALUES"),
+    ("elsewhere:links.2.mass=1", "no case named 'elsewhere'"),
+])
+def test_bad_paths_and_values_are_located_before_anything_runs(run_cli, tmp_path, vary, said):
+    out = tmp_path / "s.csv"
+    r = run_cli("sweep", DESIGN, "--vary", vary, "-o", out)
+    assert r.exit_code == 2, r.stdout
+    assert r.stderr.count("\n") == 1 and f"--vary '{vary}'" in r.stderr and said in r.stderr, r.stderr
+    assert "Traceback" not in r.stderr and not out.exists()
+
+
+def test_bad_outputs_are_refused(run_cli, tmp_path):
+    for args, said in ((["-o", tmp_path / "s.txt"], "-o: expected a .csv"),
+                       (["-o", TRAJ], "is the input file"),
+                       (["--plot", tmp_path / "p.gif"], "--plot: expected a .png"),
+                       (["--vary", "links.1.mass=1,2", "--vary", "links.3.mass=1", "--plot", tmp_path / "p.png"],
+                        "one or two varied values")):
+        before = TRAJ.read_text()
+        r = run_cli("sweep", DESIGN, "--vary", "links.2.mass=2,3", *args)
+        assert r.exit_code == 2 and said in r.stderr, r.stderr
+        assert TRAJ.read_text() == before
+    assert list(tmp_path.iterdir()) == []
