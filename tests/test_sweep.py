@@ -139,3 +139,67 @@ def test_bad_outputs_are_refused(run_cli, tmp_path):
         assert r.exit_code == 2 and said in r.stderr, r.stderr
         assert TRAJ.read_text() == before
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_interrupted_sweep_resumes_to_the_same_table(run_cli, tmp_path, monkeypatch):
+    """A sweep stopped after its first chunks keeps them in TABLE.partial; --resume runs only
+    the rest and writes the table an uninterrupted sweep writes, byte for byte, then removes
+    the partial file.  Without --resume the partial file is not overwritten (exit 2)."""
+    from gearcli.batch import sweep
+    args = ["sweep", DESIGN, "--vary", "links.2.mass=2:4:9"]
+    whole = tmp_path / "whole.csv"
+    assert run_cli(*args, "-o", whole).exit_code == 0
+    out = tmp_path / "t.csv"
+    real, calls = sweep._run_chunk, []
+
+    def stops(*a):
+        calls.append(len(a[2]))
+        if len(calls) > 3:
+            raise KeyboardInterrupt
+        return real(*a)
+    monkeypatch.setattr(sweep, "_run_chunk", stops)
+    r = run_cli(*args, "-o", out)
+    assert r.exit_code != 0 and not out.exists()
+    partial = tmp_path / "t.csv.partial"
+    kept = partial.read_text().splitlines()
+    assert len(kept) == 1 + sum(calls[:3])          # the header and each finished variant
+    r = run_cli(*args, "-o", out)
+    assert r.exit_code == 2 and "--resume" in r.stderr and partial.read_text().splitlines() == kept
+    calls.clear()
+    monkeypatch.setattr(sweep, "_run_chunk", lambda *a: (calls.append(len(a[2])), real(*a))[1])
+    r = run_cli(*args, "-o", out, "--resume")
+    assert r.exit_code == 0, r.stderr
+    assert sum(calls) == 9 - (len(kept) - 1) and f"({len(kept) - 1} from {partial})" in r.stdout
+    assert out.read_bytes() == whole.read_bytes() and not partial.exists()
+
+
+def test_resume_refuses_another_sweeps_partial_file(run_cli, tmp_path):
+    out = tmp_path / "t.csv"
+    partial = tmp_path / "t.csv.partial"
+    partial.write_text('{"plan": "0123"}\n')
+    r = run_cli("sweep", DESIGN, "--vary", "links.2.mass=2,3", "-o", out, "--resume")
+    assert r.exit_code == 2 and f"{partial}:1: written by a sweep of other variants" in r.stderr
+    r = run_cli("sweep", DESIGN, "--vary", "links.2.mass=2,3", "--resume")
+    assert r.exit_code == 2 and "--resume: give -o TABLE" in r.stderr
+    partial.unlink()
+    r = run_cli("sweep", DESIGN, "--vary", "links.2.mass=2,3", "-o", out, "--resume")
+    assert r.exit_code == 2 and "no interrupted sweep" in r.stderr and not out.exists()
+
+
+def test_a_variant_that_cannot_run_is_a_row_saying_why(run_cli, tmp_path):
+    """Values valid alone but not together (the triangle inequality of an inertia given by
+    two varied entries): that variant's row has no check values, its reason, passed false;
+    the others run."""
+    mech = MECH.read_text()
+    design = _design(tmp_path, mech)
+    out = tmp_path / "s.csv"
+    assert "inertia: [0.003, 0.025, 0.025]" in mech     # alone each value keeps I1 + I2 >= I3; 0.048 with 0.0225 does not
+    r = run_cli("sweep", design, "--vary", "links.2.inertia[0]=0.003,0.048", "--vary", "links.2.inertia[1]=0.025,0.0225",
+                "-o", out)
+    assert r.exit_code == 0, r.stderr
+    header, rows = _read_csv(out)
+    bad = [row for row in rows if row[header.index("worst_check")].startswith("not run: ")]
+    assert bad and all("triangle inequality" in row[header.index("worst_check")] for row in bad)
+    assert len(bad) == 1 and bad[0][:2] == ["0.048", "0.0225"]
+    assert all(row[-1] == "false" and row[2] == "nan" for row in bad)
+    assert len(bad) < len(rows) and "could not run" in r.stdout

@@ -408,6 +408,8 @@ def sweep(
     jobs: int = typer.Option(1, "-j", "--jobs", min=1, metavar="N", help="Worker processes."),
     dask: str = typer.Option(None, "--dask", metavar="ADDRESS", help="Run on an existing dask.distributed "
                              "cluster (scheduler address)."),
+    resume: bool = typer.Option(False, "--resume", help="Continue an interrupted sweep from TABLE's partial file "
+                                "(TABLE.partial: the variants it finished)."),
 ) -> None:
     """Verify a design over a grid of mechanism values: every check of the manifest on every variant (the
     mechanism files with the --vary numbers replaced), with a table and a plot of the worst margin.  Paths and
@@ -416,7 +418,8 @@ def sweep(
     from rich.progress import BarColumn, Progress, TextColumn  # noqa: PLC0415
 
     from .batch.manifest import load_manifest  # noqa: PLC0415
-    from .batch.sweep import parse_vary, plan_sweep, plot_sweep, run_sweep, table, write_table  # noqa: PLC0415
+    from .batch.sweep import (PartialFile, parse_vary, partial_path, plan_sweep, plot_sweep,  # noqa: PLC0415
+                              read_partial, run_sweep, table, write_table)
     from .io.output import output_target  # noqa: PLC0415
     from .report.progress import LateProgress  # noqa: PLC0415
     from .report.table_files import format_of  # noqa: PLC0415
@@ -436,22 +439,46 @@ def sweep(
         if len(varies) > 2:
             raise GearcliError(f"--plot: draws the worst margin over one or two varied values, {len(varies)} vary")
         output_target(plot, inputs, "--plot")
+    if resume and output is None:
+        raise GearcliError("--resume: give -o TABLE (the partial file TABLE.partial holds the finished variants)")
     plan = plan_sweep(manifest, varies, samples, seed)
+    partial, done = None, {}
+    if output is not None:
+        partial = partial_path(output)
+        output_target(str(partial), inputs)
+        if resume and not partial.exists():
+            raise GearcliError(f"--resume: {partial} does not exist: no interrupted sweep to continue")
+        if not resume and partial.exists():
+            raise GearcliError(f"{partial}: an interrupted sweep's finished variants: give --resume to continue it, "
+                               f"or remove the file to start again")
+        done = read_partial(partial, plan) if resume else {}
     err = stderr_console()
     bar = Progress(TextColumn("sweeping"), BarColumn(), TextColumn("{task.completed}/{task.total} variants"),
                    console=err, transient=True, disable=not err.is_terminal)
-    with LateProgress(bar, "sweep") as progress:
-        progress.update(total=len(plan.variants))
-        results = run_sweep(plan, jobs=jobs, dask_address=dask, progress=lambda n: progress.update(advance=n))
+    record = PartialFile(partial, plan, resume) if partial is not None else None
+    try:
+        with LateProgress(bar, "sweep") as progress:
+            progress.update(total=len(plan.variants))
+            results = run_sweep(plan, jobs=jobs, dask_address=dask, progress=lambda n: progress.update(advance=n),
+                                done=done, record=record)
+    finally:
+        if record is not None:
+            record.close()
     cols = table(plan, results)
     if output is not None:
         write_table(cols, output, inputs)
+        partial.unlink()
     if plot is not None:
         plot_sweep(plan, cols, plot, inputs)
     names = list(cols)[:len(varies)]
     passed = sum(cols["passed"])
-    typer.echo(f"{counted(len(plan.variants), 'variant')} of {design}: {passed} pass every check")
-    best = max(range(len(plan.variants)), key=lambda i: cols["worst_margin_%"][i])
+    typer.echo(f"{counted(len(plan.variants), 'variant')} of {design}: {passed} pass every check"
+               + (f" ({len(done)} from {partial})" if done else ""))
+    not_run = [w for w in cols["worst_check"] if w.startswith("not run: ")]
+    if not_run:
+        typer.echo(f"{counted(len(not_run), 'variant')} could not run: the first: {not_run[0][9:]}")
+    best = max(range(len(plan.variants)), key=lambda i: (cols["worst_margin_%"][i] == cols["worst_margin_%"][i],
+                                                        cols["worst_margin_%"][i]))
     said = ", ".join(f"{n} = {cols[n][best]:g}" for n in names)
     typer.echo(f"best: {said}: worst margin {cols['worst_margin_%'][best]:.4g} % ({cols['worst_check'][best]})")
     for path, what in ((output, "table"), (plot, "plot")):

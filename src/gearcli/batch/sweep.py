@@ -24,6 +24,7 @@ processes, a Dask cluster), so the table is the same bytes.
 from __future__ import annotations
 
 import copy
+import json
 import math
 import re
 from dataclasses import dataclass
@@ -284,67 +285,154 @@ def _chunks(n: int, size: int) -> list[range]:
     return [range(a, min(a + size, n)) for a in range(0, n, size)]
 
 
-def _run_chunk(manifest_path: str, varies, variants) -> list[list[tuple]]:
-    return [run_variant(manifest_path, varies, values) for values in variants]
+def _run_chunk(manifest_path: str, varies, variants) -> list:
+    """:func:`run_variant` of each variant; a variant that cannot be built or solved (values
+    that are each valid alone but not together, a belt that goes slack) is the one-line
+    reason, a string, in its place."""
+    out = []
+    for values in variants:
+        try:
+            out.append(run_variant(manifest_path, varies, values))
+        except GearcliError as exc:
+            out.append(" ".join(exc.lines()[0].split()) if exc.lines() else str(exc))
+    return out
 
 
-def run_sweep(plan: Plan, jobs: int = 1, dask_address: str | None = None, progress=None) -> list[list[tuple]]:
-    """Every variant's checks (:func:`run_variant`), in variant order; ``jobs`` local
-    processes or the Dask scheduler at ``dask_address``; ``progress(n)`` after each n
-    variants."""
+def run_sweep(plan: Plan, jobs: int = 1, dask_address: str | None = None, progress=None,
+              done: dict | None = None, record=None) -> list:
+    """Every variant's checks (:func:`run_variant`, or the reason it could not run), in
+    variant order; ``jobs`` local processes or the Dask scheduler at ``dask_address``;
+    ``progress(n)`` after each n variants.  ``done``: {variant index: its result} of an
+    earlier run (``--resume``), not run again; ``record(first, results)`` is told each
+    chunk's results as it finishes (the partial file)."""
     n = len(plan.variants)
-    size = max(1, min(64, n // (8 * max(jobs, 1)) or 1))
-    parts = _chunks(n, size)
-    results: dict[int, list] = {}
+    done = dict(done or {})
+    todo = [i for i in range(n) if i not in done]
+    size = max(1, min(64, len(todo) // (8 * max(jobs, 1)) or 1))
+    parts = [todo[a:a + size] for a in range(0, len(todo), size)]
+    if progress and done:
+        progress(len(done))
+
+    def finished(idx: list, rows: list) -> None:
+        done.update(zip(idx, rows))
+        if record:
+            record(idx, rows)
+        if progress:
+            progress(len(idx))
+
+    def args(idx: list):
+        return plan.manifest_path, plan.varies, [plan.variants[i] for i in idx]
+
     if dask_address is not None:
         from dask.distributed import as_completed as dask_completed  # noqa: PLC0415 (optional)
 
         from .runner import _dask_client  # noqa: PLC0415
         with _dask_client(dask_address) as client:
-            futures = {client.submit(_run_chunk, plan.manifest_path, plan.varies,
-                                     plan.variants[r.start:r.stop], pure=False): r for r in parts}
+            futures = {client.submit(_run_chunk, *args(idx), pure=False): k for k, idx in enumerate(parts)}
             for fut in dask_completed(list(futures), loop=client.loop):
-                r = futures[fut]
-                results[r.start] = fut.result()
-                if progress:
-                    progress(len(r))
+                finished(parts[futures[fut]], fut.result())
     elif jobs <= 1 or len(parts) <= 1:
-        for r in parts:
-            results[r.start] = _run_chunk(plan.manifest_path, plan.varies, plan.variants[r.start:r.stop])
-            if progress:
-                progress(len(r))
+        for idx in parts:
+            finished(idx, _run_chunk(*args(idx)))
     else:
         from concurrent.futures import ProcessPoolExecutor, as_completed  # noqa: PLC0415
         with ProcessPoolExecutor(max_workers=jobs) as pool:
-            futures = {pool.submit(_run_chunk, plan.manifest_path, plan.varies, plan.variants[r.start:r.stop]): r
-                       for r in parts}
+            futures = {pool.submit(_run_chunk, *args(idx)): k for k, idx in enumerate(parts)}
             for fut in as_completed(futures):
-                r = futures[fut]
-                results[r.start] = fut.result()
-                if progress:
-                    progress(len(r))
-    return [row for r in parts for row in results[r.start]]
+                finished(parts[futures[fut]], fut.result())
+    return [done[i] for i in range(n)]
 
 
-def table(plan: Plan, results: list[list[tuple]]) -> dict[str, list]:
+def _fingerprint(plan: Plan) -> str:
+    """What a partial file must match to be resumed: the manifest, the --vary texts, the variants."""
+    import hashlib  # noqa: PLC0415
+    text = json.dumps([str(Path(plan.manifest_path).resolve()), [v.text for v in plan.varies],
+                       [list(v) for v in plan.variants]])
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def partial_path(output: str) -> Path:
+    """The partial file of a sweep writing ``output``: finished variants, one JSON line each."""
+    p = Path(output)
+    return p.with_name(p.name + ".partial")
+
+
+def read_partial(path: Path, plan: Plan) -> dict:
+    """{variant index: result} of a partial file written for the same ``plan``; a
+    GearcliError naming the file and line when it is not one."""
+    lines = path.read_text().splitlines()
+    if not lines:
+        raise GearcliError(f"{path}:1: an empty partial file (remove it to start again)")
+    try:
+        head = json.loads(lines[0])
+    except json.JSONDecodeError:
+        raise GearcliError(f"{path}:1: not a sweep's partial file (remove it to start again)") from None
+    if not isinstance(head, dict) or head.get("plan") != _fingerprint(plan):
+        raise GearcliError(f"{path}:1: written by a sweep of other variants (another manifest, --vary or "
+                           f"--samples): remove it, or run that sweep with --resume")
+    done = {}
+    for k, line in enumerate(lines[1:], start=2):
+        try:
+            item = json.loads(line)
+            i, rows = int(item["i"]), item["result"]
+        except (json.JSONDecodeError, KeyError, TypeError, ValueError):
+            if k == len(lines):          # the line being written when the run stopped
+                break
+            raise GearcliError(f"{path}:{k}: not a finished variant's line (remove the file to start again)") from None
+        if not 0 <= i < len(plan.variants):
+            raise GearcliError(f"{path}:{k}: variant {i} is not one of the {len(plan.variants)} of this sweep")
+        done[i] = rows if isinstance(rows, str) else [tuple(r) for r in rows]
+    return done
+
+
+class PartialFile:
+    """Appends each finished chunk to the partial file (a header line with the plan's
+    fingerprint first), flushed, so that an interrupted sweep keeps what it finished."""
+
+    def __init__(self, path: Path, plan: Plan, resume: bool):
+        self.path = path
+        self.f = open(path, "a" if resume else "x", encoding="utf-8")
+        if not resume:
+            self.f.write(json.dumps({"plan": _fingerprint(plan)}) + "\n")
+            self.f.flush()
+
+    def __call__(self, idx: list, rows: list) -> None:
+        for i, r in zip(idx, rows):
+            self.f.write(json.dumps({"i": i, "result": r}) + "\n")
+        self.f.flush()
+
+    def close(self) -> None:
+        self.f.close()
+
+
+def table(plan: Plan, results: list) -> dict[str, list]:
     """The sweep's table, {column: values} in order: the varied values (named by their
     paths), then per check ``CASE: COMPONENT: QUANTITY`` value, limit and margin %, then
-    ``worst_margin_%``, ``worst_check`` and ``passed``."""
+    ``worst_margin_%``, ``worst_check`` and ``passed``; a variant that could not run has NaN
+    checks, its reason as ``worst_check``, and ``passed`` false."""
     cols: dict[str, list] = {}
     for k, v in enumerate(plan.varies):
         name = v.path if v.case is None else f"{v.case}:{v.path}"
         cols[name] = [values[k] for values in plan.variants]
-    checks = [f"{c[0]}: {c[1]}: {c[2]}" for c in results[0]] if results else []
+    ran = next((r for r in results if not isinstance(r, str)), [])
+    checks = [f"{c[0]}: {c[1]}: {c[2]}" for c in ran]
+    nan = (math.nan,) * 8
     for j, name in enumerate(checks):
-        unit = results[0][j][3]
+        unit = ran[j][3]
         u = f" [{unit}]" if unit else ""
-        cols[f"{name}: value{u}"] = [r[j][4] for r in results]
-        cols[f"{name}: limit{u}"] = [r[j][5] for r in results]
-        cols[f"{name}: margin %"] = [r[j][6] for r in results]
-    worst = [min(range(len(r)), key=lambda j: (r[j][7], r[j][6])) if r else None for r in results]
-    cols["worst_margin_%"] = [r[w][6] if w is not None else math.nan for r, w in zip(results, worst)]
-    cols["worst_check"] = [checks[w] if w is not None else "" for w in worst]
-    cols["passed"] = [all(c[7] for c in r) for r in results]
+        for field, at in ((f"value{u}", 4), (f"limit{u}", 5), ("margin %", 6)):
+            cols[f"{name}: {field}"] = [(nan if isinstance(r, str) else r[j])[at] for r in results]
+    worst, why = [], []
+    for r in results:
+        if isinstance(r, str) or not r:
+            worst.append(math.nan)
+            why.append(f"not run: {r}" if isinstance(r, str) else "")
+            continue
+        w = min(range(len(r)), key=lambda j: (r[j][7], r[j][6]))
+        worst.append(r[w][6])
+        why.append(checks[w])
+    cols["worst_margin_%"], cols["worst_check"] = worst, why
+    cols["passed"] = [not isinstance(r, str) and all(c[7] for c in r) for r in results]
     return cols
 
 
