@@ -2,7 +2,7 @@
 rated Bendix wrist over a 10,000-sample duty cycle, every check, at >= 50 variants/s with one
 compile in all); prints figures, not a test.
 
-    python benchmarks/bench_sweep.py [--variants 40] [--jobs 1]
+    python benchmarks/bench_sweep.py [--variants 40] [--jobs 1] [--dask-workers 0]
 
 The duty cycle is the bundled Bendix motion resampled to 10,000 samples (a temporary file),
 verified with designs/ci_example.yaml's checks; the variants vary the tool flange's mass and
@@ -32,6 +32,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--variants", type=int, default=40)
     ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--dask-workers", type=int, default=0, help="also time a dask LocalCluster of this many "
+                    "single-threaded worker processes (0: not)")
     args = ap.parse_args()
     src = ROOT / "mechanisms" / "bendix_wrist_traj.csv"
     head = src.read_text().splitlines()[0]
@@ -58,9 +60,19 @@ def main() -> None:
     rows = run_sweep(plan, jobs=args.jobs)
     dt = time.perf_counter() - t0
     n = len(plan.variants)
-    print(f"gearcli sweep, rated Bendix wrist, 10,000 samples, {len(rows[0])} checks a variant, -j {args.jobs}:")
-    print(f"  {n} variants in {dt:.2f} s: {n / dt:.2f} variants/s ({dt / n * 1e3:.0f} ms a variant); "
+    print(f"gearcli sweep, rated Bendix wrist, 10,000 samples, {len(rows[0])} checks a variant:")
+    print(f"  -j {args.jobs}: {n} variants in {dt:.2f} s: {n / dt:.2f} variants/s ({dt / n * 1e3:.0f} ms a variant); "
           f"kernels built: {len(compiles)} (numpy path)")
+    if args.dask_workers:
+        from dask.distributed import LocalCluster
+        with LocalCluster(n_workers=args.dask_workers, threads_per_worker=1, dashboard_address=None) as cluster:
+            run_sweep(plan, dask_address=cluster.scheduler_address)      # warm the workers (imports)
+            t0 = time.perf_counter()
+            again = run_sweep(plan, dask_address=cluster.scheduler_address)
+            dd = time.perf_counter() - t0
+        same = "the same results" if again == rows else "DIFFERENT results"
+        print(f"  dask LocalCluster, {args.dask_workers} workers: {n / dd:.2f} variants/s, {dt / dd:.2f}x -j {args.jobs} "
+              f"({same})")
     print(f"  {load_line()}")
 
 
