@@ -203,3 +203,31 @@ def test_a_variant_that_cannot_run_is_a_row_saying_why(run_cli, tmp_path):
     assert len(bad) == 1 and bad[0][:2] == ["0.048", "0.0225"]
     assert all(row[-1] == "false" and row[2] == "nan" for row in bad)
     assert len(bad) < len(rows) and "could not run" in r.stdout
+
+
+def test_a_sweep_builds_no_kernel_even_for_the_inertia_ratio(run_cli, tmp_path, monkeypatch):
+    """A design with a servo-sizing check (the load-to-rotor inertia ratio, from the mass
+    matrix) over 6,000 samples (past the first-call rule): every variant is solved, and its
+    inertia seen at the motor computed, on the numpy path; no kernel is built in the sweep
+    (each would be a compile per variant).  The ratio follows the varied load inertia: the
+    disc's J over n^2 J_rotor."""
+    from test_sizing import J_ROTOR, N_RATIO, disc_trajectory, rated_stage
+
+    from gearcli.dynamics.llvm import driver
+    text = rated_stage(f", rotor_inertia: {J_ROTOR}, max_inertia_ratio: 50")
+    (tmp_path / "stage.yaml").write_text(text)
+    t = np.linspace(0, 1, 6000)
+    disc_trajectory(tmp_path / "tr.csv", t, np.sin(t), np.cos(t), -np.sin(t))
+    (tmp_path / "d.yaml").write_text("cases:\n  - {name: c, mechanism: stage.yaml, trajectories: [tr.csv], "
+                                     "cycles_per_hour: 100}\n")
+    disc = next(ln for ln in text.splitlines() if "name: disc" in ln)
+    assert "inertia: [" in disc
+    monkeypatch.setattr(driver.Jit, "__init__", lambda *a, **k: pytest.fail("a kernel was built"))
+    out = tmp_path / "s.csv"
+    r = run_cli("sweep", tmp_path / "d.yaml", "--vary", "links.disc.inertia[2]=0.01,0.02", "-o", out)
+    assert r.exit_code == 0, r.stderr
+    header, rows = _read_csv(out)
+    ratio = header.index("c: motor servo: inertia ratio: value")
+    values = [float(row[ratio]) for row in rows]
+    assert values[1] == pytest.approx(2 * values[0], rel=1e-6)
+    assert values[0] == pytest.approx(0.01 / (N_RATIO ** 2 * J_ROTOR), rel=1e-3)

@@ -66,7 +66,8 @@ def solve_samples(an, traj_path, degrees: bool, threads: int | None = None, back
                     attach=tr.attach, backend=backend)
         check_belts(an, res)
     cols = LazyColumns(an, res, tr.t)
-    cols.update(inertia_columns(an, tr.q, tr.attach))     # servo sizing: inertia at the rated motors
+    # servo sizing: inertia at the rated motors (numpy where the solve was told numpy: a sweep's variant)
+    cols.update(inertia_columns(an, tr.q, tr.attach, "numpy" if backend == "numpy" else "auto"))
     return Samples(tr.t, cols, tr.qd @ an.S.T, backend_text(res))
 
 
@@ -81,7 +82,7 @@ def _streamed(an, traj_path, tr, threads, backend, checks) -> Samples:
                         attach=part.attach, backend=backend)
             check_belts(an, res)
         cols = LazyColumns(an, res, part.t)
-        cols.update(inertia_columns(an, part.q, part.attach))
+        cols.update(inertia_columns(an, part.q, part.attach, "numpy" if backend == "numpy" else "auto"))
         if kept is None:
             probe = Samples(part.t, cols, part.qd @ an.S.T)
             for ch in checks:
