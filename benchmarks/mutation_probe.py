@@ -264,6 +264,8 @@ MUTATIONS = [
              (("dynamics/llvm/bearing_newton.py", "return change, e.b.and_(ok, finite), finite", "return change, ok, ir.Constant(I1, 1)"),)),
     Mutation("bearing-infinite-moment", "numpy: a bearing friction moment grown to infinity passes the fixed point's test (then the sign search meets the overflow)",
              (("dynamics/bearing_friction.py", "finite = np.isfinite(new)", "finite = np.ones_like(new, dtype=bool)"),)),
+    Mutation("llvm-data-body-com", "llvm data kernel: a link's centre of mass read one double early (the inertia's last entry)",
+             (("dynamics/llvm/kernel.py", "return v[0], tuple(v[1:10]), tuple(v[10:13])", "return v[0], tuple(v[1:10]), tuple(v[9:12])"),)),
     Mutation("llvm-sin-quadrant", "llvm: inline sin with the quadrant's sign flipped",
              (("dynamics/llvm/trig.py", "b.select(sin_neg, e.neg(sin_mag), sin_mag)", "b.select(sin_neg, sin_mag, e.neg(sin_mag))"),)),
 ]

@@ -205,12 +205,14 @@ def test_a_variant_that_cannot_run_is_a_row_saying_why(run_cli, tmp_path):
     assert len(bad) < len(rows) and "could not run" in r.stdout
 
 
-def test_a_sweep_builds_no_kernel_even_for_the_inertia_ratio(run_cli, tmp_path, monkeypatch):
+def test_a_sweep_builds_one_kernel_for_all_its_variants(run_cli, tmp_path, monkeypatch):
     """A design with a servo-sizing check (the load-to-rotor inertia ratio, from the mass
-    matrix) over 6,000 samples (past the first-call rule): every variant is solved, and its
-    inertia seen at the motor computed, on the numpy path; no kernel is built in the sweep
-    (each would be a compile per variant).  The ratio follows the varied load inertia: the
-    disc's J over n^2 J_rotor."""
+    matrix) over 6,000 samples (past the first-call rule).  Varying a link's inertia, the one
+    data kernel (inertial values at run time) solves every variant and the inertia seen at the
+    motor is computed on the numpy path: one kernel built for three variants (a kernel of
+    constants would be a compile per variant).  Varying the rotor's rated inertia (not a
+    link's), the numpy path: none.  The ratio follows the varied load inertia: the disc's J
+    over n^2 J_rotor."""
     from test_sizing import J_ROTOR, N_RATIO, disc_trajectory, rated_stage
 
     from gearcli.dynamics.llvm import driver
@@ -222,12 +224,17 @@ def test_a_sweep_builds_no_kernel_even_for_the_inertia_ratio(run_cli, tmp_path, 
                                      "cycles_per_hour: 100}\n")
     disc = next(ln for ln in text.splitlines() if "name: disc" in ln)
     assert "inertia: [" in disc
-    monkeypatch.setattr(driver.Jit, "__init__", lambda *a, **k: pytest.fail("a kernel was built"))
+    built, real = [], driver.Jit.__init__
+    monkeypatch.setattr(driver.Jit, "__init__", lambda self, *a, **k: (built.append(1), real(self, *a, **k))[1])
     out = tmp_path / "s.csv"
-    r = run_cli("sweep", tmp_path / "d.yaml", "--vary", "links.disc.inertia[2]=0.01,0.02", "-o", out)
+    r = run_cli("sweep", tmp_path / "d.yaml", "--vary", "links.disc.inertia[2]=0.01,0.02,0.03", "-o", out)
     assert r.exit_code == 0, r.stderr
+    assert len(built) == 1
+    built.clear()
+    r = run_cli("sweep", tmp_path / "d.yaml", "--vary", f"motors.servo.rating.rotor_inertia={J_ROTOR},{2 * J_ROTOR}")
+    assert r.exit_code == 0 and built == [], r.stderr
     header, rows = _read_csv(out)
     ratio = header.index("c: motor servo: inertia ratio: value")
     values = [float(row[ratio]) for row in rows]
-    assert values[1] == pytest.approx(2 * values[0], rel=1e-6)
+    assert values[1] == pytest.approx(2 * values[0], rel=1e-6) and values[2] == pytest.approx(3 * values[0], rel=1e-6)
     assert values[0] == pytest.approx(0.01 / (N_RATIO ** 2 * J_ROTOR), rel=1e-3)

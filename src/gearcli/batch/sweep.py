@@ -24,6 +24,7 @@ processes, a Dask cluster), so the table is the same bytes.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import json
 import math
 import re
@@ -239,6 +240,28 @@ def _manifest(path: str):
     return load_manifest(path)
 
 
+INERTIAL = ("mass", "com", "inertia")
+"""The keys of a link a data kernel takes at run time (:func:`data_kernel_applies`)."""
+
+
+def data_kernel_applies(varies) -> bool:
+    """True when every --vary names a link's mass, centre of mass or inertia: the variants
+    differ only in the values the data kernel reads at run time
+    (:attr:`gearcli.dynamics.llvm.program.Program.data_bodies`), so one compile serves them all."""
+    return all(len(v.steps) >= 3 and v.steps[0] == "links" and v.steps[2] in INERTIAL for v in varies)
+
+
+@lru_cache(maxsize=8)
+def _data_solver(mech_path: str):
+    """A solver of the mechanism file as it is whose kernel reads the links' inertial values
+    at run time (compiled on its first solve, then kept for every variant), or None where the
+    llvm backend cannot solve it (the numpy path then)."""
+    from ..dynamics.determinacy import load_analysed  # noqa: PLC0415
+    from ..dynamics.solve import Solver  # noqa: PLC0415
+    solver = Solver(load_analysed(mech_path), data_bodies=True)
+    return solver if solver.llvm_available() else None
+
+
 @lru_cache(maxsize=64)
 def _trajectory(path: str, names: tuple, degrees: bool, linear: tuple, loads: tuple, payloads: tuple):
     from ..io.trajectory import read_trajectory  # noqa: PLC0415
@@ -249,7 +272,10 @@ def _trajectory(path: str, names: tuple, degrees: bool, linear: tuple, loads: tu
 def run_variant(manifest_path: str, varies: tuple[Vary, ...], values: tuple[float, ...]) -> list[tuple]:
     """Every check of the manifest on one variant: [(case, component, quantity, unit, value,
     limit, margin %, passed)] in the manifest's order of cases and checks (picklable in and
-    out: a local process or a Dask worker runs it the same)."""
+    out: a local process or a Dask worker runs it the same).  Variants of the links' inertial
+    values alone are solved by one data kernel per mechanism and process
+    (:func:`data_kernel_applies`); the others, and trajectories that pick and place payloads,
+    by the numpy path."""
     from ..design.checks import build_checks  # noqa: PLC0415
     from ..design.evaluate import combine, partials, profile_rates  # noqa: PLC0415
     from ..dynamics.determinacy import analyse  # noqa: PLC0415
@@ -259,17 +285,24 @@ def run_variant(manifest_path: str, varies: tuple[Vary, ...], values: tuple[floa
 
     manifest = _manifest(manifest_path)
     datas = _data(manifest, varies, values)
+    data_kernel = data_kernel_applies(varies)
     out = []
     for case in manifest.cases:
         # every value passed the schema alone (plan_sweep): the model's checks run here
-        an = analyse(mechanism_from_data(datas[case.name], str(case.mechanism), schema=False))
+        mech = mechanism_from_data(datas[case.name], str(case.mechanism), schema=False)
+        solver = _data_solver(str(case.mechanism)) if data_kernel else None
+        # the links' inertial values change no part of the analysis (topology, geometry, schedule)
+        an = analyse(mech) if solver is None else dataclasses.replace(solver.an, mech=mech)
         checks = build_checks(an, case.req, Collector(str(case.mechanism)))
         parts = []
         for tp in case.trajectories:
             tr = _trajectory(str(tp), tuple(an.independent_names), case.degrees,
                              tuple(bool(x) for x in an.prismatic_independent), tuple(an.mech.loads),
                              tuple(p.name for p in an.mech.payloads))
-            samples = solve_samples(an, tp, case.degrees, threads=1, backend="numpy", checks=checks, tr=tr)
+            ds = solver if not tr.attach else None
+            with_kernel = None if ds is None else (lambda p, an=an, ds=ds: ds.solve_bodies(an, p.q, p.qd, p.qdd, p.loads))
+            samples = solve_samples(an, tp, case.degrees, threads=1, backend="numpy", checks=checks, tr=tr,
+                                    solve_with=with_kernel)
             parts.append(partials(checks, samples, an.mech))
         spans = [p[0][6] if p else 0.0 for p in parts]
         rates = profile_rates(case.shares or (None,) * len(parts), spans, case.req.cycles_per_hour,

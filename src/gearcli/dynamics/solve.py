@@ -121,9 +121,10 @@ class Solver:
     :class:`gearcli.Solver` (:class:`.forward.Solver`) adds the forward-dynamics methods.
     """
 
-    def __init__(self, an, backend: str = "auto", jobs: int | None = None):
+    def __init__(self, an, backend: str = "auto", jobs: int | None = None, data_bodies: bool = False):
         self.an = an
         self.backend, self.jobs = backend, jobs
+        self.data_bodies = data_bodies   # the kernel reads the links' inertial values at run time (solve_bodies)
         self.groups = unknown_groups(an)
         self.plans = make_plans(an)
         self._program = None
@@ -137,7 +138,7 @@ class Solver:
         when the kernel cannot be used here (``self.kernel_problem`` says why); built on
         first use."""
         if self._program is None and self.kernel_problem is None:
-            self._program = build_program(self.an, self.plans)
+            self._program = build_program(self.an, self.plans, data_bodies=self.data_bodies)
             if not self._program.covered:
                 self.kernel_problem = (f"a block has more than {MAX_SIGNED} signed meshes, or a singular "
                                        "separating-force-free matrix")
@@ -151,6 +152,19 @@ class Solver:
             from .llvm.driver import LlvmKernel  # noqa: PLC0415  (imports llvmlite)
             self._llvm = LlvmKernel(self.kernel_program(), self.an)
         return self._llvm
+
+    def solve_bodies(self, an, q, qd, qdd, loads: dict | None = None) -> Result:
+        """:meth:`solve` on the llvm path, one thread, with the masses, centres of mass and
+        inertias of ``an``'s links: ``an`` is this solver's mechanism but for those values (a
+        sweep's variant), solved by the one kernel compiled for all of them (a solver made
+        with ``data_bodies=True``); the result is ``an``'s loads, to rounding."""
+        if not self.data_bodies:
+            raise ValueError("solve_bodies needs a Solver(an, data_bodies=True)")
+        kernel = self.llvm_kernel()
+        if kernel is None:
+            raise ValueError(f"the llvm backend cannot solve this mechanism: {self.llvm_problem}")
+        kernel.set_bodies(an)
+        return self.solve(q, qd, qdd, loads=loads, backend="llvm", jobs=1)
 
     def llvm_available(self) -> bool:
         """True when the llvm backend can solve this mechanism (without compiling it)."""

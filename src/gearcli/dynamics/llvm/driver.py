@@ -23,7 +23,7 @@ import numpy as np
 from . import cache as llvm_cache
 from .signs import WARM
 from .jobs import job_ranges, run_parts, sign_error, threads_for
-from .program import Program, load_arrays
+from .program import Program, body_rows, load_arrays
 from .kernel import ARGS, LOSS_OUTPUTS, build_module
 from .links import load_groups
 from .outputs import OUTPUTS
@@ -207,6 +207,7 @@ class LlvmKernel:
         self.build_seconds = self.jit.build_seconds
         self.compile_seconds = time.perf_counter() - t0 - self.build_seconds
         self.prog = prog
+        self.bodies = body_rows(an) if prog.data_bodies else None   # a data kernel's bodies (set_bodies)
         self._load_order, groups = load_groups(loads)
         self._load_groups = np.array([[k0, k1] for _, k0, k1 in groups] or [[0, 0]], np.int64)
 
@@ -219,6 +220,15 @@ class LlvmKernel:
     def ids(prog: Program, an) -> tuple[str, str]:
         """(fingerprint, program key) of the kernel (:func:`_program_ids`)."""
         return _program_ids(prog, an)
+
+    def set_bodies(self, an) -> None:
+        """A data kernel (:attr:`.program.Program.data_bodies`) solves with the masses, centres
+        of mass and inertias of ``an``'s links from now on (``an``: the same mechanism but
+        for those values)."""
+        rows = body_rows(an)
+        if not self.prog.data_bodies or rows.shape != self.bodies.shape:
+            raise ValueError("set_bodies: a data kernel, and a mechanism with its links, are needed")
+        self.bodies = rows
 
     def load_args(self, an, values: dict, n: int) -> list:
         """The external loads' arguments of the code (vals, ldpt, ldrow, ldgrp), contiguous."""
@@ -253,6 +263,7 @@ class LlvmKernel:
         SG, fail = work
         none = np.empty((1, 1))
         keep = [np.ascontiguousarray(a, float) for a in (q, qd, qdd)] + self.load_args(an, values, n)
+        keep += [self.bodies if self.prog.data_bodies else none]
         keep += [out[k] if out[k].size else none for k in OUTPUTS] + [SG]
         keep += [out[k] if out.get(k) is not None and out[k].size else none for k in LOSS_OUTPUTS] + [moments, fail]
         ptrs = [a.ctypes.data for a in keep]

@@ -33,10 +33,11 @@ from .blocks import block
 from .signs import WARM
 from .build import DP, I64, I64P, ConstantPool, Emitter
 from .links import at_rest, external, floats, inertia, joint, joint_space, load_groups
+from .program import BODY_WIDTH
 from .outputs import OUTPUTS, widths, write_outputs
 
 LOSS_OUTPUTS = ("gear_loss", "joint_friction", "joint_loss")
-ARGS = ("qi", "qdi", "qddi", "vals", "ldpt", "ldrow", "ldgrp") + OUTPUTS + ("signs",) + LOSS_OUTPUTS + (
+ARGS = ("qi", "qdi", "qddi", "vals", "ldpt", "ldrow", "ldgrp", "bodies") + OUTPUTS + ("signs",) + LOSS_OUTPUTS + (
     "moments", "fail", "start", "stop")
 
 
@@ -57,6 +58,13 @@ def _carries(rec) -> bool:
     return 0 < int(rec.m) <= MAX_EXHAUSTIVE
 
 
+def _body(e: Emitter, bodies, L: int) -> tuple:
+    """(mass, inertia (9,), com (3,)) of link L read from a data kernel's ``bodies`` argument
+    (:func:`.program.body_rows`)."""
+    v = [e.load(bodies, BODY_WIDTH * L + i) for i in range(BODY_WIDTH)]
+    return v[0], tuple(v[1:10]), tuple(v[10:13])
+
+
 def _sample(e: Emitter, fn, prog, loads, n, before: list) -> list:
     """The code of sample n (the loop body); returns the sign pattern each :func:`_carries`
     block settled on, which the next sample's search tries first (``before``: those of the sample
@@ -72,7 +80,7 @@ def _sample(e: Emitter, fn, prog, loads, n, before: list) -> list:
     for rec, pose in zip(prog.joints, prog.poses):
         joint(e, s, rec, pose)
     for L in prog.moving:
-        inertia(e, s, int(L), prog.bodies[L], prog.gravity)
+        inertia(e, s, int(L), _body(e, a["bodies"], int(L)) if prog.data_bodies else prog.bodies[L], prog.gravity)
     external(e, s, fn, [L for L, _, _ in load_groups(loads)[1]], n, a["vals"], a["ldrow"], a["ldpt"], a["ldgrp"])
     belt_pretension(e, s, prog)
     lp, w = prog.losses, widths(prog)
@@ -119,7 +127,7 @@ def build_module(prog, loads) -> ir.Module:
     """The IR module of ``prog``'s kernel (``loads``: per external load of the mechanism,
     its link id first (:func:`.driver.mech_loads`); only their links shape the code))."""
     mod = ir.Module(name="gearcli_kernel")
-    types = [DP] * 5 + [I64P] * 2 + [DP] * (len(OUTPUTS) + len(LOSS_OUTPUTS) + 2) + [I64P, I64, I64]
+    types = [DP] * 5 + [I64P] * 2 + [DP] + [DP] * (len(OUTPUTS) + len(LOSS_OUTPUTS) + 2) + [I64P, I64, I64]
     fn = signature(mod, "run", types, ARGS)
     fail = fn.args[ARGS.index("fail")]
 

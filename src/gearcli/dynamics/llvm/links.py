@@ -113,9 +113,13 @@ def joint(e: Emitter, s: Sample, rec, pose) -> None:
 
 
 def inertia(e: Emitter, s: Sample, L: int, body, g) -> None:
-    """rhs[L] = the d'Alembert wrench of link L (``body`` its :data:`.records.BODY`) about
-    o_L, base frame (Eqs. 17-18)."""
-    m, I, com = float(body.mass), floats(body.inertia), floats(body.com)
+    """rhs[L] = the d'Alembert wrench of link L (``body`` its :data:`.records.BODY`, or a
+    (mass, inertia (9,), com (3,)) of values read at run time: a data kernel) about o_L, base
+    frame (Eqs. 17-18)."""
+    if isinstance(body, tuple):
+        m, I, com = body
+    else:
+        m, I, com = float(body.mass), floats(body.inertia), floats(body.com)
     RL, wL, dwL = s.R[L], s.w[L], s.dw[L]
     wb = e.mtv(RL, wL)
     Nb = e.vadd(e.mv(I, e.mtv(RL, dwL)), e.cx(wb, e.mv(I, wb)))

@@ -104,6 +104,8 @@ class MassKernel(LlvmKernel):
 
     @staticmethod
     def build(prog, loads):
+        if prog.data_bodies:        # its masses are constants: a data program's are NaN
+            raise ValueError("the mass kernel is built from a program with constant bodies")
         return build_module(prog, loads)
 
     @staticmethod

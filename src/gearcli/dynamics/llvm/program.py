@@ -86,6 +86,10 @@ class Program:
     # moving), carrier] and [T_i, the tangent points X (2 spans x 2 pulleys x 3), e_A, e_B]
     belt_int: np.ndarray = _arr()
     belt_flt: np.ndarray = _arr()
+    # True: the kernel reads every link's mass, centre of mass and inertia at run time (its
+    # ``bodies`` argument, :func:`body_rows`), not as constants: one compile for every
+    # variant of those values (gearcli sweep); ``bodies`` is then NaN (the cache key's mark)
+    data_bodies: bool = False
 
     def arrays(self) -> list:
         """(name, array) of every array field, in field order (the disk cache's fingerprint)."""
@@ -111,6 +115,18 @@ def _bodies(an):
         link = an.mech.bodies[L]          # payloads merged
         out[L] = (link.mass, np.ravel(link.inertia), link.com)
     return out
+
+
+BODY_WIDTH = 13
+"""Doubles per link of a data kernel's ``bodies`` argument: mass, inertia (9, row-major, about
+the centre of mass, link axes), centre of mass (3, link frame)."""
+
+
+def body_rows(an) -> np.ndarray:
+    """The ``bodies`` argument of a data kernel (:attr:`Program.data_bodies`) for the
+    mechanism of ``an``: (links, :data:`BODY_WIDTH`) C-ordered, by link id."""
+    b = _bodies(an)
+    return np.ascontiguousarray(np.column_stack([b.mass, b.inertia, b.com]), float)
 
 
 def load_arrays(an, values: dict, n: int, order: list) -> list:
@@ -309,10 +325,11 @@ numpy path's: only the m + 1 own-sign trials).  A pattern is an i64 bit set in t
 30 planets (18, 30, 60 meshes) 4.5, 20 and 340 s (load 2), against 0.1 s of numpy."""
 
 
-def build_program(an, plans) -> Program:
+def build_program(an, plans, data_bodies: bool = False) -> Program:
     """The :class:`Program` of ``an`` and its block plans (:func:`..blocks.make_plans`); not
     ``covered`` when a block has more than :data:`MAX_SIGNED` signed meshes or a singular
-    base matrix."""
+    base matrix.  ``data_bodies``: the links' inertial values are run-time data
+    (:attr:`Program.data_bodies`; nothing else of the program depends on them)."""
     if any(len(p.signed) > MAX_SIGNED for p in plans):
         return Program(0, {}, [], [], False)
     try:
@@ -346,7 +363,8 @@ def build_program(an, plans) -> Program:
                  + list(weights.values()) + [np.array(f[0] + f[1] + f[2], float) for f in free.values()])
     ints = (lambda xs: np.array(xs, I64))
     return Program(c, offsets, signed, [p.names for p in plans], True, joints=joints, poses=poses,
-                   bodies=_bodies(an), moving=ints(an.tree.moving), base=int(an.tree.base),
+                   bodies=_bodies(an) if not data_bodies else np.full(len(an.tree.links), np.nan, BODY),
+                   data_bodies=data_bodies, moving=ints(an.tree.moving), base=int(an.tree.base),
                    gravity=np.asarray(an.mech.gravity, float), S=np.ascontiguousarray(an.S, float),
                    A=np.ascontiguousarray(an.A, float), blocks=records(bd.brec, BLOCK), block_links=ints(bd.blinks),
                    group_col=ints(bd.gcol), t_col=ints(bd.tcol), ainv=cat(bd.ainv),

@@ -1,0 +1,53 @@
+"""The data kernel (issue 37, "parameters as run-time data"): one compiled kernel whose links'
+masses, centres of mass and inertias are run-time data solves every variant of those values
+as the numpy path solves that variant's own mechanism, losses included."""
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gearcli import analyse, load_mechanism, solve
+from gearcli.dynamics.solve import Solver
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _worst(a, b, n):
+    """Largest difference of the motor torques and joint reactions, per sample relative to
+    the sample's largest reaction."""
+    scale = np.abs(b.joint.reshape(n, -1)).max(axis=1)
+    d = np.maximum(np.abs(a.motor - b.motor).max(axis=1), np.abs(a.joint - b.joint).reshape(n, -1).max(axis=1))
+    return float((d / scale).max())
+
+
+@pytest.mark.parametrize("name", ["bendix_wrist_rated", "cobot_6axis", "scara", "planetary_3p"])
+def test_one_kernel_solves_every_inertial_variant(name):
+    base = load_mechanism(ROOT / "mechanisms" / f"{name}.yaml")
+    an = analyse(base)
+    data = Solver(an, data_bodies=True)
+    rng = np.random.default_rng(3)
+    n = 1500
+    q, qd, qdd = (0.3 * rng.uniform(-1, 1, (n, an.dof)) for _ in range(3))
+    for k, scale in enumerate((1.0, 1.7, 0.4)):
+        links = tuple(dataclasses.replace(L, mass=L.mass * scale, com=np.asarray(L.com) + 0.01 * k,
+                                          inertia=np.asarray(L.inertia) * scale) if L.mass else L for L in base.links)
+        variant = analyse(dataclasses.replace(base, links=links))
+        got = data.solve_bodies(variant, q, qd, qdd)
+        assert got.backend == "llvm"
+        assert _worst(got, solve(variant, q, qd, qdd, backend="numpy"), n) < 1e-12
+        if k:                          # the variant's values, not the first ones the kernel saw
+            assert np.abs(got.motor - solve(an, q, qd, qdd, backend="numpy").motor).max() > 1e-6 * np.abs(got.motor).max()
+    assert data.llvm_kernel().prog.data_bodies and np.isnan(data.llvm_kernel().prog.bodies["mass"]).all()
+
+
+def test_solve_bodies_needs_a_data_solver_and_the_same_links():
+    an = analyse(load_mechanism(ROOT / "mechanisms" / "paper_2dof.yaml"))
+    with pytest.raises(ValueError, match="data_bodies=True"):
+        Solver(an).solve_bodies(an, np.zeros((2, an.dof)), np.zeros((2, an.dof)), np.zeros((2, an.dof)))
+    other = analyse(load_mechanism(ROOT / "mechanisms" / "bendix_wrist.yaml"))
+    with pytest.raises(ValueError, match="set_bodies"):
+        Solver(an, data_bodies=True).solve_bodies(other, np.zeros((2, an.dof)), np.zeros((2, an.dof)),
+                                                  np.zeros((2, an.dof)))
