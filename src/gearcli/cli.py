@@ -486,6 +486,89 @@ def sweep(
             typer.echo(f"Wrote the {what} to {path}")
 
 
+@app.command()
+@reports_bad_input
+def select(
+    design: Path = typer.Argument(..., metavar="DESIGN.yaml", show_default=False,
+                                  help="Design manifest with slots: the parts to choose, each from a catalogue CSV."),
+    objective: str = typer.Option("mass", "--objective", metavar="mass|cost|inertia", help="What the choice "
+                                  "minimises: the sum of the chosen parts' catalogue column of that name."),
+    output: str = typer.Option(None, "-o", "--output", metavar="DIR", help="Write the chosen design there: each "
+                               "mechanism file with the chosen parts' values and a manifest gearcli verify runs."),
+    table_out: str = typer.Option(None, "--table", metavar="TABLE.csv|parquet|feather", help="Write every "
+                                  "combination, ranked: its parts, objective, worst margin and failing checks."),
+    plot: str = typer.Option(None, "--plot", metavar="FIG.png|svg|pdf", help="Draw the objective against the "
+                             "worst margin of every combination, with the feasible ones' Pareto front."),
+    jobs: int = typer.Option(1, "-j", "--jobs", min=1, metavar="N", help="Worker processes."),
+    dask: str = typer.Option(None, "--dask", metavar="ADDRESS", help="Run on an existing dask.distributed "
+                             "cluster (scheduler address)."),
+) -> None:
+    """Choose one part per slot from its catalogue (motors, reducers, bearings, ...) so that every check of the
+    manifest passes at the least total mass (cost, inertia): every combination is verified with its own loads (a
+    heavier outer part loads the inner joints).  Exit 0 with a feasible choice, 1 when none passes (the closest
+    ones and their failing checks are shown), 2 on bad input."""
+    from rich.progress import BarColumn, Progress, TextColumn  # noqa: PLC0415
+
+    from .batch.manifest import load_manifest  # noqa: PLC0415
+    from .batch.select import plan_select, plot_pareto, rank, select_table, slots_of, write_choice  # noqa: PLC0415
+    from .batch.sweep import run_sweep, write_table  # noqa: PLC0415
+    from .io.output import output_target  # noqa: PLC0415
+    from .report.progress import LateProgress  # noqa: PLC0415
+    from .report.table_files import format_of  # noqa: PLC0415
+
+    if jobs > 1 and dask is not None:
+        raise GearcliError("select: give -j/--jobs or --dask, not both (a Dask cluster has its own workers)")
+    manifest = load_manifest(design)
+    inputs = [design] + [c.mechanism for c in manifest.cases] + [t for c in manifest.cases for t in c.trajectories]
+    if table_out is not None:
+        if table_out == "-" or format_of(table_out) not in ("csv", "parquet", "feather"):
+            raise GearcliError(f"--table: expected a .csv, .parquet or .feather file name, got '{table_out}'")
+        output_target(table_out, inputs, "--table")
+    if plot is not None:
+        if plot == "-" or Path(plot).suffix.lower() not in (".png", ".svg", ".pdf"):
+            raise GearcliError(f"--plot: expected a .png, .svg or .pdf file name, got '{plot}'")
+        output_target(plot, inputs, "--plot")
+    if output is not None and (not output.strip() or Path(output).exists() and not Path(output).is_dir()):
+        raise GearcliError(f"-o: expected a directory for the chosen design, got '{output}'")
+    slots = slots_of(manifest)
+    inputs += [s.catalogue for s in slots]
+    plan, combos, objectives = plan_select(manifest, slots, objective)
+    err = stderr_console()
+    bar = Progress(TextColumn("selecting"), BarColumn(), TextColumn("{task.completed}/{task.total} combinations"),
+                   console=err, transient=True, disable=not err.is_terminal)
+    with LateProgress(bar, "select") as progress:
+        progress.update(total=len(plan.variants))
+        results = run_sweep(plan, jobs=jobs, dask_address=dask, progress=lambda n: progress.update(advance=n))
+    ranked = rank(combos, objectives, results)
+    if table_out is not None:
+        write_table(select_table(slots, plan, ranked, objective), table_out, inputs)
+    if plot is not None:
+        plot_pareto(ranked, objective, plot, inputs)
+    feasible = sum(r.feasible for r in ranked)
+    typer.echo(f"{counted(len(ranked), 'combination')} of {counted(len(slots), 'slot')}: {feasible} feasible")
+
+    def parts(r) -> str:
+        return ", ".join(f"{s.name} = {s.parts[k].name}" for s, k in zip(slots, r.combo))
+    if feasible:
+        best = ranked[0]
+        typer.echo(f"chosen: {parts(best)}: total {objective} {best.objective:.6g}, worst margin {best.worst:.4g} % "
+                   f"({best.worst_check})")
+        for s, k in zip(slots, best.combo):
+            typer.echo(f"  {s.name}: {s.parts[k].name} ({s.parts[k].source})")
+        if output is not None:
+            for f in write_choice(manifest, slots, plan, best, Path(output)):
+                typer.echo(f"Wrote {f}")
+    else:
+        typer.echo("no combination passes every check; the closest:")
+        for r in ranked[:3]:
+            typer.echo(f"  {parts(r)}: worst margin {r.worst:.4g} %; failing: {'; '.join(r.failing)}")
+    for path, what in ((table_out, "ranked table"), (plot, "plot")):
+        if path is not None:
+            typer.echo(f"Wrote the {what} to {path}")
+    if not feasible:
+        raise typer.Exit(EXIT_CHECK_FAILED)
+
+
 def _worm_lines(manifest) -> list[str]:
     """One line per worm pair of each case: its efficiencies from the geometry and, when
     self-locking, that it holds a load without a brake (docs/concepts/drive-elements.md, Worm pairs)."""

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import glob
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 
@@ -80,6 +80,8 @@ class Manifest:
     path: Path
     name: str
     cases: tuple[Case, ...]
+    slots: tuple = ()        # the slots of gearcli select, as written (validated by the schema)
+    lines: dict = field(default_factory=dict, compare=False)   # YAML path -> line, for located errors
 
 
 MIN_POSITIVE = 1e-12
@@ -181,7 +183,7 @@ def load_manifest(path: str | Path) -> Manifest:
         located = sorted(col.issues, key=lambda i: i.line or 0)
         raise ManifestError([str(i) for i in located] + issues)
     name = data["name"] if "name" in data else path.stem
-    return Manifest(path, name, tuple(cases))
+    return Manifest(path, name, tuple(cases), tuple(data.get("slots", ())), lines)
 
 
 def _shown(name: str) -> str:

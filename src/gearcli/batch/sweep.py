@@ -52,6 +52,7 @@ class Vary:
     path: str
     steps: tuple
     values: tuple[float, ...]
+    mode: str = "set"        # "add": the value is added to the file's (gearcli select's parts)
 
 
 def _number(text: str, where: str) -> float:
@@ -151,10 +152,12 @@ def locate(data, steps: tuple, path: str):
     raise GearcliError(f"empty path '{path}'")
 
 
-def _set(data, steps: tuple, path: str, value: float) -> None:
-    container, key = locate(data, steps, path)
+def _set(data, v: Vary, value: float) -> None:
+    """The number ``v`` names in ``data`` set to ``value`` (or, ``v.mode`` "add", increased by it)."""
+    container, key = locate(data, v.steps, v.path)
     old = container[key]
-    container[key] = int(value) if isinstance(old, int) and float(value).is_integer() else float(value)
+    new = old + value if v.mode == "add" else value
+    container[key] = int(new) if isinstance(old, int) and float(new).is_integer() else float(new)
 
 
 @dataclass(frozen=True)
@@ -180,7 +183,7 @@ def _data(manifest, varies, values) -> dict[str, dict]:
         data = copy.deepcopy(_base(str(case.mechanism)))
         for v, x in zip(varies, values):
             if v.case is None or v.case == case.name:
-                _set(data, v.steps, v.path, x)
+                _set(data, v, x)
         out[case.name] = data
     return out
 

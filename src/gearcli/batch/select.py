@@ -1,0 +1,308 @@
+"""``gearcli select``: choose parts from catalogues so that a design passes every check.
+
+A design manifest's ``slots`` name the parts to choose: each slot has a catalogue (a CSV file,
+one part a row, :func:`read_catalogue`) and maps some of its columns onto numbers of the
+cases' mechanism files, in ``gearcli sweep``'s path terms: ``set`` replaces the file's value
+(a motor's ratings, a reducer's rated torque), ``add`` adds to it (the part's mass to the
+link that carries it, its inertia to the link it turns with).  Every combination of one part
+per slot is a variant of the mechanism files, verified as ``gearcli verify`` verifies them,
+each with its own loads: a heavier part on an outer joint raises the loads on the inner
+ones, and the combination is judged on those (the exhaustive search needs no iteration
+between choosing and solving, and so cannot cycle).  The feasible combinations (every check
+passes) are ranked by the objective, the sum of the chosen parts' ``mass``, ``cost`` or
+``inertia`` column; when none is feasible, the closest ones (largest worst margin) say which
+checks fail them.
+"""
+from __future__ import annotations
+
+import csv
+import itertools
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import GearcliError, MechanismError
+from .sweep import Plan, Vary, _data, _steps, locate, _base
+
+MAX_COMBINATIONS = 100_000
+"""More combinations than this are refused (narrow the catalogues)."""
+
+OBJECTIVES = ("mass", "cost", "inertia")
+
+
+@dataclass(frozen=True)
+class Part:
+    """One catalogue row: its ``name``, ``source``, numbers by column and CSV line."""
+
+    name: str
+    source: str
+    values: dict
+    line: int
+
+
+@dataclass(frozen=True)
+class Slot:
+    name: str
+    catalogue: Path
+    parts: tuple[Part, ...]
+    ops: tuple[tuple[str, str, str], ...]     # (catalogue column, mechanism path, "set" | "add")
+
+
+def read_catalogue(path: Path) -> tuple[Part, ...]:
+    """The parts of a catalogue CSV (schemas/catalogue.schema.json per row): a GearcliError
+    naming the file, the line and the column of the first problem."""
+    from ..io.schemas import packaged_schema  # noqa: PLC0415
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise GearcliError(f"{path}: cannot read the catalogue: {getattr(exc, 'strerror', None) or exc}") from None
+    rows = list(csv.reader(text.splitlines()))
+    if not rows or not any(c.strip() for c in rows[0]):
+        raise GearcliError(f"{path}:1: an empty catalogue (expected a header with name, source and number columns)")
+    header = [c.strip() for c in rows[0]]
+    for k, c in enumerate(header):
+        if not c:
+            raise GearcliError(f"{path}:1: column {k + 1} has no name")
+        if header.index(c) != k:
+            raise GearcliError(f"{path}:1: column '{c}' twice")
+    for need in ("name", "source"):
+        if need not in header:
+            raise GearcliError(f"{path}:1: no '{need}' column (a part's designation and where its numbers come from)")
+    schema = packaged_schema("catalogue.schema.json")
+    parts, names = [], {}
+    for line, row in enumerate(rows[1:], start=2):
+        if not any(c.strip() for c in row):
+            continue
+        if len(row) != len(header):
+            raise GearcliError(f"{path}:{line}: {len(row)} cells, the header has {len(header)}")
+        values = {}
+        for c, cell in zip(header, row):
+            cell = cell.strip()
+            if c in ("name", "source"):
+                if not cell:
+                    raise GearcliError(f"{path}:{line}: column '{c}': empty (every part needs its {c})")
+                continue
+            try:
+                x = float(cell)
+            except ValueError:
+                raise GearcliError(f"{path}:{line}: column '{c}': expected a number (SI units), got '{cell}'") from None
+            if not math.isfinite(x):
+                raise GearcliError(f"{path}:{line}: column '{c}': expected a finite number, got '{cell}'")
+            minimum = schema["properties"].get(c, {}).get("minimum")
+            if minimum is not None and x < minimum:
+                raise GearcliError(f"{path}:{line}: column '{c}': expected at least {minimum:g}, got {x:g}")
+            values[c] = x
+        name, source = row[header.index("name")].strip(), row[header.index("source")].strip()
+        if name in names:
+            raise GearcliError(f"{path}:{line}: part '{name}' twice (first on line {names[name]})")
+        names[name] = line
+        parts.append(Part(name, source, values, line))
+    if not parts:
+        raise GearcliError(f"{path}: no parts (a header and no rows)")
+    return tuple(parts)
+
+
+def _where(manifest, key: str) -> str:
+    line = manifest.lines.get(key)
+    return f"{manifest.path}:{line}: {key}" if line else f"{manifest.path}: {key}"
+
+
+def slots_of(manifest) -> tuple[Slot, ...]:
+    """The manifest's slots with their catalogues read and every mapping checked against the
+    catalogue (the column exists) and each case's mechanism (the path names a number)."""
+    if not manifest.slots:
+        raise GearcliError(f"{manifest.path}: no slots (select needs `slots:`, the parts to choose; "
+                           f"docs/how-to/select.md)")
+    slots, seen = [], {}
+    for i, spec in enumerate(manifest.slots):
+        name = spec["name"]
+        if name in seen:
+            raise GearcliError(f"{_where(manifest, f'slots[{i}].name')}: duplicate slot name '{name}' (first at {seen[name]})")
+        seen[name] = f"slots[{i}]"
+        path = (manifest.path.parent / spec["catalogue"])
+        parts = read_catalogue(path)
+        ops = []
+        for mode in ("set", "add"):
+            for column, target in spec.get(mode, {}).items():
+                where = _where(manifest, f"slots[{i}].{mode}.{column}")
+                missing = [p for p in parts if column not in p.values]
+                if missing:
+                    raise GearcliError(f"{where}: the catalogue {path} has no number column '{column}'")
+                try:
+                    steps = _steps(target, where)
+                except GearcliError as exc:
+                    raise GearcliError(str(exc)) from None
+                for case in manifest.cases:
+                    if Path(case.mechanism).suffix.lower() not in (".yaml", ".yml"):
+                        raise GearcliError(f"{where}: case '{case.name}': select varies YAML mechanism files, "
+                                           f"{case.mechanism} is not one")
+                    try:
+                        locate(_base(str(case.mechanism)), steps, target)
+                    except GearcliError as exc:
+                        raise GearcliError(f"{where}: case '{case.name}' ({case.mechanism}): {exc}") from None
+                ops.append((column, target, mode))
+        slots.append(Slot(name, path, parts, tuple(ops)))
+    return tuple(slots)
+
+
+def plan_select(manifest, slots: tuple[Slot, ...], objective: str) -> tuple[Plan, list[tuple[int, ...]], list[float]]:
+    """(the sweep plan of every combination, each combination's part indices, its objective).
+    Each part is tried alone first (the others at the file's values): a part that makes the
+    mechanism invalid is a located error before anything runs."""
+    from ..io.yaml_reader import mechanism_from_data  # noqa: PLC0415
+    if objective not in OBJECTIVES:
+        raise GearcliError(f"--objective: expected one of {', '.join(OBJECTIVES)}, got '{objective}'")
+    for s in slots:
+        lacking = [p for p in s.parts if objective not in p.values]
+        if lacking:
+            raise GearcliError(f"{s.catalogue}:{lacking[0].line}: part '{lacking[0].name}' has no '{objective}' "
+                               f"(--objective {objective} sums it over the chosen parts)")
+    varies = tuple(Vary(f"{s.name}.{column}", None, target, _steps(target, target), (), mode)
+                   for s in slots for column, target, mode in s.ops)
+    for s in slots:
+        for part in s.parts:
+            alone = [v for v in varies if v.text.startswith(f"{s.name}.")]
+            values = [part.values[v.text.split(".", 1)[1]] for v in alone]
+            for case in manifest.cases:
+                try:
+                    mechanism_from_data(_data(manifest, alone, values)[case.name], str(case.mechanism))
+                except MechanismError as exc:
+                    i = exc.issues[0]
+                    raise GearcliError(f"{s.catalogue}:{part.line}: part '{part.name}' in slot '{s.name}', case "
+                                       f"'{case.name}': {i.path + ': ' if i.path else ''}{i.message}") from None
+    total = math.prod(len(s.parts) for s in slots)
+    if total > MAX_COMBINATIONS:
+        raise GearcliError(f"select: {total:,} combinations, more than {MAX_COMBINATIONS:,}: narrow the catalogues")
+    combos = list(itertools.product(*(range(len(s.parts)) for s in slots)))
+    variants, objectives = [], []
+    for combo in combos:
+        row = []
+        for s, k in zip(slots, combo):
+            row += [s.parts[k].values[column] for column, _, _ in s.ops]
+        variants.append(tuple(row))
+        objectives.append(sum(s.parts[k].values[objective] for s, k in zip(slots, combo)))
+    return Plan(str(manifest.path), varies, tuple(variants)), combos, objectives
+
+
+@dataclass(frozen=True)
+class Ranked:
+    """A combination: its part indices, objective, worst margin (%) and check, whether every
+    check passes, and the checks that fail it."""
+
+    combo: tuple[int, ...]
+    objective: float
+    worst: float
+    worst_check: str
+    feasible: bool
+    failing: tuple[str, ...]
+
+
+def rank(combos, objectives, results) -> list[Ranked]:
+    """Feasible combinations first, by objective (then the larger worst margin); then the
+    others by their worst margin, largest first (the closest to passing)."""
+    out = []
+    for combo, obj, r in zip(combos, objectives, results):
+        if isinstance(r, str):
+            out.append(Ranked(combo, obj, -math.inf, f"not run: {r}", False, (r,)))
+            continue
+        w = min(range(len(r)), key=lambda j: (r[j][7], r[j][6]))
+        failing = tuple(f"{c[0]}: {c[1]}: {c[2]} ({c[6]:.3g} %)" for c in r if not c[7])
+        out.append(Ranked(combo, obj, r[w][6], f"{r[w][0]}: {r[w][1]}: {r[w][2]}", not failing, failing))
+    return sorted(out, key=lambda x: (not x.feasible, x.objective if x.feasible else 0.0, -x.worst))
+
+
+def write_choice(manifest, slots, plan: Plan, ranked: Ranked, directory: Path) -> list[Path]:
+    """The chosen design in ``directory``: each case's mechanism file with the chosen parts'
+    values, and a manifest (the original's cases, trajectories by absolute path, no slots)
+    that ``gearcli verify`` runs on it.  Returns the files written."""
+    import yaml  # noqa: PLC0415
+
+    from ..io.output import atomic_output  # noqa: PLC0415
+    from ..io.yaml_safe import read_text, yaml_lines  # noqa: PLC0415
+    values = [s.parts[k].values[column] for s, k in zip(slots, ranked.combo) for column, _, _ in s.ops]
+    datas = _data(manifest, plan.varies, values)
+    directory.mkdir(parents=True, exist_ok=True)
+    written, mech_files = [], {}
+    for case in manifest.cases:
+        key = str(case.mechanism)
+        if key not in mech_files:
+            target = directory / Path(case.mechanism).name
+            if target.resolve() == Path(case.mechanism).resolve():
+                raise GearcliError(f"{directory}: would overwrite the mechanism file {case.mechanism}: choose another -o")
+            with atomic_output(target, [case.mechanism, manifest.path]) as f:
+                chosen = ", ".join(f"{s.name} = {s.parts[k].name} ({s.parts[k].source})" for s, k in zip(slots, ranked.combo))
+                f.write(f"# Written by gearcli select from {case.mechanism}: {chosen}\n")
+                f.write(yaml.safe_dump(datas[case.name], sort_keys=False))
+            mech_files[key] = target
+            written.append(target)
+    data, _ = yaml_lines(read_text(manifest.path, "design manifest"), str(manifest.path))
+    data.pop("slots", None)
+    base = manifest.path.parent
+
+    def absolute(item):       # a trajectory path or glob (or a mission profile's item) from anywhere
+        if isinstance(item, dict):
+            return {**item, "file": str((base / item["file"]).resolve())}
+        return str((base / item).resolve())
+    for spec, case in zip(data["cases"], manifest.cases):
+        spec["mechanism"] = mech_files[str(case.mechanism)].name
+        items = spec["trajectories"] if isinstance(spec["trajectories"], list) else [spec["trajectories"]]
+        spec["trajectories"] = [absolute(t) for t in items]
+    design = directory / manifest.path.name
+    if design.resolve() == manifest.path.resolve():
+        raise GearcliError(f"{directory}: would overwrite the manifest {manifest.path}: choose another -o")
+    with atomic_output(design, [manifest.path]) as f:
+        f.write(f"# Written by gearcli select from {manifest.path}: the chosen parts' design\n")
+        f.write(yaml.safe_dump(data, sort_keys=False))
+    written.append(design)
+    return written
+
+
+def select_table(slots, plan: Plan, ranked: list[Ranked], objective: str) -> dict[str, list]:
+    """The ranked table: rank, each slot's part, the objective, the worst margin and check,
+    feasible, the failing checks."""
+    cols: dict[str, list] = {"rank": list(range(1, len(ranked) + 1))}
+    for j, s in enumerate(slots):
+        cols[s.name] = [s.parts[r.combo[j]].name for r in ranked]
+    cols[f"total_{objective}"] = [r.objective for r in ranked]
+    cols["worst_margin_%"] = [r.worst for r in ranked]
+    cols["worst_check"] = [r.worst_check for r in ranked]
+    cols["feasible"] = [r.feasible for r in ranked]
+    cols["failing_checks"] = ["; ".join(r.failing) for r in ranked]
+    return cols
+
+
+def plot_pareto(ranked: list[Ranked], objective: str, path: str, inputs=()) -> None:
+    """Total ``objective`` against the worst margin of every combination (feasible ones
+    green, the others red), the Pareto front of the feasible ones (least objective for a
+    margin) drawn through them, the chosen one ringed."""
+    import matplotlib  # noqa: PLC0415
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    from ..io.output import atomic_output  # noqa: PLC0415
+    units = {"mass": "kg", "cost": "", "inertia": "kg·m²"}
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    ok = [r for r in ranked if r.feasible and math.isfinite(r.worst)]
+    bad = [r for r in ranked if not r.feasible and math.isfinite(r.worst)]
+    if bad:
+        ax.scatter([r.objective for r in bad], [r.worst for r in bad], c="tab:red", s=18, label="a check fails")
+    if ok:
+        ax.scatter([r.objective for r in ok], [r.worst for r in ok], c="tab:green", s=18, label="feasible")
+        front, best = [], -math.inf
+        for r in sorted(ok, key=lambda r: (r.objective, -r.worst)):
+            if r.worst > best:
+                front.append(r)
+                best = r.worst
+        ax.plot([r.objective for r in front], [r.worst for r in front], "g-", lw=1, label="Pareto front")
+        ax.scatter([ok[0].objective], [ok[0].worst], s=120, facecolors="none", edgecolors="k", label="chosen")
+    ax.axhline(0.0, color="red", linestyle="--", lw=1)
+    unit = units[objective]
+    ax.set_xlabel(f"total {objective}" + (f" [{unit}]" if unit else ""))
+    ax.set_ylabel("worst margin [%] (below 0: a check fails)")
+    ax.set_title(f"{len(ranked)} combinations: {len(ok)} feasible", fontsize=10)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    with atomic_output(path, inputs, binary=True) as f:
+        fig.savefig(f, format=Path(path).suffix.lower().lstrip("."), dpi=110)
+    plt.close(fig)

@@ -1,0 +1,155 @@
+"""gearcli select (issue 37): one part per slot from catalogues, every check passing, least
+total mass.  The choice is checked against brute force: every combination written out by
+hand (text edits of the mechanism file) and verified with plain ``gearcli verify``.  The
+catalogues here are test data, written for these tests (their source column says so)."""
+from __future__ import annotations
+
+import itertools
+import json
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+MECH = ROOT / "mechanisms" / "paper_2dof_rated.yaml"
+RATING = "    rating: {peak_torque: 16.0, rms_torque: 9.5, max_speed: 30, max_power: 200, thermal_window: 1.0}\n"
+FOREARM = '  - name: "2"                     # forearm; frame at the wrist\n    mass: 2.5\n'
+MOTORS = [("M-S", 1.0, 12, 7, 30, 150), ("M-M", 1.4, 13.5, 9.5, 30, 200), ("M-L", 2.0, 16, 11, 30, 250),
+          ("M-XL", 3.0, 22, 14, 30, 300)]
+SLOTS = """slots:
+  - name: motor5
+    catalogue: motors.csv
+    set: {peak_torque: motors.motor5.rating.peak_torque, rms_torque: motors.motor5.rating.rms_torque,
+          max_speed: motors.motor5.rating.max_speed, max_power: motors.motor5.rating.max_power}
+  - name: tool
+    catalogue: tools.csv
+    add: {mass: links.2.mass}
+"""
+
+
+def _catalogues(tmp: Path, motors=MOTORS, tools=(("T-0", 0.0), ("T-3", 0.3))) -> None:
+    rows = ["name,source,mass,peak_torque,rms_torque,max_speed,max_power"]
+    rows += [f"{n},test data for tests/test_select.py,{m},{p},{r},{s},{w}" for n, m, p, r, s, w in motors]
+    (tmp / "motors.csv").write_text("\n".join(rows) + "\n")
+    (tmp / "tools.csv").write_text("name,source,mass\n" + "".join(f"{n},test data,{m}\n" for n, m in tools))
+
+
+def _design(tmp: Path, slots: str = SLOTS, mech: Path = MECH) -> Path:
+    text = (ROOT / "designs" / "paper_arm_duty.yaml").read_text()
+    text = text.replace("../mechanisms/paper_2dof_rated.yaml", str(mech))
+    text = text.replace("../mechanisms/paper_2dof_traj.csv", str(ROOT / "mechanisms" / "paper_2dof_traj.csv"))
+    (tmp / "d.yaml").write_text(text + slots)
+    return tmp / "d.yaml"
+
+
+def _by_hand(run_cli, tmp: Path, motor, tool_mass) -> bool:
+    """Plain gearcli verify of the mechanism file edited by hand for this combination."""
+    n, _, p, r, s, w = motor
+    text = MECH.read_text()
+    assert RATING in text and FOREARM in text
+    text = text.replace(RATING, RATING.replace("peak_torque: 16.0, rms_torque: 9.5, max_speed: 30, max_power: 200",
+                                               f"peak_torque: {p}, rms_torque: {r}, max_speed: {s}, max_power: {w}"))
+    text = text.replace(FOREARM, FOREARM.replace("mass: 2.5", f"mass: {2.5 + tool_mass!r}"))
+    d = tmp / f"{n}_{tool_mass}"
+    d.mkdir()
+    (d / "m.yaml").write_text(text)
+    design = _design(d, "", d / "m.yaml")
+    return run_cli("verify", design, "-j", "1").exit_code == 0
+
+
+def test_the_choice_is_the_lightest_that_plain_verify_passes(run_cli, tmp_path):
+    _catalogues(tmp_path)
+    table = tmp_path / "ranked.csv"
+    r = run_cli("select", _design(tmp_path), "--table", table)
+    assert r.exit_code == 0, r.stderr
+    feasible = {}
+    for motor, (tool, mass) in itertools.product(MOTORS, (("T-0", 0.0), ("T-3", 0.3))):
+        if _by_hand(run_cli, tmp_path, motor, mass):
+            feasible[(motor[0], tool)] = motor[1] + mass
+    best = min(feasible, key=feasible.get)
+    assert f"chosen: motor5 = {best[0]}, tool = {best[1]}: total mass {feasible[best]:.6g}" in r.stdout
+    assert f"8 combinations of 2 slots: {len(feasible)} feasible" in r.stdout
+    rows = [ln.split(",") for ln in table.read_text().splitlines()]
+    assert rows[0][:4] == ["rank", "motor5", "tool", "total_mass"]
+    shown = {(row[1], row[2]) for row in rows[1:] if row[6] == "true"}
+    assert shown == set(feasible)
+    masses = [float(row[3]) for row in rows[1:] if row[6] == "true"]
+    assert masses == sorted(masses)                 # feasible first, lightest first
+
+
+def test_a_heavier_outer_part_changes_the_inner_joints_choice(run_cli, tmp_path):
+    """The tool sits on the forearm (outer); motor 5 drives the upper arm (inner).  With the
+    light tool the 13.5 N*m motor suffices; the 0.3 kg tool raises motor 5's peak torque past
+    it and the choice moves to the 16 N*m one, each combination verified with its own loads."""
+    chosen = {}
+    for tools in ((("T-0", 0.0),), (("T-3", 0.3),)):
+        d = tmp_path / tools[0][0]
+        d.mkdir()
+        _catalogues(d, tools=tools)
+        r = run_cli("select", _design(d))
+        assert r.exit_code == 0, r.stderr
+        chosen[tools[0][0]] = r.stdout.split("chosen: motor5 = ", 1)[1].split(",", 1)[0]
+    assert chosen == {"T-0": "M-M", "T-3": "M-L"}
+
+
+def test_the_chosen_design_is_written_and_verify_passes_it(run_cli, tmp_path):
+    _catalogues(tmp_path, tools=(("T-3", 0.3),))
+    out = tmp_path / "chosen"
+    r = run_cli("select", _design(tmp_path), "-o", out, "--plot", tmp_path / "pareto.png")
+    assert r.exit_code == 0, r.stderr
+    mech, design = out / MECH.name, out / "d.yaml"
+    assert mech.is_file() and design.is_file() and (tmp_path / "pareto.png").read_bytes()[:4] == b"\x89PNG"
+    js = tmp_path / "v.json"
+    v = run_cli("verify", design, "--json", js, "-j", "1")
+    assert v.exit_code == 0, v.stdout + v.stderr
+    import yaml
+    data = yaml.safe_load(mech.read_text())
+    assert next(m for m in data["motors"] if m["name"] == "motor5")["rating"]["peak_torque"] == 16
+    assert next(L for L in data["links"] if L["name"] == "2")["mass"] == pytest.approx(2.8)
+    assert "slots" not in yaml.safe_load(design.read_text())
+    assert len(json.loads(js.read_text())["checks"]) == 42
+
+
+def test_nothing_feasible_shows_the_closest_and_what_fails_them(run_cli, tmp_path):
+    _catalogues(tmp_path, motors=MOTORS[:1])
+    out = tmp_path / "chosen"
+    r = run_cli("select", _design(tmp_path), "-o", out)
+    assert r.exit_code == 1
+    assert "0 feasible" in r.stdout and "no combination passes every check; the closest:" in r.stdout
+    assert "motor5 = M-S, tool = T-0: worst margin" in r.stdout and "motor motor5: peak torque" in r.stdout
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("motors, tools, slots, said", [
+    ("name,source,mass,peak_torque\nA,x,1,twelve\n", None, None, "motors.csv:2: column 'peak_torque': expected a number"),
+    ("name,mass\nA,1\n", None, None, "motors.csv:1: no 'source' column"),
+    ("name,source,mass\nA,x,1\nA,x,2\n", None, None, "motors.csv:3: part 'A' twice (first on line 2)"),
+    ("name,source,mass\nA,,1\n", None, None, "motors.csv:2: column 'source': empty"),
+    ("name,source,mass\nA,x,-1\n", None, None, "motors.csv:2: column 'mass': expected at least 0"),
+    (None, "name,source\nT,x\n", None, "has no number column 'mass'"),
+    (None, None, SLOTS.replace("links.2.mass", "links.forearm.mass"), "no link named 'forearm'"),
+    (None, None, SLOTS.replace("motors.csv", "nowhere.csv"), "nowhere.csv: cannot read the catalogue"),
+    (None, None, "", "no slots"),
+])
+def test_bad_catalogues_and_slots_are_located(run_cli, tmp_path, motors, tools, slots, said):
+    _catalogues(tmp_path)
+    if motors is not None:
+        (tmp_path / "motors.csv").write_text(motors)
+    if tools is not None:
+        (tmp_path / "tools.csv").write_text(tools)
+    out = tmp_path / "chosen"
+    r = run_cli("select", _design(tmp_path, SLOTS if slots is None else slots), "-o", out)
+    assert r.exit_code == 2 and said in r.stderr, r.stderr
+    assert r.stderr.count("\n") == 1 and "Traceback" not in r.stderr and not out.exists()
+
+
+def test_a_slot_path_and_the_objective_are_checked(run_cli, tmp_path):
+    _catalogues(tmp_path)
+    d = _design(tmp_path)
+    r = run_cli("select", d, "--objective", "cost")
+    assert r.exit_code == 2 and "motors.csv:2: part 'M-S' has no 'cost'" in r.stderr
+    r = run_cli("select", d, "--objective", "beauty")
+    assert r.exit_code == 2 and "--objective: expected one of mass, cost, inertia" in r.stderr
+    slots = SLOTS.replace("links.2.mass", "links.2.inertia")
+    r = run_cli("select", _design(tmp_path, slots))
+    assert r.exit_code == 2 and "slots[1].add.mass" in r.stderr and "is a list in the file, not a number" in r.stderr
