@@ -51,3 +51,26 @@ def test_solve_bodies_needs_a_data_solver_and_the_same_links():
     with pytest.raises(ValueError, match="set_bodies"):
         Solver(an, data_bodies=True).solve_bodies(other, np.zeros((2, an.dof)), np.zeros((2, an.dof)),
                                                   np.zeros((2, an.dof)))
+
+
+def test_threads_sharing_a_data_kernel_keep_their_own_values():
+    """A Dask worker's threads share one data kernel: each thread's variant is solved with its
+    own values (they were one attribute of the kernel: a thread could solve with another's)."""
+    from concurrent.futures import ThreadPoolExecutor
+    base = load_mechanism(ROOT / "mechanisms" / "bendix_wrist_rated.yaml")
+    an = analyse(base)
+    data = Solver(an, data_bodies=True)
+    rng = np.random.default_rng(5)
+    n = 4000
+    q, qd, qdd = (rng.uniform(-1, 1, (n, an.dof)) for _ in range(3))
+    variants = [analyse(dataclasses.replace(base, links=tuple(
+        dataclasses.replace(L, mass=L.mass * s) if L.mass else L for L in base.links))) for s in (0.5, 1.0, 2.0, 3.0)]
+    want = [solve(v, q, qd, qdd, backend="numpy").motor for v in variants]
+    data.solve_bodies(an, q[:2], qd[:2], qdd[:2])          # compiled before the threads start
+
+    def run(k):
+        return [data.solve_bodies(variants[k], q, qd, qdd).motor for _ in range(5)]
+    with ThreadPoolExecutor(4) as pool:
+        got = list(pool.map(run, range(4)))
+    for k in range(4):
+        assert all(np.allclose(g, want[k], rtol=0, atol=1e-12 * np.abs(want[k]).max()) for g in got[k])

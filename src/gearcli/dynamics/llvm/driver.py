@@ -12,6 +12,7 @@ independent of the split (bitwise identical results for any number of jobs).
 from __future__ import annotations
 
 import ctypes
+import threading
 import hashlib
 import time
 import weakref
@@ -208,6 +209,7 @@ class LlvmKernel:
         self.compile_seconds = time.perf_counter() - t0 - self.build_seconds
         self.prog = prog
         self.bodies = body_rows(an) if prog.data_bodies else None   # a data kernel's bodies (set_bodies)
+        self._local = threading.local()      # set_bodies per thread: a Dask worker's threads share the kernel
         self._load_order, groups = load_groups(loads)
         self._load_groups = np.array([[k0, k1] for _, k0, k1 in groups] or [[0, 0]], np.int64)
 
@@ -223,12 +225,12 @@ class LlvmKernel:
 
     def set_bodies(self, an) -> None:
         """A data kernel (:attr:`.program.Program.data_bodies`) solves with the masses, centres
-        of mass and inertias of ``an``'s links from now on (``an``: the same mechanism but
-        for those values)."""
+        of mass and inertias of ``an``'s links from now on, in this thread (``an``: the same
+        mechanism but for those values)."""
         rows = body_rows(an)
         if not self.prog.data_bodies or rows.shape != self.bodies.shape:
             raise ValueError("set_bodies: a data kernel, and a mechanism with its links, are needed")
-        self.bodies = rows
+        self._local.bodies = rows            # this thread's solves (another thread keeps its own)
 
     def load_args(self, an, values: dict, n: int) -> list:
         """The external loads' arguments of the code (vals, ldpt, ldrow, ldgrp), contiguous."""
@@ -263,7 +265,7 @@ class LlvmKernel:
         SG, fail = work
         none = np.empty((1, 1))
         keep = [np.ascontiguousarray(a, float) for a in (q, qd, qdd)] + self.load_args(an, values, n)
-        keep += [self.bodies if self.prog.data_bodies else none]
+        keep += [getattr(self._local, "bodies", self.bodies) if self.prog.data_bodies else none]
         keep += [out[k] if out[k].size else none for k in OUTPUTS] + [SG]
         keep += [out[k] if out.get(k) is not None and out[k].size else none for k in LOSS_OUTPUTS] + [moments, fail]
         ptrs = [a.ctypes.data for a in keep]
