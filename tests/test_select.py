@@ -153,3 +153,32 @@ def test_a_slot_path_and_the_objective_are_checked(run_cli, tmp_path):
     slots = SLOTS.replace("links.2.mass", "links.2.inertia")
     r = run_cli("select", _design(tmp_path, slots))
     assert r.exit_code == 2 and "slots[1].add.mass" in r.stderr and "is a list in the file, not a number" in r.stderr
+
+
+def test_the_bundled_bearing_catalogue_and_the_slot_conditions(run_cli, tmp_path):
+    """catalogues/skf_deep_groove_60.csv reads (9 parts, each cited; 6001's ratings are the
+    tutorial's elbow bearings'), and a slot's match/at_least keep the parts that fit: on the
+    12 mm elbow shaft only the 6001 is considered, so select chooses it for both bearings; a
+    condition no part meets is a located error."""
+    from gearcli.batch.select import read_catalogue
+    cat = ROOT / "catalogues" / "skf_deep_groove_60.csv"
+    parts = read_catalogue(cat)
+    assert len(parts) == 9 and all("SKF" in p.source for p in parts)
+    by = {p.name: p.values for p in parts}
+    assert (by["6001"]["bore"], by["6001"]["C"], by["6001"]["C0"]) == (0.012, 5400, 2360)
+    assert "C: 5400, C0: 2360" in (ROOT / "docs" / "examples" / "geared_joint.yaml").read_text()
+    bores = [p.values["bore"] for p in parts]
+    assert bores == sorted(bores) and [p.values["C"] for p in parts] == sorted(p.values["C"] for p in parts)
+    design = (ROOT / "docs" / "examples" / "geared_joint_design.yaml").read_text()
+    design = design.replace("geared_joint.yaml", str(ROOT / "docs" / "examples" / "geared_joint.yaml"))
+    design = design.replace("geared_joint_traj.csv", str(ROOT / "docs" / "examples" / "geared_joint_traj.csv"))
+    slots = "slots:\n" + "".join(
+        f"  - name: {b}\n    catalogue: {cat}\n    set: {{C: joints.Je.bearings.{b}.C, C0: joints.Je.bearings.{b}.C0}}\n"
+        f"    match: {{bore: 0.012}}\n    at_least: {{C0: 1000}}\n" for b in ("near", "far"))
+    (tmp_path / "d.yaml").write_text(design + slots)
+    r = run_cli("select", tmp_path / "d.yaml")
+    assert r.exit_code == 0, r.stderr
+    assert "1 combination of 2 slots: 1 feasible" in r.stdout and "chosen: near = 6001, far = 6001" in r.stdout
+    (tmp_path / "d.yaml").write_text(design + slots.replace("bore: 0.012", "bore: 0.013", 1))
+    r = run_cli("select", tmp_path / "d.yaml")
+    assert r.exit_code == 2 and "slots[0].match.bore: no part of" in r.stderr and "has bore = 0.013" in r.stderr

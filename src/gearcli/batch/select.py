@@ -107,6 +107,25 @@ def _where(manifest, key: str) -> str:
     return f"{manifest.path}:{line}: {key}" if line else f"{manifest.path}: {key}"
 
 
+def _admitted(manifest, i: int, spec: dict, path: Path, parts: tuple[Part, ...]) -> tuple[Part, ...]:
+    """The parts of a slot's catalogue that meet its ``match``, ``at_least`` and ``at_most``
+    (necessary conditions: a bore, a peak torque); a located error when a column is missing
+    or no part is left."""
+    tests = {"match": lambda x, v: abs(x - v) <= 1e-9 * max(abs(v), 1e-300),
+             "at_least": lambda x, v: x >= v, "at_most": lambda x, v: x <= v}
+    for kind, test in tests.items():
+        for column, v in spec.get(kind, {}).items():
+            where = _where(manifest, f"slots[{i}].{kind}.{column}")
+            if any(column not in p.values for p in parts):
+                raise GearcliError(f"{where}: the catalogue {path} has no number column '{column}'")
+            parts = tuple(p for p in parts if test(p.values[column], v))
+            if not parts:
+                raise GearcliError(f"{where}: no part of {path} has {column} "
+                                   f"{ {'match': '=', 'at_least': '>=', 'at_most': '<='}[kind]} {v:g} "
+                                   f"(with the slot's other conditions before it)")
+    return parts
+
+
 def slots_of(manifest) -> tuple[Slot, ...]:
     """The manifest's slots with their catalogues read and every mapping checked against the
     catalogue (the column exists) and each case's mechanism (the path names a number)."""
@@ -120,7 +139,7 @@ def slots_of(manifest) -> tuple[Slot, ...]:
             raise GearcliError(f"{_where(manifest, f'slots[{i}].name')}: duplicate slot name '{name}' (first at {seen[name]})")
         seen[name] = f"slots[{i}]"
         path = (manifest.path.parent / spec["catalogue"])
-        parts = read_catalogue(path)
+        parts = _admitted(manifest, i, spec, path, read_catalogue(path))
         ops = []
         for mode in ("set", "add"):
             for column, target in spec.get(mode, {}).items():
