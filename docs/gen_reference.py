@@ -1,6 +1,6 @@
-"""Write docs/reference/mechanism.md from schemas/mechanism.schema.json and
-docs/reference/design-manifest.md from schemas/design.schema.json: each schema is the one
-source of its file's keys (tests/test_docs.py fails when a page differs).
+"""Write docs/reference/mechanism.md, design-manifest.md and catalogue.md from
+schemas/mechanism.schema.json, design.schema.json and catalogue.schema.json: each schema is
+the one source of its file's keys (tests/test_docs.py fails when a page differs).
 
     python docs/gen_reference.py
 """
@@ -13,6 +13,7 @@ ROOT = Path(__file__).resolve().parents[1]
 PAGES = {   # kind: (schema, page, title)
     "mechanism": ("mechanism.schema.json", "mechanism.md", "Mechanism file (YAML)"),
     "design": ("design.schema.json", "design-manifest.md", "Design manifest (YAML, gearcli verify)"),
+    "catalogue": ("catalogue.schema.json", "catalogue.md", "Parts catalogue (CSV, gearcli select)"),
 }
 
 
@@ -77,6 +78,9 @@ def page(kind: str = "mechanism") -> str:
              "the one source of these keys (a test fails when this page differs from it). SI units.", "",
              schema.get("description", ""), "", "## Top level", ""]
     lines += _table(schema["properties"], schema.get("required", ()))
+    extra = schema.get("additionalProperties")
+    if isinstance(extra, dict):         # a catalogue's free columns
+        lines.append(f"| (any other column) | {_cell(_type(extra))} | {_cell(extra.get('description', ''))} |")
     for name, spec in schema.get("$defs", {}).items():
         if "properties" not in spec:
             continue
