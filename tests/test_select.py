@@ -182,3 +182,9 @@ def test_the_bundled_bearing_catalogue_and_the_slot_conditions(run_cli, tmp_path
     (tmp_path / "d.yaml").write_text(design + slots.replace("bore: 0.012", "bore: 0.013", 1))
     r = run_cli("select", tmp_path / "d.yaml")
     assert r.exit_code == 2 and "slots[0].match.bore: no part of" in r.stderr and "has bore = 0.013" in r.stderr
+
+
+def test_an_empty_slot_mapping_is_worded_by_gearcli(run_cli, tmp_path):
+    _catalogues(tmp_path)
+    r = run_cli("select", _design(tmp_path, SLOTS.replace("add: {mass: links.2.mass}", "add: {}")))
+    assert r.exit_code == 2 and "slots[1].add: must not be empty (give at least one column)" in r.stderr, r.stderr

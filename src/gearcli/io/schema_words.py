@@ -100,6 +100,11 @@ def _min_length(err) -> str:
     return "must not be empty"
 
 
+def _min_properties(err) -> str:
+    """minProperties (a select slot's set, add, match, at_least, at_most: at least one column)."""
+    return "must not be empty (give at least one column)"
+
+
 def _pattern(err) -> str | None:
     if err.instance == "" and err.schema.get("minLength"):
         return None                                 # said by minLength
@@ -126,7 +131,7 @@ def _alternatives(err) -> str:
 
 WORDING = {"type": _type, "minItems": _length, "maxItems": _length, "enum": _enum, "minimum": _bound,
            "maximum": _bound, "exclusiveMinimum": _bound, "exclusiveMaximum": _bound, "minLength": _min_length,
-           "pattern": _pattern, "oneOf": _alternatives, "anyOf": _alternatives}
+           "pattern": _pattern, "oneOf": _alternatives, "anyOf": _alternatives, "minProperties": _min_properties}
 """Validator keyword -> its message (``required``, ``additionalProperties`` and the
 branches of ``oneOf`` are worded in :func:`schema_messages`, which knows the paths)."""
 
