@@ -188,3 +188,35 @@ def test_an_empty_slot_mapping_is_worded_by_gearcli(run_cli, tmp_path):
     _catalogues(tmp_path)
     r = run_cli("select", _design(tmp_path, SLOTS.replace("add: {mass: links.2.mass}", "add: {}")))
     assert r.exit_code == 2 and "slots[1].add: must not be empty (give at least one column)" in r.stderr, r.stderr
+
+
+def test_the_iterative_search_reaches_the_same_choice_here(run_cli, tmp_path):
+    """--search iterate (slot by slot from the most capable parts, each candidate verified with
+    its own loads) on the small case: the exhaustive search's choice, verifying fewer
+    combinations; its ranked table holds only those it verified."""
+    _catalogues(tmp_path)
+    d = _design(tmp_path)
+    full = run_cli("select", d, "--search", "exhaustive")
+    it = run_cli("select", d, "--search", "iterate", "--table", tmp_path / "it.csv")
+    assert full.exit_code == 0 and it.exit_code == 0, it.stderr
+    pick = (lambda out: out.split("chosen: ", 1)[1].split(":", 1)[0])
+    assert pick(it.stdout) == pick(full.stdout)
+    n = len((tmp_path / "it.csv").read_text().splitlines()) - 1
+    assert f"{n} of 8 combinations of 2 slots verified by the iterative search" in it.stdout and n <= 8
+
+
+def test_iterate_descends_and_stops(monkeypatch):
+    """The search on a feasibility given by hand: it starts from the heaviest parts, takes the
+    lightest feasible part slot by slot, and stops where no one-slot change is lighter (here
+    (1, 0): (0, 0) would be lighter but fails, and (0, 1) too)."""
+    from gearcli.batch.select import Part, Slot, iterate
+    slots = tuple(Slot(n, Path("x.csv"), tuple(Part(f"{n}{k}", "test", {"mass": float(k + 1)}, k + 2)
+                                                for k in range(3)), ()) for n in "ab")
+    ok = {(1, 0), (2, 0), (2, 1), (2, 2), (1, 1), (1, 2)}
+    seen = []
+
+    def evaluate(combos):
+        seen.extend(combos)
+        return [[("c", "x", "q", "", 0.0, 1.0, 1.0 if c in ok else -1.0, c in ok)] for c in combos]
+    verified, choice = iterate(slots, "mass", evaluate)
+    assert choice == (1, 0) and seen[0] == (0, 2) and len(seen) == len(set(seen)) == len(verified)

@@ -9,6 +9,7 @@ SI units throughout: m, kg, kg*m^2, rad (degrees only in ``*_deg`` fields of inp
 from __future__ import annotations
 
 import json
+import math
 import sys
 from contextlib import nullcontext
 from pathlib import Path
@@ -499,6 +500,10 @@ def select(
                                   "combination, ranked: its parts, objective, worst margin and failing checks."),
     plot: str = typer.Option(None, "--plot", metavar="FIG.png|svg|pdf", help="Draw the objective against the "
                              "worst margin of every combination, with the feasible ones' Pareto front."),
+    search: str = typer.Option("auto", "--search", metavar="auto|exhaustive|iterate", help="'exhaustive': verify "
+                               "every combination (the lightest); 'iterate': choose slot by slot, each candidate verified with its "
+                               "own loads, until no one-slot change is lighter; 'auto': exhaustive up to 2,000 "
+                               "combinations."),
     jobs: int = typer.Option(1, "-j", "--jobs", min=1, metavar="N", help="Worker processes."),
     dask: str = typer.Option(None, "--dask", metavar="ADDRESS", help="Run on an existing dask.distributed "
                              "cluster (scheduler address)."),
@@ -510,7 +515,8 @@ def select(
     from rich.progress import BarColumn, Progress, TextColumn  # noqa: PLC0415
 
     from .batch.manifest import load_manifest  # noqa: PLC0415
-    from .batch.select import plan_select, plot_pareto, rank, select_table, slots_of, write_choice  # noqa: PLC0415
+    from .batch.select import (EXHAUSTIVE_LIMIT, combinations, iterate, objective_of, plan_of,  # noqa: PLC0415
+                               plot_pareto, prepare, rank, select_table, slots_of, write_choice)
     from .batch.sweep import run_sweep, write_table  # noqa: PLC0415
     from .io.output import output_target  # noqa: PLC0415
     from .report.progress import LateProgress  # noqa: PLC0415
@@ -532,20 +538,37 @@ def select(
         raise GearcliError(f"-o: expected a directory for the chosen design, got '{output}'")
     slots = slots_of(manifest)
     inputs += [s.catalogue for s in slots]
-    plan, combos, objectives = plan_select(manifest, slots, objective)
+    if search not in ("auto", "exhaustive", "iterate"):
+        raise GearcliError(f"--search: expected auto, exhaustive or iterate, got '{search}'")
+    varies = prepare(manifest, slots, objective)
+    total = math.prod(len(s.parts) for s in slots)
+    how = search if search != "auto" else ("exhaustive" if total <= EXHAUSTIVE_LIMIT else "iterate")
     err = stderr_console()
     bar = Progress(TextColumn("selecting"), BarColumn(), TextColumn("{task.completed}/{task.total} combinations"),
                    console=err, transient=True, disable=not err.is_terminal)
     with LateProgress(bar, "select") as progress:
-        progress.update(total=len(plan.variants))
-        results = run_sweep(plan, jobs=jobs, dask_address=dask, progress=lambda n: progress.update(advance=n))
-    ranked = rank(combos, objectives, results)
+        def evaluate(combos: list) -> list:
+            progress.update(total=(progress.total or 0) + len(combos))
+            return run_sweep(plan_of(manifest, varies, slots, combos), jobs=jobs, dask_address=dask,
+                             progress=lambda n: progress.update(advance=n))
+        if how == "exhaustive":
+            combos = combinations(slots)
+            results = evaluate(combos)
+        else:
+            verified, _ = iterate(slots, objective, evaluate)
+            combos, results = list(verified), list(verified.values())
+    ranked = rank(combos, [objective_of(slots, c, objective) for c in combos], results)
+    plan = plan_of(manifest, varies, slots, [r.combo for r in ranked[:1]])
     if table_out is not None:
         write_table(select_table(slots, plan, ranked, objective), table_out, inputs)
     if plot is not None:
         plot_pareto(ranked, objective, plot, inputs)
     feasible = sum(r.feasible for r in ranked)
-    typer.echo(f"{counted(len(ranked), 'combination')} of {counted(len(slots), 'slot')}: {feasible} feasible")
+    if how == "exhaustive":
+        typer.echo(f"{counted(len(ranked), 'combination')} of {counted(len(slots), 'slot')}: {feasible} feasible")
+    else:
+        typer.echo(f"{len(ranked):,} of {counted(total, 'combination')} of {counted(len(slots), 'slot')} verified by the "
+                   f"iterative search: {feasible} feasible")
 
     def parts(r) -> str:
         return ", ".join(f"{s.name} = {s.parts[k].name}" for s, k in zip(slots, r.combo))

@@ -25,7 +25,10 @@ from ..errors import GearcliError, MechanismError
 from .sweep import Plan, Vary, _data, _steps, locate, _base
 
 MAX_COMBINATIONS = 100_000
-"""More combinations than this are refused (narrow the catalogues)."""
+"""More combinations than this are refused by the exhaustive search (narrow the catalogues)."""
+
+EXHAUSTIVE_LIMIT = 2_000
+"""--search auto verifies every combination up to this many, else searches iteratively."""
 
 OBJECTIVES = ("mass", "cost", "inertia")
 
@@ -164,10 +167,10 @@ def slots_of(manifest) -> tuple[Slot, ...]:
     return tuple(slots)
 
 
-def plan_select(manifest, slots: tuple[Slot, ...], objective: str) -> tuple[Plan, list[tuple[int, ...]], list[float]]:
-    """(the sweep plan of every combination, each combination's part indices, its objective).
-    Each part is tried alone first (the others at the file's values): a part that makes the
-    mechanism invalid is a located error before anything runs."""
+def prepare(manifest, slots: tuple[Slot, ...], objective: str) -> tuple[Vary, ...]:
+    """The variations one combination makes (each slot's set/add columns), once every part
+    has been tried alone (the others at the file's values): a part that makes the mechanism
+    invalid, or lacks the objective's column, is a located error before anything runs."""
     from ..io.yaml_reader import mechanism_from_data  # noqa: PLC0415
     if objective not in OBJECTIVES:
         raise GearcliError(f"--objective: expected one of {', '.join(OBJECTIVES)}, got '{objective}'")
@@ -189,18 +192,61 @@ def plan_select(manifest, slots: tuple[Slot, ...], objective: str) -> tuple[Plan
                     i = exc.issues[0]
                     raise GearcliError(f"{s.catalogue}:{part.line}: part '{part.name}' in slot '{s.name}', case "
                                        f"'{case.name}': {i.path + ': ' if i.path else ''}{i.message}") from None
+    return varies
+
+
+def values_of_combo(slots, combo) -> tuple[float, ...]:
+    """The numbers a combination (one part index per slot) sets or adds, in the order of
+    :func:`prepare`'s variations."""
+    return tuple(s.parts[k].values[column] for s, k in zip(slots, combo) for column, _, _ in s.ops)
+
+
+def objective_of(slots, combo, objective: str) -> float:
+    return sum(s.parts[k].values[objective] for s, k in zip(slots, combo))
+
+
+def combinations(slots) -> list[tuple[int, ...]]:
+    """Every combination of one part per slot (at most :data:`MAX_COMBINATIONS`)."""
     total = math.prod(len(s.parts) for s in slots)
     if total > MAX_COMBINATIONS:
-        raise GearcliError(f"select: {total:,} combinations, more than {MAX_COMBINATIONS:,}: narrow the catalogues")
-    combos = list(itertools.product(*(range(len(s.parts)) for s in slots)))
-    variants, objectives = [], []
-    for combo in combos:
-        row = []
-        for s, k in zip(slots, combo):
-            row += [s.parts[k].values[column] for column, _, _ in s.ops]
-        variants.append(tuple(row))
-        objectives.append(sum(s.parts[k].values[objective] for s, k in zip(slots, combo)))
-    return Plan(str(manifest.path), varies, tuple(variants)), combos, objectives
+        raise GearcliError(f"select: {total:,} combinations, more than {MAX_COMBINATIONS:,} to verify each: "
+                           f"use --search iterate, or narrow the catalogues (match, at_least, at_most)")
+    return list(itertools.product(*(range(len(s.parts)) for s in slots)))
+
+
+def plan_of(manifest, varies, slots, combos) -> Plan:
+    return Plan(str(manifest.path), varies, tuple(values_of_combo(slots, c) for c in combos))
+
+
+def iterate(slots, objective: str, evaluate, max_rounds: int = 50) -> tuple[dict, tuple]:
+    """Choose slot by slot and re-verify until the choice is stable: start from each slot's
+    part of the largest ``objective`` (the most capable, as a rule), then, slot after slot,
+    take the lightest part whose design (the other slots as chosen so far) passes every check,
+    each candidate verified with its own loads (``evaluate(combos) -> results``).  Returns
+    ({combination: result} of every one verified, the stable choice).
+
+    Each candidate is judged on its own loads, not on loads solved for an earlier choice, so
+    once the choice passes, the current one is always among the candidates: the total
+    objective never rises and, ties going to the lower part index, the search cannot cycle;
+    it ends on a choice that no change of one slot makes lighter (a local optimum; the
+    exhaustive search finds the lightest)."""
+    current = [max(range(len(s.parts)), key=lambda k: s.parts[k].values[objective]) for s in slots]
+    verified: dict = {}
+
+    def passed(r) -> bool:
+        return not isinstance(r, str) and all(c[7] for c in r)
+    for _ in range(max_rounds):
+        before = tuple(current)
+        for j, s in enumerate(slots):
+            combos = [tuple(current[:j] + [k] + current[j + 1:]) for k in range(len(s.parts))]
+            todo = [c for c in combos if c not in verified]
+            verified.update(zip(todo, evaluate(todo)))
+            ok = [c for c in combos if passed(verified[c])]
+            if ok:
+                current[j] = min(ok, key=lambda c: (objective_of(slots, c, objective), c[j]))[j]
+        if tuple(current) == before:
+            return verified, before
+    raise GearcliError(f"select: the iterative search did not settle in {max_rounds} rounds")
 
 
 @dataclass(frozen=True)
