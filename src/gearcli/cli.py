@@ -419,27 +419,19 @@ def sweep(
     from rich.progress import BarColumn, Progress, TextColumn  # noqa: PLC0415
 
     from .batch.manifest import load_manifest  # noqa: PLC0415
-    from .batch.sweep import (PartialFile, parse_vary, partial_path, plan_sweep, plot_sweep,  # noqa: PLC0415
-                              read_partial, run_sweep, table, write_table)
+    from .batch.sweep import (PartialFile, output_names, parse_vary, partial_path, plan_sweep,  # noqa: PLC0415
+                              plot_sweep, read_partial, run_sweep, table, write_table)
     from .io.output import output_target  # noqa: PLC0415
     from .report.progress import LateProgress  # noqa: PLC0415
-    from .report.table_files import format_of  # noqa: PLC0415
 
     if jobs > 1 and dask is not None:
         raise GearcliError("sweep: give -j/--jobs or --dask, not both (a Dask cluster has its own workers)")
     varies = [parse_vary(v) for v in vary]
     manifest = load_manifest(design)
     inputs = [design] + [c.mechanism for c in manifest.cases] + [t for c in manifest.cases for t in c.trajectories]
-    if output is not None:
-        if output == "-" or format_of(output) not in ("csv", "parquet", "feather"):
-            raise GearcliError(f"-o: expected a .csv, .parquet or .feather file name, got '{output}'")
-        output_target(output, inputs)
-    if plot is not None:
-        if plot == "-" or Path(plot).suffix.lower() not in (".png", ".svg", ".pdf"):
-            raise GearcliError(f"--plot: expected a .png, .svg or .pdf file name, got '{plot}'")
-        if len(varies) > 2:
-            raise GearcliError(f"--plot: draws the worst margin over one or two varied values, {len(varies)} vary")
-        output_target(plot, inputs, "--plot")
+    output_names(inputs, ("-o", output), plot)
+    if plot is not None and len(varies) > 2:
+        raise GearcliError(f"--plot: draws the worst margin over one or two varied values, {len(varies)} vary")
     if resume and output is None:
         raise GearcliError("--resume: give -o TABLE (the partial file TABLE.partial holds the finished variants)")
     plan = plan_sweep(manifest, varies, samples, seed)
@@ -517,23 +509,14 @@ def select(
     from .batch.manifest import load_manifest  # noqa: PLC0415
     from .batch.select import (EXHAUSTIVE_LIMIT, combinations, iterate, objective_of, plan_of,  # noqa: PLC0415
                                plot_pareto, prepare, rank, select_table, slots_of, write_choice)
-    from .batch.sweep import run_sweep, write_table  # noqa: PLC0415
-    from .io.output import output_target  # noqa: PLC0415
+    from .batch.sweep import output_names, run_sweep, write_table  # noqa: PLC0415
     from .report.progress import LateProgress  # noqa: PLC0415
-    from .report.table_files import format_of  # noqa: PLC0415
 
     if jobs > 1 and dask is not None:
         raise GearcliError("select: give -j/--jobs or --dask, not both (a Dask cluster has its own workers)")
     manifest = load_manifest(design)
     inputs = [design] + [c.mechanism for c in manifest.cases] + [t for c in manifest.cases for t in c.trajectories]
-    if table_out is not None:
-        if table_out == "-" or format_of(table_out) not in ("csv", "parquet", "feather"):
-            raise GearcliError(f"--table: expected a .csv, .parquet or .feather file name, got '{table_out}'")
-        output_target(table_out, inputs, "--table")
-    if plot is not None:
-        if plot == "-" or Path(plot).suffix.lower() not in (".png", ".svg", ".pdf"):
-            raise GearcliError(f"--plot: expected a .png, .svg or .pdf file name, got '{plot}'")
-        output_target(plot, inputs, "--plot")
+    output_names(inputs, ("--table", table_out), plot)
     if output is not None and (not output.strip() or Path(output).exists() and not Path(output).is_dir()):
         raise GearcliError(f"-o: expected a directory for the chosen design, got '{output}'")
     slots = slots_of(manifest)
@@ -560,7 +543,7 @@ def select(
     ranked = rank(combos, [objective_of(slots, c, objective) for c in combos], results)
     plan = plan_of(manifest, varies, slots, [r.combo for r in ranked[:1]])
     if table_out is not None:
-        write_table(select_table(slots, plan, ranked, objective), table_out, inputs)
+        write_table(select_table(slots, ranked, objective), table_out, inputs)
     if plot is not None:
         plot_pareto(ranked, objective, plot, inputs)
     feasible = sum(r.feasible for r in ranked)

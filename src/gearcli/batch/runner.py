@@ -197,7 +197,7 @@ DASK_TIMEOUT = 10.0
 """s to wait for the Dask scheduler before reporting it unreachable."""
 
 
-def _dask_client(address: str):
+def dask_client(address: str):
     try:
         from dask.distributed import Client  # noqa: PLC0415 (optional dependency)
     except ImportError:
@@ -213,7 +213,7 @@ def _run_dask(todo: list[Job], address: str, progress) -> dict:
     from dask.distributed import as_completed as dask_completed  # noqa: PLC0415 (optional)
 
     results = {}
-    with _dask_client(address) as client:
+    with dask_client(address) as client:
         # one solver thread per task: a Dask worker already runs tasks in its own threads
         futures = {client.submit(run_job, job, 1, pure=False): job for job in todo}
         for fut in dask_completed(list(futures), loop=client.loop):

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import GearcliError, MechanismError
-from .sweep import Plan, Vary, _data, _steps, locate, _base
+from .sweep import Plan, Vary, file_data, locate, path_steps, save_figure, variant_data
 
 MAX_COMBINATIONS = 100_000
 """More combinations than this are refused by the exhaustive search (narrow the catalogues)."""
@@ -151,7 +151,7 @@ def slots_of(manifest) -> tuple[Slot, ...]:
                 if missing:
                     raise GearcliError(f"{where}: the catalogue {path} has no number column '{column}'")
                 try:
-                    steps = _steps(target, where)
+                    steps = path_steps(target, where)
                 except GearcliError as exc:
                     raise GearcliError(str(exc)) from None
                 for case in manifest.cases:
@@ -159,7 +159,7 @@ def slots_of(manifest) -> tuple[Slot, ...]:
                         raise GearcliError(f"{where}: case '{case.name}': select varies YAML mechanism files, "
                                            f"{case.mechanism} is not one")
                     try:
-                        locate(_base(str(case.mechanism)), steps, target)
+                        locate(file_data(str(case.mechanism)), steps, target)
                     except GearcliError as exc:
                         raise GearcliError(f"{where}: case '{case.name}' ({case.mechanism}): {exc}") from None
                 ops.append((column, target, mode))
@@ -179,7 +179,7 @@ def prepare(manifest, slots: tuple[Slot, ...], objective: str) -> tuple[Vary, ..
         if lacking:
             raise GearcliError(f"{s.catalogue}:{lacking[0].line}: part '{lacking[0].name}' has no '{objective}' "
                                f"(--objective {objective} sums it over the chosen parts)")
-    varies = tuple(Vary(f"{s.name}.{column}", None, target, _steps(target, target), (), mode)
+    varies = tuple(Vary(f"{s.name}.{column}", None, target, path_steps(target, target), (), mode)
                    for s in slots for column, target, mode in s.ops)
     for s in slots:
         for part in s.parts:
@@ -187,7 +187,7 @@ def prepare(manifest, slots: tuple[Slot, ...], objective: str) -> tuple[Vary, ..
             values = [part.values[v.text.split(".", 1)[1]] for v in alone]
             for case in manifest.cases:
                 try:
-                    mechanism_from_data(_data(manifest, alone, values)[case.name], str(case.mechanism))
+                    mechanism_from_data(variant_data(manifest, alone, values)[case.name], str(case.mechanism))
                 except MechanismError as exc:
                     i = exc.issues[0]
                     raise GearcliError(f"{s.catalogue}:{part.line}: part '{part.name}' in slot '{s.name}', case "
@@ -285,7 +285,7 @@ def write_choice(manifest, slots, plan: Plan, ranked: Ranked, directory: Path) -
     from ..io.output import atomic_output  # noqa: PLC0415
     from ..io.yaml_safe import read_text, yaml_lines  # noqa: PLC0415
     values = [s.parts[k].values[column] for s, k in zip(slots, ranked.combo) for column, _, _ in s.ops]
-    datas = _data(manifest, plan.varies, values)
+    datas = variant_data(manifest, plan.varies, values)
     directory.mkdir(parents=True, exist_ok=True)
     written, mech_files = [], {}
     for case in manifest.cases:
@@ -322,7 +322,7 @@ def write_choice(manifest, slots, plan: Plan, ranked: Ranked, directory: Path) -
     return written
 
 
-def select_table(slots, plan: Plan, ranked: list[Ranked], objective: str) -> dict[str, list]:
+def select_table(slots, ranked: list[Ranked], objective: str) -> dict[str, list]:
     """The ranked table: rank, each slot's part, the objective, the worst margin and check,
     feasible, the failing checks."""
     cols: dict[str, list] = {"rank": list(range(1, len(ranked) + 1))}
@@ -344,7 +344,6 @@ def plot_pareto(ranked: list[Ranked], objective: str, path: str, inputs=()) -> N
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt  # noqa: PLC0415
 
-    from ..io.output import atomic_output  # noqa: PLC0415
     units = {"mass": "kg", "cost": "", "inertia": "kg·m²"}
     fig, ax = plt.subplots(figsize=(7, 4.5))
     ok = [r for r in ranked if r.feasible and math.isfinite(r.worst)]
@@ -365,9 +364,5 @@ def plot_pareto(ranked: list[Ranked], objective: str, path: str, inputs=()) -> N
     ax.set_xlabel(f"total {objective}" + (f" [{unit}]" if unit else ""))
     ax.set_ylabel("worst margin [%] (below 0: a check fails)")
     ax.set_title(f"{len(ranked)} combinations: {len(ok)} feasible", fontsize=10)
-    ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    with atomic_output(path, inputs, binary=True) as f:
-        fig.savefig(f, format=Path(path).suffix.lower().lstrip("."), dpi=110)
-    plt.close(fig)
+    save_figure(fig, ax, path, inputs)

@@ -91,7 +91,9 @@ def values_of(text: str, where: str) -> tuple[float, ...]:
     return tuple(_number(s.strip(), where) for s in items)
 
 
-def _steps(path: str, where: str) -> tuple:
+def path_steps(path: str, where: str) -> tuple:
+    """The steps of a --vary (or slot) PATH: its keys and names, and an int per ``[i]``;
+    ``where`` names the option in the error of a malformed part."""
     steps = []
     for part in path.split("."):
         m = re.fullmatch(r"([^\[\]]+)((?:\[\d+\])*)", part)
@@ -112,7 +114,7 @@ def parse_vary(text: str) -> Vary:
     path = path.strip()
     if not path:
         raise GearcliError(f"{where}: the path before '=' is empty")
-    return Vary(text, case.strip() if case is not None else None, path, _steps(path, where),
+    return Vary(text, case.strip() if case is not None else None, path, path_steps(path, where),
                 values_of(rhs, where))
 
 
@@ -171,16 +173,17 @@ class Plan:
 
 
 @lru_cache(maxsize=8)
-def _base(mech_path: str) -> dict:
+def file_data(mech_path: str) -> dict:
+    """A mechanism file's YAML data as written (read once; copied before a variant changes it)."""
     from ..io.yaml_safe import read_text, yaml_lines  # noqa: PLC0415
     return yaml_lines(read_text(mech_path), mech_path)[0]
 
 
-def _data(manifest, varies, values) -> dict[str, dict]:
+def variant_data(manifest, varies, values) -> dict[str, dict]:
     """{case name: its mechanism file's YAML data with the variant's values}."""
     out = {}
     for case in manifest.cases:
-        data = copy.deepcopy(_base(str(case.mechanism)))
+        data = copy.deepcopy(file_data(str(case.mechanism)))
         for v, x in zip(varies, values):
             if v.case is None or v.case == case.name:
                 _set(data, v, x)
@@ -212,11 +215,11 @@ def plan_sweep(manifest, varies: list[Vary], samples: int | None = None, seed: i
                 raise GearcliError(f"{where}: case '{case.name}': sweep varies YAML mechanism files, "
                                    f"{case.mechanism} is not one (gearcli export writes a URDF; write the YAML by hand)")
             try:
-                locate(_base(str(case.mechanism)), v.steps, v.path)
+                locate(file_data(str(case.mechanism)), v.steps, v.path)
             except GearcliError as exc:
                 raise GearcliError(f"{where}: case '{case.name}' ({case.mechanism}): {exc}") from None
             for x in dict.fromkeys(v.values):
-                data = _data(manifest, [v], [x])[case.name]
+                data = variant_data(manifest, [v], [x])[case.name]
                 try:
                     mechanism_from_data(data, str(case.mechanism))
                 except MechanismError as exc:
@@ -287,7 +290,7 @@ def run_variant(manifest_path: str, varies: tuple[Vary, ...], values: tuple[floa
     from .runner import solve_samples  # noqa: PLC0415
 
     manifest = _manifest(manifest_path)
-    datas = _data(manifest, varies, values)
+    datas = variant_data(manifest, varies, values)
     data_kernel = data_kernel_applies(varies)
     out = []
     for case in manifest.cases:
@@ -364,8 +367,8 @@ def run_sweep(plan: Plan, jobs: int = 1, dask_address: str | None = None, progre
     if dask_address is not None:
         from dask.distributed import as_completed as dask_completed  # noqa: PLC0415 (optional)
 
-        from .runner import _dask_client  # noqa: PLC0415
-        with _dask_client(dask_address) as client:
+        from .runner import dask_client  # noqa: PLC0415
+        with dask_client(dask_address) as client:
             futures = {client.submit(_run_chunk, *args(idx), pure=False): k for k, idx in enumerate(parts)}
             for fut in dask_completed(list(futures), loop=client.loop):
                 finished(parts[futures[fut]], fut.result())
@@ -514,7 +517,6 @@ def plot_sweep(plan: Plan, cols: dict[str, list], path: str, inputs=()) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt  # noqa: PLC0415
 
-    from ..io.output import atomic_output  # noqa: PLC0415
     names = list(cols)[:len(plan.varies)]
     worst = np.asarray(cols["worst_margin_%"], float)
     fig, ax = plt.subplots(figsize=(7, 4.5))
@@ -543,9 +545,33 @@ def plot_sweep(plan: Plan, cols: dict[str, list], path: str, inputs=()) -> None:
         ax.set_xlabel(names[0])
         ax.set_ylabel(names[1])
     ax.set_title(f"{Path(plan.manifest_path).name}: worst margin of {len(worst)} variants", fontsize=10)
+    save_figure(fig, ax, path, inputs)
+
+
+def save_figure(fig, ax, path: str, inputs=()) -> None:
+    """A sweep's or a selection's figure, gridded, written atomically (PNG, SVG or PDF by the extension)."""
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    from ..io.output import atomic_output  # noqa: PLC0415
     ax.grid(True, alpha=0.3)
     fig.tight_layout()
-    fmt = Path(path).suffix.lower().lstrip(".")
     with atomic_output(path, inputs, binary=True) as f:
-        fig.savefig(f, format=fmt, dpi=110)
+        fig.savefig(f, format=Path(path).suffix.lower().lstrip("."), dpi=110)
     plt.close(fig)
+
+
+def output_names(inputs, table: tuple[str, str | None] = ("-o", None), plot: str | None = None) -> None:
+    """Refuse, before anything runs, a table name (``table``: its option and name) that is not
+    .csv, .parquet or .feather and a plot name that is not .png, .svg or .pdf, or either naming
+    an input or an unwritable place (:func:`gearcli.io.output.output_target`)."""
+    from ..io.output import output_target  # noqa: PLC0415
+    from ..report.table_files import format_of  # noqa: PLC0415
+    option, name = table
+    if name is not None:
+        if name == "-" or format_of(name) not in ("csv", "parquet", "feather"):
+            raise GearcliError(f"{option}: expected a .csv, .parquet or .feather file name, got '{name}'")
+        output_target(name, inputs, option)
+    if plot is not None:
+        if plot == "-" or Path(plot).suffix.lower() not in (".png", ".svg", ".pdf"):
+            raise GearcliError(f"--plot: expected a .png, .svg or .pdf file name, got '{plot}'")
+        output_target(plot, inputs, "--plot")
