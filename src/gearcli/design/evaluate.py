@@ -87,7 +87,9 @@ def _signal(check: Check, s: Samples, mech, cache: dict) -> np.ndarray:
     if kind in ("bearing_P", "bearing_P0"):
         jt = mech.joints[check.signal[1]]
         b = jt.bearings[check.signal[2]]
-        if ("loads", jt.name) not in cache:
+        if ("loads", jt.name) not in cache:        # one joint's at a time: its bearings' checks follow each other
+            for k in [k for k in cache if k[0] == "loads"]:
+                del cache[k]
             cache[("loads", jt.name)] = bearing_loads(s, jt.name, jt.bearings)
         Fr, Fa = cache[("loads", jt.name)][check.signal[2]]
         if b.type == "crossed_roller":           # its only bearing: the joint's tilting moment too,
@@ -145,11 +147,13 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
     span = float(s.t[-1] - s.t[0]) if s.t.size else 0.0
     cache: dict = {}
     component = None
-    # one component's checks after another, its signals (bearing loads, stresses, revolutions)
-    # dropped when the next begins: a long trajectory holds a few (N,) arrays, not every check's
+    # one component's checks after another, its signals (stresses, equivalent loads) dropped
+    # when the next begins: a long trajectory holds a few (N,) arrays, not every check's; the
+    # revolutions of each joint and the last joint's bearing loads (its other bearings' checks
+    # follow) are kept
     for i, ch in sorted(enumerate(checks), key=lambda ic: ic[1].component):
         if ch.component != component:
-            cache.clear()
+            cache = {k: v for k, v in cache.items() if k[0] in ("revs", "loads")}
             component = ch.component
         total = wsum = revs = 0.0
         counts = None

@@ -110,11 +110,12 @@ def mechanism_from_data(data: dict, file: str = "<string>", lines: dict | None =
     """The mechanism of a mechanism file's parsed YAML mapping ``data`` (``lines``: YAML path
     -> line, for the problems' places); ``schema=False`` skips the JSON Schema's checks, for
     data whose every value has passed them before (a sweep's variant, each of its values
-    tried alone: :func:`gearcli.batch.sweep.plan_sweep`); the model's own checks still run."""
+    tried alone: :func:`gearcli.batch.sweep.plan_sweep`), and the checks of each number alone
+    (:func:`number_issues`); the model's own checks still run."""
     lines = lines or {}
     col = Collector(file, lines)
-    number_issues(data, col)
     if schema:
+        number_issues(data, col)
         _schema_issues(data, col, {i.path for i in col.issues})
     col.raise_if_any()
     later = Collector(file, lines)       # problems that leave the mechanism buildable (planet assembly)
