@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.mechanism import Mechanism
-from ..spatial import cross, mm_const, mv
+from .algebra import ARRAYS, matrices, stack_matrices, stack_vectors, vectors
 from ..analysis.tree import Tree
 
 
@@ -42,6 +42,14 @@ class Kinematics:
     oj: list
     qd: np.ndarray | None = None       # (N, J) every real joint's rate, rad/s (m/s)
     qd_ind: np.ndarray | None = None   # (N, dof) the independent rates, when the caller had them
+    terms: dict | None = None          # per link (R, o, w, dw, a) as values of :class:`.algebra.Arrays`
+
+    def link_terms(self, L: int) -> tuple:
+        """Link L's (R, o, w, dw, a) as values of :class:`.algebra.Arrays` (a 9-tuple and
+        3-tuples: floats where constant, else (N,) arrays), for the shared physics terms."""
+        if self.terms is not None and L in self.terms:
+            return self.terms[L]
+        return (matrices(self.R[L]),) + tuple(vectors(x) for x in (self.o[L], self.w[L], self.dw[L], self.a[L]))
 
     def independent_rates(self, an) -> np.ndarray:
         """(N, dof) the independent joint rates q'_ind: as given to :func:`forward`, else
@@ -66,73 +74,82 @@ def forward(mech: Mechanism, tree: Tree, q: np.ndarray, qd: np.ndarray | None = 
     """Positions, velocities, accelerations of all links for joint values ``q`` (N, J).
 
     ``q``, ``qd``, ``qdd`` hold every real joint's coordinate (rad, rad/s, rad/s^2) in the
-    order of ``mech.joints``; velocities and accelerations default to zero.
+    order of ``mech.joints``; velocities and accelerations default to zero.  Each joint's
+    terms are :func:`joint_frame` and :func:`child_motion` over all samples at once (the
+    kernel emits the same functions per sample, :mod:`.llvm.links`).
     """
     q = np.atleast_2d(np.asarray(q, float))
     N = q.shape[0]
     qd = np.zeros_like(q) if qd is None else np.atleast_2d(qd)
     qdd = np.zeros_like(q) if qdd is None else np.atleast_2d(qdd)
-    L = len(tree.links)
-    zero = np.zeros((N, 3))
-    R = [None] * L
-    o = [None] * L
-    w = [None] * L
-    dw = [None] * L
-    a = [None] * L
-    b = tree.base
-    R[b] = np.broadcast_to(np.eye(3), (N, 3, 3))
-    o[b], w[b], dw[b], a[b] = zero, zero, zero, zero
-    Rj = [None] * len(mech.joints)
-    oj = [None] * len(mech.joints)
+    cols = [np.ascontiguousarray(x.T) for x in (q, qd, qdd)]      # per joint a contiguous (N,) row
+    al = ARRAYS
+    links: dict = {tree.base: (EYE, ZERO3, ZERO3, ZERO3, ZERO3)}  # per link (R, o, w, dw, a)
+    frames: dict = {}
     for ji in tree.order:
         jt = mech.joints[ji]
         p, c = tree.parent[tree.index[jt.child]], tree.index[jt.child]
-        on_base = p == b                          # parent at rest: skip the zero terms
-        if on_base:
-            Rj0 = np.broadcast_to(jt.R_pj, (N, 3, 3))   # (N,3,3) joint frame at q = 0
-            oj0 = np.broadcast_to(jt.p_pj, (N, 3))      # (N,3) joint origin
-        else:
-            Rj0 = mm_const(R[p], jt.R_pj)
-            oj0 = o[p] + mv(R[p], jt.p_pj)
-        z = np.ascontiguousarray(Rj0[:, :, 2])    # (N,3) joint axis
-        qd_j, qdd_j = qd[:, ji:ji + 1], qdd[:, ji:ji + 1]
-        if jt.type == "prismatic":
-            Rj[ji] = Rj0
-            oj[ji] = oj0 + z * q[:, ji:ji + 1]
-            w[c], dw[c] = w[p], dw[p]
-        else:
-            Rj[ji] = _turn_z(Rj0, q[:, ji])
-            oj[ji] = oj0
-            if on_base:
-                w[c], dw[c] = z * qd_j, z * qdd_j
-            else:
-                w[c] = w[p] + z * qd_j
-                dw[c] = dw[p] + z * qdd_j + cross(w[p], z) * qd_j
-        R[c] = Rj[ji] if np.array_equal(jt.R_jc, np.eye(3)) else mm_const(Rj[ji], jt.R_jc)
-        if on_base:
-            a_j = zero
-        else:
-            r = oj[ji] - o[p]
-            a_j = a[p] + cross(dw[p], r) + cross(w[p], cross(w[p], r))
-        if jt.type == "prismatic":
-            a_j = a_j + z * qdd_j
-            if not on_base:
-                a_j = a_j + 2 * cross(w[p], z * qd_j)
-        if not np.any(jt.p_jc):
-            o[c], a[c] = oj[ji], a_j
-        else:
-            rc = mv(Rj[ji], jt.p_jc)
-            o[c] = oj[ji] + rc
-            a[c] = a_j + cross(dw[c], rc) + cross(w[c], cross(w[c], rc))
-    return Kinematics(R, o, w, dw, a, Rj, oj, qd,
-                      None if qd_ind is None else np.atleast_2d(np.asarray(qd_ind, float)))
+        prismatic = jt.type == "prismatic"
+        R_p, o_p, w_p, dw_p, a_p = links[p]
+        Rj, oj, _, _ = frames[ji] = joint_frame(al, matrices(jt.R_pj), vectors(jt.p_pj), R_p, o_p, cols[0][ji],
+                                                prismatic)
+        links[c] = child_motion(al, Rj, oj, matrices(jt.R_jc), vectors(jt.p_jc), o_p, w_p, dw_p, a_p,
+                                cols[1][ji], cols[2][ji], prismatic)
+    L, J = len(tree.links), len(mech.joints)
+    parts = [[stack_matrices(links[i][0], N) if i in links else None for i in range(L)]]
+    parts += [[stack_vectors(links[i][k], N) if i in links else None for i in range(L)] for k in range(1, 5)]
+    Rj = [stack_matrices(frames[j][0], N) if j in frames else None for j in range(J)]
+    oj = [stack_vectors(frames[j][1], N) if j in frames else None for j in range(J)]
+    return Kinematics(*parts, Rj, oj, qd, None if qd_ind is None else np.atleast_2d(np.asarray(qd_ind, float)),
+                      terms=links)
 
 
-def _turn_z(R0: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """R0 @ Rz(q) for R0 (N,3,3) and angles q (N,), by columns."""
-    c, s = np.cos(q)[:, None], np.sin(q)[:, None]
-    out = np.empty(R0.shape)
-    out[:, :, 0] = c * R0[:, :, 0] + s * R0[:, :, 1]
-    out[:, :, 1] = c * R0[:, :, 1] - s * R0[:, :, 0]
-    out[:, :, 2] = R0[:, :, 2]
-    return out
+EYE = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
+ZERO3 = (0.0, 0.0, 0.0)
+
+
+def joint_frame(al, R_pj, p_pj, R_p, o_p, q, prismatic: bool):
+    """(R_j, o_j, cos q, sin q): joint j's frame at its coordinate q, base axes (Eq. 2).
+
+    The frame at q = 0 is fixed in the parent p (``R_pj``, ``p_pj`` in p's frame; ``R_p``,
+    ``o_p`` the parent's orientation and origin); a revolute joint turns it about its z by q,
+    R_j = R_p R_pj Rz(q) (by columns: c x0 + s y0, c y0 - s x0, z0), a prismatic joint moves
+    its origin along z by q.  ``al``: the algebra (:mod:`.algebra`)."""
+    R0 = al.mm(R_p, R_pj)
+    oj = al.vadd(o_p, al.mv(R_p, p_pj))
+    if prismatic:
+        return R0, al.vadd(oj, al.scale((R0[2], R0[5], R0[8]), q)), 1.0, 0.0
+    cq, sq = al.sincos(q)
+    Rj = []
+    for i in range(3):
+        r0, r1 = R0[3 * i], R0[3 * i + 1]
+        Rj += [al.add(al.mul(cq, r0), al.mul(sq, r1)), al.sub(al.mul(cq, r1), al.mul(sq, r0)), R0[3 * i + 2]]
+    return tuple(Rj), oj, cq, sq
+
+
+def arm_acceleration(al, a, dw, w, r):
+    """a + dw x r + w x (w x r): the acceleration of a point at r from a point of acceleration
+    a on a body turning at w, dw (base axes)."""
+    return al.vadd(a, al.vadd(al.cx(dw, r), al.cx(w, al.cx(w, r))))
+
+
+def child_motion(al, R_j, o_j, R_jc, p_jc, o_p, w_p, dw_p, a_p, qd, qdd, prismatic: bool):
+    """(R_c, o_c, w_c, dw_c, a_c) of a joint's child link, base axes (paper Eqs. 3-5).
+
+    From the joint frame (R_j, o_j) of :func:`joint_frame` (z = the axis), the child's fixed
+    place in it (``R_jc``, ``p_jc``), the parent's origin, angular velocity and acceleration
+    and its origin's acceleration, and the joint rate and acceleration q', q'':
+    revolute w_c = w_p + z q', dw_c = dw_p + z q'' + (w_p x z) q'; prismatic w_c = w_p,
+    dw_c = dw_p and the joint origin gains z q'' + 2 w_p x (z q') (Coriolis).  The
+    accelerations of the joint origin and of the child's origin follow the arms
+    (:func:`arm_acceleration`)."""
+    z = (R_j[2], R_j[5], R_j[8])
+    aj = arm_acceleration(al, a_p, dw_p, w_p, al.vsub(o_j, o_p))
+    if prismatic:
+        wc, dwc = w_p, dw_p
+        aj = al.vadd(aj, al.vadd(al.scale(z, qdd), al.scale(al.cx(w_p, al.scale(z, qd)), 2.0)))
+    else:
+        wc = al.vadd(w_p, al.scale(z, qd))
+        dwc = al.vadd(al.vadd(dw_p, al.scale(z, qdd)), al.scale(al.cx(w_p, z), qd))
+    rc = al.mv(R_j, p_jc)
+    return al.mm(R_j, R_jc), al.vadd(o_j, rc), wc, dwc, arm_acceleration(al, aj, dwc, wc, rc)

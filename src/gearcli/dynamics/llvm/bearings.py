@@ -50,7 +50,6 @@ from ..bearing_friction import MAX_ITERATIONS, TOL
 from .bearing_newton import level, loads, newton, unaffected, within
 from .build import D, I1, I64, Emitter
 from .links import Sample, floats
-from .friction_terms import _sign
 from .signs import WARM, _consistent, _sign_bit, tolerance
 
 
@@ -88,7 +87,7 @@ class _Joints:
         self.rec = [lp.joints[jrow.index(lp.bearing_joints[k])] for k in bb.joints]
         self.zw = [e.mv(s.R[int(rc[1])], floats(lp.joint_flt[jrow.index(int(rc[0]))][:3])) for rc in self.rec]
         qd = [e.const(s.qd[int(rc[0])]) for rc in self.rec]
-        self.sg = [_sign(e, v) for v in qd]
+        self.sg = [e.sign(v) for v in qd]
         self.moving = [e.b.fcmp_unordered("une", v, ir.Constant(D, 0.0)) for v in qd]
         if bb.wF is not None:
             self.W = [floats(w) for w in bb.wF]

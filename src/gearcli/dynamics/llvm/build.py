@@ -19,6 +19,8 @@ import struct
 
 import llvmlite.ir as ir
 
+from ..algebra import Algebra
+
 D = ir.DoubleType()
 I1 = ir.IntType(1)
 I64 = ir.IntType(64)
@@ -59,9 +61,11 @@ class ConstantPool:
         self.ptr.initializer = g.bitcast(DP)
 
 
-class Emitter:
-    """Folding double arithmetic on an :class:`llvmlite.ir.IRBuilder` (see module docstring);
-    with a :class:`ConstantPool` the constants of its arithmetic come from the pool."""
+class Emitter(Algebra):
+    """Folding double arithmetic on an :class:`llvmlite.ir.IRBuilder` (see module docstring):
+    the primitives of :class:`gearcli.dynamics.algebra.Algebra`, whose composites (dot, cross,
+    matrix-vector products) it inherits; with a :class:`ConstantPool` the constants of its
+    arithmetic come from the pool."""
 
     def __init__(self, builder: ir.IRBuilder, module: ir.Module, pool: ConstantPool | None = None):
         self.b = builder
@@ -128,46 +132,38 @@ class Emitter:
             return a
         return self.b.fdiv(self._operand(a), self._operand(b), flags=FLAGS)
 
-    def dot(self, xs, ys):
-        """sum_i xs[i] ys[i], left to right."""
-        s = 0.0
-        for x, y in zip(xs, ys):
-            s = self.add(s, self.mul(x, y))
-        return s
-
     def call(self, name: str, a):
         """llvm.<name>.f64(a) (folded for a constant)."""
         if isinstance(a, float):
             return abs(a) if name == "fabs" else getattr(math, name)(a)
         return self.b.call(self.intrinsic(name), [a])
 
-    # --- 3-vectors and 3x3 matrices (tuples of values) -----------------------------------
-    def vadd(self, a, b):
-        return tuple(self.add(x, y) for x, y in zip(a, b))
+    def signed(self, v, pos: float, neg: float):
+        """pos where v > 0, neg where v < 0, else 0.0 (a NaN gives 0: no sign pattern accepts a
+        NaN sample anyway)."""
+        if isinstance(v, float):
+            return pos if v > 0.0 else neg if v < 0.0 else 0.0
+        zero = ir.Constant(D, 0.0)
+        return self.b.select(self.b.fcmp_ordered(">", v, zero), ir.Constant(D, pos),
+                             self.b.select(self.b.fcmp_ordered("<", v, zero), ir.Constant(D, neg), zero))
 
-    def vsub(self, a, b):
-        return tuple(self.sub(x, y) for x, y in zip(a, b))
+    def sincos(self, q):
+        """(cos q, sin q) of an angle, inline (:mod:`.trig`; a constant folds)."""
+        from .trig import sincos  # noqa: PLC0415 (trig emits with this class)
+        return sincos(self, q)
 
-    def scale(self, a, s):
-        return tuple(self.mul(x, s) for x in a)
-
-    def cx(self, a, b):
-        """a x b."""
-        return (self.sub(self.mul(a[1], b[2]), self.mul(a[2], b[1])),
-                self.sub(self.mul(a[2], b[0]), self.mul(a[0], b[2])),
-                self.sub(self.mul(a[0], b[1]), self.mul(a[1], b[0])))
-
-    def mv(self, R, v):
-        """R v."""
-        return tuple(self.dot(R[3 * i:3 * i + 3], v) for i in range(3))
-
-    def mtv(self, R, v):
-        """R^T v."""
-        return tuple(self.dot(R[i::3], v) for i in range(3))
-
-    def mm(self, A, B):
-        """A B."""
-        return tuple(self.dot(A[3 * i:3 * i + 3], B[j::3]) for i in range(3) for j in range(3))
+    def interp(self, x, table):
+        """np.interp(x, speeds, values) of a table (speeds, values) at x >= 0: linear between rows,
+        held beyond the ends (a constant: folded)."""
+        xs, ys = (tuple(float(v) for v in col) for col in table)
+        y = ys[0]
+        if len(xs) == 1:
+            return y
+        for i in range(len(xs) - 1):
+            slope = (ys[i + 1] - ys[i]) / (xs[i + 1] - xs[i])
+            seg = self.add(ys[i], self.mul(slope, self.sub(x, xs[i])))
+            y = self.b.select(self.b.fcmp_ordered(">", x, ir.Constant(D, xs[i])), self.const(seg), self.const(y))
+        return self.b.select(self.b.fcmp_ordered(">=", x, ir.Constant(D, xs[-1])), ir.Constant(D, ys[-1]), y)
 
     # --- memory -------------------------------------------------------------------------
     def load(self, ptr, index):

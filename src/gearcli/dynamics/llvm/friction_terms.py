@@ -18,49 +18,20 @@ what the sample's rates give before any block solve, and the loss outputs.
 """
 from __future__ import annotations
 
-import llvmlite.ir as ir
-
-from .build import D, FLAGS, Emitter
+from .build import FLAGS, Emitter
 from .links import Sample, floats
-
-
-def _signed(e: Emitter, v, pos: float, neg: float):
-    """pos where v > 0, neg where v < 0, else 0.0 (a double; NaN gives 0: no sign pattern
-    accepts a NaN sample anyway)."""
-    zero = ir.Constant(D, 0.0)
-    return e.b.select(e.b.fcmp_ordered(">", v, zero), ir.Constant(D, pos),
-                      e.b.select(e.b.fcmp_ordered("<", v, zero), ir.Constant(D, neg), zero))
-
-
-def _sign(e: Emitter, v):
-    """sign(v) as a double: -1, 0 or 1 (np.sign; NaN gives 0: as :func:`_signed`)."""
-    return _signed(e, v, 1.0, -1.0)
 
 
 def mesh_rates(e: Emitter, s: Sample, lp) -> tuple[list, list]:
     """(theta'_{j,c}, s_v) of every lossy mesh (doubles)."""
     rates = [e.const(e.dot(floats(lp.rate_flt[k]), s.qdi)) for k in range(len(lp.rate_meshes))]
-    return rates, [_sign(e, r) for r in rates]
-
-
-def interp(e: Emitter, x, table):
-    """np.interp(x, speeds, values) of a table (speeds, values) at x >= 0: linear between rows,
-    held beyond the ends (a constant: folded)."""
-    xs, ys = (tuple(float(v) for v in col) for col in table)
-    y = ys[0]
-    if len(xs) == 1:
-        return y
-    for i in range(len(xs) - 1):
-        slope = (ys[i + 1] - ys[i]) / (xs[i + 1] - xs[i])
-        seg = e.add(ys[i], e.mul(slope, e.sub(x, xs[i])))
-        y = e.b.select(e.b.fcmp_ordered(">", x, ir.Constant(D, xs[i])), e.const(seg), e.const(y))
-    return e.b.select(e.b.fcmp_ordered(">=", x, ir.Constant(D, xs[-1])), ir.Constant(D, ys[-1]), y)
+    return rates, [e.sign(r) for r in rates]
 
 
 def worm_signs(e: Emitter, s: Sample, worms) -> list:
     """s_v of each lossy worm pair: the sign of its worm's rate relative to the carrier
     (:class:`.loss_program.WormLosses`; exactly 0 at rest)."""
-    return [_sign(e, e.const(e.dot(floats(worms.rate_flt[k]), s.qdi))) for k in range(len(worms.circuits))]
+    return [e.sign(e.const(e.dot(floats(worms.rate_flt[k]), s.qdi))) for k in range(len(worms.circuits))]
 
 
 def reducer_terms(e: Emitter, s: Sample, red) -> list:
@@ -72,21 +43,21 @@ def reducer_terms(e: Emitter, s: Sample, red) -> list:
     out = []
     for k in range(len(red.circuits)):
         w = e.const(e.dot(floats(red.rate_flt[k]), s.qdi))
-        sw, speed = _sign(e, w), e.const(e.mul(red.scale[k], e.call("fabs", w)))
+        sw, speed = e.sign(w), e.const(e.mul(red.scale[k], e.call("fabs", w)))
         z = e.mv(s.R[int(red.carriers[k])], floats(red.axis[k]))
         fwd, bwd, t0 = red.tables[k]
         mode = red.mode[k] if red.mode else 0
         if mode == 0:          # c_r = 1/eta_f forward, eta_b backward
-            inv_f, eta_b = e.div(1.0, interp(e, speed, fwd)), interp(e, speed, bwd)
+            inv_f, eta_b = e.div(1.0, e.interp(speed, fwd)), e.interp(speed, bwd)
             A = e.const(e.sub(e.mul(0.5, e.add(inv_f, eta_b)), 1.0))
             B = e.const(e.mul(0.5, e.sub(eta_b, inv_f)))
         elif mode == 1:        # a belt's loss couple on its driven pulley k, forward only
-            A = e.const(e.mul(0.5, e.sub(1.0, interp(e, speed, fwd))))
+            A = e.const(e.mul(0.5, e.sub(1.0, e.interp(speed, fwd))))
             B = e.neg(A)
         else:                  # ... on j, backward only
-            A = e.const(e.mul(-0.5, e.sub(1.0, interp(e, speed, bwd))))
+            A = e.const(e.mul(-0.5, e.sub(1.0, e.interp(speed, bwd))))
             B = A
-        T0 = 0.0 if t0 is None else e.const(interp(e, speed, t0))
+        T0 = 0.0 if t0 is None else e.const(e.interp(speed, t0))
         out.append((sw, A, B, z, w, T0, speed))
         if t0 is None:
             continue
@@ -109,7 +80,7 @@ def joint_friction(e: Emitter, s: Sample, lp, rows: dict) -> dict:
         if not (f[6] or f[7]):         # bearing friction only (.bearings)
             continue
         qd = e.const(s.qd[ji])         # -F_c sign(q') - F_v q' (+0 at rest, as numpy's)
-        Q = own[ji] = e.b.fsub(_signed(e, qd, -f[6], f[6]), e.const(e.mul(f[7], qd)), flags=FLAGS)
+        Q = own[ji] = e.b.fsub(e.signed(qd, -f[6], f[6]), e.const(e.mul(f[7], qd)), flags=FLAGS)
         if ji not in late:
             _write_joint(e, s, ji, Q, rows)
         Rc, oc = s.R[child], s.o[child]
@@ -161,7 +132,7 @@ def _reducer_outputs(e: Emitter, s: Sample, red, gear_col, rows: dict) -> dict:
             continue
         sw, A, B, _, w, T0, speed = s.red[k]
         u = s.sol[int(gear_col[ci])]
-        delta = e.add(e.mul(A, e.mul(sw, sw)), e.mul(B, e.mul(_sign(e, u), sw)))
+        delta = e.add(e.mul(A, e.mul(sw, sw)), e.mul(B, e.mul(e.sign(u), sw)))
         drag = e.const(e.mul(T0, speed))      # T0 |a| - delta u w: +0 at rest, as numpy's
         e.store(e.b.fsub(drag, e.const(e.mul(e.mul(delta, u), w)), flags=FLAGS), rows["gear_loss"], ci)
         if red.reducer[k]:

@@ -1,7 +1,9 @@
 """Generated per-sample kinematics and link loads (the first half of :mod:`.kernel`).
 
-The same formulas as :func:`..kinematics.forward` and :func:`..inertia.inertia_load` (paper Eqs. 2-5 and 17-18, the external loads
-of :func:`..external.external_wrenches`), emitted straight-line per joint and link with
+The terms of :func:`..kinematics.forward` and :func:`..inertia.inertia_load` (paper Eqs. 2-5 and
+17-18: the same functions, :func:`..kinematics.joint_frame`, :func:`..kinematics.child_motion`,
+:func:`..inertia.inertia_wrench`, over the emitter's algebra), and the external loads of
+:func:`..external.external_wrenches`, emitted straight-line per joint and link with
 every fixed transform, mass, inertia and load point of the :class:`~.program.Program`
 as a constant (:class:`~.build.Emitter` folds the zeros and ones: a joint on the base,
 an identity R_pj, a centre of mass on an axis cost nothing).
@@ -13,7 +15,8 @@ from dataclasses import dataclass, field
 import llvmlite.ir as ir
 
 from .build import D, I64, Emitter
-from .trig import sincos
+from ..inertia import inertia_wrench
+from ..kinematics import child_motion, joint_frame
 
 EYE = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
 ZERO3 = (0.0, 0.0, 0.0)
@@ -63,25 +66,6 @@ def joint_space(e: Emitter, S, qi: list, qdi: list, qddi: list) -> Sample:
                   qdi=list(qdi))
 
 
-def _joint_frame(e: Emitter, pose, Rp, op, qk, prismatic: bool):
-    """(R, o, cos, sin) of the joint frame at qk, base axes."""
-    R0 = e.mm(Rp, floats(pose.R_pj))
-    oj = e.vadd(op, e.mv(Rp, floats(pose.p_pj)))
-    if prismatic:
-        return R0, e.vadd(oj, e.scale((R0[2], R0[5], R0[8]), qk)), 1.0, 0.0
-    cq, sq = sincos(e, qk)
-    Rj = []
-    for i in range(3):
-        r0, r1 = R0[3 * i], R0[3 * i + 1]
-        Rj += [e.add(e.mul(cq, r0), e.mul(sq, r1)), e.sub(e.mul(cq, r1), e.mul(sq, r0)), R0[3 * i + 2]]
-    return tuple(Rj), oj, cq, sq
-
-
-def _arm_accel(e: Emitter, a, dw, w, r):
-    """a + dw x r + w x (w x r)."""
-    return e.vadd(a, e.vadd(e.cx(dw, r), e.cx(w, e.cx(w, r))))
-
-
 def at_rest(s: Sample, base: int) -> None:
     """The base link: identity axes, origin, velocities and accelerations zero (constants)."""
     s.R[base], s.o[base], s.w[base], s.dw[base], s.a[base] = EYE, ZERO3, ZERO3, ZERO3, ZERO3
@@ -89,45 +73,26 @@ def at_rest(s: Sample, base: int) -> None:
 
 def joint(e: Emitter, s: Sample, rec, pose) -> None:
     """The child link of one joint (``rec`` its :data:`.records.JOINT`, ``pose`` its
-    :data:`.records.POSE`): its R, o, w, dw, a, and the joint's cos, sin."""
-    ji, p, c, pr = int(rec.joint), int(rec.parent), int(rec.child), int(rec.prismatic)
-    qdk, qddk = s.qd[ji], s.qdd[ji]
-    op, wp, dwp = s.o[p], s.w[p], s.dw[p]
+    :data:`.records.POSE`): its R, o, w, dw, a, and the joint's cos, sin (the terms of
+    :func:`..kinematics.joint_frame` and :func:`..kinematics.child_motion`)."""
+    ji, p, c, pr = int(rec.joint), int(rec.parent), int(rec.child), int(rec.prismatic) == 1
     if ji not in s.frames:
-        s.frames[ji] = _joint_frame(e, pose, s.R[p], op, s.q[ji], pr == 1)
+        s.frames[ji] = joint_frame(e, floats(pose.R_pj), floats(pose.p_pj), s.R[p], s.o[p], s.q[ji], pr)
     Rj, oj, cq, sq = s.frames[ji]
     s.cs[ji] = (cq, sq)
-    z = (Rj[2], Rj[5], Rj[8])
-    aj = _arm_accel(e, s.a[p], dwp, wp, e.vsub(oj, op))
-    if pr == 1:
-        wc, dwc = wp, dwp
-        aj = e.vadd(aj, e.vadd(e.scale(z, qddk), e.scale(e.cx(wp, e.scale(z, qdk)), 2.0)))
-    else:
-        wc = e.vadd(wp, e.scale(z, qdk))
-        dwc = e.vadd(e.vadd(dwp, e.scale(z, qddk)), e.scale(e.cx(wp, z), qdk))
-    s.R[c] = e.mm(Rj, floats(pose.R_jc))
-    rc = e.mv(Rj, floats(pose.p_jc))
-    s.o[c] = e.vadd(oj, rc)
-    s.a[c] = _arm_accel(e, aj, dwc, wc, rc)
-    s.w[c], s.dw[c] = wc, dwc
+    s.R[c], s.o[c], s.w[c], s.dw[c], s.a[c] = child_motion(e, Rj, oj, floats(pose.R_jc), floats(pose.p_jc), s.o[p],
+                                                           s.w[p], s.dw[p], s.a[p], s.qd[ji], s.qdd[ji], pr)
 
 
 def inertia(e: Emitter, s: Sample, L: int, body, g) -> None:
     """rhs[L] = the d'Alembert wrench of link L (``body`` its :data:`.records.BODY`, or a
     (mass, inertia (9,), com (3,)) of values read at run time: a data kernel) about o_L, base
-    frame (Eqs. 17-18)."""
+    frame (Eqs. 17-18, :func:`..inertia.inertia_wrench`)."""
     if isinstance(body, tuple):
         m, I, com = body
     else:
         m, I, com = float(body.mass), floats(body.inertia), floats(body.com)
-    RL, wL, dwL = s.R[L], s.w[L], s.dw[L]
-    wb = e.mtv(RL, wL)
-    Nb = e.vadd(e.mv(I, e.mtv(RL, dwL)), e.cx(wb, e.mv(I, wb)))
-    rc = e.mv(RL, com)
-    ac = _arm_accel(e, s.a[L], dwL, wL, rc)
-    F = e.scale(e.vsub(ac, floats(g)), m)
-    M = e.vadd(e.mv(RL, Nb), e.cx(rc, F))
-    s.rhs[L] = F + M
+    s.rhs[L] = inertia_wrench(e, m, I, com, s.R[L], s.w[L], s.dw[L], s.a[L], floats(g))
 
 
 def load_groups(loads) -> tuple[list, list]:

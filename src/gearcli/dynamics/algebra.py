@@ -1,0 +1,181 @@
+"""The algebra every per-sample physics term is written against, and its numpy evaluation.
+
+A physics term of the solver (the kinematics of Eqs. 2-5, the d'Alembert wrench of Eqs.
+17-18, the friction laws, ...) is one Python function of an *algebra* ``al`` and values:
+
+    def inertia_wrench(al, m, I_c, r_c, R, w, dw, a, g):
+        wb = al.mtv(R, w)
+        ...
+
+and is evaluated in two ways, by the same source:
+
+* :class:`Arrays` (here): a value is a Python ``float`` (a constant of the mechanism) or a
+  numpy array over the samples, shape (N,); the numpy reference path calls the term once
+  for all N samples;
+* :class:`gearcli.dynamics.llvm.build.Emitter`: a value is a ``float`` or an LLVM
+  ``double``; the generator calls the term once and gets the instructions of one sample.
+
+Both fold the constants alike (:class:`Algebra`'s primitives): a product with an exact 0.0
+is 0.0, with 1.0 (-1.0) the other operand (negated), a sum with 0.0 the other term.  So the
+two paths perform the same operations in the same order (the kernel may fuse a multiply and
+an add: ``contract``), and a term written wrongly is wrong on both paths: the tests that find
+it are the by-hand and power-balance ones (``tests/physics``), not the paths' comparison.
+
+A 3-vector is a 3-tuple of values, a 3x3 matrix a row-major 9-tuple of values.  Control flow
+(the sign search, block factorisations, fixed points, threads) stays each path's own.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+class Algebra:
+    """The composite operations, written once over the primitives ``add``, ``sub``, ``mul``,
+    ``neg`` of a subclass (each folding constants as the module docstring says)."""
+
+    def dot(self, xs, ys):
+        """sum_i xs[i] ys[i], left to right."""
+        s = 0.0
+        for x, y in zip(xs, ys):
+            s = self.add(s, self.mul(x, y))
+        return s
+
+    def vadd(self, a, b):
+        return tuple(self.add(x, y) for x, y in zip(a, b))
+
+    def vsub(self, a, b):
+        return tuple(self.sub(x, y) for x, y in zip(a, b))
+
+    def scale(self, a, s):
+        return tuple(self.mul(x, s) for x in a)
+
+    def cx(self, a, b):
+        """a x b."""
+        return (self.sub(self.mul(a[1], b[2]), self.mul(a[2], b[1])),
+                self.sub(self.mul(a[2], b[0]), self.mul(a[0], b[2])),
+                self.sub(self.mul(a[0], b[1]), self.mul(a[1], b[0])))
+
+    def mv(self, R, v):
+        """R v."""
+        return tuple(self.dot(R[3 * i:3 * i + 3], v) for i in range(3))
+
+    def mtv(self, R, v):
+        """R^T v."""
+        return tuple(self.dot(R[i::3], v) for i in range(3))
+
+    def mm(self, A, B):
+        """A B."""
+        return tuple(self.dot(A[3 * i:3 * i + 3], B[j::3]) for i in range(3) for j in range(3))
+
+    def sign(self, v):
+        """sign(v): -1, 0 or 1 (0 at an exact zero; a NaN gives 0)."""
+        return self.signed(v, 1.0, -1.0)
+
+
+class Arrays(Algebra):
+    """The numpy evaluation: values are floats or (N,) arrays (every sample at once)."""
+
+    def const(self, a):
+        return a
+
+    def add(self, a, b):
+        if isinstance(a, float) and a == 0.0:
+            return b
+        if isinstance(b, float) and b == 0.0:
+            return a
+        return a + b
+
+    def neg(self, a):
+        return -a
+
+    def sub(self, a, b):
+        if isinstance(a, float) and isinstance(b, float):
+            return a - b
+        if isinstance(b, float) and b == 0.0:
+            return a
+        if isinstance(a, float) and a == 0.0:
+            return -b
+        return a - b
+
+    def mul(self, a, b):
+        if isinstance(a, float) and isinstance(b, float):
+            return a * b
+        if isinstance(b, float):
+            a, b = b, a
+        if isinstance(a, float):
+            if a == 0.0:
+                return 0.0
+            if a == 1.0:
+                return b
+            if a == -1.0:
+                return -b
+        return a * b
+
+    def div(self, a, b):
+        if isinstance(b, float) and b == 1.0:
+            return a
+        return a / b
+
+    def call(self, name: str, a):
+        """fabs, sqrt, sin, cos of a (folded for a constant)."""
+        if isinstance(a, float):
+            return abs(a) if name == "fabs" else getattr(math, name)(a)
+        return np.abs(a) if name == "fabs" else getattr(np, name)(a)
+
+    def sincos(self, q):
+        """(cos q, sin q)."""
+        if isinstance(q, float):
+            return math.cos(q), math.sin(q)
+        return np.cos(q), np.sin(q)
+
+    def signed(self, v, pos: float, neg: float):
+        """pos where v > 0, neg where v < 0, else 0.0 (a NaN gives 0.0)."""
+        if isinstance(v, float):
+            return pos if v > 0.0 else neg if v < 0.0 else 0.0
+        return np.where(v > 0.0, pos, np.where(v < 0.0, neg, 0.0))
+
+    def interp(self, x, table):
+        """np.interp(x, speeds, values) of a table (speeds, values) at x >= 0: linear between
+        rows, held beyond the ends."""
+        xs, ys = (np.asarray(col, float) for col in table)
+        if len(xs) == 1:
+            return float(ys[0])
+        return np.interp(x, xs, ys)
+
+
+ARRAYS = Arrays()
+"""The numpy algebra (stateless: one for every caller)."""
+
+
+def as_array(v, n: int) -> np.ndarray:
+    """A value of :class:`Arrays` as an (N,) array (a constant broadcast, read-only)."""
+    return np.broadcast_to(np.float64(v), (n,)) if isinstance(v, float) else v
+
+
+def stack_vectors(vs, n: int) -> np.ndarray:
+    """A k-tuple of :class:`Arrays` values (a 3-vector, a 6-vector wrench) as an (N, k) array."""
+    return np.stack([np.broadcast_to(np.float64(x), (n,)) if isinstance(x, float) else x for x in vs], axis=1)
+
+
+def stack_matrices(Ms, n: int) -> np.ndarray:
+    """A row-major 9-tuple of :class:`Arrays` values as an (N, 3, 3) array."""
+    return stack_vectors(Ms, n).reshape(n, 3, 3)
+
+
+def vectors(a: np.ndarray) -> tuple:
+    """An (N, 3) array as a 3-vector of (N,) arrays (contiguous copies), or a (3,) constant as
+    a 3-tuple of floats."""
+    a = np.asarray(a, float)
+    if a.ndim == 1:
+        return tuple(float(x) for x in a)
+    return tuple(np.ascontiguousarray(a[:, i]) for i in range(3))
+
+
+def matrices(R: np.ndarray) -> tuple:
+    """An (N, 3, 3) array as a row-major 9-tuple of (N,) arrays, or a (3, 3) constant as floats."""
+    R = np.asarray(R, float)
+    if R.ndim == 2:
+        return tuple(float(x) for x in R.reshape(9))
+    return tuple(np.ascontiguousarray(R[:, i, j]) for i in range(3) for j in range(3))
