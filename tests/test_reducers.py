@@ -7,7 +7,6 @@ The energy balances of the bundled reducer mechanisms (lossless to 1e-12, lossy 
 """
 from __future__ import annotations
 
-import dataclasses
 import json
 import textwrap
 from pathlib import Path
@@ -169,19 +168,20 @@ def test_lossy_reducer_on_a_moving_housing_balances_power(backend):
 def test_the_hand_case_catches_a_missing_one_over_i0(monkeypatch):
     """A deliberate bug, the torque on the input without the 1/i0 (c_r times -i0): the holding
     motor torque of the hand case comes out 100x too large."""
-    from gearcli.dynamics import equations
-    good = equations.power_flow_factor
-    monkeypatch.setattr(equations, "power_flow_factor", lambda red, u, a: -100.0 * good(red, u, a))
+    from gearcli.dynamics import loss_terms
+    good = loss_terms.power_flow_delta              # c_r = 1 + delta -> -100 c_r
+    monkeypatch.setattr(loss_terms, "power_flow_delta",
+                        lambda al, A, B, sigma, s_w: al.sub(al.mul(-100.0, al.add(1.0, good(al, A, B, sigma, s_w))), 1.0))
     c = at_speed(hoist(), [0.0, 1.5])
     assert not np.allclose(c["motor:m"], [-0.5, -0.5 / 0.8], rtol=1e-3)
 
 
 def test_the_hand_case_catches_swapped_efficiencies(monkeypatch):
     """A deliberate bug, eta_f and eta_b swapped: lifting then needs -0.5/0.6, not -0.5/0.8."""
-    from gearcli.dynamics import equations
-    good = equations.power_flow_factor
-    monkeypatch.setattr(equations, "power_flow_factor",
-                        lambda red, u, a: good(dataclasses.replace(red, forward=red.backward, backward=red.forward), u, a))
+    from gearcli.dynamics import loss_terms
+    good = loss_terms.power_flow_coefficients
+    monkeypatch.setattr(loss_terms, "power_flow_coefficients",
+                        lambda al, speed, forward, backward, mode=0: good(al, speed, backward, forward, mode))
     c = at_speed(hoist(), [1.5, -1.5])
     assert not np.allclose(c["motor:m"], [-0.5 / 0.8, -0.5 * 0.6], rtol=1e-3)
 

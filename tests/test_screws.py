@@ -98,9 +98,10 @@ def test_self_locking_lead_screw_lowers_under_power():
 def test_the_hand_case_catches_a_wrong_torque_sign(monkeypatch):
     """A deliberate bug, the screw torque's sign flipped (c_r -> -c_r): the lifting torque
     comes out -0.8842 N*m."""
-    from gearcli.dynamics import equations
-    good = equations.screw_factor
-    monkeypatch.setattr(equations, "screw_factor", lambda sc, F, a: -good(sc, F, a))
+    from gearcli.dynamics import loss_terms
+    good = loss_terms.power_flow_delta              # c_r = 1 + delta -> -c_r
+    monkeypatch.setattr(loss_terms, "power_flow_delta",
+                        lambda al, A, B, sigma, s_w: al.sub(-2.0, good(al, A, B, sigma, s_w)))
     c = at_speed(lift(), [0.05])
     assert not np.allclose(c["motor:m"], [0.8842], atol=5e-5)
 

@@ -118,6 +118,10 @@ class Arrays(Algebra):
             return a
         return a / b
 
+    def plus_zero(self, a):
+        """a + 0.0, not folded: -0.0 becomes +0.0 (a loss at rest reads 0, not -0)."""
+        return a + 0.0
+
     def call(self, name: str, a):
         """fabs, sqrt, sin, cos of a (folded for a constant)."""
         if isinstance(a, float):

@@ -42,12 +42,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.gears import helical_terms
-from ..model.reducers import power_flow_factor
-from ..model.screws import screw_factor
 from ..model.belts import belt_arms, loss_couples
 from ..spatial import cross, mv
 from .kinematics import Kinematics
-from .losses import mesh_friction_moment, relative_rate
+from .algebra import ARRAYS
+from . import loss_terms
+from .losses import mesh_friction_moment, power_flow_terms, relative_rate
 
 
 def tooth_force_direction(ut: np.ndarray, us: np.ndarray, sigma, tan_phi: float,
@@ -114,7 +114,7 @@ class Columns:
             if sc is not None:                   # the axis u = z_S through a point P on it
                 self.world[ci] = dict(u=mv(Rc, c.zj), P=oc + mv(Rc, c.axis_point), h=sc.h)
                 if sc.power_flow_lossy:
-                    self.world[ci].update(screw=sc, a=relative_rate(an, kin, ci))
+                    self.world[ci].update(flow=power_flow_terms(an, ci, relative_rate(an, kin, ci)))
                 continue
             if c.geometry is not None:
                 gm, gp = c.geometry, an.mech.gears[c.gear]
@@ -129,7 +129,7 @@ class Columns:
                 self.world[ci] = dict(zj=mv(Rc, c.zj), zk=mv(Rc, c.zk))
                 red = an.mech.gears[c.gear].reducer
                 if red is not None and red.power_flow_lossy:   # the input's rate a, for c_r
-                    self.world[ci].update(red=red, a=relative_rate(an, kin, ci))
+                    self.world[ci].update(flow=power_flow_terms(an, ci, relative_rate(an, kin, ci)))
 
     def joint(self, ji: int, L: int) -> np.ndarray:
         """(N, 6, 5) columns of joint ``ji``'s reaction on link L."""
@@ -193,8 +193,7 @@ class Columns:
                 d = d + (sg * wv["sv"][:, None] * wm.mu) * wv["hh"]
             return ((float(L == c.k) - float(L == c.j)) * _force_at(d, wv["P"], o))[:, :, None]
         if "h" in wv:                 # a screw: F u through P and the torque h c_r F u on the nut, minus on the screw
-            cr = 1.0 if "screw" not in wv else screw_factor(
-                wv["screw"], np.broadcast_to(np.asarray(sigma, float), wv["a"].shape), wv["a"])[:, None]
+            cr = 1.0 if "flow" not in wv else _power_flow_factor(wv["flow"], sigma)
             col = _force_at(wv["u"], wv["P"], o)
             col[:, 3:] += (wv["h"] * cr) * wv["u"]
             return ((float(L == c.k) - float(L == c.j)) * col)[:, :, None]
@@ -207,8 +206,8 @@ class Columns:
                 col[:, 3:] += sign * sv * wv["fr"]
             return col[:, :, None]
         cr = 1.0        # a lossy reducer's power-flow factor c_r (model.reducers), (N, 1)
-        if "red" in wv:
-            cr = power_flow_factor(wv["red"], np.broadcast_to(np.asarray(sigma, float), wv["a"].shape), wv["a"])[:, None]
+        if "flow" in wv:
+            cr = _power_flow_factor(wv["flow"], sigma)
         col = 0.0
         if L == c.j:
             col = col + cr * _moment(wv["zj"])
@@ -256,3 +255,10 @@ class Columns:
             if L in g.links:
                 out[:, :, c0:c0 + g.size] = self.group(g, L, 1.0)
             c0 += g.size
+
+
+def _power_flow_factor(f, sigma) -> np.ndarray:
+    """(N, 1) c_r = 1 + delta of a power-flow element's terms ``f``
+    (:func:`.losses.power_flow_terms`) for the sign pattern sigma (a float or (N,))."""
+    delta = loss_terms.power_flow_delta(ARRAYS, f.A, f.B, sigma, f.s_w)
+    return (1.0 + np.broadcast_to(delta, f.s_w.shape))[:, None]

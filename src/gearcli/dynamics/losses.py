@@ -33,10 +33,12 @@ parent, q'_J the joint's own rate; it dissipates F_c |q'_J| + F_v q'_J^2.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-from ..model.reducers import input_torque, no_load_torque, reducer_loss
-from ..model.screws import screw_loss
+from . import loss_terms as T
+from .algebra import ARRAYS
 from ..model.worms import worm_force
 from ..model.belts import belt_arms, belt_loss, slack_problem
 from ..errors import GearcliError
@@ -84,7 +86,7 @@ def reducers(an):
 
 
 def subtract_reducer_drag(an, kin, b: dict) -> None:
-    """b_L -= the reducers' no-load running torques (:func:`gearcli.model.reducers.no_load_torque`:
+    """b_L -= the reducers' no-load running torques (:func:`.loss_terms.no_load_torque`:
     on the input about z_I, the opposite on the housing), in place: known loads, like joint
     friction."""
     moving = set(an.tree.moving)
@@ -92,7 +94,8 @@ def subtract_reducer_drag(an, kin, b: dict) -> None:
         if red.no_load_torque is None:
             continue
         c = an.circuits[ci]
-        tq = no_load_torque(red, relative_rate(an, kin, ci))
+        f = power_flow_terms(an, ci, relative_rate(an, kin, ci))
+        tq = np.broadcast_to(T.no_load_torque(ARRAYS, f.T0, f.s_w) + 0.0, f.s_w.shape)   # (+0.0: no -0 at rest)
         z = np.einsum("nij,j->ni", kin.R[c.carrier], c.zj)
         w = np.concatenate([np.zeros_like(z), tq[:, None] * z], axis=1)
         for L, sign in ((c.j, 1.0), (c.carrier, -1.0)):
@@ -178,34 +181,64 @@ def fill_worms(an, qd_ind: np.ndarray, res) -> None:
 def fill_reducers(an, qd_ind: np.ndarray, res) -> None:
     """A solved ``res``'s reducer fields, in place, from its unknowns u (``gear_t``) and the
     independent rates ``qd_ind``: ``gear_sep`` holds the torque each reducer exerts on its input
-    about z_I, losses included (:func:`gearcli.model.reducers.input_torque`), and ``gear_loss``
-    (a lossy mechanism) its dissipated power (:func:`gearcli.model.reducers.reducer_loss`); a
-    screw's ``gear_loss`` (:func:`gearcli.model.screws.screw_loss`)."""
-    for ci, red in reducers(an):
-        a, u = mesh_rate(an, qd_ind, ci), res.gear_t[:, ci]
-        res.gear_sep[:, ci] = input_torque(red, u, a)
+    about z_I, losses included (:func:`.loss_terms.input_torque`), and ``gear_loss`` (a lossy
+    mechanism) its dissipated power, and a screw's (:func:`.loss_terms.element_loss`)."""
+    for ci, c in enumerate(an.circuits):
+        gp = an.mech.gears[c.gear]
+        if gp.reducer is None and (gp.screw is None or res.gear_loss is None):
+            continue
+        u, f = res.gear_t[:, ci], power_flow_terms(an, ci, mesh_rate(an, qd_ind, ci))
+        delta = T.power_flow_delta(ARRAYS, f.A, f.B, ARRAYS.sign(u), f.s_w)
+        if gp.reducer is not None:
+            res.gear_sep[:, ci] = T.input_torque(ARRAYS, delta, u, f.T0, f.s_w)
         if res.gear_loss is not None:
-            res.gear_loss[:, ci] = reducer_loss(red, u, a)
-    if res.gear_loss is not None:
-        for ci, c in enumerate(an.circuits):
-            sc = an.mech.gears[c.gear].screw
-            if sc is not None:
-                res.gear_loss[:, ci] = screw_loss(sc, res.gear_t[:, ci], mesh_rate(an, qd_ind, ci))
+            res.gear_loss[:, ci] = T.element_loss(ARRAYS, delta, u, f.w, f.T0, f.speed)
+
+
+@dataclass(frozen=True)
+class PowerFlow:
+    """A power-flow element's per-sample terms (:mod:`.loss_terms`): delta = A s_w^2 +
+    B sigma s_w, its drive rate w and s_w = sign(w), its speed |a| and no-load torque T0."""
+
+    A: object
+    B: object
+    s_w: np.ndarray
+    w: np.ndarray
+    speed: np.ndarray
+    T0: object
+
+
+def power_flow_terms(an, ci: int, a: np.ndarray) -> PowerFlow:
+    """The :class:`PowerFlow` of circuit ``ci``, a reducer or a screw, at its rates ``a`` (N,):
+    a reducer's input rate relative to the housing (its drive rate w = a), a screw's rate
+    relative to the nut (w = -h a: :mod:`gearcli.model.screws`); the tables read at |a|."""
+    gp = an.mech.gears[an.circuits[ci].gear]
+    el = gp.reducer if gp.reducer is not None else gp.screw
+    w = a if gp.reducer is not None else -gp.screw.h * a
+    speed = ARRAYS.call("fabs", a)
+    A, B = T.power_flow_coefficients(ARRAYS, speed, _table(el.forward), _table(el.backward))
+    t0 = getattr(el, "no_load_torque", None)
+    return PowerFlow(A, B, ARRAYS.sign(w), w, speed, 0.0 if t0 is None else ARRAYS.interp(speed, _table(t0)))
+
+
+def _table(t) -> tuple:
+    """A :class:`gearcli.model.power_flow.SpeedTable` as (speeds, values)."""
+    return t.speeds, t.values
 
 
 def mesh_loss(an, kin, ci: int, t: np.ndarray) -> np.ndarray:
-    """Mesh power loss P_p = c_p |t_p| |theta'_{j,c}| r_j (N,), W."""
+    """Mesh power loss P_p = c_p |t_p| |theta'_{j,c}| r_j (N,), W (:func:`.loss_terms.mesh_loss`)."""
     c = an.circuits[ci]
     loss = an.mech.gears[c.gear].loss_factor
     if not loss or c.geometry is None:
         return np.zeros_like(t)
-    return loss * np.abs(t) * np.abs(relative_rate(an, kin, ci)) * c.geometry.r_j
+    return T.mesh_loss(ARRAYS, float(loss), float(c.geometry.r_j), t, relative_rate(an, kin, ci))
 
 
 def friction_force(coulomb, viscous, qd: np.ndarray) -> np.ndarray:
-    """The joint friction law, -F_c sign(qd) - F_v qd (broadcast: one joint's (N,) rates, or
-    (N, J) with per-joint coefficients (J,)); +0.0: no -0 where both are zero."""
-    return -coulomb * np.sign(qd) - viscous * qd + 0.0
+    """The joint friction law, -F_c sign(qd) - F_v qd (:func:`.loss_terms.joint_friction`;
+    broadcast: one joint's (N,) rates, or (N, J) with per-joint coefficients (J,)); +0.0 at rest."""
+    return T.joint_friction(ARRAYS, coulomb, viscous, qd)
 
 
 def joint_friction_forces(joints, qd_all: np.ndarray) -> np.ndarray:

@@ -39,12 +39,3 @@ class SpeedTable:
     def is_constant(self) -> bool:
         """True for one row (the value does not depend on the speed)."""
         return len(self.values) == 1
-
-
-def efficiency_factor(forward: SpeedTable, backward: SpeedTable, u, w, speed) -> np.ndarray:
-    """c_r (N,): 1/eta_f where u w < 0 (the input drives), eta_b where u w > 0 (the output
-    drives), 1 where u w = 0 (at rest: lossless); the tables read at |speed| (rad/s of the
-    input relative to its carrier).  A sign decided by the joint rates (w), never by world
-    vectors."""
-    s = np.sign(np.asarray(u, float)) * np.sign(np.asarray(w, float))
-    return np.where(s < 0, 1.0 / forward.at(speed), np.where(s > 0, backward.at(speed), 1.0))

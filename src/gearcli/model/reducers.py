@@ -37,7 +37,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .power_flow import SpeedTable, efficiency_factor
+from .power_flow import SpeedTable
 
 REDUCER_KINDS = ("strain_wave", "cycloidal")
 
@@ -102,37 +102,6 @@ def strain_wave_ratio(z_f: int, z_c: int) -> float:
     """i0 = -Z_F / (Z_C - Z_F) of a strain-wave gear with the circular spline held (200/202 ->
     -100): the flexspline (Z_F teeth) turns backwards relative to the wave generator."""
     return -z_f / (z_c - z_f)
-
-
-def power_flow_factor(red: Reducer, u, a) -> np.ndarray:
-    """c_r (N,): the torque on the input per unit of its lossless value u.
-
-    1/eta_f where the input drives (u a < 0), eta_b where the output drives (u a > 0), 1 where
-    u a = 0 (at rest: lossless).  ``u`` the lossless torque on I about z_I, ``a`` the input's
-    rate relative to the housing about z_I (rad/s, from the joint rates)."""
-    return efficiency_factor(red.forward, red.backward, u, a, a)
-
-
-def no_load_torque(red: Reducer, a) -> np.ndarray:
-    """(N,) the no-load running torque on the input about z_I, -T0(|a|) sign(a) (N*m; the
-    housing takes the opposite); zeros without one."""
-    a = np.asarray(a, float)
-    if red.no_load_torque is None:
-        return np.zeros_like(a)
-    return -red.no_load_torque.at(a) * np.sign(a) + 0.0
-
-
-def input_torque(red: Reducer, u, a) -> np.ndarray:
-    """The torque the element exerts on its input about z_I, losses included (N*m, (N,)):
-    c_r u plus the no-load running torque (``gear:<p>:input_torque``)."""
-    return power_flow_factor(red, u, a) * np.asarray(u, float) + no_load_torque(red, a)
-
-
-def reducer_loss(red: Reducer, u, a) -> np.ndarray:
-    """The power the element dissipates (W, (N,) >= 0): -(c_r - 1) u a + T0 |a|, which is
-    -(the power it delivers to I, O and H) since its torques sum to zero."""
-    u, a = np.asarray(u, float), np.asarray(a, float)
-    return -(power_flow_factor(red, u, a) - 1.0) * u * a - no_load_torque(red, a) * a + 0.0
 
 
 def windup(red: Reducer, T) -> np.ndarray | None:

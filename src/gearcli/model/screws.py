@@ -29,7 +29,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .power_flow import SpeedTable, efficiency_factor
+from .power_flow import SpeedTable
 
 
 @dataclass(frozen=True)
@@ -78,18 +78,6 @@ def friction_efficiencies(lead: float, diameter: float, mu: float) -> tuple[floa
     phi) / tan(beta) (<= 0 where beta <= phi: self-locking)."""
     beta, phi = math.atan(lead / (math.pi * diameter)), math.atan(mu)
     return math.tan(beta) / math.tan(beta + phi), math.tan(beta - phi) / math.tan(beta)
-
-
-def screw_factor(screw: Screw, F, a) -> np.ndarray:
-    """c_r (N,) of the screw's torque at the axial forces F and screw rates a (rad/s)."""
-    a = np.asarray(a, float)
-    return efficiency_factor(screw.forward, screw.backward, F, -screw.h * a, a)
-
-
-def screw_loss(screw: Screw, F, a) -> np.ndarray:
-    """The power the screw dissipates, W (N,) >= 0: -(c_r - 1) F w, w = -h a."""
-    F, a = np.asarray(F, float), np.asarray(a, float)
-    return (screw_factor(screw, F, a) - 1.0) * F * screw.h * a + 0.0
 
 
 def mean_axial_load(F, n, dt) -> float:

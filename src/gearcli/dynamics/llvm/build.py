@@ -138,6 +138,12 @@ class Emitter(Algebra):
             return abs(a) if name == "fabs" else getattr(math, name)(a)
         return self.b.call(self.intrinsic(name), [a])
 
+    def plus_zero(self, a):
+        """a + 0.0, not folded: -0.0 becomes +0.0 (a loss at rest reads 0, not -0)."""
+        if isinstance(a, float):
+            return a + 0.0
+        return self.b.fadd(a, ir.Constant(D, 0.0), flags=FLAGS)
+
     def signed(self, v, pos: float, neg: float):
         """pos where v > 0, neg where v < 0, else 0.0 (a NaN gives 0: no sign pattern accepts a
         NaN sample anyway)."""

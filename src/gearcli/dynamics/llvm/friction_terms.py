@@ -1,5 +1,7 @@
 """Generated friction terms of one sample (:mod:`..losses`, :mod:`.loss_program`), for :mod:`.kernel`:
-what the sample's rates give before any block solve, and the loss outputs.
+what the sample's rates give before any block solve, and the loss outputs.  The laws are the
+shared functions of :mod:`..loss_terms` (the numpy path calls the same ones); what is here is
+where the generator applies them.
 
 * :func:`mesh_rates`: each lossy mesh's rate theta'_{j,c} = r . q'_ind from the
   independent joint rates (:func:`..losses.relative_rate`) and s_v = sign of it (0 at rest,
@@ -7,7 +9,7 @@ what the sample's rates give before any block solve, and the loss outputs.
 * :func:`reducer_terms`: each lossy reducer's input rate, power-flow coefficients and its
   no-load torque (a known load);
 * :func:`joint_friction`: each friction joint's own friction -F_c sign(q'_J) - F_v q'_J
-  from the sample's joint rate (the law of :func:`..losses.friction_force`; the bearing
+  from the sample's joint rate (the law of :func:`..loss_terms.joint_friction`; the bearing
   friction is :mod:`.bearings`'); rhs[L] -= that generalised force Q times the joint's unit
   wrench: about the axis (revolute) or along it through the joint origin (prismatic), on
   the child, reversed on the parent;
@@ -18,6 +20,8 @@ what the sample's rates give before any block solve, and the loss outputs.
 """
 from __future__ import annotations
 
+from ..loss_terms import (element_loss, input_torque, joint_friction as joint_friction_law, mesh_loss,
+                          no_load_torque, power_flow_coefficients, power_flow_delta)
 from .build import FLAGS, Emitter
 from .links import Sample, floats
 
@@ -47,21 +51,12 @@ def reducer_terms(e: Emitter, s: Sample, red) -> list:
         z = e.mv(s.R[int(red.carriers[k])], floats(red.axis[k]))
         fwd, bwd, t0 = red.tables[k]
         mode = red.mode[k] if red.mode else 0
-        if mode == 0:          # c_r = 1/eta_f forward, eta_b backward
-            inv_f, eta_b = e.div(1.0, e.interp(speed, fwd)), e.interp(speed, bwd)
-            A = e.const(e.sub(e.mul(0.5, e.add(inv_f, eta_b)), 1.0))
-            B = e.const(e.mul(0.5, e.sub(eta_b, inv_f)))
-        elif mode == 1:        # a belt's loss couple on its driven pulley k, forward only
-            A = e.const(e.mul(0.5, e.sub(1.0, e.interp(speed, fwd))))
-            B = e.neg(A)
-        else:                  # ... on j, backward only
-            A = e.const(e.mul(-0.5, e.sub(1.0, e.interp(speed, bwd))))
-            B = A
+        A, B = (e.const(v) for v in power_flow_coefficients(e, speed, fwd, bwd, mode))
         T0 = 0.0 if t0 is None else e.const(e.interp(speed, t0))
         out.append((sw, A, B, z, w, T0, speed))
         if t0 is None:
             continue
-        tq = e.const(e.neg(e.mul(T0, sw)))
+        tq = e.const(no_load_torque(e, T0, sw))
         for L, coef in red.sides[k]:
             if L >= 0:
                 s.rhs[L] = s.rhs[L][:3] + tuple(e.sub(s.rhs[L][3 + h], e.mul(e.mul(coef, tq), z[h])) for h in range(3))
@@ -79,8 +74,7 @@ def joint_friction(e: Emitter, s: Sample, lp, rows: dict) -> dict:
         f = floats(lp.joint_flt[k])
         if not (f[6] or f[7]):         # bearing friction only (.bearings)
             continue
-        qd = e.const(s.qd[ji])         # -F_c sign(q') - F_v q' (+0 at rest, as numpy's)
-        Q = own[ji] = e.b.fsub(e.signed(qd, -f[6], f[6]), e.const(e.mul(f[7], qd)), flags=FLAGS)
+        Q = own[ji] = e.const(joint_friction_law(e, f[6], f[7], e.const(s.qd[ji])))
         if ji not in late:
             _write_joint(e, s, ji, Q, rows)
         Rc, oc = s.R[child], s.o[child]
@@ -108,7 +102,7 @@ def write_losses(e: Emitter, s: Sample, lp, gear_col, rates: list, own: dict, ro
     for k, ci in enumerate(lp.rate_meshes):
         c, rj = floats(lp.loss_flt[k])
         t = s.sol[int(gear_col[ci])]
-        e.store(e.mul(e.mul(e.mul(c, e.call("fabs", t)), e.call("fabs", rates[k])), rj), rows["gear_loss"], ci)
+        e.store(mesh_loss(e, c, rj, t, rates[k]), rows["gear_loss"], ci)
     inputs = _reducer_outputs(e, s, lp.reducers, gear_col, rows) if lp.reducers is not None else {}
     done = set(lp.reducers.circuits) if lp.reducers is not None else set()
     for ci in set(range(len(gear_col))) - set(lp.rate_meshes) - done:
@@ -124,19 +118,18 @@ def write_losses(e: Emitter, s: Sample, lp, gear_col, rates: list, own: dict, ro
 def _reducer_outputs(e: Emitter, s: Sample, red, gear_col, rows: dict) -> dict:
     """Each lossy power-flow element's ``gear_loss`` -delta u w + T0 |a| (delta = c_r - 1 with
     sigma = sign(u): u = 0 makes both terms' product 0); returns each reducer's input torque
-    (1 + delta) u - T0 s_w (:func:`gearcli.model.reducers.reducer_loss`,
-    :func:`~gearcli.model.reducers.input_torque`, :func:`gearcli.model.screws.screw_loss`)."""
+    (1 + delta) u - T0 s_w (:func:`..loss_terms.element_loss`,
+    :func:`..loss_terms.input_torque`)."""
     out = {}
     for k, ci in enumerate(red.circuits):
         if red.mode and red.mode[k]:        # a belt's loss: :func:`..losses.fill_belts`, both paths
             continue
         sw, A, B, _, w, T0, speed = s.red[k]
         u = s.sol[int(gear_col[ci])]
-        delta = e.add(e.mul(A, e.mul(sw, sw)), e.mul(B, e.mul(e.sign(u), sw)))
-        drag = e.const(e.mul(T0, speed))      # T0 |a| - delta u w: +0 at rest, as numpy's
-        e.store(e.b.fsub(drag, e.const(e.mul(e.mul(delta, u), w)), flags=FLAGS), rows["gear_loss"], ci)
+        delta = power_flow_delta(e, A, B, e.sign(u), sw)
+        e.store(element_loss(e, delta, u, w, T0, speed), rows["gear_loss"], ci)
         if red.reducer[k]:
-            out[ci] = e.const(e.sub(e.add(u, e.mul(delta, u)), e.mul(T0, sw)))
+            out[ci] = e.const(input_torque(e, delta, u, T0, sw))
     return out
 
 
