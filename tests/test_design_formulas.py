@@ -12,7 +12,7 @@ from gearcli.design import bearings as B
 from gearcli.design import gears as G
 from gearcli.design import iso281 as I
 from gearcli.model.ratings import BEARING_FACTOR_DEFAULTS
-from gearcli.model.shaft import split_two_bearings
+from gearcli.model.shaft import split_components
 from gearcli.report import rms as Rms
 
 LBF = 4.4482216152605      # N
@@ -66,6 +66,12 @@ def test_static_safety_iso76_by_hand():
     P0 = B.static_equivalent_load([2000.0, 1000.0], [1000.0, -3000.0], 0.6, 0.5)
     assert P0 == pytest.approx([2000.0, 2100.0])
     assert B.static_safety(10_000.0, float(P0.max())) == pytest.approx(10_000.0 / 2100.0)
+
+
+def split_two_bearings(F, M, z1, z2):
+    """(R1, R2) (N, 2) through the product's split, from (N, 3) F and M."""
+    R1x, R1y, R2x, R2y = split_components(F[:, 0], F[:, 1], M[:, 0], M[:, 1], z1, z2)
+    return np.column_stack([R1x, R1y]), np.column_stack([R2x, R2y])
 
 
 def test_two_bearing_split_is_the_simply_supported_shaft():

@@ -99,22 +99,28 @@ def test_generator_lists_every_module_the_ir_comes_from():
     or that only run the code (threads; the losses' numpy formulas and the bearing friction's
     fixed point around the kernel); so is every module of dynamics/llvm/."""
     import ast  # noqa: PLC0415
+    import os  # noqa: PLC0415
 
     from gearcli.dynamics.llvm.driver import GENERATOR  # noqa: PLC0415
 
     here = ROOT / "src" / "gearcli" / "dynamics" / "llvm"
     exempt = {"cache", "program", "basis", "records", "loss_program", "lossy_maps", "terms", "output_maps", "jobs", "__init__",
-              "../losses", "../bearing_friction"}
+              "../losses", "../bearing_friction", "../../__version__"}
     assert {p.stem for p in here.glob("*.py")} - exempt <= set(GENERATOR)
     for name in GENERATOR:
-        top = name.startswith("../")          # a module of gearcli.dynamics itself
-        for node in ast.walk(ast.parse((here / f"{name}.py").read_text())):
-            if not isinstance(node, ast.ImportFrom) or node.level not in ((1,) if top else (1, 2)):
+        path = (here / f"{name}.py").resolve()
+        for node in ast.walk(ast.parse(path.read_text())):
+            if not isinstance(node, ast.ImportFrom) or not node.level:
                 continue
-            used = [node.module] if node.module else [a.name for a in node.names]
-            if top or node.level == 2:
-                used = [f"../{u}" for u in used]
-            assert set(used) - exempt <= set(GENERATOR), (name, used)
+            base = path.parents[node.level - 1]          # the package the relative import starts from
+            used = [base / node.module.replace(".", "/")] if node.module else [base / a.name for a in node.names]
+            used = [os.path.relpath(u, here.resolve()) for u in used]
+            assert set(used) - exempt - SHAPE_ONLY <= set(GENERATOR), (name, used)
+
+
+SHAPE_ONLY = {"../../model/mechanism", "../../analysis/tree", "../../spatial", "../../errors", "../../model/gears",
+              "../../model/ratings"}
+"""Modules the shared terms import for types, constants or numpy helpers of their numpy callers, never for IR."""
 
 
 @pytest.mark.parametrize("damage", ["flip a byte", "truncate", "empty", "header only"])

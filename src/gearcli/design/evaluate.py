@@ -21,7 +21,7 @@ from ..report.rms import running_rms, rms_of, square_integral, trapezoid_weights
 from .gears import hertz_contact_stress, lewis_bending_stress
 from ..model.reducers import reducer_life
 from ..model.screws import screw_life_hours
-from ..model.shaft import split_two_bearings
+from ..model.shaft import split_components
 
 
 @dataclass(frozen=True)
@@ -39,7 +39,7 @@ def bearing_loads(s: Samples, joint: str, bearings) -> list[tuple[np.ndarray, np
     """Radial and axial load (N) on each bearing of a joint, per sample.
 
     One bearing takes the whole reaction force; two share its force and tilting moment as
-    a shaft on two supports (:func:`gearcli.model.shaft.split_two_bearings`), the
+    a shaft on two supports (:func:`gearcli.model.shaft.split_components`), the
     locating one taking the axial force.
     """
     c = s.cols
@@ -47,10 +47,9 @@ def bearing_loads(s: Samples, joint: str, bearings) -> list[tuple[np.ndarray, np
     none = np.zeros_like(s.t)
     if len(bearings) == 1:
         return [(c[f"joint:{joint}:radial"], axial)]
-    F = np.column_stack([c[f"joint:{joint}:f{a}"] for a in "xy"])      # the split needs x, y only
-    M = np.column_stack([c[f"joint:{joint}:m{a}"] for a in "xy"])
-    R = split_two_bearings(F, M, bearings[0].position, bearings[1].position)
-    return [(np.hypot(r[:, 0], r[:, 1]), axial if b.locating else none) for r, b in zip(R, bearings)]
+    R1x, R1y, R2x, R2y = split_components(*(c[f"joint:{joint}:{k}"] for k in ("fx", "fy", "mx", "my")),
+                                          bearings[0].position, bearings[1].position)
+    return [(np.hypot(x, y), axial if b.locating else none) for x, y, b in ((R1x, R1y, bearings[0]), (R2x, R2y, bearings[1]))]
 
 
 def signal(check: Check, s: Samples, mech, cache: dict | None = None) -> np.ndarray:

@@ -8,7 +8,7 @@ relative rotation with
 reversed on the parent, P_b the magnitude of the bearing's load vector (radial and axial
 together), from gearcli's per-bearing split of the joint reaction: one bearing takes the
 whole reaction force, P = |f|; two share the force and the tilting moment as a shaft on two
-supports (:func:`gearcli.model.shaft.split_two_bearings`, positions along the axis from
+supports (:mod:`gearcli.model.shaft`, positions along the axis from
 the joint origin), the locating one taking the axial force.  Revolute joints only.
 
 The moments depend on the reactions they change, so the balance equations become
@@ -23,9 +23,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..algebra import ARRAYS
 from ..model.shaft import split_components
 from ..errors import GearcliError
-from .losses import joint_axis_wrench
+from .wrenches import joint_axis_wrench
 
 TOL = 1e-12
 MAX_ITERATIONS = 500
@@ -60,7 +61,7 @@ def bearing_loads(mech, joints: list[int], x_all: dict) -> tuple[np.ndarray, np.
     ``joints[k]`` (revolute) from its reaction x_all[("joint", ji)] (N, 5): [fx, fy, fz, mx,
     my] the parent exerts on the child, joint frame, about its origin.  One bearing takes the
     whole force, P_1 = |f| (P_2 = 0); two share it by the shaft statics of
-    :func:`~gearcli.model.shaft.split_two_bearings` (:func:`~gearcli.model.shaft.split_components`),
+    :mod:`gearcli.model.shaft` (:func:`~gearcli.model.shaft.split_components`),
     the locating one taking fz too: P = sqrt(R_x^2 + R_y^2 (+ fz^2)).  All joints at once,
     each component a contiguous (K, N) array."""
     z1, z2, loc, _, single = bearing_layout(mech, joints)
@@ -68,9 +69,23 @@ def bearing_loads(mech, joints: list[int], x_all: dict) -> tuple[np.ndarray, np.
     R1x, R1y, R2x, R2y = split_components(fx, fy, mx, my, z1[:, None], z2[:, None])
     if single.any():
         R1x[single], R1y[single] = fx[single], fy[single]
-    fz2 = fz * fz
-    return (np.sqrt(R1x * R1x + R1y * R1y + loc[:, :1] * fz2),
-            np.sqrt(R2x * R2x + R2y * R2y + loc[:, 1:] * fz2))
+    return load_magnitudes(ARRAYS, (R1x, R1y, R2x, R2y), fz, loc[:, :1], loc[:, 1:])
+
+
+def load_magnitudes(al, R, fz, loc1, loc2) -> tuple:
+    """(P_1, P_2): each bearing's load magnitude sqrt(R_x^2 + R_y^2 (+ fz^2 on the locating
+    one)) from the split R = (R1x, R1y, R2x, R2y) (:func:`gearcli.model.shaft.split_terms`)
+    and the axial force fz; ``loc1``, ``loc2`` 1.0 for the locating bearing, else 0.0.  Over
+    the algebra ``al`` (:mod:`gearcli.algebra`): both paths."""
+    R1x, R1y, R2x, R2y = R
+    fz2 = al.mul(fz, fz)
+    return (al.call("sqrt", al.add(al.add(al.mul(R1x, R1x), al.mul(R1y, R1y)), al.mul(loc1, fz2))),
+            al.call("sqrt", al.add(al.add(al.mul(R2x, R2x), al.mul(R2y, R2y)), al.mul(loc2, fz2))))
+
+
+def friction_moment(al, P1, P2, arm1, arm2):
+    """sum_b M_b = 1/2 mu_1 d_1 P_1 + 1/2 mu_2 d_2 P_2 (N*m, >= 0), ``arm`` = 1/2 mu_b d_b."""
+    return al.add(al.mul(arm1, P1), al.mul(arm2, P2))
 
 
 def bearing_layout(mech, joints: list[int]):
@@ -100,7 +115,7 @@ def friction_moments(mech, joints: list[int], x_all: dict) -> np.ndarray:
     out = np.empty((len(joints), N))
     for s in range(0, N, BLOCK):
         P1, P2 = bearing_loads(mech, joints, {("joint", ji): x_all[("joint", ji)][s:s + BLOCK] for ji in joints})
-        out[:, s:s + BLOCK] = arm[:, :1] * P1 + arm[:, 1:] * P2
+        out[:, s:s + BLOCK] = friction_moment(ARRAYS, P1, P2, arm[:, :1], arm[:, 1:])
     return out.T
 
 

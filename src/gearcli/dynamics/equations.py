@@ -45,9 +45,10 @@ from ..model.gears import helical_terms
 from ..model.belts import belt_arms, loss_couples
 from ..spatial import cross, mv
 from .kinematics import Kinematics
-from .algebra import ARRAYS
+from ..algebra import ARRAYS
 from . import loss_terms
 from .losses import mesh_friction_moment, power_flow_terms, relative_rate
+from .wrenches import joint_axis_wrench
 
 
 def tooth_force_direction(ut: np.ndarray, us: np.ndarray, sigma, tan_phi: float,
@@ -149,14 +150,7 @@ class Columns:
         """(N, 6) wrench on link L of a unit generalised force of joint ``ji``: about its axis
         (revolute) or along it through the joint origin (prismatic), on the child, reversed
         on the parent, zero on any other link (``sign``: +-1 on L instead, a motor's)."""
-        an, kin = self.an, self.kin
-        jt = an.mech.joints[ji]
-        if sign is None:
-            sign = float(an.tree.index[jt.child] == L) - float(an.tree.index[jt.parent] == L)
-        z = kin.Rj[ji][:, :, 2]
-        if jt.type == "prismatic":
-            return sign * _force_at(z, kin.oj[ji], kin.o[L])
-        return sign * _moment(z)
+        return joint_axis_wrench(self.an, self.kin, ji, L, sign)
 
     def motor(self, mi: int, L: int) -> np.ndarray:
         """(N, 6, 1) column of motor ``mi``'s torque on link L: about the input link's joint axis on the input link, reversed on the stator (a transmission motor: its joints' generalised forces)."""

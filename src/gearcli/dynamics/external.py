@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..spatial import cross, mv
+from ..algebra import ARRAYS, stack_vectors, vectors
+from ..spatial import mv
+from .wrenches import load_wrench
 from .kinematics import Kinematics
 
 
@@ -51,8 +53,8 @@ def external_wrenches(an, kin: Kinematics, values: dict[str, np.ndarray]) -> dic
         f, m = w[:, :3], w[:, 3:]
         if ld.frame == "link":
             f, m = mv(R, f), mv(R, m)
-        arm = np.broadcast_to(mv(R, np.asarray(ld.point, float)), f.shape)   # o_L -> point, base axes
-        W = np.concatenate([f, m + cross(arm, f)], axis=1)
+        arm = mv(R, np.asarray(ld.point, float))          # o_L -> point, base axes
+        W = stack_vectors(load_wrench(ARRAYS, vectors(f), vectors(m), vectors(arm)), f.shape[0])
         out[L] = out[L] + W if L in out else W
     return out
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .algebra import ARRAYS, matrices, stack_vectors, vectors
+from ..algebra import ARRAYS, matrices, stack_vectors, vectors
 from .kinematics import Kinematics, arm_acceleration
 
 
@@ -33,7 +33,7 @@ def inertia_wrench(al, m, I_c, r_c, R_0i, omega_i, alpha_i, a_i, g) -> tuple:
 
     F* = m a_c (17) and N* = I_c dw + w x (I_c w) (18), gravity moved to the left:
     returns [F* - m g ; R N*_body + r_c x (F* - m g)], N and N*m, a 6-tuple of values of the
-    algebra ``al`` (:mod:`.algebra`: numpy over the samples, or the kernel's emitter).
+    algebra ``al`` (:mod:`gearcli.algebra`: numpy over the samples, or the kernel's emitter).
 
     m : mass, kg.  I_c : inertia about the centre of mass, link axes, kg*m^2 (row-major 9).
     r_c : centre of mass in the link frame, m.  R_0i : link orientation (9).  omega_i,

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.mechanism import Mechanism
-from .algebra import ARRAYS, matrices, stack_matrices, stack_vectors, vectors
+from ..algebra import ARRAYS, matrices, stack_matrices, stack_vectors, vectors
 from ..analysis.tree import Tree
 
 
@@ -42,14 +42,22 @@ class Kinematics:
     oj: list
     qd: np.ndarray | None = None       # (N, J) every real joint's rate, rad/s (m/s)
     qd_ind: np.ndarray | None = None   # (N, dof) the independent rates, when the caller had them
-    terms: dict | None = None          # per link (R, o, w, dw, a) as values of :class:`.algebra.Arrays`
+    terms: dict | None = None          # per link (R, o, w, dw, a) as values of :class:`gearcli.algebra.Arrays`
+    frames: dict | None = None         # per joint (R_j, o_j, cos, sin), the same
 
     def link_terms(self, L: int) -> tuple:
-        """Link L's (R, o, w, dw, a) as values of :class:`.algebra.Arrays` (a 9-tuple and
+        """Link L's (R, o, w, dw, a) as values of :class:`gearcli.algebra.Arrays` (a 9-tuple and
         3-tuples: floats where constant, else (N,) arrays), for the shared physics terms."""
         if self.terms is not None and L in self.terms:
             return self.terms[L]
         return (matrices(self.R[L]),) + tuple(vectors(x) for x in (self.o[L], self.w[L], self.dw[L], self.a[L]))
+
+    def joint_axis(self, ji: int) -> tuple:
+        """Joint ji's axis z and origin o_j (base frame) as 3-vectors of :class:`gearcli.algebra.Arrays`."""
+        if self.frames is not None and ji in self.frames:
+            Rj, oj = self.frames[ji][:2]
+            return (Rj[2], Rj[5], Rj[8]), oj
+        return vectors(self.Rj[ji][:, :, 2]), vectors(self.oj[ji])
 
     def independent_rates(self, an) -> np.ndarray:
         """(N, dof) the independent joint rates q'_ind: as given to :func:`forward`, else
@@ -101,7 +109,7 @@ def forward(mech: Mechanism, tree: Tree, q: np.ndarray, qd: np.ndarray | None = 
     Rj = [stack_matrices(frames[j][0], N) if j in frames else None for j in range(J)]
     oj = [stack_vectors(frames[j][1], N) if j in frames else None for j in range(J)]
     return Kinematics(*parts, Rj, oj, qd, None if qd_ind is None else np.atleast_2d(np.asarray(qd_ind, float)),
-                      terms=links)
+                      terms=links, frames=frames)
 
 
 EYE = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
@@ -114,7 +122,7 @@ def joint_frame(al, R_pj, p_pj, R_p, o_p, q, prismatic: bool):
     The frame at q = 0 is fixed in the parent p (``R_pj``, ``p_pj`` in p's frame; ``R_p``,
     ``o_p`` the parent's orientation and origin); a revolute joint turns it about its z by q,
     R_j = R_p R_pj Rz(q) (by columns: c x0 + s y0, c y0 - s x0, z0), a prismatic joint moves
-    its origin along z by q.  ``al``: the algebra (:mod:`.algebra`)."""
+    its origin along z by q.  ``al``: the algebra (:mod:`gearcli.algebra`)."""
     R0 = al.mm(R_p, R_pj)
     oj = al.vadd(o_p, al.mv(R_p, p_pj))
     if prismatic:

@@ -1,6 +1,6 @@
 """The per-sample laws of the losses, written once for both paths (docs/concepts/losses.md).
 
-Each function takes the algebra ``al`` (:mod:`.algebra`: numpy over the samples, or the
+Each function takes the algebra ``al`` (:mod:`gearcli.algebra`: numpy over the samples, or the
 kernel's emitter) and values of it; the numpy reference (:mod:`.losses`, :mod:`.equations`)
 and the generator (:mod:`.llvm.friction_terms`) call the same functions.  Every sign that
 decides a direction is a sign of a rate formed from the joint rates (s_v, s_w) or of the

@@ -38,7 +38,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import loss_terms as T
-from .algebra import ARRAYS
+from ..algebra import ARRAYS
+from .wrenches import joint_axis_wrench
 from ..model.worms import worm_force
 from ..model.belts import belt_arms, belt_loss, slack_problem
 from ..errors import GearcliError
@@ -259,18 +260,6 @@ def joint_friction_force(jt, qd: np.ndarray) -> np.ndarray:
     if fr is None:
         return np.zeros_like(qd)
     return friction_force(fr.coulomb, fr.viscous, qd)
-
-
-def joint_axis_wrench(an, kin, ji: int, L: int) -> np.ndarray:
-    """(N, 6) wrench on link L, base frame, about o_L, of a unit generalised force of joint
-    ``ji`` on its child (reversed on its parent; zero on other links): a moment about the
-    axis (revolute) or a force along it through the joint origin (prismatic)."""
-    jt = an.mech.joints[ji]
-    sign = float(an.tree.index[jt.child] == L) - float(an.tree.index[jt.parent] == L)
-    z = kin.Rj[ji][:, :, 2]
-    if jt.type == "prismatic":
-        return sign * np.concatenate([z, cross(kin.oj[ji] - kin.o[L], z)], axis=1)
-    return sign * np.concatenate([np.zeros_like(z), z], axis=1)
 
 
 def subtract_joint_friction(an, kin, b: dict, qd_all: np.ndarray) -> None:

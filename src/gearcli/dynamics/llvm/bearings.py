@@ -46,7 +46,8 @@ from __future__ import annotations
 
 import llvmlite.ir as ir
 
-from ..bearing_friction import MAX_ITERATIONS, TOL
+from ...model.shaft import split_terms
+from ..bearing_friction import MAX_ITERATIONS, TOL, friction_moment, load_magnitudes
 from .bearing_newton import level, loads, newton, unaffected, within
 from .build import D, I1, I64, Emitter
 from .links import Sample, floats
@@ -55,27 +56,22 @@ from .signs import WARM, _consistent, _sign_bit, tolerance
 
 def split(e: Emitter, lp, k: int, x: list) -> list:
     """[R1x, R1y, R2x, R2y, fz] of bearing joint k from its reaction x = [fx, fy, fz, mx, my]
-    (joint frame; any basis turned about the axis): the two-bearing split of
-    :func:`gearcli.model.shaft.split_components` (one bearing: R1 = f), linear in x."""
+    (joint frame; any basis turned about the axis): the two-bearing split
+    :func:`gearcli.model.shaft.split_terms` (one bearing: R1 = f), linear in x."""
     z1, z2 = (float(v) for v in lp.bearing_flt[k, :2])
     fx, fy, fz, mx, my = x
     if lp.bearing_single[k]:
         return [fx, fy, 0.0, 0.0, fz]
-    inv = 1.0 / (z2 - z1)
-    R2x = e.mul(e.sub(my, e.mul(z1, fx)), inv)
-    R2y = e.mul(e.sub(e.neg(mx), e.mul(z1, fy)), inv)
-    return [e.sub(fx, R2x), e.sub(fy, R2y), R2x, R2y, fz]
+    return list(split_terms(e, fx, fy, mx, my, z1, z2)) + [fz]
 
 
 def moment(e: Emitter, lp, k: int, R: list):
-    """sum_b 1/2 mu_b d_b P_b of bearing joint k from its :func:`split` R: the twin of
-    :func:`..bearing_friction.friction_moments` (its constants, :func:`..bearing_friction.bearing_layout`)."""
+    """sum_b 1/2 mu_b d_b P_b of bearing joint k from its :func:`split` R
+    (:func:`..bearing_friction.load_magnitudes`, :func:`..bearing_friction.friction_moment`;
+    the constants of :func:`..bearing_friction.bearing_layout`)."""
     loc1, loc2, arm1, arm2 = (float(v) for v in lp.bearing_flt[k, 2:])
-    R1x, R1y, R2x, R2y, fz = R
-    fz2 = e.mul(fz, fz)
-    P1 = e.call("sqrt", e.add(e.add(e.mul(R1x, R1x), e.mul(R1y, R1y)), e.mul(loc1, fz2)))
-    P2 = e.call("sqrt", e.add(e.add(e.mul(R2x, R2x), e.mul(R2y, R2y)), e.mul(loc2, fz2)))
-    return e.add(e.mul(arm1, P1), e.mul(arm2, P2))
+    P1, P2 = load_magnitudes(e, R[:4], R[4], loc1, loc2)
+    return friction_moment(e, P1, P2, arm1, arm2)
 
 
 class _Joints:

@@ -19,7 +19,6 @@ from .hot_pairs import HotLossyBlock
 from .build import I64, Emitter
 from .links import Sample, floats
 from .signs import SignedBlock, resolve, signs_of, tolerance
-from .trig import sincos
 from .world import LowRankBlock, WorldBlock
 
 
@@ -106,7 +105,7 @@ def store(e: Emitter, s: Sample, rec, prog, x: list) -> None:
             cq, sq = s.cs[j]
         else:
             angle = e.dot(s.q, floats(turns[off:off + len(s.q)]))
-            cq, sq = sincos(e, angle)
+            cq, sq = e.sincos(angle)
         for h in (0, 3):
             x0, x1 = x[c0 + h], x[c0 + h + 1]
             s.sol[int(gcol[g0 + c0 + h])] = e.add(e.mul(cq, x0), e.mul(sq, x1))

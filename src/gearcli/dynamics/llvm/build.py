@@ -19,14 +19,9 @@ import struct
 
 import llvmlite.ir as ir
 
-from ..algebra import Algebra
-
-D = ir.DoubleType()
-I1 = ir.IntType(1)
-I64 = ir.IntType(64)
-DP = D.as_pointer()
-I64P = I64.as_pointer()
-FLAGS = ("contract",)
+from ...algebra import Algebra
+from . import trig
+from .types import D, DP, FLAGS, I1, I64, I64P  # noqa: F401 (the types, for the generator's modules)
 
 
 class ConstantPool:
@@ -63,7 +58,7 @@ class ConstantPool:
 
 class Emitter(Algebra):
     """Folding double arithmetic on an :class:`llvmlite.ir.IRBuilder` (see module docstring):
-    the primitives of :class:`gearcli.dynamics.algebra.Algebra`, whose composites (dot, cross,
+    the primitives of :class:`gearcli.algebra.Algebra`, whose composites (dot, cross,
     matrix-vector products) it inherits; with a :class:`ConstantPool` the constants of its
     arithmetic come from the pool."""
 
@@ -155,8 +150,7 @@ class Emitter(Algebra):
 
     def sincos(self, q):
         """(cos q, sin q) of an angle, inline (:mod:`.trig`; a constant folds)."""
-        from .trig import sincos  # noqa: PLC0415 (trig emits with this class)
-        return sincos(self, q)
+        return trig.sincos(self, q)
 
     def interp(self, x, table):
         """np.interp(x, speeds, values) of a table (speeds, values) at x >= 0: linear between rows,

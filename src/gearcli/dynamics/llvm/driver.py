@@ -75,10 +75,12 @@ def mech_loads(an) -> list:
 
 
 GENERATOR = ("kernel", "blocks", "build", "links", "outputs", "signs", "dense_solve", "trig", "world", "driver",
-             "losses", "friction_terms", "inverse_cache", "hot_pairs", "mass", "bearings", "bearing_newton", "../result_arrays", "../signs",
-             "../bearing_friction")
-"""The modules (paths from :mod:`gearcli.dynamics.llvm`, without .py) whose code makes a kernel program's IR text (a test
-checks that every module they import from the package is listed or makes only hashed input)."""
+             "losses", "friction_terms", "inverse_cache", "hot_pairs", "mass", "bearings", "bearing_newton", "types",
+             "../result_arrays", "../signs", "../bearing_friction", "../kinematics", "../inertia", "../loss_terms",
+             "../wrenches", "../../algebra", "../../model/shaft")
+"""The modules (paths from :mod:`gearcli.dynamics.llvm`, without .py) whose code makes a kernel program's IR text: the
+generator's own and the shared physics terms it emits (:mod:`gearcli.algebra`; a test checks that every module they
+import from the package is listed or makes only hashed input)."""
 
 
 @lru_cache(maxsize=1)

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from ..loss_terms import (element_loss, input_torque, joint_friction as joint_friction_law, mesh_loss,
                           no_load_torque, power_flow_coefficients, power_flow_delta)
+from ..wrenches import unit_joint_wrench
 from .build import FLAGS, Emitter
 from .links import Sample, floats
 
@@ -79,14 +80,11 @@ def joint_friction(e: Emitter, s: Sample, lp, rows: dict) -> dict:
             _write_joint(e, s, ji, Q, rows)
         Rc, oc = s.R[child], s.o[child]
         z = e.mv(Rc, f[:3])
+        oj = e.vadd(oc, e.mv(Rc, f[3:6])) if prismatic else None
         for L, sign in ((child, 1.0), (parent, -1.0)):
             if L < 0:
                 continue
-            if prismatic:
-                oj = e.vadd(oc, e.mv(Rc, f[3:6]))
-                w = z + e.cx(e.vsub(oj, s.o[L]), z)
-            else:
-                w = (0.0, 0.0, 0.0) + z
+            w = unit_joint_wrench(e, z, oj, s.o[L], bool(prismatic))
             s.rhs[L] = tuple(e.sub(s.rhs[L][h], e.mul(e.mul(sign, Q), w[h])) for h in range(6))
     for ji in sorted(set(range(len(s.qd))) - late - set(own)):
         _write_joint(e, s, ji, 0.0, rows)

@@ -17,6 +17,7 @@ import llvmlite.ir as ir
 from .build import D, I64, Emitter
 from ..inertia import inertia_wrench
 from ..kinematics import child_motion, joint_frame
+from ..wrenches import load_wrench
 
 EYE = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
 ZERO3 = (0.0, 0.0, 0.0)
@@ -140,8 +141,7 @@ def external(e: Emitter, s: Sample, fn, links, n, vals, ldrow, ldpt, ldgrp) -> N
         f = tuple(e.b.select(in_link, e.const(a), b) for a, b in zip(e.mv(s.R[L], f), f))
         m = tuple(e.b.select(in_link, e.const(a), b) for a, b in zip(e.mv(s.R[L], m), m))
         point = tuple(e.load(ldpt, e.b.add(rec, ir.Constant(I64, i))) for i in range(3))
-        mo = e.vadd(m, e.cx(e.mv(s.R[L], point), f))
-        new = [e.const(e.add(a, w)) for a, w in zip(acc, f + mo)]
+        new = [e.const(e.add(a, w)) for a, w in zip(acc, load_wrench(e, f, m, e.mv(s.R[L], point)))]
         k_next = e.b.add(k, one)
         e.b.cbranch(e.b.icmp_signed("<", k_next, k1), loop, done)
         k.add_incoming(k0, pre)

@@ -13,7 +13,7 @@ import math
 
 import llvmlite.ir as ir
 
-from .build import D, I64, Emitter
+from .types import D, I64
 
 REDUCE_LIMIT = 1e5
 PIO2_HI = 1.5707963267948966           # pi/2 rounded to a double
@@ -25,7 +25,7 @@ COS = (4.16666666666666019037e-02, -1.38888888888741095749e-03, 2.48015872894767
        -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.13596475577881948265e-11)
 
 
-def _horner(e: Emitter, z, coefs):
+def _horner(e, z, coefs):      # e: the :class:`.build.Emitter`
     """coefs[0] + z (coefs[1] + z (...))."""
     acc = coefs[-1]
     for c in reversed(coefs[:-1]):
@@ -33,11 +33,11 @@ def _horner(e: Emitter, z, coefs):
     return acc
 
 
-def _fma(e: Emitter, a, b, c):
+def _fma(e, a, b, c):
     return e.b.call(e.intrinsic("fma", 3), [e.const(a), e.const(b), e.const(c)])
 
 
-def _reduced(e: Emitter, q):
+def _reduced(e, q):
     """(cos, sin) of q by reduction to |r| <= pi/4 (|q| <= REDUCE_LIMIT)."""
     b = e.b
     k = b.call(e.intrinsic("rint"), [e.mul(q, INV_PIO2)])
@@ -56,7 +56,7 @@ def _reduced(e: Emitter, q):
     return (b.select(cos_neg, e.neg(cos_mag), cos_mag), b.select(sin_neg, e.neg(sin_mag), sin_mag))
 
 
-def sincos(e: Emitter, q):
+def sincos(e, q):
     """(cos q, sin q) of an angle (a constant folds)."""
     if isinstance(q, float):
         return math.cos(q), math.sin(q)

@@ -13,13 +13,15 @@ and is evaluated in two ways, by the same source:
   numpy array over the samples, shape (N,); the numpy reference path calls the term once
   for all N samples;
 * :class:`gearcli.dynamics.llvm.build.Emitter`: a value is a ``float`` or an LLVM
-  ``double``; the generator calls the term once and gets the instructions of one sample.
+  ``double``; the generator calls the term once and gets the instructions of one sample
+  (:mod:`gearcli.dynamics.llvm`).
 
 Both fold the constants alike (:class:`Algebra`'s primitives): a product with an exact 0.0
 is 0.0, with 1.0 (-1.0) the other operand (negated), a sum with 0.0 the other term.  So the
 two paths perform the same operations in the same order (the kernel may fuse a multiply and
 an add: ``contract``), and a term written wrongly is wrong on both paths: the tests that find
-it are the by-hand and power-balance ones (``tests/physics``), not the paths' comparison.
+it are the by-hand and power-balance ones (pytest marker ``physics``, run first), not the
+paths' comparison.
 
 A 3-vector is a 3-tuple of values, a 3x3 matrix a row-major 9-tuple of values.  Control flow
 (the sign search, block factorisations, fixed points, threads) stays each path's own.

@@ -1,0 +1,38 @@
+"""Wrenches of unit generalised forces and of external loads: terms written once for both paths.
+
+A wrench is [force ; moment], base frame, about the origin o_L of the link L it acts on (N,
+N*m), a 6-tuple of values of the algebra ``al`` (:mod:`gearcli.algebra`); the numpy path
+stacks it to (N, 6), the kernel emits it per sample.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..algebra import ARRAYS, stack_vectors
+
+
+def unit_joint_wrench(al, z, o_j, o_L, prismatic: bool) -> tuple:
+    """The wrench on L of a unit generalised force of a joint: a unit force along its axis z
+    through its origin o_j, [z ; (o_j - o_L) x z] (prismatic), or a unit moment about the
+    axis, [0 ; z] (revolute; ``o_j`` unused)."""
+    if prismatic:
+        return z + al.cx(al.vsub(o_j, o_L), z)
+    return (0.0, 0.0, 0.0) + tuple(z)
+
+
+def load_wrench(al, f, m, arm) -> tuple:
+    """The wrench about o_L of a force f and moment m applied at the point o_L + arm (base
+    axes): [f ; m + arm x f]."""
+    return tuple(f) + al.vadd(m, al.cx(arm, f))
+
+
+def joint_axis_wrench(an, kin, ji: int, L: int, sign: float | None = None) -> np.ndarray:
+    """(N, 6) :func:`unit_joint_wrench` of joint ``ji`` on link L over the samples of ``kin``:
+    on its child, reversed on its parent, zero on other links (``sign``: +-1 on L instead, a
+    motor's on its input link and its stator)."""
+    jt = an.mech.joints[ji]
+    if sign is None:
+        sign = float(an.tree.index[jt.child] == L) - float(an.tree.index[jt.parent] == L)
+    z, oj = kin.joint_axis(ji)
+    W = unit_joint_wrench(ARRAYS, z, oj, kin.link_terms(L)[1], jt.type == "prismatic")
+    return sign * stack_vectors(W, kin.n)
