@@ -69,13 +69,6 @@ def mv(R: np.ndarray, x: np.ndarray) -> np.ndarray:
     return np.einsum("nij,nj->ni", R, x)
 
 
-def mm_const(R: np.ndarray, C: np.ndarray) -> np.ndarray:
-    """R @ C for a batch R (N,3,3) and one matrix C (3,3), as one BLAS call."""
-    if R.flags.c_contiguous:
-        return (R.reshape(-1, 3) @ C).reshape(R.shape)
-    return R @ C
-
-
 def mtv(R: np.ndarray, x: np.ndarray) -> np.ndarray:
     """Batched R^T x for R (N,3,3) and x (N,3)."""
     return np.einsum("nji,nj->ni", R, x)

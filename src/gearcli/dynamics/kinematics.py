@@ -9,7 +9,10 @@ All quantities are in the base frame ("world"), arrays shaped ``(N, 3)`` or ``(N
 
 The recursion is Walker and Orin's (paper Eqs. 2-5), written for a general tree of joints
 with arbitrary fixed transforms, so primary and secondary links (paper Eqs. 10-11) are
-handled alike and no centre of mass needs to lie on an axis.
+handled alike and no centre of mass needs to lie on an axis.  One joint's terms,
+:func:`joint_frame` and :func:`child_motion`, are written once over the algebra of
+:mod:`gearcli.algebra`: :func:`forward` evaluates them over all samples, the generated
+kernel emits them per sample (:func:`gearcli.dynamics.llvm.links.joint`).
 """
 from __future__ import annotations
 
@@ -77,6 +80,11 @@ class Kinematics:
         return self.oj[0].shape[0]
 
 
+EYE = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
+ZERO3 = (0.0, 0.0, 0.0)
+"""The base at rest: identity axes, zero origin, velocities and accelerations (constants)."""
+
+
 def forward(mech: Mechanism, tree: Tree, q: np.ndarray, qd: np.ndarray | None = None,
             qdd: np.ndarray | None = None, qd_ind: np.ndarray | None = None) -> Kinematics:
     """Positions, velocities, accelerations of all links for joint values ``q`` (N, J).
@@ -110,10 +118,6 @@ def forward(mech: Mechanism, tree: Tree, q: np.ndarray, qd: np.ndarray | None = 
     oj = [stack_vectors(frames[j][1], N) if j in frames else None for j in range(J)]
     return Kinematics(*parts, Rj, oj, qd, None if qd_ind is None else np.atleast_2d(np.asarray(qd_ind, float)),
                       terms=links, frames=frames)
-
-
-EYE = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
-ZERO3 = (0.0, 0.0, 0.0)
 
 
 def joint_frame(al, R_pj, p_pj, R_p, o_p, q, prismatic: bool):

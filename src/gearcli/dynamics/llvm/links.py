@@ -16,11 +16,9 @@ import llvmlite.ir as ir
 
 from .build import D, I64, Emitter
 from ..inertia import inertia_wrench
-from ..kinematics import child_motion, joint_frame
+from ..kinematics import EYE, ZERO3, child_motion, joint_frame
 from ..wrenches import load_wrench
 
-EYE = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
-ZERO3 = (0.0, 0.0, 0.0)
 
 
 @dataclass

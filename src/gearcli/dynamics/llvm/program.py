@@ -153,6 +153,7 @@ class _Builder:
     def __init__(self):
         self.brec, self.blinks, self.gcol, self.tcol = [], [], [], []
         self.ainv, self.prec, self.cmat, self.later, self.cbrec, self.turns = [], [], [], [], [], []
+        self.poses = None       # the kinematics of the poses :func:`_term_props` checks, made once
 
     @staticmethod
     def add_floats(parts: list, arr) -> int:
@@ -243,19 +244,21 @@ def _term_props(bd: _Builder, an, terms, values, rec) -> None:
     the terms stay."""
     F, k0, nt = int(rec["F"]), int(rec["term0"]), int(rec["nterm"])
     later = [(t, v) for t, v in zip(terms[k0:k0 + nt], values[k0:k0 + nt]) if t.row < 0]
-    rng = np.random.default_rng(0)
-    poses = [np.zeros((1, len(an.mech.joints)))] + [rng.uniform(-3, 3, (1, len(an.mech.joints))) for _ in range(2)]
-    kins = [forward(an.mech, an.tree, q) for q in poses]
+    if bd.poses is None:              # home and two other poses, one kinematics for every block
+        rng = np.random.default_rng(0)
+        q = np.vstack([np.zeros(len(an.mech.joints))] + [rng.uniform(-3, 3, len(an.mech.joints)) for _ in range(2)])
+        bd.poses = forward(an.mech, an.tree, q)
+    kin = bd.poses
     by_link: dict = {}
     for t, v in later:
         ws = []
-        for kin in kins:
-            RF, RX = kin.R[F][0], kin.R[int(t.frame)][0]
+        for n in range(3):
+            RF, RX = kin.R[F][n], kin.R[int(t.frame)][n]
             d = RF.T @ RX @ np.asarray(v.d, float)
             if t.moment == 1:
                 ws.append(np.concatenate([np.zeros(3), v.coef * d]))
             else:
-                P = RF.T @ (RX @ np.asarray(v.p, float) + kin.o[int(t.frame)][0] - kin.o[F][0])
+                P = RF.T @ (RX @ np.asarray(v.p, float) + kin.o[int(t.frame)][n] - kin.o[F][n])
                 ws.append(np.concatenate([v.coef * d, v.coef * np.cross(P, d)]))
         if any(not np.allclose(w, ws[0], rtol=1e-12, atol=1e-12 * (1 + np.abs(ws[0]).max())) for w in ws[1:]):
             return
