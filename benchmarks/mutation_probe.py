@@ -74,6 +74,10 @@ TESTS = [
     "tests/test_load_sharing.py::test_unequal_stiffness_shares_in_proportion",
     "tests/test_load_sharing.py::test_least_load_map_two_parallel_springs",
     "tests/test_load_sharing.py::test_split_path_drive_by_hand",
+    "tests/test_reducers.py::test_strain_wave_holds_lifts_and_lowers_a_load_by_hand",
+    "tests/test_reducers.py::test_lossy_reducer_on_a_moving_housing_balances_power",
+    "tests/test_screws.py::test_ball_screw_lifts_and_lowers_1_kN_by_hand",
+    "tests/test_screws.py::test_self_locking_lead_screw_lowers_under_power",
 ]
 
 
