@@ -83,9 +83,12 @@ class Arrays(Algebra):
         return a
 
     def add(self, a, b):
-        if isinstance(a, float) and a == 0.0:
+        fa, fb = isinstance(a, float), isinstance(b, float)
+        if fa and fb:
+            return a + b
+        if fa and a == 0.0:
             return b
-        if isinstance(b, float) and b == 0.0:
+        if fb and b == 0.0:
             return a
         return a + b
 
@@ -93,26 +96,26 @@ class Arrays(Algebra):
         return -a
 
     def sub(self, a, b):
-        if isinstance(a, float) and isinstance(b, float):
+        fa, fb = isinstance(a, float), isinstance(b, float)
+        if fa and fb:
             return a - b
-        if isinstance(b, float) and b == 0.0:
+        if fb and b == 0.0:
             return a
-        if isinstance(a, float) and a == 0.0:
+        if fa and a == 0.0:
             return -b
         return a - b
 
     def mul(self, a, b):
-        if isinstance(a, float) and isinstance(b, float):
+        fa = isinstance(a, float)
+        if fa == isinstance(b, float):      # two constants, or two per-sample values
             return a * b
-        if isinstance(b, float):
-            a, b = b, a
-        if isinstance(a, float):
-            if a == 0.0:
-                return 0.0
-            if a == 1.0:
-                return b
-            if a == -1.0:
-                return -b
+        c, v = (a, b) if fa else (b, a)
+        if c == 0.0:
+            return 0.0
+        if c == 1.0:
+            return v
+        if c == -1.0:
+            return -v
         return a * b
 
     def div(self, a, b):
@@ -162,7 +165,10 @@ def as_array(v, n: int) -> np.ndarray:
 
 def stack_vectors(vs, n: int) -> np.ndarray:
     """A k-tuple of :class:`Arrays` values (a 3-vector, a 6-vector wrench) as an (N, k) array."""
-    return np.stack([np.broadcast_to(np.float64(x), (n,)) if isinstance(x, float) else x for x in vs], axis=1)
+    out = np.empty((n, len(vs)))
+    for i, x in enumerate(vs):
+        out[:, i] = x
+    return out
 
 
 def stack_matrices(Ms, n: int) -> np.ndarray:
