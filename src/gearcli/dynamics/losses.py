@@ -95,8 +95,9 @@ def subtract_reducer_drag(an, kin, b: dict) -> None:
         if red.no_load_torque is None:
             continue
         c = an.circuits[ci]
-        f = power_flow_terms(an, ci, relative_rate(an, kin, ci))
-        tq = np.broadcast_to(T.no_load_torque(ARRAYS, f.T0, f.s_w) + 0.0, f.s_w.shape)   # (+0.0: no -0 at rest)
+        a = relative_rate(an, kin, ci)
+        T0 = ARRAYS.interp(ARRAYS.call("fabs", a), _table(red.no_load_torque))
+        tq = np.broadcast_to(ARRAYS.plus_zero(T.no_load_torque(ARRAYS, T0, ARRAYS.sign(a))), a.shape)   # no -0 at rest
         z = np.einsum("nij,j->ni", kin.R[c.carrier], c.zj)
         w = np.concatenate([np.zeros_like(z), tq[:, None] * z], axis=1)
         for L, sign in ((c.j, 1.0), (c.carrier, -1.0)):
