@@ -98,3 +98,51 @@ def test_the_emitter_folds_the_same_cases():
     assert str(e.add(0.0, -0.0)) == str(ARRAYS.add(0.0, -0.0)) == "0.0"
     assert not e.b.block.instructions            # nothing emitted so far
     assert e.mul(2.0, v) is not v and len(e.b.block.instructions) == 1
+
+
+def test_one_sample_terms_equal_the_rows_of_a_batch():
+    """The numpy path evaluates the shared terms of a one-sample call with Python floats
+    (:class:`Floats`) and of N samples with arrays (:class:`Arrays`): the same operations,
+    so the kinematics (Eqs. 2-5), the d'Alembert wrenches (Eqs. 17-18) and the joint-axis
+    wrenches of one sample equal its row of the batch bit for bit (but a zero's sign), on
+    every bundled mechanism, at rest and moving; and a one-sample solve equals its row to
+    rounding (the block solves' LAPACK calls differ with the batch size, as before)."""
+    import dataclasses
+
+    import gearcli
+    from gearcli.dynamics.inertia import inertia_load
+    from gearcli.dynamics.kinematics import forward
+    from gearcli.dynamics.wrenches import joint_axis_wrench
+
+    def same(a, b):
+        return np.array_equal(a, b, equal_nan=True)      # -0.0 == 0.0: the float path does not fold
+
+    rng = np.random.default_rng(7)
+    bits = 0
+    for path in sorted((SRC.parents[1] / "mechanisms").glob("*.yaml")):
+        an = gearcli.analyse(gearcli.load_mechanism(path))
+        J = len(an.mech.joints)
+        q, qd, qdd = (rng.normal(size=(3, J)) for _ in range(3))
+        qd[0], qdd[0], qd[1, 0] = 0.0, 0.0, 0.0          # at rest, and one joint held
+        kin = forward(an.mech, an.tree, q, qd, qdd)
+        b_all = inertia_load(an, kin)
+        for i in range(3):
+            k1 = forward(an.mech, an.tree, q[i:i + 1], qd[i:i + 1], qdd[i:i + 1])
+            assert isinstance(k1.link_terms(an.tree.moving[0])[1][0], float)   # the float path ran
+            for name in ("R", "o", "w", "dw", "a", "Rj", "oj"):
+                for x, y in zip(getattr(kin, name), getattr(k1, name)):
+                    assert x is None or same(y[0], x[i]), (path.name, name, i)
+                    bits += 1
+            for L, b in inertia_load(an, k1).items():
+                assert same(b[0], b_all[L][i]), (path.name, L, i)
+            for ji, jt in enumerate(an.mech.joints):
+                L = an.tree.index[jt.child]
+                assert same(joint_axis_wrench(an, k1, ji, L)[0], joint_axis_wrench(an, kin, ji, L)[i])
+        qi, qdi, qddi = (rng.normal(size=(3, an.dof)) for _ in range(3))
+        batch = gearcli.solve(an, qi, qdi, qddi, backend="numpy")
+        one = gearcli.solve(an, qi[1:2], qdi[1:2], qddi[1:2], backend="numpy")
+        for f in dataclasses.fields(batch):
+            b, o = getattr(batch, f.name), getattr(one, f.name)
+            if isinstance(b, np.ndarray) and b.dtype.kind == "f" and b.ndim >= 1 and b.shape[0] == 3:
+                assert np.allclose(o[0], b[1], rtol=0, atol=1e-13 * max(np.abs(b[1]).max(), 1.0)), f.name
+    assert bits > 1000

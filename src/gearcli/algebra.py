@@ -12,6 +12,9 @@ and is evaluated in two ways, by the same source:
 * :class:`Arrays` (here): a value is a Python ``float`` (a constant of the mechanism) or a
   numpy array over the samples, shape (N,); the numpy reference path calls the term once
   for all N samples;
+* :class:`Floats` (here): one sample, every value a Python ``float`` (a call over one
+  sample, an analysis pose or a ``simulate`` step, would otherwise pay numpy's cost per
+  operation on (1,) arrays); the same operations, nothing folded;
 * :class:`gearcli.dynamics.llvm.build.Emitter`: a value is a ``float`` or an LLVM
   ``double``; the generator calls the term once and gets the instructions of one sample
   (:mod:`gearcli.dynamics.llvm`).
@@ -29,6 +32,7 @@ A 3-vector is a 3-tuple of values, a 3x3 matrix a row-major 9-tuple of values.  
 from __future__ import annotations
 
 import math
+import operator
 
 import numpy as np
 
@@ -81,6 +85,34 @@ class Arrays(Algebra):
 
     def const(self, a):
         return a
+
+    # The composites over per-sample values only (no constant to fold): the primitives'
+    # operations in the same order, without a call per primitive (the one-sample path).
+
+    def dot(self, xs, ys):
+        if not xs or _any_float(xs) or _any_float(ys):
+            return Algebra.dot(self, xs, ys)
+        it = zip(xs, ys)
+        x, y = next(it)
+        s = x * y
+        for x, y in it:
+            s = s + x * y
+        return s
+
+    def vadd(self, a, b):
+        if _any_float(a) or _any_float(b):
+            return Algebra.vadd(self, a, b)
+        return tuple(x + y for x, y in zip(a, b))
+
+    def vsub(self, a, b):
+        if _any_float(a) or _any_float(b):
+            return Algebra.vsub(self, a, b)
+        return tuple(x - y for x, y in zip(a, b))
+
+    def cx(self, a, b):
+        if _any_float(a) or _any_float(b):
+            return Algebra.cx(self, a, b)
+        return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
     def add(self, a, b):
         fa, fb = isinstance(a, float), isinstance(b, float)
@@ -154,8 +186,94 @@ class Arrays(Algebra):
         return np.interp(x, xs, ys)
 
 
+class Floats(Algebra):
+    """The numpy path at one sample: every value a Python float, plain IEEE arithmetic.
+
+    A call over one sample (an analysis pose, a ``simulate`` step) spends its time in the
+    per-operation cost of numpy on (1,) arrays; here an operation is the float's own.  Nothing
+    is folded (a constant and a per-sample value are both floats), so a result equals
+    :class:`Arrays`' at that sample but for the sign of a zero (0.0 * x reads -0.0 for x < 0
+    where the folded product reads 0.0): the operations and their order are the primitives'.
+    sqrt, sin, cos are numpy's (the (N,) path's functions), a division by zero gives inf or
+    nan as numpy's does.
+    """
+
+    add = staticmethod(operator.add)
+    sub = staticmethod(operator.sub)
+    mul = staticmethod(operator.mul)
+    neg = staticmethod(operator.neg)
+
+    def const(self, a):
+        return a
+
+    def div(self, a, b):
+        return a / b if b != 0.0 else float(np.divide(a, b))
+
+    def plus_zero(self, a):
+        return a + 0.0
+
+    def call(self, name: str, a):
+        return abs(a) if name == "fabs" else float(getattr(np, name)(a))
+
+    def sincos(self, q):
+        return float(np.cos(q)), float(np.sin(q))
+
+    def signed(self, v, pos: float, neg: float):
+        return pos if v > 0.0 else neg if v < 0.0 else 0.0
+
+    def interp(self, x, table):
+        return float(Arrays.interp(self, x, table))
+
+    def dot(self, xs, ys):
+        s = 0.0
+        for x, y in zip(xs, ys):
+            s = s + x * y
+        return s
+
+    def vadd(self, a, b):
+        return (a[0] + b[0], a[1] + b[1], a[2] + b[2]) if len(a) == 3 else tuple(map(operator.add, a, b))
+
+    def vsub(self, a, b):
+        return (a[0] - b[0], a[1] - b[1], a[2] - b[2]) if len(a) == 3 else tuple(map(operator.sub, a, b))
+
+    def scale(self, a, s):
+        return tuple(x * s for x in a)
+
+    def cx(self, a, b):
+        return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+    def mv(self, R, v):
+        x, y, z = v
+        return (R[0] * x + R[1] * y + R[2] * z, R[3] * x + R[4] * y + R[5] * z,
+                R[6] * x + R[7] * y + R[8] * z)
+
+    def mtv(self, R, v):
+        x, y, z = v
+        return (R[0] * x + R[3] * y + R[6] * z, R[1] * x + R[4] * y + R[7] * z,
+                R[2] * x + R[5] * y + R[8] * z)
+
+    def mm(self, A, B):
+        return tuple(A[i] * B[j] + A[i + 1] * B[j + 3] + A[i + 2] * B[j + 6]
+                     for i in (0, 3, 6) for j in (0, 1, 2))
+
+
+def algebra_for(n: int):
+    """The algebra of the numpy path for n samples: :data:`FLOATS` at one, else :data:`ARRAYS`."""
+    return FLOATS if n == 1 else ARRAYS
+
+
+def _any_float(vs) -> bool:
+    """Whether a tuple of values holds a constant (a Python float)."""
+    for v in vs:
+        if isinstance(v, float):
+            return True
+    return False
+
+
 ARRAYS = Arrays()
 """The numpy algebra (stateless: one for every caller)."""
+FLOATS = Floats()
+"""The one-sample numpy algebra (stateless)."""
 
 
 def as_array(v, n: int) -> np.ndarray:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..algebra import ARRAYS, matrices, stack_vectors, vectors
+from ..algebra import algebra_for, matrices, stack_vectors, vectors
 from .kinematics import Kinematics, arm_acceleration
 
 
@@ -19,11 +19,11 @@ def inertia_load(an, kin: Kinematics) -> dict[int, np.ndarray]:
     :func:`inertia_wrench` over all samples at once."""
     mech, tree = an.mech, an.tree
     g = vectors(mech.gravity)
-    out = {}
+    out, al = {}, algebra_for(kin.n)
     for L in tree.moving:
         link = mech.bodies[L]          # payloads merged (model.loads.with_payloads)
         R, _, w, dw, a = kin.link_terms(L)
-        W = inertia_wrench(ARRAYS, float(link.mass), matrices(link.inertia), vectors(link.com), R, w, dw, a, g)
+        W = inertia_wrench(al, float(link.mass), matrices(link.inertia), vectors(link.com), R, w, dw, a, g)
         out[L] = stack_vectors(W, kin.n)
     return out
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.mechanism import Mechanism
-from ..algebra import ARRAYS, matrices, stack_matrices, stack_vectors, vectors
+from ..algebra import algebra_for, matrices, stack_matrices, stack_vectors, vectors
 from ..analysis.tree import Tree
 
 
@@ -98,8 +98,8 @@ def forward(mech: Mechanism, tree: Tree, q: np.ndarray, qd: np.ndarray | None = 
     N = q.shape[0]
     qd = np.zeros_like(q) if qd is None else np.atleast_2d(qd)
     qdd = np.zeros_like(q) if qdd is None else np.atleast_2d(qdd)
-    cols = [np.ascontiguousarray(x.T) for x in (q, qd, qdd)]      # per joint a contiguous (N,) row
-    al = ARRAYS
+    al = algebra_for(N)      # one sample: Python floats (the per-operation cost of numpy avoided)
+    cols = [x[0].tolist() if N == 1 else np.ascontiguousarray(x.T) for x in (q, qd, qdd)]  # per joint its (N,) values
     links: dict = {tree.base: (EYE, ZERO3, ZERO3, ZERO3, ZERO3)}  # per link (R, o, w, dw, a)
     frames: dict = {}
     for ji in tree.order:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..algebra import ARRAYS, stack_vectors
+from ..algebra import algebra_for, stack_vectors
 
 
 def unit_joint_wrench(al, z, o_j, o_L, prismatic: bool) -> tuple:
@@ -34,5 +34,5 @@ def joint_axis_wrench(an, kin, ji: int, L: int, sign: float | None = None) -> np
     if sign is None:
         sign = float(an.tree.index[jt.child] == L) - float(an.tree.index[jt.parent] == L)
     z, oj = kin.joint_axis(ji)
-    W = unit_joint_wrench(ARRAYS, z, oj, kin.link_terms(L)[1], jt.type == "prismatic")
+    W = unit_joint_wrench(algebra_for(kin.n), z, oj, kin.link_terms(L)[1], jt.type == "prismatic")
     return sign * stack_vectors(W, kin.n)
