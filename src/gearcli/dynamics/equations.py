@@ -42,12 +42,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.gears import helical_terms
-from ..model.belts import belt_arms, loss_couples
+from ..model.belts import belt_arms
 from ..spatial import cross, mv
 from .kinematics import Kinematics
 from ..algebra import ARRAYS
 from . import loss_terms
-from .losses import mesh_friction_moment, power_flow_terms, relative_rate
+from .losses import loss_couples, mesh_friction_moment, power_flow_terms, relative_rate
 from .wrenches import joint_axis_wrench
 
 
@@ -215,7 +215,7 @@ class Columns:
         """(N, 6) column of a belt's effective pull E on link L (:mod:`gearcli.model.belts`): on
         pulley j +1/2 e_A at X_jA and -1/2 e_B at X_jB, on k the opposites at X_kA, X_kB; a
         lossy belt adds its loss couple on the driven pulley, the carrier taking the reaction
-        (:func:`gearcli.model.belts.loss_couples`)."""
+        (:func:`.losses.loss_couples`)."""
         c, o = self.an.circuits[ci], self.kin.o[L]
         col = np.zeros((self.kin.n, 6))
         for side, link in ((0, c.j), (1, c.k)):

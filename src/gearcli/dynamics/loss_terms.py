@@ -41,7 +41,7 @@ def power_flow_coefficients(al, speed, forward, backward, mode: int = 0) -> tupl
     ``forward``, ``backward`` the (speeds, values) tables of eta_f, eta_b over it.
 
     ``mode`` 0: a reducer's or screw's factor c_r on its torque.  A belt's loss couple is two
-    such elements of one circuit (:func:`gearcli.model.belts.loss_couples`): 1 the couple on
+    such elements of one circuit (:func:`gearcli.dynamics.losses.loss_couples`): 1 the couple on
     the driven pulley k where power flows j -> k, A = -B = (1 - eta_f)/2; 2 the couple on j
     where it flows k -> j, A = B = -(1 - eta_b)/2."""
     if mode == 0:

@@ -38,10 +38,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import loss_terms as T
-from ..algebra import ARRAYS
+from ..algebra import ARRAYS, as_array
 from .wrenches import joint_axis_wrench
 from ..model.worms import worm_force
-from ..model.belts import belt_arms, belt_loss, slack_problem
+from ..model.belts import Belt, belt_arms, slack_problem
 from ..errors import GearcliError
 from ..spatial import cross
 
@@ -149,9 +149,39 @@ def check_belts(an, res) -> None:
             raise SlackError(bad, an.mech.gears[c.gear].name, bt.pretension, abs(float(E[bad])) / 2)
 
 
+def loss_couples(belt: Belt, tj: float, tk: float, rk: float, rate, sigma) -> tuple[np.ndarray, np.ndarray]:
+    """(on j, on k) (N,): a lossy belt's loss couple about z per unit of its effective pull E
+    (the carrier takes the opposite), N*m per N.  ``rate`` (N,) is pulley j's rate relative
+    to the carrier about z (from the joint rates), ``tj``, ``tk`` E's torque arms on j and k
+    (:func:`gearcli.model.belts.belt_arms`), ``sigma`` = sign(E).
+
+    The belt is two power-flow elements of drive rate w = tj omega_j = -tk omega_k (minus the
+    power of E on k per unit E), s_w = sign(w), read at |omega_j| (the kernel's two elements
+    of :mod:`.llvm.loss_program`, the same laws :func:`.loss_terms.power_flow_coefficients`
+    modes 1 and 2 and :func:`.loss_terms.power_flow_delta`): where power flows j -> k
+    (sigma s_w = -1) the driven pulley k gets -tk (1 - eta_f) per unit E, -(1 - eta_f) |E tk|
+    against its rotation; where it flows k -> j (sigma s_w = +1) j gets -tj (1 - eta_b) per
+    unit E; at rest (w = 0) nothing.  ``rk`` (omega_k / omega_j) is not needed here."""
+    al, n = ARRAYS, np.shape(rate)[0]
+    rate, sigma = np.asarray(rate, float), np.asarray(sigma, float)
+    s_w, speed = al.sign(al.mul(float(tj), rate)), al.call("fabs", rate)
+    tables = (belt.forward.speeds, belt.forward.values), (belt.backward.speeds, belt.backward.values)
+    on_k = al.mul(-float(tk), T.power_flow_delta(al, *T.power_flow_coefficients(al, speed, *tables, 1), sigma, s_w))
+    on_j = al.mul(float(tj), T.power_flow_delta(al, *T.power_flow_coefficients(al, speed, *tables, 2), sigma, s_w))
+    return as_array(on_j, n), as_array(on_k, n)
+
+
+def belt_loss(belt: Belt, tj: float, tk: float, rk: float, rate, E) -> np.ndarray:
+    """The power a lossy belt dissipates (N,), W >= 0: minus the power of its loss couples
+    (:func:`loss_couples`) times E, +0 at rest."""
+    rate, E = np.asarray(rate, float), np.asarray(E, float)
+    on_j, on_k = loss_couples(belt, tj, tk, rk, rate, np.sign(E))
+    return -(on_j * rate + on_k * rk * rate) * E + 0.0
+
+
 def fill_belts(an, qd_ind: np.ndarray, res) -> None:
     """A solved ``res``'s belt fields, in place: ``gear_loss`` (a lossy mechanism) the loss of a
-    lossy belt (:func:`gearcli.model.belts.belt_loss`)."""
+    lossy belt (:func:`belt_loss`)."""
     for ci, c in enumerate(an.circuits):
         bt = an.mech.gears[c.gear].belt
         if bt is None:

@@ -129,25 +129,3 @@ def belt_arms(geo: BeltGeometry) -> dict:
     tj = float(z @ (np.cross(geo.X[0, 0] - geo.C_j, 0.5 * geo.e[0]) + np.cross(geo.X[1, 0] - geo.C_j, -0.5 * geo.e[1])))
     tk = float(z @ (np.cross(geo.X[0, 1] - geo.C_k, -0.5 * geo.e[0]) + np.cross(geo.X[1, 1] - geo.C_k, 0.5 * geo.e[1])))
     return {"tj": tj, "tk": tk, "rk": -tj / tk}
-
-
-def loss_couples(belt: Belt, tj: float, tk: float, rk: float, rate, sigma) -> tuple[np.ndarray, np.ndarray]:
-    """(on j, on k) (N,): the loss couple about z per unit E (the carrier takes the opposite).
-    ``rate`` (N,) is pulley j's rate relative to the carrier about z, k's is rk times it; with
-    w = tk omega_k the power of E on k per unit E, power flows j -> k where sigma sign(w) > 0:
-    the driven pulley k gets -(1 - eta_f) |tk| sign(omega_k) sigma (times E: minus its share of
-    |E tk| against its rotation), else j gets -(1 - eta_b) |tj| sign(omega_j) sigma; at rest
-    nothing.  The efficiencies are read at |omega_j|."""
-    rate, sigma = np.asarray(rate, float), np.asarray(sigma, float)
-    wk = rk * rate
-    flow = sigma * np.sign(tk * wk)
-    on_k = np.where(flow > 0, -(1.0 - belt.forward.at(rate)) * abs(tk) * np.sign(wk) * sigma, 0.0)
-    on_j = np.where(flow < 0, -(1.0 - belt.backward.at(rate)) * abs(tj) * np.sign(rate) * sigma, 0.0)
-    return on_j, on_k
-
-
-def belt_loss(belt: Belt, tj: float, tk: float, rk: float, rate, E) -> np.ndarray:
-    """The power the belt dissipates (N,), W >= 0: minus the power of its loss couples."""
-    rate, E = np.asarray(rate, float), np.asarray(E, float)
-    on_j, on_k = loss_couples(belt, tj, tk, rk, rate, np.sign(E))
-    return -(on_j * rate + on_k * rk * rate) * E + 0.0

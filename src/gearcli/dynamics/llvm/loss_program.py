@@ -125,7 +125,7 @@ class ReducerLosses:
     # per element how A, B follow from the efficiencies: 0 a reducer's or screw's factor c_r on
     # its torque; 1 a belt's loss couple on the driven pulley k where power flows j -> k,
     # A = -B = (1 - eta_f)/2; 2 the same on j where it flows k -> j, A = B = -(1 - eta_b)/2
-    # (model.belts.loss_couples; a belt is two elements of one circuit)
+    # (losses.loss_couples; a belt is two elements of one circuit)
     mode: tuple = ()
 
     def parts(self) -> list:
