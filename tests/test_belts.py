@@ -73,13 +73,21 @@ def test_belt_carrying_a_torque_by_hand(backend):
 
 
 def test_the_hand_case_catches_swapped_spans(monkeypatch):
-    """A deliberate bug, the spans swapped in E's column (+E/2 on span B, -E/2 on A): the hand
-    case's tension of span A comes out 50 N, not 150 N."""
-    from gearcli.dynamics.equations import Columns
-    good = Columns._belt
-    monkeypatch.setattr(Columns, "_belt", lambda self, ci, wv, L, sigma: -good(self, ci, wv, L, sigma))
-    c = at_speed(drive(), [1.0])
-    assert not np.allclose(c["gear:belt:tension_a"], 150.0, rtol=1e-6)
+    """A deliberate bug, the spans swapped in E's column terms (+E/2 on span B, -E/2 on A; the
+    terms both paths sum, :mod:`gearcli.dynamics.column_terms`): the hand case's tension of
+    span A comes out 50 N, not 150 N, on either path."""
+    from gearcli.dynamics import column_terms
+    good = column_terms._mesh
+
+    def swapped(an, ci, L, t_pos):
+        cols = good(an, ci, L, t_pos)
+        if an.mech.gears[an.circuits[ci].gear].belt is None:
+            return cols
+        return [[(kind, X, sgn, -coef, d, p) for kind, X, sgn, coef, d, p in terms] for terms in cols]
+    monkeypatch.setattr(column_terms, "_mesh", swapped)
+    for backend in ("numpy", "llvm"):
+        c = at_speed(drive(), [1.0], backend)
+        assert not np.allclose(c["gear:belt:tension_a"], 150.0, rtol=1e-6), backend
 
 
 def test_a_slack_span_is_a_located_error(run_cli, tmp_path):

@@ -175,6 +175,10 @@ def _frame(an, gs, common: set) -> tuple[int | None, dict]:
     return None, {}
 
 
+SNAP = 8 * np.finfo(float).eps
+"""A constant-frame block's home column entry at most this fraction of its column's largest is 0."""
+
+
 def make_plans(an) -> tuple[BlockPlan, ...]:
     """Block plans of ``an.schedule`` (computed once per analysis, owned by the solver)."""
     tree = an.tree
@@ -197,10 +201,15 @@ def make_plans(an) -> tuple[BlockPlan, ...]:
         RF, oF = home.R[F][0], home.o[F][0]
 
         def to_F(col, L):
-            """world column(s) about o_L at home -> F axes about o_F."""
+            """world column(s) about o_L at home -> F axes about o_F, each entry within a few
+            ulps of its column's largest set to an exact 0: a structural zero that the axes'
+            products left at 1e-17 (the column terms turn a joint's axes by R_c R_jc^T) would
+            cost the kernel a multiply per sample where the constant 0 folds away."""
             col = col[0]
             f, m = col[:3], col[3:] + np.cross(home.o[L][0] - oF, col[:3], axis=0)
-            return np.vstack([RF.T @ f, RF.T @ m])
+            out = np.vstack([RF.T @ f, RF.T @ m])
+            out[np.abs(out) <= SNAP * np.abs(out).max(axis=0)] = 0.0
+            return out
 
         Ainv = _constant_matrices(an, blk, gs, offs, signed, to_F, cols)
         C, parent_side = _propagation_columns(an, F, gs, signed, to_F, cols)

@@ -36,41 +36,26 @@ the motors acting on it.  :meth:`Columns.balance` assembles the columns of one l
   B and -ratio times one of joint A, each on the joint's child and reversed on its parent
   (a moment about the axis of a revolute joint, a force along that of a prismatic one);
 * motor with a transmission (Motor.joints): c times a unit generalised force of each joint.
+
+The lossless columns are the terms of :mod:`.column_terms` (each term's wrench
+:func:`~.wrenches.term_wrench`), the same the kernel sums; the losses' additions (a mesh's
+friction couple, a reducer's or screw's delta u of c_r = 1 + delta, a worm's sliding friction,
+a belt's loss couples) are added here, as the kernel's :mod:`.llvm.losses` adds them.
 """
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
-from ..model.gears import helical_terms
 from ..model.belts import belt_arms
 from ..spatial import cross, mv
 from .kinematics import Kinematics
-from ..algebra import ARRAYS
+from ..algebra import ARRAYS, algebra_for, stack_vectors, vectors
 from . import loss_terms
 from .losses import loss_couples, mesh_friction_moment, power_flow_terms, relative_rate
-from .wrenches import joint_axis_wrench
-
-
-def tooth_force_direction(ut: np.ndarray, us: np.ndarray, sigma, tan_phi: float,
-                          axial: np.ndarray | None = None) -> np.ndarray:
-    """Tooth force on gear j per unit of tangential force t (paper Eq. 14, ERRATA 7).
-
-    g_jk = t ut + |t| tan(phi) us = t (ut + sigma tan(phi) us), sigma = sign(t); for a
-    helical pair phi is the transverse pressure angle and the axial thrust t a is added,
-    a = -+tan(beta) z_j for a right-/left-hand gear j
-    (:func:`gearcli.model.gears.helical_terms`).
-
-    Parameters
-    ----------
-    ut : (N, 3) unit tangential direction (turns j in j's positive sense), base frame.
-    us : (N, 3) unit separating direction on j (away from the mesh partner, perpendicular to
-        the pitch element), base frame.
-    sigma : (N,) or scalar, sign of t.
-    tan_phi : tangent of the (transverse) pressure angle.
-    axial : (N, 3) axial thrust per unit of t, base frame (None: spur).
-    """
-    d = ut + (np.asarray(sigma, float).reshape(-1, 1) * tan_phi) * us
-    return d if axial is None else d + axial
+from .column_terms import group_terms
+from .wrenches import term_wrench
 
 
 def _force_at(d: np.ndarray, point: np.ndarray, origin: np.ndarray) -> np.ndarray:
@@ -85,80 +70,44 @@ def _moment(d: np.ndarray) -> np.ndarray:
 class Columns:
     """Wrench columns C_u,L of every unknown u on every link L, base frame, about o_L.
 
-    Built for one chunk of samples from its :class:`~gearcli.dynamics.kinematics.Kinematics`.
+    Built for one chunk of samples from its :class:`~gearcli.dynamics.kinematics.Kinematics`:
+    the terms of :mod:`.column_terms` summed over the samples, and the losses' additions.
     """
 
     def __init__(self, an, kin: Kinematics):
-        self.an, self.kin = an, kin
-        self.tan_phi = {}
-        self.world = {}
+        self.an, self.kin, self.al = an, kin, algebra_for(kin.n)
+        self.world = {}       # per lossy circuit, what its loss additions read (base axes)
         for ci, c in enumerate(an.circuits):
-            Rc, oc = kin.R[c.carrier], kin.o[c.carrier]
             if c.joints is not None:
-                continue  # joint coupling: see axial()
-            bt = an.mech.gears[c.gear].belt
-            if bt is not None:                   # a belt: the spans' tangent points and directions
-                geo = c.belt
-                self.world[ci] = dict(belt=bt, X=[[oc + mv(Rc, geo.X[s, p]) for p in (0, 1)] for s in (0, 1)],
-                                      es=[mv(Rc, geo.e[s]) for s in (0, 1)], z=mv(Rc, geo.z))
-                if bt.lossy:
-                    self.world[ci].update(rate=relative_rate(an, kin, ci), **belt_arms(geo))
                 continue
-            wm = an.mech.gears[c.gear].worm
-            if wm is not None:                   # a worm pair: the flank load's directions at P
-                geo = c.worm
-                self.world[ci] = dict(P=oc + mv(Rc, geo.P), e=mv(Rc, geo.e_hat), n=mv(Rc, geo.n_c),
-                                      hh=mv(Rc, geo.h_hat), worm=wm,
-                                      sv=np.sign(relative_rate(an, kin, ci)) if wm.mu else None)
-                continue
-            sc = an.mech.gears[c.gear].screw
-            if sc is not None:                   # the axis u = z_S through a point P on it
-                self.world[ci] = dict(u=mv(Rc, c.zj), P=oc + mv(Rc, c.axis_point), h=sc.h)
-                if sc.power_flow_lossy:
-                    self.world[ci].update(flow=power_flow_terms(an, ci, relative_rate(an, kin, ci)))
-                continue
-            if c.geometry is not None:
-                gm, gp = c.geometry, an.mech.gears[c.gear]
-                tan_t, a = helical_terms(gm, gp.pressure_angle, gp.helix_angle, gp.hand)
-                self.world[ci] = dict(P=oc + mv(Rc, gm.P), ut=mv(Rc, gm.ut), us=mv(Rc, gm.us),
-                                      ax=mv(Rc, a) if gp.helix_angle else None)
-                self.tan_phi[ci] = tan_t
-                fr = mesh_friction_moment(an, ci)
-                if fr is not None:     # friction couple on j per unit sigma s_v t, and s_v
-                    self.world[ci].update(fr=mv(Rc, fr), sv=np.sign(relative_rate(an, kin, ci)))
-            else:
-                self.world[ci] = dict(zj=mv(Rc, c.zj), zk=mv(Rc, c.zk))
-                red = an.mech.gears[c.gear].reducer
-                if red is not None and red.power_flow_lossy:   # the input's rate a, for c_r
-                    self.world[ci].update(flow=power_flow_terms(an, ci, relative_rate(an, kin, ci)))
+            Rc, gp = kin.R[c.carrier], an.mech.gears[c.gear]
+            if gp.belt is not None and gp.belt.lossy:        # the loss couples about z
+                self.world[ci] = dict(belt=gp.belt, z=mv(Rc, c.belt.z), rate=relative_rate(an, kin, ci),
+                                      **belt_arms(c.belt))
+            elif gp.worm is not None and gp.worm.mu:         # the sliding friction along h at P
+                self.world[ci] = dict(P=kin.o[c.carrier] + mv(Rc, c.worm.P), hh=mv(Rc, c.worm.h_hat),
+                                      mu=gp.worm.mu, sv=np.sign(relative_rate(an, kin, ci)))
+            elif (gp.screw or gp.reducer) is not None and (gp.screw or gp.reducer).power_flow_lossy:
+                self.world[ci] = dict(z=mv(Rc, c.zj), flow=power_flow_terms(an, ci, relative_rate(an, kin, ci)),
+                                      sides=_power_flow_sides(c, gp))
+            elif c.geometry is not None and (fr := mesh_friction_moment(an, ci)) is not None:
+                self.world[ci] = dict(fr=mv(Rc, fr), sv=np.sign(relative_rate(an, kin, ci)))
 
-    def joint(self, ji: int, L: int) -> np.ndarray:
-        """(N, 6, 5) columns of joint ``ji``'s reaction on link L."""
-        an, kin = self.an, self.kin
-        jt = an.mech.joints[ji]
-        sign = 1.0 if an.tree.index[jt.child] == L else -1.0
-        E = kin.Rj[ji]
-        o, oj = kin.o[L], kin.oj[ji]
-        if jt.type == "prismatic":
-            cols = [_force_at(E[:, :, 0], oj, o), _force_at(E[:, :, 1], oj, o),
-                    _moment(E[:, :, 0]), _moment(E[:, :, 1]), _moment(E[:, :, 2])]
-        else:
-            cols = [_force_at(E[:, :, i], oj, o) for i in range(3)] + [_moment(E[:, :, 0]), _moment(E[:, :, 1])]
-        return sign * np.stack(cols, axis=2)
-
-    def axial(self, ji: int, L: int, sign: float | None = None) -> np.ndarray:
-        """(N, 6) wrench on link L of a unit generalised force of joint ``ji``: about its axis
-        (revolute) or along it through the joint origin (prismatic), on the child, reversed
-        on the parent, zero on any other link (``sign``: +-1 on L instead, a motor's)."""
-        return joint_axis_wrench(self.an, self.kin, ji, L, sign)
-
-    def motor(self, mi: int, L: int) -> np.ndarray:
-        """(N, 6, 1) column of motor ``mi``'s torque on link L: about the input link's joint axis on the input link, reversed on the stator (a transmission motor: its joints' generalised forces)."""
-        an = self.an
-        if an.motor_joints and an.motor_joints[mi] is not None:
-            return sum(coef * self.axial(ji, L) for ji, coef in an.motor_joints[mi])[:, :, None]
-        x = an.motor_links[mi]
-        return self.axial(an.tree.parent_joint[x], L, 1.0 if L == x else -1.0)[:, :, None]
+    def terms(self, g, L: int, sigma=1.0) -> np.ndarray:
+        """(N, 6, g.size) the lossless columns of group ``g`` on link L: the sum of its
+        :func:`~.column_terms.group_terms` (a signed term times ``sigma``, (N,) or a float)."""
+        al, kin, n = self.al, self.kin, self.kin.n
+        o_L = kin.link_terms(L)[1]
+        sigma = sigma if isinstance(sigma, float) else np.broadcast_to(np.asarray(sigma, float), (n,))
+        cols = _terms_of(self.an, g, L)
+        out = np.empty((n, 6, len(cols)))
+        for j, terms in enumerate(cols):
+            W = (0.0,) * 6
+            for moment, X, signed, coef, d, p in terms:
+                R_X, o_X = kin.link_terms(X)[:2]
+                W = al.vadd(W, term_wrench(al, moment, al.mul(coef, sigma) if signed else coef, d, p, R_X, o_X, o_L))
+            out[:, :, j] = stack_vectors(W, n)
+        return out
 
     def mesh_friction(self, ci: int, L: int) -> np.ndarray | None:
         """(N, 6, 1) friction couple of geared mesh ``ci`` on link L per unit of sigma s_v t
@@ -169,76 +118,33 @@ class Columns:
         sign = 1.0 if L == self.an.circuits[ci].j else -1.0
         return sign * _moment(wv["fr"])[:, :, None]
 
-    def mesh(self, ci: int, L: int, sigma) -> np.ndarray:
-        """(N, 6, 1) column of mesh unknown ``ci`` on link L; ``sigma`` = sign(t), (N,) or
-        scalar.  A lossy mesh adds its friction couple sigma s_v (:meth:`mesh_friction`)."""
-        c = self.an.circuits[ci]
-        if c.joints is not None:
-            b, a = c.joints
-            return (self.axial(b, L) - c.ratio * self.axial(a, L))[:, :, None]
-        wv = self.world[ci]
-        o = self.kin.o[L]
-        if "belt" in wv:              # +E/2 on span A, -E/2 on span B: on j along e_S, on k against
-            return self._belt(ci, wv, L, sigma)[:, :, None]
-        if "worm" in wv:              # the force on the wheel per unit N, minus on the worm (model.worms)
-            wm, sg = wv["worm"], np.asarray(sigma, float).reshape(-1, 1)
-            d = np.cos(wm.pressure_angle) * wv["e"] + sg * (np.sin(wm.pressure_angle) * wv["n"])
-            if wv["sv"] is not None:
-                d = d + (sg * wv["sv"][:, None] * wm.mu) * wv["hh"]
-            return ((float(L == c.k) - float(L == c.j)) * _force_at(d, wv["P"], o))[:, :, None]
-        if "h" in wv:                 # a screw: F u through P and the torque h c_r F u on the nut, minus on the screw
-            cr = 1.0 if "flow" not in wv else _power_flow_factor(wv["flow"], sigma)
-            col = _force_at(wv["u"], wv["P"], o)
-            col[:, 3:] += (wv["h"] * cr) * wv["u"]
-            return ((float(L == c.k) - float(L == c.j)) * col)[:, :, None]
-        if c.geometry is not None:
-            sign = 1.0 if L == c.j else -1.0
-            d = tooth_force_direction(wv["ut"], wv["us"], sigma, self.tan_phi[ci], wv["ax"])
-            col = sign * _force_at(d, wv["P"], o)
-            if "fr" in wv:
-                sv = np.asarray(sigma, float).reshape(-1, 1) * wv["sv"][:, None]
-                col[:, 3:] += sign * sv * wv["fr"]
-            return col[:, :, None]
-        cr = 1.0        # a lossy reducer's power-flow factor c_r (model.reducers), (N, 1)
-        if "flow" in wv:
-            cr = _power_flow_factor(wv["flow"], sigma)
-        col = 0.0
-        if L == c.j:
-            col = col + cr * _moment(wv["zj"])
-        if L == c.k:
-            col = col - c.ratio * _moment(wv["zk"])
-        if L == c.carrier:
-            col = col - cr * _moment(wv["zj"]) + c.ratio * _moment(wv["zk"])
-        return col[:, :, None]
-
-    def _belt(self, ci: int, wv: dict, L: int, sigma) -> np.ndarray:
-        """(N, 6) column of a belt's effective pull E on link L (:mod:`gearcli.model.belts`): on
-        pulley j +1/2 e_A at X_jA and -1/2 e_B at X_jB, on k the opposites at X_kA, X_kB; a
-        lossy belt adds its loss couple on the driven pulley, the carrier taking the reaction
-        (:func:`.losses.loss_couples`)."""
-        c, o = self.an.circuits[ci], self.kin.o[L]
-        col = np.zeros((self.kin.n, 6))
-        for side, link in ((0, c.j), (1, c.k)):
-            if L == link:
-                sign = 1.0 if side == 0 else -1.0
-                col += sign * (0.5 * _force_at(wv["es"][0], wv["X"][0][side], o) - 0.5 * _force_at(wv["es"][1], wv["X"][1][side], o))
-        if "rate" in wv:
-            on_j, on_k = loss_couples(wv["belt"], wv["tj"], wv["tk"], wv["rk"], wv["rate"],
-                                      np.broadcast_to(np.asarray(sigma, float), wv["rate"].shape))
-            for link, cp in ((c.j, on_j), (c.k, on_k)):
-                if L == link:
-                    col[:, 3:] += cp[:, None] * wv["z"]
-                if L == c.carrier:
-                    col[:, 3:] -= cp[:, None] * wv["z"]
+    def group(self, g, L: int, sigma=1.0) -> np.ndarray:
+        """(N, 6, g.size) columns of unknown group ``g`` on link L (sigma: sign of t), the
+        losses' additions included."""
+        col = self.terms(g, L, sigma)
+        wv = self.world.get(g.index) if g.kind == "mesh" else None
+        if wv is not None:
+            col[:, :, 0] += self._loss(self.an.circuits[g.index], wv, L, sigma)
         return col
 
-    def group(self, g, L: int, sigma=1.0) -> np.ndarray:
-        """(N, 6, g.size) columns of unknown group ``g`` on link L (sigma: sign of t)."""
-        if g.kind == "joint":
-            return self.joint(g.index, L)
-        if g.kind == "motor":
-            return self.motor(g.index, L)
-        return self.mesh(g.index, L, sigma)
+    def _loss(self, c, wv: dict, L: int, sigma) -> np.ndarray | float:
+        """(N, 6) the loss addition of lossy circuit c on link L per unit of its unknown."""
+        sg = np.asarray(sigma, float).reshape(-1, 1)
+        if "fr" in wv:                    # the friction couple sigma s_v fr on j, minus on k
+            sign = float(L == c.j) - float(L == c.k)
+            return _moment(sign * sg * wv["sv"][:, None] * wv["fr"])
+        if "mu" in wv:                    # sigma s_v mu h at P on the wheel, minus on the worm
+            d = (sg * wv["sv"][:, None] * wv["mu"]) * wv["hh"]
+            return (float(L == c.k) - float(L == c.j)) * _force_at(d, wv["P"], self.kin.o[L])
+        if "flow" in wv:                  # delta coef z on the element's sides (c_r = 1 + delta)
+            coef = sum(k for link, k in wv["sides"] if link == L)
+            f = wv["flow"]
+            delta = np.broadcast_to(loss_terms.power_flow_delta(ARRAYS, f.A, f.B, sigma, f.s_w), f.s_w.shape)
+            return _moment((coef * delta)[:, None] * wv["z"])
+        on_j, on_k = loss_couples(wv["belt"], wv["tj"], wv["tk"], wv["rk"], wv["rate"],
+                                  np.broadcast_to(np.asarray(sigma, float), wv["rate"].shape))
+        cp = (float(L == c.j) - float(L == c.carrier)) * on_j + (float(L == c.k) - float(L == c.carrier)) * on_k
+        return _moment(cp[:, None] * wv["z"])
 
     def balance(self, groups, L: int, out: np.ndarray) -> None:
         """Left-hand side of link L's balance (Eqs. 15-16 primary, 19-20 secondary), every t
@@ -251,8 +157,27 @@ class Columns:
             c0 += g.size
 
 
-def _power_flow_factor(f, sigma) -> np.ndarray:
-    """(N, 1) c_r = 1 + delta of a power-flow element's terms ``f``
-    (:func:`.losses.power_flow_terms`) for the sign pattern sigma (a float or (N,))."""
-    delta = loss_terms.power_flow_delta(ARRAYS, f.A, f.B, sigma, f.s_w)
-    return (1.0 + np.broadcast_to(delta, f.s_w.shape))[:, None]
+def _terms_of(an, g, L: int) -> list:
+    """:func:`~.column_terms.group_terms` of unknown group ``g`` on link L, per column
+    [(moment, X, signed, coef, d_X, p_X)] with floats and 3-tuples: made once per analysis
+    (and again if its mechanism or circuits are replaced)."""
+    made_of, cache = _TERMS.get(an, (None, None))
+    if made_of != (id(an.mech), id(an.circuits)):       # (an analysis whose parts were replaced)
+        cache = {}
+        _TERMS[an] = ((id(an.mech), id(an.circuits)), cache)
+    if (g.kind, g.index, L) not in cache:
+        cache[g.kind, g.index, L] = [[(m == 1, X, s >= 0, float(c), vectors(d), vectors(p)) for m, X, s, c, d, p in terms]
+                                 for terms in group_terms(an, g, L, 0)]
+    return cache[g.kind, g.index, L]
+
+
+_TERMS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def _power_flow_sides(c, gp) -> tuple:
+    """((link, coef), ...): where a lossy reducer's or screw's delta u acts, as a moment coef
+    delta u z (z its axis): a reducer's on its input (+1) and housing (-1), a screw's torque
+    h u on the nut (+h) and the screw (-h) (the kernel's ``ReducerLosses.sides``)."""
+    if gp.reducer is not None:
+        return ((c.j, 1.0), (c.carrier, -1.0))
+    return ((c.j, -gp.screw.h), (c.k, gp.screw.h))

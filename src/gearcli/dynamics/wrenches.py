@@ -20,6 +20,18 @@ def unit_joint_wrench(al, z, o_j, o_L, prismatic: bool) -> tuple:
     return (0.0, 0.0, 0.0) + tuple(z)
 
 
+def term_wrench(al, moment: bool, coef, d_X, p_X, R_X, o_X, o_L) -> tuple:
+    """The wrench on L of one column term per unit of its unknown (:mod:`.column_terms`): a
+    moment coef d, [0 ; coef d], or a force coef d through P, [coef d ; (P - o_L) x coef d]
+    as (P - o_L) x d times coef, with d = R_X d_X and P = o_X + R_X p_X given in the axes of
+    link X (``R_X``, ``o_X`` its orientation and origin, base frame)."""
+    d = al.mv(R_X, d_X)
+    if moment:
+        return (0.0, 0.0, 0.0) + al.scale(d, coef)
+    arm = al.vsub(al.vadd(o_X, al.mv(R_X, p_X)), o_L)
+    return al.scale(d, coef) + al.scale(al.cx(arm, d), coef)
+
+
 def load_wrench(al, f, m, arm) -> tuple:
     """The wrench about o_L of a force f and moment m applied at the point o_L + arm (base
     axes): [f ; m + arm x f]."""

@@ -20,6 +20,7 @@ from .build import I64, Emitter
 from .links import Sample, floats
 from .signs import SignedBlock, resolve, signs_of, tolerance
 from .world import LowRankBlock, WorldBlock
+from ..wrenches import term_wrench as wrench_of_term
 
 
 def gather(e: Emitter, s: Sample, F: int, links) -> list:
@@ -75,12 +76,7 @@ def term_wrench(e: Emitter, s: Sample, term, value, L: int, sig: list):
     coef = float(value.coef)
     if term.sign >= 0:
         coef = e.mul(coef, sig[int(term.sign)])
-    d = e.mv(s.R[X], floats(value.d))
-    if term.moment == 1:
-        return (0.0, 0.0, 0.0) + e.scale(d, coef)
-    P = e.mv(s.R[X], floats(value.p))
-    arm = e.vsub(e.vadd(s.o[X], P), s.o[L])
-    return e.scale(d, coef) + e.scale(e.cx(arm, d), coef)
+    return wrench_of_term(e, term.moment == 1, coef, floats(value.d), floats(value.p), s.R[X], s.o[X], s.o[L])
 
 
 def propagate_terms(e: Emitter, s: Sample, k0: int, nt: int, prog, x: list, sig: list) -> None:
