@@ -200,8 +200,8 @@ MUTATIONS = [
              (("dynamics/llvm/blocks.py", "1.0 if L == P else -1.0", "1.0"),)),
     Mutation("llvm-child-basis-turn", "llvm: joint reaction turned to the child's basis by +q instead of -q",
              (("dynamics/llvm/blocks.py", "e.add(e.mul(cq, x0), e.mul(sq, x1))", "e.sub(e.mul(cq, x0), e.mul(sq, x1))"),)),
-    Mutation("term-arm", "column term's moment arm from the frame link's origin (the shared term: both paths)",
-             (("dynamics/wrenches.py", "arm = al.vsub(al.vadd(o_X, al.mv(R_X, p_X)), o_L)", "arm = al.mv(R_X, p_X)"),)),
+    Mutation("term-point", "column term's point without its frame link's origin (the shared term: both paths)",
+             (("dynamics/wrenches.py", "return al.vadd(o_X, al.mv(R_X, p_X))", "return al.mv(R_X, p_X)"),)),
     # issue 19: losses in the generated kernel
     Mutation("llvm-loss-couple-sign", "llvm: constant-frame block, mesh friction couple with the rate instead of against it",
              (("dynamics/llvm/losses.py", "return [e.mul(sig[i], sv) for", "return [e.mul(e.neg(sig[i]), sv) for"),)),

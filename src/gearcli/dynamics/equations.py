@@ -51,11 +51,11 @@ import numpy as np
 from ..model.belts import belt_arms
 from ..spatial import cross, mv
 from .kinematics import Kinematics
-from ..algebra import ARRAYS, algebra_for, stack_vectors, vectors
+from ..algebra import ARRAYS, algebra_for, vectors
 from . import loss_terms
 from .losses import loss_couples, mesh_friction_moment, power_flow_terms, relative_rate
 from .column_terms import group_terms
-from .wrenches import term_wrench
+from .wrenches import term_direction, term_point, term_wrench
 
 
 def _force_at(d: np.ndarray, point: np.ndarray, origin: np.ndarray) -> np.ndarray:
@@ -76,6 +76,7 @@ class Columns:
 
     def __init__(self, an, kin: Kinematics):
         self.an, self.kin, self.al = an, kin, algebra_for(kin.n)
+        self._axes = {}       # (X, d_X): a term direction d, (X, p_X, None): a term point P (base frame)
         self.world = {}       # per lossy circuit, what its loss additions read (base axes)
         for ci, c in enumerate(an.circuits):
             if c.joints is not None:
@@ -101,12 +102,18 @@ class Columns:
         sigma = sigma if isinstance(sigma, float) else np.broadcast_to(np.asarray(sigma, float), (n,))
         cols = _terms_of(self.an, g, L)
         out = np.empty((n, 6, len(cols)))
+        axes = self._axes
         for j, terms in enumerate(cols):
             W = (0.0,) * 6
             for moment, X, signed, coef, d, p in terms:
-                R_X, o_X = kin.link_terms(X)[:2]
-                W = al.vadd(W, term_wrench(al, moment, al.mul(coef, sigma) if signed else coef, d, p, R_X, o_X, o_L))
-            out[:, :, j] = stack_vectors(W, n)
+                if (X, d) not in axes:          # (a joint's columns share its point, a mesh's too)
+                    axes[X, d] = term_direction(al, d, kin.link_terms(X)[0])
+                if not moment and (X, p, None) not in axes:
+                    axes[X, p, None] = term_point(al, p, *kin.link_terms(X)[:2])
+                W = al.vadd(W, term_wrench(al, moment, al.mul(coef, sigma) if signed else coef, axes[X, d],
+                                           None if moment else axes[X, p, None], o_L))
+            for h, v in enumerate(W):       # (a constant broadcast)
+                out[:, h, j] = v
         return out
 
     def mesh_friction(self, ci: int, L: int) -> np.ndarray | None:

@@ -20,15 +20,24 @@ def unit_joint_wrench(al, z, o_j, o_L, prismatic: bool) -> tuple:
     return (0.0, 0.0, 0.0) + tuple(z)
 
 
-def term_wrench(al, moment: bool, coef, d_X, p_X, R_X, o_X, o_L) -> tuple:
+def term_direction(al, d_X, R_X) -> tuple:
+    """A column term's direction d = R_X d_X in base axes (d_X given in link X's axes)."""
+    return al.mv(R_X, d_X)
+
+
+def term_point(al, p_X, R_X, o_X) -> tuple:
+    """A column term's point P = o_X + R_X p_X in the base frame (p_X given in link X's frame,
+    ``R_X``, ``o_X`` its orientation and origin)."""
+    return al.vadd(o_X, al.mv(R_X, p_X))
+
+
+def term_wrench(al, moment: bool, coef, d, P, o_L) -> tuple:
     """The wrench on L of one column term per unit of its unknown (:mod:`.column_terms`): a
-    moment coef d, [0 ; coef d], or a force coef d through P, [coef d ; (P - o_L) x coef d]
-    as (P - o_L) x d times coef, with d = R_X d_X and P = o_X + R_X p_X given in the axes of
-    link X (``R_X``, ``o_X`` its orientation and origin, base frame)."""
-    d = al.mv(R_X, d_X)
+    moment coef d, [0 ; coef d], or a force coef d through P, [coef d ; coef (P - o_L) x d]
+    (d, P from :func:`term_direction`, :func:`term_point`; ``P`` unused for a moment)."""
     if moment:
         return (0.0, 0.0, 0.0) + al.scale(d, coef)
-    arm = al.vsub(al.vadd(o_X, al.mv(R_X, p_X)), o_L)
+    arm = al.vsub(P, o_L)
     return al.scale(d, coef) + al.scale(al.cx(arm, d), coef)
 
 

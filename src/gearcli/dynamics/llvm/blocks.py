@@ -20,7 +20,7 @@ from .build import I64, Emitter
 from .links import Sample, floats
 from .signs import SignedBlock, resolve, signs_of, tolerance
 from .world import LowRankBlock, WorldBlock
-from ..wrenches import term_wrench as wrench_of_term
+from ..wrenches import term_direction, term_point, term_wrench as wrench_of_term
 
 
 def gather(e: Emitter, s: Sample, F: int, links) -> list:
@@ -76,7 +76,9 @@ def term_wrench(e: Emitter, s: Sample, term, value, L: int, sig: list):
     coef = float(value.coef)
     if term.sign >= 0:
         coef = e.mul(coef, sig[int(term.sign)])
-    return wrench_of_term(e, term.moment == 1, coef, floats(value.d), floats(value.p), s.R[X], s.o[X], s.o[L])
+    d = term_direction(e, floats(value.d), s.R[X])
+    P = None if term.moment == 1 else term_point(e, floats(value.p), s.R[X], s.o[X])
+    return wrench_of_term(e, term.moment == 1, coef, d, P, s.o[L])
 
 
 def propagate_terms(e: Emitter, s: Sample, k0: int, nt: int, prog, x: list, sig: list) -> None:
