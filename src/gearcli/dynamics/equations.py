@@ -88,7 +88,7 @@ class Columns:
             elif gp.worm is not None and gp.worm.mu:         # the sliding friction along h at P
                 self.world[ci] = dict(P=kin.o[c.carrier] + mv(Rc, c.worm.P), hh=mv(Rc, c.worm.h_hat),
                                       mu=gp.worm.mu, sv=np.sign(relative_rate(an, kin, ci)))
-            elif (gp.screw or gp.reducer) is not None and (gp.screw or gp.reducer).power_flow_lossy:
+            elif any(el is not None and el.power_flow_lossy for el in (gp.screw, gp.reducer)):
                 self.world[ci] = dict(z=mv(Rc, c.zj), flow=power_flow_terms(an, ci, relative_rate(an, kin, ci)),
                                       sides=_power_flow_sides(c, gp))
             elif c.geometry is not None and (fr := mesh_friction_moment(an, ci)) is not None:

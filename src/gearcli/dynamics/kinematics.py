@@ -50,7 +50,8 @@ class Kinematics:
 
     def link_terms(self, L: int) -> tuple:
         """Link L's (R, o, w, dw, a) as values of :class:`gearcli.algebra.Arrays` (a 9-tuple and
-        3-tuples: floats where constant, else (N,) arrays), for the shared physics terms."""
+        3-tuples: floats where constant, else (N,) arrays; at one sample every value a float,
+        :class:`gearcli.algebra.Floats`), for the shared physics terms."""
         if self.terms is not None and L in self.terms:
             return self.terms[L]
         return (matrices(self.R[L]),) + tuple(vectors(x) for x in (self.o[L], self.w[L], self.dw[L], self.a[L]))
