@@ -53,7 +53,7 @@ from ..spatial import cross, mv
 from .kinematics import Kinematics
 from ..algebra import ARRAYS, algebra_for, vectors
 from . import loss_terms
-from .losses import loss_couples, mesh_friction_moment, power_flow_terms, relative_rate
+from .losses import loss_couples, mesh_friction_moment, power_flow_sides, power_flow_terms, relative_rate
 from .column_terms import group_terms
 from .wrenches import term_direction, term_point, term_wrench
 
@@ -90,7 +90,7 @@ class Columns:
                                       mu=gp.worm.mu, sv=np.sign(relative_rate(an, kin, ci)))
             elif any(el is not None and el.power_flow_lossy for el in (gp.screw, gp.reducer)):
                 self.world[ci] = dict(z=mv(Rc, c.zj), flow=power_flow_terms(an, ci, relative_rate(an, kin, ci)),
-                                      sides=_power_flow_sides(c, gp))
+                                      sides=power_flow_sides(c, gp))
             elif c.geometry is not None and (fr := mesh_friction_moment(an, ci)) is not None:
                 self.world[ci] = dict(fr=mv(Rc, fr), sv=np.sign(relative_rate(an, kin, ci)))
 
@@ -148,7 +148,7 @@ class Columns:
             f = wv["flow"]
             delta = np.broadcast_to(loss_terms.power_flow_delta(ARRAYS, f.A, f.B, sigma, f.s_w), f.s_w.shape)
             return _moment((coef * delta)[:, None] * wv["z"])
-        on_j, on_k = loss_couples(wv["belt"], wv["tj"], wv["tk"], wv["rk"], wv["rate"],
+        on_j, on_k = loss_couples(wv["belt"], wv["tj"], wv["tk"], wv["rate"],
                                   np.broadcast_to(np.asarray(sigma, float), wv["rate"].shape))
         cp = (float(L == c.j) - float(L == c.carrier)) * on_j + (float(L == c.k) - float(L == c.carrier)) * on_k
         return _moment(cp[:, None] * wv["z"])
@@ -179,12 +179,3 @@ def _terms_of(an, g, L: int) -> list:
 
 
 _TERMS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-
-
-def _power_flow_sides(c, gp) -> tuple:
-    """((link, coef), ...): where a lossy reducer's or screw's delta u acts, as a moment coef
-    delta u z (z its axis): a reducer's on its input (+1) and housing (-1), a screw's torque
-    h u on the nut (+h) and the screw (-h) (the kernel's ``ReducerLosses.sides``)."""
-    if gp.reducer is not None:
-        return ((c.j, 1.0), (c.carrier, -1.0))
-    return ((c.j, -gp.screw.h), (c.k, gp.screw.h))

@@ -149,7 +149,7 @@ def check_belts(an, res) -> None:
             raise SlackError(bad, an.mech.gears[c.gear].name, bt.pretension, abs(float(E[bad])) / 2)
 
 
-def loss_couples(belt: Belt, tj: float, tk: float, rk: float, rate, sigma) -> tuple[np.ndarray, np.ndarray]:
+def loss_couples(belt: Belt, tj: float, tk: float, rate, sigma) -> tuple[np.ndarray, np.ndarray]:
     """(on j, on k) (N,): a lossy belt's loss couple about z per unit of its effective pull E
     (the carrier takes the opposite), N*m per N.  ``rate`` (N,) is pulley j's rate relative
     to the carrier about z (from the joint rates), ``tj``, ``tk`` E's torque arms on j and k
@@ -161,11 +161,11 @@ def loss_couples(belt: Belt, tj: float, tk: float, rk: float, rate, sigma) -> tu
     modes 1 and 2 and :func:`.loss_terms.power_flow_delta`): where power flows j -> k
     (sigma s_w = -1) the driven pulley k gets -tk (1 - eta_f) per unit E, -(1 - eta_f) |E tk|
     against its rotation; where it flows k -> j (sigma s_w = +1) j gets -tj (1 - eta_b) per
-    unit E; at rest (w = 0) nothing.  ``rk`` (omega_k / omega_j) is not needed here."""
+    unit E; at rest (w = 0) nothing."""
     al, n = ARRAYS, np.shape(rate)[0]
     rate, sigma = np.asarray(rate, float), np.asarray(sigma, float)
     s_w, speed = al.sign(al.mul(float(tj), rate)), al.call("fabs", rate)
-    tables = (belt.forward.speeds, belt.forward.values), (belt.backward.speeds, belt.backward.values)
+    tables = _table(belt.forward), _table(belt.backward)
     on_k = al.mul(-float(tk), T.power_flow_delta(al, *T.power_flow_coefficients(al, speed, *tables, 1), sigma, s_w))
     on_j = al.mul(float(tj), T.power_flow_delta(al, *T.power_flow_coefficients(al, speed, *tables, 2), sigma, s_w))
     return as_array(on_j, n), as_array(on_k, n)
@@ -175,8 +175,18 @@ def belt_loss(belt: Belt, tj: float, tk: float, rk: float, rate, E) -> np.ndarra
     """The power a lossy belt dissipates (N,), W >= 0: minus the power of its loss couples
     (:func:`loss_couples`) times E, +0 at rest."""
     rate, E = np.asarray(rate, float), np.asarray(E, float)
-    on_j, on_k = loss_couples(belt, tj, tk, rk, rate, np.sign(E))
+    on_j, on_k = loss_couples(belt, tj, tk, rate, np.sign(E))
     return -(on_j * rate + on_k * rk * rate) * E + 0.0
+
+
+def power_flow_sides(c, gp) -> tuple:
+    """((link, coef), ...): where a lossy reducer's or screw's power-flow change delta u acts,
+    as a moment coef delta u z about its axis z: a reducer's on its input (+1) and housing
+    (-1), a screw's torque h u on the screw (-h) and the nut (+h) (circuit ``c`` of gear pair
+    ``gp``; both paths' columns: :class:`.equations.Columns`, :mod:`.llvm.loss_program`)."""
+    if gp.reducer is not None:
+        return ((c.j, 1.0), (c.carrier, -1.0))
+    return ((c.j, -gp.screw.h), (c.k, gp.screw.h))
 
 
 def fill_belts(an, qd_ind: np.ndarray, res) -> None:

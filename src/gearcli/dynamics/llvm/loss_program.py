@@ -35,7 +35,7 @@ import numpy as np
 from ..bearing_friction import bearing_layout, friction_joints
 from ..blocks import primary_side
 from ..kinematics import forward
-from ..losses import mesh_friction_moment
+from ..losses import mesh_friction_moment, power_flow_sides
 from ..pattern_maps import PatternMaps
 from ...model.belts import belt_arms
 from ...model.friction import JointFriction
@@ -335,7 +335,7 @@ def _reducer_losses(an) -> ReducerLosses | None:
             modes = (1, 2)
         else:
             k = 1.0 if gp.reducer is not None else -gp.screw.h       # w = k a
-            parts = (((c.j, 1.0), (c.carrier, -1.0)) if gp.reducer is not None else ((c.j, -gp.screw.h), (c.k, gp.screw.h)),)
+            parts = (power_flow_sides(c, gp),)
             modes = (0,)
         for coefs, m in zip(parts, modes):
             circ.append(ci)
