@@ -89,6 +89,12 @@ q6, qd6, qdd6 = off + amp * np.sin(arg), amp * freq * np.cos(arg), -amp * freq**
 np.savetxt("mechanisms/cobot_6axis_traj.csv", np.column_stack([t6, q6, qd6, qdd6, np.ones_like(t6)]), delimiter=",",
            header=",".join(["t"] + [f"{p}:J{i}" for p in ("q", "qd", "qdd") for i in range(1, 7)] + ["attach:part"]),
            comments="", fmt="%.17g")
+# the same cycle at 250 Hz (every 4th sample) for designs/cobot_6axis_select.yaml: select
+# verifies a design per candidate part, and the peaks and means of this smooth motion move
+# by less than 0.1 % at the coarser rate
+np.savetxt("mechanisms/cobot_6axis_traj_250hz.csv", np.column_stack([t6, q6, qd6, qdd6, np.ones_like(t6)])[::4],
+           delimiter=",", header=",".join(["t"] + [f"{p}:J{i}" for p in ("q", "qd", "qdd") for i in range(1, 7)]
+                                          + ["attach:part"]), comments="", fmt="%.17g")
 
 # rv_turret: the first axis J1 (rad) swinging -90 -> +90 deg in 1.5 s, dwelling 0.5 s, and back:
 # a 4 s cycle (3.93 rad/s at most at the output: 4540 rpm at the RV input)

@@ -220,3 +220,44 @@ def test_iterate_descends_and_stops(monkeypatch):
         return [[("c", "x", "q", "", 0.0, 1.0, 1.0 if c in ok else -1.0, c in ok)] for c in combos]
     verified, choice = iterate(slots, "mass", evaluate)
     assert choice == (1, 0) and seen[0] == (0, 2) and len(seen) == len(set(seen)) == len(verified)
+
+
+def test_iterate_climbs_to_a_passing_choice_when_the_most_capable_parts_fail(monkeypatch):
+    """The most capable (heaviest) part can fail a check a smaller one passes (a large motor's
+    speed): from a failing start the search takes, slot by slot, the part that most reduces
+    the summed shortfall of the failing checks, and once a choice passes it descends as
+    before.  Here the heaviest parts (2, 2) fail two checks; slot a's part 1 fixes one,
+    slot b's part 0 the other; no one-slot change from the start passes."""
+    from gearcli.batch.select import Part, Slot, iterate
+    slots = tuple(Slot(n, Path("x.csv"), tuple(Part(f"{n}{k}", "test", {"mass": float(k + 1)}, k + 2)
+                                                for k in range(3)), ()) for n in "ab")
+
+    def checks(c):
+        a_ok, b_ok = c[0] != 2, c[1] == 0
+        return [("c", "x", "speed a", "", 0.0, 1.0, 5.0 if a_ok else -10.0 - c[0], a_ok),
+                ("c", "x", "speed b", "", 0.0, 1.0, 5.0 if b_ok else -10.0 - c[1], b_ok)]
+    verified, choice = iterate(slots, "mass", lambda combos: [checks(c) for c in combos])
+    assert choice == (0, 0) and all(r[0][7] and r[1][7] for c, r in verified.items() if c == choice)
+
+
+def test_a_slot_column_onto_several_numbers(run_cli, tmp_path):
+    """One catalogue column onto a list of paths: the part's value goes to each (here the
+    tool's mass added to both the forearm and the upper arm: the choice's loads rise as the
+    sum says); a bad path in the list is located by the column."""
+    from gearcli.batch.manifest import load_manifest
+    from gearcli.batch.select import prepare, slots_of
+    from gearcli.batch.sweep import variant_data
+    _catalogues(tmp_path)
+    d = _design(tmp_path, SLOTS.replace("add: {mass: links.2.mass}", "add: {mass: [links.2.mass, links.1.mass]}"))
+    m = load_manifest(d)
+    slots = slots_of(m)
+    varies = prepare(m, slots, "mass")
+    assert [v.path for v in varies][-2:] == ["links.2.mass", "links.1.mass"]
+    data = variant_data(m, varies, (12, 7, 30, 150, 0.3, 0.3))[m.cases[0].name]
+    base = variant_data(m, (), ())[m.cases[0].name]
+    by = {str(link["name"]): link for link in data["links"]}
+    was = {str(link["name"]): link for link in base["links"]}
+    assert by["2"]["mass"] == pytest.approx(was["2"]["mass"] + 0.3) and by["1"]["mass"] == pytest.approx(was["1"]["mass"] + 0.3)
+    r = run_cli("select", _design(tmp_path, SLOTS.replace("add: {mass: links.2.mass}",
+                                                          "add: {mass: [links.2.mass, links.9.mass]}")))
+    assert r.exit_code == 2 and "slots[1].add.mass" in r.stderr and "no link named '9'" in r.stderr

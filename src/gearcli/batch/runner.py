@@ -47,7 +47,7 @@ the results are those of one call): of each part only the columns its checks rea
 
 
 def solve_samples(an, traj_path, degrees: bool, threads: int | None = None, backend: str = "auto",
-                  checks=None, tr=None, solve_with=None) -> Samples:
+                  checks=None, tr=None, solve_with=None, inertia_with=None) -> Samples:
     """Solve a trajectory file: times, every output column (each computed when a check
     first reads it: :class:`~gearcli.report.columns.LazyColumns`), and every real joint's
     rate; ``threads``: the solver's threads (None: every core).  With ``checks``, a long
@@ -56,24 +56,28 @@ def solve_samples(an, traj_path, degrees: bool, threads: int | None = None, back
     :func:`~gearcli.design.evaluate.partials`, 1e6 samples of the rated arm peak at 0.65 GB
     where they took 1.48 GB; its solve takes 0.26 GB).  ``tr``: the trajectory already read
     (a sweep solves the same one for every variant); ``solve_with(part)``: the solve of a
-    trajectory part (a sweep's data kernel), instead of :func:`~gearcli.dynamics.solve.solve`."""
+    trajectory part (a sweep's data kernel), instead of :func:`~gearcli.dynamics.solve.solve`;
+    ``inertia_with(q, attach)``: the motors' inertia columns likewise, instead of
+    :func:`~gearcli.design.sizing.inertia_columns` on ``backend``."""
     if tr is None:
         tr = read_trajectory(traj_path, an.independent_names, degrees=degrees, linear=an.prismatic_independent,
                              loads=an.mech.loads, payloads=[p.name for p in an.mech.payloads])
     solve_with = solve_with or (lambda p: solve(an, p.q, p.qd, p.qdd, loads=p.loads, jobs=threads, check_finite=False,
                                                 attach=p.attach, backend=backend))   # (read checked the values)
+    # servo sizing: inertia at the rated motors (numpy where the solve was told numpy: a sweep's variant)
+    inertia_with = inertia_with or (lambda q, attach: inertia_columns(an, q, attach,
+                                                                      "numpy" if backend == "numpy" else "auto"))
     if checks is not None and len(tr.t) > STREAM:
-        return _streamed(an, traj_path, tr, backend, checks, solve_with)
+        return _streamed(an, traj_path, tr, backend, checks, solve_with, inertia_with)
     with at_samples(traj_path, tr):
         res = solve_with(tr)
         check_belts(an, res)
     cols = LazyColumns(an, res, tr.t)
-    # servo sizing: inertia at the rated motors (numpy where the solve was told numpy: a sweep's variant)
-    cols.update(inertia_columns(an, tr.q, tr.attach, "numpy" if backend == "numpy" else "auto"))
+    cols.update(inertia_with(tr.q, tr.attach))
     return Samples(tr.t, cols, tr.qd @ an.S.T, backend_text(res))
 
 
-def _streamed(an, traj_path, tr, backend, checks, solve_with) -> Samples:
+def _streamed(an, traj_path, tr, backend, checks, solve_with, inertia_with) -> Samples:
     """:func:`solve_samples` of ``tr`` a :data:`STREAM` of samples at a time, each part's
     columns that ``checks`` read (those the first part's signals looked up) kept."""
     from ..pipeline import progress_slices  # noqa: PLC0415
@@ -83,7 +87,7 @@ def _streamed(an, traj_path, tr, backend, checks, solve_with) -> Samples:
             res = solve_with(part)
             check_belts(an, res)
         cols = LazyColumns(an, res, part.t)
-        cols.update(inertia_columns(an, part.q, part.attach, "numpy" if backend == "numpy" else "auto"))
+        cols.update(inertia_with(part.q, part.attach))
         if kept is None:
             probe = Samples(part.t, cols, part.qd @ an.S.T)
             for ch in checks:

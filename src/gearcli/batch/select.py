@@ -145,26 +145,33 @@ def slots_of(manifest) -> tuple[Slot, ...]:
         parts = _admitted(manifest, i, spec, path, read_catalogue(path))
         ops = []
         for mode in ("set", "add"):
-            for column, target in spec.get(mode, {}).items():
+            for column, targets in spec.get(mode, {}).items():
                 where = _where(manifest, f"slots[{i}].{mode}.{column}")
                 missing = [p for p in parts if column not in p.values]
                 if missing:
                     raise GearcliError(f"{where}: the catalogue {path} has no number column '{column}'")
-                try:
-                    steps = path_steps(target, where)
-                except GearcliError as exc:
-                    raise GearcliError(str(exc)) from None
-                for case in manifest.cases:
-                    if Path(case.mechanism).suffix.lower() not in (".yaml", ".yml"):
-                        raise GearcliError(f"{where}: case '{case.name}': select varies YAML mechanism files, "
-                                           f"{case.mechanism} is not one")
-                    try:
-                        locate(file_data(str(case.mechanism)), steps, target)
-                    except GearcliError as exc:
-                        raise GearcliError(f"{where}: case '{case.name}' ({case.mechanism}): {exc}") from None
-                ops.append((column, target, mode))
+                for target in ([targets] if isinstance(targets, str) else targets):
+                    ops.append(_op(manifest, where, column, target, mode))
         slots.append(Slot(name, path, parts, tuple(ops)))
     return tuple(slots)
+
+
+def _op(manifest, where: str, column: str, target: str, mode: str) -> tuple[str, str, str]:
+    """One mapping of a slot, (column, path, mode), once the path names a number of every
+    case's mechanism file (a located error otherwise)."""
+    try:
+        steps = path_steps(target, where)
+    except GearcliError as exc:
+        raise GearcliError(str(exc)) from None
+    for case in manifest.cases:
+        if Path(case.mechanism).suffix.lower() not in (".yaml", ".yml"):
+            raise GearcliError(f"{where}: case '{case.name}': select varies YAML mechanism files, "
+                               f"{case.mechanism} is not one")
+        try:
+            locate(file_data(str(case.mechanism)), steps, target)
+        except GearcliError as exc:
+            raise GearcliError(f"{where}: case '{case.name}' ({case.mechanism}): {exc}") from None
+    return (column, target, mode)
 
 
 def prepare(manifest, slots: tuple[Slot, ...], objective: str) -> tuple[Vary, ...]:
@@ -229,12 +236,18 @@ def iterate(slots, objective: str, evaluate, max_rounds: int = 50) -> tuple[dict
     once the choice passes, the current one is always among the candidates: the total
     objective never rises and, ties going to the lower part index, the search cannot cycle;
     it ends on a choice that no change of one slot makes lighter (a local optimum; the
-    exhaustive search finds the lightest)."""
+    exhaustive search finds the lightest).  While the choice fails (the most capable part of
+    a slot can fail a check a smaller one passes: a large motor's speed), a slot none of whose
+    parts makes it pass takes the part that most reduces the sum of the failing checks'
+    margins, if any does."""
     current = [max(range(len(s.parts)), key=lambda k: s.parts[k].values[objective]) for s in slots]
     verified: dict = {}
 
     def passed(r) -> bool:
         return not isinstance(r, str) and all(c[7] for c in r)
+
+    def shortfall(r) -> float:       # the margins by which checks fail, summed (<= 0)
+        return -math.inf if isinstance(r, str) else sum(min(c[6], 0.0) for c in r)
     for _ in range(max_rounds):
         before = tuple(current)
         for j, s in enumerate(slots):
@@ -244,15 +257,29 @@ def iterate(slots, objective: str, evaluate, max_rounds: int = 50) -> tuple[dict
             ok = [c for c in combos if passed(verified[c])]
             if ok:
                 current[j] = min(ok, key=lambda c: (objective_of(slots, c, objective), c[j]))[j]
+            else:
+                # no part of this slot makes the choice pass: climb towards passing, taking the
+                # part that most reduces the failing checks' summed shortfall, if any does (it
+                # falls strictly while the choice fails, so this phase cannot cycle either); the
+                # most capable parts can fail a check a smaller one passes (a large motor's speed)
+                here = tuple(current)
+                best = max(combos, key=lambda c: (shortfall(verified[c]), -c[j]))
+                if shortfall(verified[best]) > shortfall(verified[here]):
+                    current[j] = best[j]
         if tuple(current) == before:
             return verified, before
     raise GearcliError(f"select: the iterative search did not settle in {max_rounds} rounds")
 
 
+INERTIA_RATIO = "inertia ratio"
+"""The quantity of a motor's load-to-rotor inertia ratio check (:mod:`gearcli.design.sizing`)."""
+
+
 @dataclass(frozen=True)
 class Ranked:
     """A combination: its part indices, objective, worst margin (%) and check, whether every
-    check passes, and the checks that fail it."""
+    check passes, the checks that fail it, and the largest load-to-rotor inertia ratio of
+    its motors (NaN without an inertia-ratio check)."""
 
     combo: tuple[int, ...]
     objective: float
@@ -260,6 +287,7 @@ class Ranked:
     worst_check: str
     feasible: bool
     failing: tuple[str, ...]
+    inertia_ratio: float = math.nan
 
 
 def rank(combos, objectives, results) -> list[Ranked]:
@@ -272,7 +300,9 @@ def rank(combos, objectives, results) -> list[Ranked]:
             continue
         w = min(range(len(r)), key=lambda j: (r[j][7], r[j][6]))
         failing = tuple(f"{c[0]}: {c[1]}: {c[2]} ({c[6]:.3g} %)" for c in r if not c[7])
-        out.append(Ranked(combo, obj, r[w][6], f"{r[w][0]}: {r[w][1]}: {r[w][2]}", not failing, failing))
+        ratios = [c[4] for c in r if c[2] == INERTIA_RATIO]
+        out.append(Ranked(combo, obj, r[w][6], f"{r[w][0]}: {r[w][1]}: {r[w][2]}", not failing, failing,
+                          max(ratios) if ratios else math.nan))
     return sorted(out, key=lambda x: (not x.feasible, x.objective if x.feasible else 0.0, -x.worst))
 
 
@@ -324,45 +354,90 @@ def write_choice(manifest, slots, plan: Plan, ranked: Ranked, directory: Path) -
 
 def select_table(slots, ranked: list[Ranked], objective: str) -> dict[str, list]:
     """The ranked table: rank, each slot's part, the objective, the worst margin and check,
-    feasible, the failing checks."""
+    the largest inertia ratio (with inertia-ratio checks), feasible, the failing checks."""
     cols: dict[str, list] = {"rank": list(range(1, len(ranked) + 1))}
     for j, s in enumerate(slots):
         cols[s.name] = [s.parts[r.combo[j]].name for r in ranked]
     cols[f"total_{objective}"] = [r.objective for r in ranked]
     cols["worst_margin_%"] = [r.worst for r in ranked]
     cols["worst_check"] = [r.worst_check for r in ranked]
+    if any(math.isfinite(r.inertia_ratio) for r in ranked):
+        cols["largest_inertia_ratio"] = [r.inertia_ratio for r in ranked]
     cols["feasible"] = [r.feasible for r in ranked]
     cols["failing_checks"] = ["; ".join(r.failing) for r in ranked]
     return cols
 
 
+MARGIN_FLOOR = -100.0
+"""The worst-margin panel's lower edge, %: a combination failing by more drawn on it (a
+margin of -4000 % would otherwise squash the feasible ones, all above 0, into a line)."""
+
+
+def _front(points) -> list:
+    """The Pareto front of (x, y, ...) points, x to minimise and y to maximise: each point no
+    other beats on both, by increasing x."""
+    front, best = [], -math.inf
+    for p in sorted(points, key=lambda p: (p[0], -p[1])):
+        if p[1] > best:
+            front.append(p)
+            best = p[1]
+    return front
+
+
 def plot_pareto(ranked: list[Ranked], objective: str, path: str, inputs=()) -> None:
     """Total ``objective`` against the worst margin of every combination (feasible ones
-    green, the others red), the Pareto front of the feasible ones (least objective for a
-    margin) drawn through them, the chosen one ringed."""
+    green, the others red; those failing by more than 100 % on the panel's lower edge), the
+    Pareto front of the feasible ones (least objective for a margin) drawn through them, the
+    chosen one ringed; with inertia-ratio checks, a second panel: the objective against the
+    largest load-to-rotor inertia ratio and its front (least objective for a ratio)."""
     import matplotlib  # noqa: PLC0415
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt  # noqa: PLC0415
 
     units = {"mass": "kg", "cost": "", "inertia": "kg·m²"}
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    ratio = any(math.isfinite(r.inertia_ratio) for r in ranked)
+    fig, axes = plt.subplots(1, 2 if ratio else 1, figsize=(12 if ratio else 7, 4.5), squeeze=False)
+    ax = axes[0][0]
     ok = [r for r in ranked if r.feasible and math.isfinite(r.worst)]
     bad = [r for r in ranked if not r.feasible and math.isfinite(r.worst)]
-    if bad:
-        ax.scatter([r.objective for r in bad], [r.worst for r in bad], c="tab:red", s=18, label="a check fails")
+    near = [r for r in bad if r.worst >= MARGIN_FLOOR]
+    far = [r for r in bad if r.worst < MARGIN_FLOOR]
+    if near:
+        ax.scatter([r.objective for r in near], [r.worst for r in near], c="tab:red", s=18, label="a check fails")
+    if far:
+        ax.scatter([r.objective for r in far], [MARGIN_FLOOR] * len(far), c="tab:red", marker="v", s=22,
+                   label=f"a check fails by more than {-MARGIN_FLOOR:g} %")
     if ok:
         ax.scatter([r.objective for r in ok], [r.worst for r in ok], c="tab:green", s=18, label="feasible")
-        front, best = [], -math.inf
-        for r in sorted(ok, key=lambda r: (r.objective, -r.worst)):
-            if r.worst > best:
-                front.append(r)
-                best = r.worst
-        ax.plot([r.objective for r in front], [r.worst for r in front], "g-", lw=1, label="Pareto front")
+        front = _front([(r.objective, r.worst) for r in ok])
+        ax.plot([p[0] for p in front], [p[1] for p in front], "g-", lw=1, label="Pareto front")
         ax.scatter([ok[0].objective], [ok[0].worst], s=120, facecolors="none", edgecolors="k", label="chosen")
     ax.axhline(0.0, color="red", linestyle="--", lw=1)
+    if far:
+        ax.set_ylim(bottom=MARGIN_FLOOR * 1.05)
     unit = units[objective]
-    ax.set_xlabel(f"total {objective}" + (f" [{unit}]" if unit else ""))
+    xlabel = f"total {objective}" + (f" [{unit}]" if unit else "")
+    ax.set_xlabel(xlabel)
     ax.set_ylabel("worst margin [%] (below 0: a check fails)")
     ax.set_title(f"{len(ranked)} combinations: {len(ok)} feasible", fontsize=10)
     ax.legend(fontsize=8)
+    if ratio:
+        bx = axes[0][1]
+        shown = [r for r in ranked if math.isfinite(r.inertia_ratio)]
+        for group, colour, label in (([r for r in shown if not r.feasible], "tab:red", "a check fails"),
+                                     ([r for r in shown if r.feasible], "tab:green", "feasible")):
+            if group:
+                bx.scatter([r.objective for r in group], [r.inertia_ratio for r in group], c=colour, s=18, label=label)
+        okr = [r for r in ok if math.isfinite(r.inertia_ratio)]
+        if okr:
+            front = _front([(r.objective, -r.inertia_ratio) for r in okr])
+            bx.plot([p[0] for p in front], [-p[1] for p in front], "g-", lw=1, label="Pareto front")
+            bx.scatter([ok[0].objective], [ok[0].inertia_ratio], s=120, facecolors="none", edgecolors="k",
+                       label="chosen")
+        bx.set_yscale("log")
+        bx.set_xlabel(xlabel)
+        bx.set_ylabel("largest load-to-rotor inertia ratio of the motors")
+        bx.set_title("inertia ratio (log scale)", fontsize=10)
+        bx.legend(fontsize=8)
+        bx.grid(True, alpha=0.3)
     save_figure(fig, ax, path, inputs)

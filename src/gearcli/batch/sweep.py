@@ -250,11 +250,26 @@ INERTIAL = ("mass", "com", "inertia")
 """The keys of a link a data kernel takes at run time (:func:`data_kernel_applies`)."""
 
 
+BEARING_RATINGS = ("C", "C0", "X", "Y", "e", "X0", "Y0", "M", "f0", "a_ISO", "kappa", "e_C", "Cu", "pitch_diameter")
+"""The numbers of a joint's bearing that only the design checks read (its friction and
+position enter the solve)."""
+
+
+def checks_only(steps: tuple) -> bool:
+    """True when a path names a number that only the design checks read, never the solve:
+    a part's ``rating`` (a motor's, a gear pair's, a reducer's, a screw's, a belt's) or a
+    bearing's load ratings and factors (:data:`BEARING_RATINGS`)."""
+    return (len(steps) >= 4 and steps[2] == "rating"
+            or len(steps) == 5 and steps[0] == "joints" and steps[2] == "bearings" and steps[4] in BEARING_RATINGS)
+
+
 def data_kernel_applies(varies) -> bool:
-    """True when every --vary names a link's mass, centre of mass or inertia: the variants
-    differ only in the values the data kernel reads at run time
+    """True when every --vary names a link's mass, centre of mass or inertia, or a number
+    only the checks read (:func:`checks_only`): the variants' solves differ only in the
+    values the data kernel reads at run time
     (:attr:`gearcli.dynamics.llvm.program.Program.data_bodies`), so one compile serves them all."""
-    return all(len(v.steps) >= 3 and v.steps[0] == "links" and v.steps[2] in INERTIAL for v in varies)
+    return all(len(v.steps) >= 3 and v.steps[0] == "links" and v.steps[2] in INERTIAL or checks_only(v.steps)
+               for v in varies)
 
 
 @lru_cache(maxsize=8)
@@ -266,6 +281,58 @@ def _data_solver(mech_path: str):
     from ..dynamics.solve import Solver  # noqa: PLC0415
     solver = Solver(load_analysed(mech_path), data_bodies=True)
     return solver if solver.llvm_available() else None
+
+
+class _Bodies:
+    """One variant's links on the data kernel, as :func:`~gearcli.dynamics.forward.mass_matrix`'s
+    stacked solve calls a solver (its ``an`` and ``solve``)."""
+
+    def __init__(self, kernel, an):
+        self.kernel, self.an = kernel, an
+
+    def solve(self, q, qd, qdd, loads=None, **_):
+        # the carried payloads' entries (no external load given: their masses are the bodies')
+        known = {ld.name for ld in self.kernel.an.mech.loads}
+        return self.kernel.solve_bodies(self.an, q, qd, qdd, {k: v for k, v in (loads or {}).items() if k in known})
+
+
+class VariantKernel:
+    """The solves of one variant (``an``: the file's analysis with the variant's mechanism)
+    on the data kernel ``kernel``: a trajectory's samples, group by group of the payloads
+    carried (each group's mechanism :meth:`~gearcli.model.mechanism.Mechanism.attached`:
+    the same links with other inertial values), and the inertia the motors see (the mass
+    matrix's columns solved on the kernel)."""
+
+    def __init__(self, kernel, an):
+        self.kernel, self.an = kernel, an
+
+    def _carry(self, an, attached):
+        return an if not attached else dataclasses.replace(an, mech=an.mech.attached(attached))
+
+    def _groups(self, attach, n: int, run):
+        from ..dynamics.payloads import attach_flags, by_groups  # noqa: PLC0415
+        if not attach:
+            return run(self.an, slice(None))
+        return by_groups(self.an, attach_flags(self.an, attach, n), run, n, carry=self._carry)
+
+    def solve(self, p):
+        def run(a, rows):
+            part = {k: (np.asarray(v, float)[rows] if np.ndim(v) == 2 else v) for k, v in (p.loads or {}).items()}
+            return self.kernel.solve_bodies(a, p.q[rows], p.qd[rows], p.qdd[rows], part or None)
+        return self._groups(p.attach, len(p.q), run)
+
+    def inertia(self, q, attach) -> dict:
+        from ..design.sizing import inertia_columns  # noqa: PLC0415
+        rated = [f"motor:{m.name}:inertia" for m in self.an.mech.motors
+                 if m.rating is not None and m.rating.rotor_inertia is not None]
+        if not rated:
+            return {}
+
+        def run(a, rows):
+            cols = inertia_columns(a, q[rows], None, "numpy", solver=_Bodies(self.kernel, a))
+            return np.column_stack([cols[k] for k in rated])
+        J = self._groups(attach, len(q), run)
+        return {k: J[:, i] for i, k in enumerate(rated)}
 
 
 @lru_cache(maxsize=64)
@@ -305,10 +372,9 @@ def run_variant(manifest_path: str, varies: tuple[Vary, ...], values: tuple[floa
             tr = _trajectory(str(tp), tuple(an.independent_names), case.degrees,
                              tuple(bool(x) for x in an.prismatic_independent), tuple(an.mech.loads),
                              tuple(p.name for p in an.mech.payloads))
-            ds = solver if not tr.attach else None
-            with_kernel = None if ds is None else (lambda p, an=an, ds=ds: ds.solve_bodies(an, p.q, p.qd, p.qdd, p.loads))
+            vk = None if solver is None else VariantKernel(solver, an)
             samples = solve_samples(an, tp, case.degrees, threads=1, backend="numpy", checks=checks, tr=tr,
-                                    solve_with=with_kernel)
+                                    solve_with=vk and vk.solve, inertia_with=vk and vk.inertia)
             parts.append(partials(checks, samples, an.mech))
         spans = [p[0][6] if p else 0.0 for p in parts]
         rates = profile_rates(case.shares or (None,) * len(parts), spans, case.req.cycles_per_hour,

@@ -109,14 +109,14 @@ def sizing_checks(an, check_type) -> list:
     return out
 
 
-def inertia_columns(an, q, attach: dict | None = None, backend: str = "auto") -> dict:
+def inertia_columns(an, q, attach: dict | None = None, backend: str = "auto", solver=None) -> dict:
     """``{"motor:<m>:inertia": (N,)}`` the inertia each motor with a rated rotor inertia sees
     along the motion q (N, dof), kg*m^2 (:func:`gearcli.dynamics.forward.motor_inertia`,
-    ``backend`` its path), with the payloads ``attach`` carries at each sample."""
+    ``backend`` and ``solver`` its path), with the payloads ``attach`` carries at each sample."""
     rated = [k for k, m in enumerate(an.mech.motors) if m.rating is not None and m.rating.rotor_inertia is not None]
     if not rated:
         return {}
     from ..dynamics.forward import motor_inertia  # noqa: PLC0415
 
-    J = motor_inertia(an, q, diagonal=True, attach=attach, backend=backend)
+    J = motor_inertia(an, q, diagonal=True, attach=attach, backend=backend, solver=solver)
     return {f"motor:{an.mech.motors[k].name}:inertia": J[:, k] for k in rated}

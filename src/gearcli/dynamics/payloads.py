@@ -63,11 +63,14 @@ def groups(an, flags: np.ndarray) -> list[tuple[tuple[str, ...], np.ndarray]]:
     return out
 
 
-def by_groups(an, flags: np.ndarray, run, n: int):
+def by_groups(an, flags: np.ndarray, run, n: int, carry=carrying):
     """``run(analysis, rows)`` of every group of samples (:func:`groups`), its array results
     (samples first) scattered back to the n samples.  ``run`` returns a result whose array
-    fields have the group's samples first (a :class:`~.solve.Result`, or an array)."""
-    parts = [(rows, run(carrying(an, attached), rows)) for attached, rows in groups(an, flags)]
+    fields have the group's samples first (a :class:`~.solve.Result`, or an array).
+    ``carry(an, attached)``: the analysis carrying the payloads ``attached`` (a sweep's data
+    kernel takes ``an``'s with the mechanism's :meth:`~gearcli.model.mechanism.Mechanism.attached`,
+    whose links' inertial values alone differ)."""
+    parts = [(rows, run(carry(an, attached), rows)) for attached, rows in groups(an, flags)]
     first = parts[0][1]
     if isinstance(first, np.ndarray):
         out = np.empty((n,) + first.shape[1:], first.dtype)
