@@ -109,8 +109,8 @@ def _shown(lines: list[str]) -> list[str]:
 
 @pytest.fixture
 def site(tmp_path):
-    """A folder with what the pages' commands read (mechanisms/, designs/, docs/examples/)."""
-    for d in ("mechanisms", "designs", "docs/examples", "benchmarks"):
+    """A folder with what the pages' commands read (mechanisms/, designs/, docs/examples/, catalogues/)."""
+    for d in ("mechanisms", "designs", "docs/examples", "benchmarks", "catalogues"):
         shutil.copytree(ROOT / d, tmp_path / d)
     return tmp_path
 

@@ -77,12 +77,12 @@ def test_the_six_axis_arm_gets_the_lightest_motor_and_unit_of_every_joint(run_cl
     passes, and for every joint no lighter (motor, unit) pair passes with the other joints as
     chosen (each such pair verified here, outside the search): the lightest feasible motor
     and unit of every joint.  The shoulder (joint 2, the largest torques) takes a larger
-    unit than the wrist."""
+    unit than the wrist.  (-j 2: one pool of workers serves every round of the search.)"""
     from gearcli.batch.manifest import load_manifest
     from gearcli.batch.select import plan_of, prepare, slots_of
     from gearcli.batch.sweep import run_sweep
     r = run_cli("select", DESIGN, "-o", tmp_path / "chosen", "--table", tmp_path / "ranked.csv",
-                "--plot", tmp_path / "pareto.png")
+                "--plot", tmp_path / "pareto.png", "-j", "2")
     assert r.exit_code == 0, r.stderr
     chosen = _chosen(r.stdout)
     assert len(chosen) == 12 and (tmp_path / "pareto.png").stat().st_size > 0

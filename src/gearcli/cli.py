@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 import typer
 
 from . import __version__
-from .errors import GearcliError, counted
+from .errors import GearcliError, counted, plural
 from .exits import EXIT_BROKEN_PIPE, EXIT_CHECK_FAILED, bad_input_exits, print_problems, reports_bad_input, stderr_may_fail
 from .report.features import feature_notes
 from .report.sharing import sharing_notes
@@ -529,11 +529,14 @@ def select(
     err = stderr_console()
     bar = Progress(TextColumn("selecting"), BarColumn(), TextColumn("{task.completed}/{task.total} combinations"),
                    console=err, transient=True, disable=not err.is_terminal)
-    with LateProgress(bar, "select") as progress:
+    from concurrent.futures import ProcessPoolExecutor  # noqa: PLC0415
+    from contextlib import nullcontext  # noqa: PLC0415
+    with LateProgress(bar, "select") as progress, \
+            (ProcessPoolExecutor(max_workers=jobs) if jobs > 1 else nullcontext()) as pool:
         def evaluate(combos: list) -> list:
             progress.update(total=(progress.total or 0) + len(combos))
             return run_sweep(plan_of(manifest, varies, slots, combos), jobs=jobs, dask_address=dask,
-                             progress=lambda n: progress.update(advance=n))
+                             progress=lambda n: progress.update(advance=n), pool=pool)
         if how == "exhaustive":
             combos = combinations(slots)
             results = evaluate(combos)
@@ -550,8 +553,8 @@ def select(
     if how == "exhaustive":
         typer.echo(f"{counted(len(ranked), 'combination')} of {counted(len(slots), 'slot')}: {feasible} feasible")
     else:
-        typer.echo(f"{len(ranked):,} of {counted(total, 'combination')} of {counted(len(slots), 'slot')} verified by the "
-                   f"iterative search: {feasible} feasible")
+        typer.echo(f"{len(ranked):,} of {total:,} {plural(total, 'combination')} of {counted(len(slots), 'slot')} verified "
+                   f"by the iterative search: {feasible} feasible")
 
     def parts(r) -> str:
         return ", ".join(f"{s.name} = {s.parts[k].name}" for s, k in zip(slots, r.combo))

@@ -406,12 +406,14 @@ def _run_chunk(manifest_path: str, varies, variants) -> list:
 
 
 def run_sweep(plan: Plan, jobs: int = 1, dask_address: str | None = None, progress=None,
-              done: dict | None = None, record=None) -> list:
+              done: dict | None = None, record=None, pool=None) -> list:
     """Every variant's checks (:func:`run_variant`, or the reason it could not run), in
     variant order; ``jobs`` local processes or the Dask scheduler at ``dask_address``;
     ``progress(n)`` after each n variants.  ``done``: {variant index: its result} of an
     earlier run (``--resume``), not run again; ``record(first, results)`` is told each
-    chunk's results as it finishes (the partial file)."""
+    chunk's results as it finishes (the partial file).  ``pool``: a process pool of
+    ``jobs`` workers kept across calls (select's iterative search calls this once per slot:
+    a pool each time would start the workers, and load the kernel in each, every time)."""
     n = len(plan.variants)
     done = dict(done or {})
     todo = [i for i in range(n) if i not in done]
@@ -443,8 +445,9 @@ def run_sweep(plan: Plan, jobs: int = 1, dask_address: str | None = None, progre
             finished(idx, _run_chunk(*args(idx)))
     else:
         from concurrent.futures import ProcessPoolExecutor, as_completed  # noqa: PLC0415
-        with ProcessPoolExecutor(max_workers=jobs) as pool:
-            futures = {pool.submit(_run_chunk, *args(idx)): k for k, idx in enumerate(parts)}
+        from contextlib import nullcontext  # noqa: PLC0415
+        with nullcontext(pool) if pool is not None else ProcessPoolExecutor(max_workers=jobs) as workers:
+            futures = {workers.submit(_run_chunk, *args(idx)): k for k, idx in enumerate(parts)}
             for fut in as_completed(futures):
                 finished(parts[futures[fut]], fut.result())
     return [done[i] for i in range(n)]
