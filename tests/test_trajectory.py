@@ -78,3 +78,35 @@ def test_bad_rows_name_row_and_column(tmp_path, text, where, what):
     msg = str(err.value)
     assert msg.startswith(str(path)) and where in msg and what in msg
     assert "\n" not in msg
+
+
+def test_a_trajectory_read_in_chunks_is_the_one_parse(tmp_path, monkeypatch):
+    """read_trajectory parses READ_CHUNK samples at a time (the fast parser's buffers of a
+    1e6-row file were larger than the arrays it made) and joins them: with chunks of 7
+    samples, every array (times, angles, rates, accelerations, line numbers, load and attach
+    columns) equals one whole parse bit for bit, and a bad value in a later chunk is
+    reported on its own line."""
+    import gearcli.io.trajectory as trajectory
+    from gearcli.model.loads import Load
+    n = 50
+    t = np.linspace(0.0, 1.0, n)
+    rows = ["t,q:a,qd:a,qdd:a,load:tip:fz,attach:box"]
+    rows += [f"{x:.17g},{np.sin(x):.17g},{np.cos(x):.17g},{-np.sin(x):.17g},{10 * x:.17g},{int(k % 9 < 4)}"
+             for k, x in enumerate(t)]
+    path = tmp_path / "t.csv"
+    path.write_text("\n".join(rows) + "\n")
+    loads = (Load("tip", "a", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)),)
+
+    def read():
+        return read_trajectory(path, ["a"], loads=loads, payloads=["box"])
+    whole = read()
+    monkeypatch.setattr(trajectory, "READ_CHUNK", 7)
+    parts = read()
+    for f in ("t", "q", "qd", "qdd", "line"):
+        assert np.array_equal(getattr(whole, f), getattr(parts, f)), f
+    assert np.array_equal(whole.loads["tip"], parts.loads["tip"]) and whole.loads["tip"][:, 2].any()
+    assert np.array_equal(whole.attach["box"], parts.attach["box"]) and 0 < parts.attach["box"].sum() < n
+    rows[40] = rows[40].replace(",", ",x", 1)
+    path.write_text("\n".join(rows) + "\n")
+    with pytest.raises(TrajectoryError, match="t.csv:41"):
+        read()

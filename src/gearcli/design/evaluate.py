@@ -33,6 +33,7 @@ class Samples:
     cols: dict
     rates: np.ndarray
     backend: str = ""     # the solver path that ran: "llvm", or "numpy (auto: why)" (gearcli.batch)
+    merged: dict | None = None   # {check index: its partials}, merged from a long trajectory's parts
 
 
 def bearing_loads(s: Samples, joint: str, bearings) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -143,6 +144,8 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
     rainflow cycles as ((stress, number), ...) by stress (Pa) and the tooth passes.
     """
     out: list = [None] * len(checks)
+    for i, merged in (s.merged or {}).items():       # a long trajectory's, part by part
+        out[i] = merged
     span = float(s.t[-1] - s.t[0]) if s.t.size else 0.0
     cache: dict = {}
     component = None
@@ -151,6 +154,8 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
     # revolutions of each joint and the last joint's bearing loads (its other bearings' checks
     # follow) are kept
     for i, ch in sorted(enumerate(checks), key=lambda ic: ic[1].component):
+        if out[i] is not None:
+            continue
         if ch.component != component:
             cache = {k: v for k, v in cache.items() if k[0] in ("revs", "loads")}
             component = ch.component
@@ -195,6 +200,42 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
             counts = (tuple(zip(levels.tolist(), number.tolist())), revs - passes)
         out[i] = (peak, tp, total, wsum, revs, score, span, counts)
     return out
+
+
+def mergeable(check: Check) -> bool:
+    """True when a check's partials over consecutive parts of one trajectory merge into the
+    whole trajectory's (:func:`merge_partials`): extremes and trapezoid sums.  Not a gear's
+    fatigue (rainflow pairs reversals across the parts), a running RMS over a time window
+    (a window spans parts) or a cycle's energy (its time is that of the largest |x|)."""
+    return check.kind not in ("fatigue", "energy") and check.signal[0] != "running_rms"
+
+
+def merge_partials(check: Check, parts: list[tuple]) -> tuple:
+    """The :func:`partials` tuple of a whole trajectory from those of its consecutive parts,
+    each part starting at the sample the one before ended on (so that the trapezoid weights
+    of the parts add up to the whole's: the shared sample's two halves).  Peaks are the
+    largest (the earliest on a tie; a worm's least efficiency, the smallest), sums, weights,
+    revolutions and spans add, and the score follows from them as in :func:`partials`.
+    Equal to the whole trajectory's partials to rounding (the sums' order differs)."""
+    nan = [k for k, p in enumerate(parts) if p[0] != p[0]]        # the whole's argmax finds a NaN first
+    if nan:
+        best = nan[0]
+    elif check.kind == "worm_efficiency":
+        best = min(range(len(parts)), key=lambda k: (parts[k][0], k))
+    else:
+        best = max(range(len(parts)), key=lambda k: (parts[k][0], -k))
+    peak, tp = parts[best][0], parts[best][1]
+    total, wsum, revs, span = (sum(p[j] for p in parts) for j in (2, 3, 4, 6))
+    score = peak
+    if check.kind == "rms":
+        score = rms_of(total, wsum, peak)
+    elif check.kind == "life":
+        score = B.equivalent_load(total, wsum, check.exponent)
+    elif check.kind in REDUCER_KINDS:
+        score = total
+    elif check.kind == "worm_efficiency":
+        score = total / wsum if wsum > 0.0 else 0.0
+    return (peak, tp, total, wsum, revs, score, span, None)
 
 
 REDUCER_KINDS = ("reducer_average", "reducer_speed_average", "reducer_life", "screw_life")

@@ -365,13 +365,32 @@ def count_rows(path) -> int:
     return max(n - 1, 0)
 
 
+READ_CHUNK = 1 << 17
+"""Samples :func:`read_trajectory` parses at a time: the fast parser's buffers of one chunk
+(~25 MB) instead of a whole file's (1e6 rows: ~180 MB, more than the arrays it makes)."""
+
+
 def read_trajectory(path, names, degrees: bool = False, linear=(), loads=(), payloads=()) -> Trajectory:
-    """Read a whole trajectory CSV into memory (see :class:`TrajectoryReader`)."""
-    parts = list(TrajectoryReader(path, names, degrees, chunk=1 << 62, linear=linear, loads=loads,
+    """Read a whole trajectory CSV into memory (see :class:`TrajectoryReader`), a chunk of
+    :data:`READ_CHUNK` samples parsed at a time (the same values as one parse)."""
+    parts = list(TrajectoryReader(path, names, degrees, chunk=READ_CHUNK, linear=linear, loads=loads,
                                   payloads=payloads))
-    if "pyarrow" in sys.modules:      # the fast parser's buffers, kept by its memory pool (1e6 rows: ~180 MB)
+    if "pyarrow" in sys.modules:      # the fast parser's buffers, kept by its memory pool
         sys.modules["pyarrow"].default_memory_pool().release_unused()
-    return parts[0]
+    return parts[0] if len(parts) == 1 else _joined(parts)
+
+
+def _joined(parts: list[Trajectory]) -> Trajectory:
+    """One :class:`Trajectory` of consecutive chunks (for a moment both: twice the arrays)."""
+    def cat(get):
+        first = get(parts[0])
+        if first is None:
+            return None
+        if isinstance(first, dict):
+            return {k: np.concatenate([get(p)[k] for p in parts]) for k in first}
+        return np.concatenate([get(p) for p in parts])
+    fields = ("t", "q", "qd", "qdd", "line", "loads", "attach")
+    return Trajectory(*(cat(lambda p, f=f: getattr(p, f)) for f in fields))
 
 
 def write_trajectory(path, names, t, q, qd=None, qdd=None) -> None:
