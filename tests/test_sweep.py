@@ -208,11 +208,11 @@ def test_a_variant_that_cannot_run_is_a_row_saying_why(run_cli, tmp_path):
 def test_a_sweep_builds_one_kernel_for_all_its_variants(run_cli, tmp_path, monkeypatch):
     """A design with a servo-sizing check (the load-to-rotor inertia ratio, from the mass
     matrix) over 6,000 samples (past the first-call rule).  Varying a link's inertia, the one
-    data kernel (inertial values at run time) solves every variant and the inertia seen at the
-    motor is computed on the numpy path: one kernel built for three variants (a kernel of
-    constants would be a compile per variant).  Varying the rotor's rated inertia (not a
-    link's), the numpy path: none.  The ratio follows the varied load inertia: the disc's J
-    over n^2 J_rotor."""
+    data kernel (inertial values at run time) solves every variant, the inertia seen at the
+    motor included (the mass matrix's columns solved on it): one kernel built for three
+    variants (a kernel of constants would be a compile per variant).  Varying the rotor's
+    rated inertia (read by the checks alone), the same data kernel: none built anew.  The
+    ratio follows the varied load inertia: the disc's J over n^2 J_rotor."""
     from test_sizing import J_ROTOR, N_RATIO, disc_trajectory, rated_stage
 
     from gearcli.dynamics.llvm import driver
@@ -238,3 +238,30 @@ def test_a_sweep_builds_one_kernel_for_all_its_variants(run_cli, tmp_path, monke
     values = [float(row[ratio]) for row in rows]
     assert values[1] == pytest.approx(2 * values[0], rel=1e-6) and values[2] == pytest.approx(3 * values[0], rel=1e-6)
     assert values[0] == pytest.approx(0.01 / (N_RATIO ** 2 * J_ROTOR), rel=1e-3)
+
+
+@pytest.mark.parametrize("design, vary", [
+    ("servo_joint_losses.yaml", "loads.payload.force[2]=-30,-5"),      # a load's wrench: a run-time input
+    ("cobot_joint_reducer.yaml", "payloads.part.mass=1,4.5"),          # a payload picked and placed
+    ("cobot_joint_reducer.yaml", "gears.hd.rating.rated_torque=7.8,10"),   # read by the checks alone
+])
+def test_payload_load_and_rating_variants_take_the_data_kernel(monkeypatch, design, vary):
+    """A payload's mass, a load's wrench and a rating change no constant of the kernel: the
+    data kernel solves their variants (one kernel), and every check value equals the numpy
+    path's (the variant's mechanism analysed afresh) to 1e-11; a load's point is a constant
+    of the kernel, and so takes the numpy path."""
+    import gearcli.batch.sweep as sweep
+    from gearcli.batch.manifest import load_manifest
+    path = str(ROOT / "designs" / design)
+    v = sweep.parse_vary(vary)
+    assert sweep.data_kernel_applies([v])
+    assert not sweep.data_kernel_applies([sweep.parse_vary("loads.payload.point[0]=0.1")])
+    plan = sweep.plan_sweep(load_manifest(path), [v])
+    kernel = [sweep.run_variant(path, plan.varies, values) for values in plan.variants]
+    monkeypatch.setattr(sweep, "data_kernel_applies", lambda varies: False)
+    numpy = [sweep.run_variant(path, plan.varies, values) for values in plan.variants]
+    assert kernel[0] != kernel[1]                      # the value matters
+    for a, b in zip(kernel, numpy):
+        assert [x[:4] + x[5:6] + x[7:] for x in a] == [x[:4] + x[5:6] + x[7:] for x in b]
+        for x, y in zip(a, b):
+            assert x[4] == pytest.approx(y[4], rel=1e-11, abs=1e-300), x[:3]

@@ -247,7 +247,11 @@ def _manifest(path: str):
 
 
 INERTIAL = ("mass", "com", "inertia")
-"""The keys of a link a data kernel takes at run time (:func:`data_kernel_applies`)."""
+"""The keys of a link or a payload a data kernel takes at run time (:func:`data_kernel_applies`)."""
+
+LOAD_VALUES = ("force", "moment", "mass", "inertia")
+"""The keys of a load a data kernel takes at run time: its wrench (an input of every solve)
+and the mass and inertia it carries (merged into its link's)."""
 
 
 BEARING_RATINGS = ("C", "C0", "X", "Y", "e", "X0", "Y0", "M", "f0", "a_ISO", "kappa", "e_C", "Cu", "pitch_diameter")
@@ -263,13 +267,22 @@ def checks_only(steps: tuple) -> bool:
             or len(steps) == 5 and steps[0] == "joints" and steps[2] == "bearings" and steps[4] in BEARING_RATINGS)
 
 
+def run_time(steps: tuple) -> bool:
+    """True when a path names a value the data kernel reads at run time: a link's or a
+    payload's mass, centre of mass or inertia, a load's wrench, mass or inertia (not its
+    point, a constant of the kernel)."""
+    if len(steps) < 3:
+        return False
+    return (steps[0] in ("links", "payloads") and steps[2] in INERTIAL
+            or steps[0] == "loads" and steps[2] in LOAD_VALUES)
+
+
 def data_kernel_applies(varies) -> bool:
-    """True when every --vary names a link's mass, centre of mass or inertia, or a number
-    only the checks read (:func:`checks_only`): the variants' solves differ only in the
-    values the data kernel reads at run time
+    """True when every --vary names a value the data kernel reads at run time
+    (:func:`run_time`) or a number only the checks read (:func:`checks_only`): the
+    variants' solves differ only in those values
     (:attr:`gearcli.dynamics.llvm.program.Program.data_bodies`), so one compile serves them all."""
-    return all(len(v.steps) >= 3 and v.steps[0] == "links" and v.steps[2] in INERTIAL or checks_only(v.steps)
-               for v in varies)
+    return all(run_time(v.steps) or checks_only(v.steps) for v in varies)
 
 
 @lru_cache(maxsize=8)
@@ -316,8 +329,11 @@ class VariantKernel:
         return by_groups(self.an, attach_flags(self.an, attach, n), run, n, carry=self._carry)
 
     def solve(self, p):
+        # the variant's loads (their wrenches are run-time inputs), a trajectory's columns over them
+        given = {ld.name: ld.wrench for ld in self.an.mech.loads} | dict(p.loads or {})
+
         def run(a, rows):
-            part = {k: (np.asarray(v, float)[rows] if np.ndim(v) == 2 else v) for k, v in (p.loads or {}).items()}
+            part = {k: (np.asarray(v, float)[rows] if np.ndim(v) == 2 else v) for k, v in given.items()}
             return self.kernel.solve_bodies(a, p.q[rows], p.qd[rows], p.qdd[rows], part or None)
         return self._groups(p.attach, len(p.q), run)
 
