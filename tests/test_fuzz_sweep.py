@@ -19,7 +19,8 @@ from test_fuzz import MECH_DIR, NASTY_NUMBERS, apply, few, mutation, problems, r
 
 DESIGN = (Path(__file__).resolve().parents[1] / "designs" / "ci_example.yaml").read_text()
 PATHS = ["links.3.mass", "links.3.com[0]", "links.3.inertia.izz", "links.3.inertia", "links.9.mass", "links.3",
-         "gears.4-1.teeth[0]", "joints.J1.bearings.lower.C", "motors", "gravity[2]", "gravity[9]", "name",
+         "gears.4-1.teeth[0]", "joints.J1.bearings.lower.C", "joints.J1.bearings.lower.position", "motors",
+         "gravity[2]", "gravity[9]", "name", "payloads.x.mass",
          "wrist_motion:links.3.mass", "x:links.3.mass", "", ".", "links..mass", "links.3.mass[0]", "loads.x.force[2]"]
 VALUES = ["1", "0.5,1", "0:1:3", "log:0.1:1:3", "-1", "0", "1e300", "nan", "inf", "1:2", "log:0:1:2", "1:2:0",
           "1:2:1e9", "a,b", "", ",", "1,,2", "1e999", "0x10"] + [v.decode() for v in NASTY_NUMBERS if v]
@@ -61,6 +62,7 @@ SLOTS = b"""slots:
   - name: lower
     catalogue: parts.csv
     set: {C: joints.J1.bearings.lower.C, C0: joints.J1.bearings.lower.C0}
+    add: {mass: [links.3.mass, links.2.mass]}
     at_least: {C0: 100}
 """
 
