@@ -28,10 +28,12 @@ import numpy as np
 from ..report.rms import trapezoid_weights
 
 
-def revolutions(rate, t) -> np.ndarray:
+def revolutions(rate, t, weights=None) -> np.ndarray:
     """Revolutions turned at each sample, |rate_k| w_k / 2 pi (w the trapezoid weights of
-    :func:`gearcli.report.rms.trapezoid_weights`), shape (N,); rate in rad/s, t in s."""
-    return np.abs(np.asarray(rate, float)) * trapezoid_weights(t) / (2 * math.pi)
+    :func:`gearcli.report.rms.trapezoid_weights`, or ``weights``, those of ``t`` already
+    computed), shape (N,); rate in rad/s, t in s."""
+    w = trapezoid_weights(t) if weights is None else weights
+    return np.abs(np.asarray(rate, float)) * w / (2 * math.pi)
 
 
 def life_sum(P, revs, p: float, a=1.0) -> float:

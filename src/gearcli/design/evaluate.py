@@ -186,7 +186,7 @@ def partials(checks: list[Check], s: Samples, mech) -> list[tuple]:
             wsum = revs = float(np.sum(n))
             score = B.equivalent_load(total, wsum, ch.exponent)
         elif ch.kind in REDUCER_KINDS:
-            total, wsum, revs = _reducer_sums(ch, s, x)
+            total, wsum, revs = _reducer_sums(ch, s, x, _weights(cache, s))
             score = total
         elif ch.kind == "fatigue":
             peaks = F.rainflow_peaks(x)
@@ -244,10 +244,9 @@ REDUCER_KINDS = ("reducer_average", "reducer_speed_average", "reducer_life", "sc
 """Checks reduced by speed-weighted means over the duty cycle (:func:`_reducer_sums`)."""
 
 
-def _reducer_sums(ch: Check, s: Samples, x: np.ndarray) -> tuple[float, float, float]:
-    """A reducer check's sums over one trajectory (trapezoid weights dt_k): T_av and the life,
+def _reducer_sums(ch: Check, s: Samples, x: np.ndarray, dt: np.ndarray) -> tuple[float, float, float]:
+    """A reducer check's sums over one trajectory (trapezoid weights ``dt``): T_av and the life,
     (sum |a| |T|^p dt, sum |a| dt, span); n_av, (sum |a| dt, span, span)."""
-    dt = trapezoid_weights(s.t)
     a = np.abs(s.rates @ np.asarray(ch.extra["row"]))
     span = float(s.t[-1] - s.t[0]) if s.t.size else 0.0
     turned = float(np.sum(a * dt))
@@ -292,8 +291,16 @@ def _revolutions(cache: dict, s: Samples, ji: int) -> np.ndarray:
     """Revolutions of joint ``ji`` at each sample (:func:`gearcli.design.bearings.revolutions`),
     once per trajectory."""
     if ("revs", ji) not in cache:
-        cache[("revs", ji)] = B.revolutions(s.rates[:, ji], s.t)
+        cache[("revs", ji)] = B.revolutions(s.rates[:, ji], s.t, _weights(cache, s))
     return cache[("revs", ji)]
+
+
+def _weights(cache: dict, s: Samples) -> np.ndarray:
+    """The trapezoid weights of the trajectory's times (:func:`~gearcli.report.rms.trapezoid_weights`),
+    once per trajectory."""
+    if ("revs", "weights") not in cache:
+        cache[("revs", "weights")] = trapezoid_weights(s.t)
+    return cache[("revs", "weights")]
 
 
 @dataclass(frozen=True)
