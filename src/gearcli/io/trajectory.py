@@ -372,7 +372,9 @@ READ_CHUNK = 1 << 17
 
 def read_trajectory(path, names, degrees: bool = False, linear=(), loads=(), payloads=()) -> Trajectory:
     """Read a whole trajectory CSV into memory (see :class:`TrajectoryReader`), a chunk of
-    :data:`READ_CHUNK` samples parsed at a time (the same values as one parse)."""
+    :data:`READ_CHUNK` samples parsed at a time: the values of one parse, but for rates and
+    accelerations derived from the angles, which depend on the chunking to ~1e-14 (the
+    module docstring), as ``gearcli solve``'s do."""
     parts = list(TrajectoryReader(path, names, degrees, chunk=READ_CHUNK, linear=linear, loads=loads,
                                   payloads=payloads))
     if "pyarrow" in sys.modules:      # the fast parser's buffers, kept by its memory pool
