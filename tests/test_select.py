@@ -130,6 +130,15 @@ def test_nothing_feasible_shows_the_closest_and_what_fails_them(run_cli, tmp_pat
     (None, None, SLOTS.replace("links.2.mass", "links.forearm.mass"), "no link named 'forearm'"),
     (None, None, SLOTS.replace("motors.csv", "nowhere.csv"), "nowhere.csv: cannot read the catalogue"),
     (None, None, "", "no slots"),
+    (None, None, SLOTS.replace("    add: {mass: links.2.mass}\n", ""), "slots[1]: give set or add (or both)"),
+    (None, None, SLOTS.replace("add: {mass: links.2.mass}", "add: {mass: []}"),
+     "slots[1].add.mass: expected a path of the mechanism files (e.g. links.arm.mass) or a list of such paths"),
+    (None, None, SLOTS.replace("add: {mass: links.2.mass}", "add: {mass: [links.2.mass, links.2.mass]}"),
+     "slots[1].add.mass: 'links.2.mass' is listed twice"),
+    (None, None, SLOTS.replace("add: {mass: links.2.mass}", "set: {mass: motors.motor5.rating.peak_torque}"),
+     "slots[1].set.mass: 'motors.motor5.rating.peak_torque' is also set by slots[0].set.peak_torque"),
+    (None, None, SLOTS.replace("add: {mass: links.2.mass}", "add: {mass: motors.motor5.rating.max_power}"),
+     "slots[1].add.mass: 'motors.motor5.rating.max_power' is also set by slots[0].set.max_power"),
 ])
 def test_bad_catalogues_and_slots_are_located(run_cli, tmp_path, motors, tools, slots, said):
     _catalogues(tmp_path)

@@ -106,7 +106,7 @@ def _schema_issues(data, col: Collector, skip: set) -> None:
             continue
         leaf = _leaf(err)
         if err.validator == "anyOf":
-            found = [(list(err.absolute_path), "give max_abs or max_rms (or both)")]
+            found = [(list(err.absolute_path), _any_of_message(err.validator_value))]
         elif leaf.validator in ("minimum", "maximum") and isinstance(leaf.instance, (int, float)) \
                 and leaf.schema.get("minimum") == MIN_POSITIVE:        # the schema's "positive"
             found = [(list(leaf.absolute_path), _range_message(leaf.instance))]
@@ -118,6 +118,16 @@ def _schema_issues(data, col: Collector, skip: set) -> None:
         for parts, message in found:
             if json_path(parts) not in skip:
                 col.add(json_path(parts), message)
+
+
+def _any_of_message(branches: list) -> str:
+    """The words of an ``anyOf`` the value meets no branch of: keys of which one is needed
+    (a limit's max_abs or max_rms, a slot's set or add), or a slot's target, a path or a
+    list of paths."""
+    keys = [b["required"][0] for b in branches if list(b) == ["required"] and len(b["required"]) == 1]
+    if len(keys) == len(branches):
+        return f"give {' or '.join(keys)} (or both)"
+    return "expected a path of the mechanism files (e.g. links.arm.mass) or a list of such paths, none empty"
 
 
 def _leaf(err):

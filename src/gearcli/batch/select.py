@@ -135,7 +135,7 @@ def slots_of(manifest) -> tuple[Slot, ...]:
     if not manifest.slots:
         raise GearcliError(f"{manifest.path}: no slots (select needs `slots:`, the parts to choose; "
                            f"docs/how-to/select.md)")
-    slots, seen = [], {}
+    slots, seen, targets = [], {}, {}      # targets: path -> (mode, where) of its first mapping
     for i, spec in enumerate(manifest.slots):
         name = spec["name"]
         if name in seen:
@@ -145,15 +145,30 @@ def slots_of(manifest) -> tuple[Slot, ...]:
         parts = _admitted(manifest, i, spec, path, read_catalogue(path))
         ops = []
         for mode in ("set", "add"):
-            for column, targets in spec.get(mode, {}).items():
+            for column, given in spec.get(mode, {}).items():
                 where = _where(manifest, f"slots[{i}].{mode}.{column}")
                 missing = [p for p in parts if column not in p.values]
                 if missing:
                     raise GearcliError(f"{where}: the catalogue {path} has no number column '{column}'")
-                for target in ([targets] if isinstance(targets, str) else targets):
+                paths = [given] if isinstance(given, str) else given
+                for target in paths:
+                    _once(targets, target, mode, where, paths.count(target) > 1)
                     ops.append(_op(manifest, where, column, target, mode))
         slots.append(Slot(name, path, parts, tuple(ops)))
     return tuple(slots)
+
+
+def _once(targets: dict, target: str, mode: str, where: str, repeated: bool) -> None:
+    """A located error when a path is mapped twice in a way whose outcome would depend on
+    the order: listed twice for one column, set twice, or both set and added.  Added by
+    several columns or slots is a sum (a motor's and a reducer's inertia on one rotor)."""
+    if repeated:
+        raise GearcliError(f"{where}: '{target}' is listed twice (each part's value would go to it twice)")
+    first = targets.setdefault(target, (mode, where))
+    if first[1] != where and "set" in (mode, first[0]):
+        how = "set" if first[0] == "set" else "added to"
+        raise GearcliError(f"{where}: '{target}' is also {how} by {first[1].split(': ')[-1]}: a value set "
+                           f"and another set or added would depend on the slots' order")
 
 
 def _op(manifest, where: str, column: str, target: str, mode: str) -> tuple[str, str, str]:
