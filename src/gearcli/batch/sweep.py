@@ -366,10 +366,10 @@ def _trajectory(path: str, names: tuple, degrees: bool, linear: tuple, loads: tu
 def run_variant(manifest_path: str, varies: tuple[Vary, ...], values: tuple[float, ...]) -> list[tuple]:
     """Every check of the manifest on one variant: [(case, component, quantity, unit, value,
     limit, margin %, passed)] in the manifest's order of cases and checks (picklable in and
-    out: a local process or a Dask worker runs it the same).  Variants of the links' inertial
-    values alone are solved by one data kernel per mechanism and process
-    (:func:`data_kernel_applies`); the others, and trajectories that pick and place payloads,
-    by the numpy path."""
+    out: a local process or a Dask worker runs it the same).  Variants of values the data
+    kernel reads at run time or the checks alone read are solved by one data kernel per
+    mechanism and process (:func:`data_kernel_applies`), payloads picked and placed included;
+    the others by the numpy path."""
     from ..design.checks import build_checks  # noqa: PLC0415
     from ..design.evaluate import combine, partials, profile_rates  # noqa: PLC0415
     from ..dynamics.determinacy import analyse  # noqa: PLC0415
