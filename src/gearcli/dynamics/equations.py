@@ -49,18 +49,13 @@ import weakref
 import numpy as np
 
 from ..model.belts import belt_arms
-from ..spatial import cross, mv
+from ..spatial import mv
 from .kinematics import Kinematics
 from ..algebra import ARRAYS, algebra_for, vectors
 from . import loss_terms
 from .losses import loss_couples, mesh_friction_moment, power_flow_sides, power_flow_terms, relative_rate
 from .column_terms import group_terms
-from .wrenches import term_direction, term_point, term_wrench
-
-
-def _force_at(d: np.ndarray, point: np.ndarray, origin: np.ndarray) -> np.ndarray:
-    """(N,6) wrench of unit force ``d`` (N,3) applied at ``point`` about ``origin``."""
-    return np.concatenate([d, cross(point - origin, d)], axis=1)
+from .wrenches import term_direction, term_point, term_wrench, worm_friction
 
 
 def _moment(d: np.ndarray) -> np.ndarray:
@@ -86,8 +81,8 @@ class Columns:
                 self.world[ci] = dict(belt=gp.belt, z=mv(Rc, c.belt.z), rate=relative_rate(an, kin, ci),
                                       **belt_arms(c.belt))
             elif gp.worm is not None and gp.worm.mu:         # the sliding friction along h at P
-                self.world[ci] = dict(P=kin.o[c.carrier] + mv(Rc, c.worm.P), hh=mv(Rc, c.worm.h_hat),
-                                      mu=gp.worm.mu, sv=np.sign(relative_rate(an, kin, ci)))
+                self.world[ci] = dict(mu=float(gp.worm.mu), sv=np.sign(relative_rate(an, kin, ci)),
+                                      h_hat=tuple(map(float, c.worm.h_hat)), point=tuple(map(float, c.worm.P)))
             elif any(el is not None and el.power_flow_lossy for el in (gp.screw, gp.reducer)):
                 self.world[ci] = dict(z=mv(Rc, c.zj), flow=power_flow_terms(an, ci, relative_rate(an, kin, ci)),
                                       sides=power_flow_sides(c, gp))
@@ -141,8 +136,12 @@ class Columns:
             sign = float(L == c.j) - float(L == c.k)
             return _moment(sign * sg * wv["sv"][:, None] * wv["fr"])
         if "mu" in wv:                    # sigma s_v mu h at P on the wheel, minus on the worm
-            d = (sg * wv["sv"][:, None] * wv["mu"]) * wv["hh"]
-            return (float(L == c.k) - float(L == c.j)) * _force_at(d, wv["P"], self.kin.o[L])
+            al, (R_c, o_c), o_L = self.al, self.kin.link_terms(c.carrier)[:2], self.kin.link_terms(L)[1]
+            f, P = worm_friction(al, sigma if isinstance(sigma, float) else sg[:, 0], wv["sv"], wv["mu"], R_c, o_c,
+                                 wv["h_hat"], wv["point"])
+            w = tuple(f) + al.cx(al.vsub(P, o_L), f)
+            return (float(L == c.k) - float(L == c.j)) * np.stack(np.broadcast_arrays(*w, self.kin.o[L][:, 0])[:6],
+                                                                  axis=1)
         if "flow" in wv:                  # delta coef z on the element's sides (c_r = 1 + delta)
             coef = sum(k for link, k in wv["sides"] if link == L)
             f = wv["flow"]

@@ -41,6 +41,16 @@ def term_wrench(al, moment: bool, coef, d, P, o_L) -> tuple:
     return al.scale(d, coef) + al.scale(al.cx(arm, d), coef)
 
 
+def worm_friction(al, sigma, s_v, mu, R_c, o_c, h_hat, point) -> tuple:
+    """(f, P): a worm pair's sliding friction on the wheel per unit of its flank load N, the
+    force f = sigma s_v mu R_c h_hat (base axes; the worm takes -f) at the contact point
+    P = o_c + R_c point (base frame): ``h_hat`` the unit sliding direction and ``point`` the
+    contact, both in the carrier c's frame (``R_c``, ``o_c``), ``sigma`` the sign of N and
+    ``s_v`` that of the worm's rate relative to the carrier (:mod:`gearcli.model.worms`)."""
+    coef = al.mul(al.mul(sigma, s_v), mu)
+    return al.scale(term_direction(al, h_hat, R_c), coef), term_point(al, point, R_c, o_c)
+
+
 def load_wrench(al, f, m, arm) -> tuple:
     """The wrench about o_L of a force f and moment m applied at the point o_L + arm (base
     axes): [f ; m + arm x f]."""

@@ -32,6 +32,7 @@ from .links import Sample, floats
 from .signs import SignedBlock, signs_of
 from .world import lu_solve
 from ..signs import sign_patterns
+from ..wrenches import worm_friction
 
 
 def _product_table(e: Emitter, tables: dict, name: str, products: list, index, key):
@@ -312,12 +313,11 @@ def world_columns(lp, bl, s: Sample):
 
 
 def _worm_friction(e: Emitter, s: Sample, worms, k: int, sigma):
-    """(f, P): a worm pair's friction force on the wheel per unit N, sigma s_v mu h_hat, and its
-    contact point, in world axes."""
+    """(f, P): worm pair k's friction force on the wheel per unit N and its contact point, in
+    world axes (:func:`..wrenches.worm_friction`)."""
     c = int(worms.carriers[k])
-    coef = e.mul(e.mul(sigma, s.worm_sv[k]), float(worms.mu[k]))
-    f = e.scale(e.mv(s.R[c], floats(worms.h_hat[k])), coef)
-    return f, e.vadd(s.o[c], e.mv(s.R[c], floats(worms.point[k])))
+    return worm_friction(e, sigma, s.worm_sv[k], float(worms.mu[k]), s.R[c], s.o[c], floats(worms.h_hat[k]),
+                         floats(worms.point[k]))
 
 
 def _reducer_delta(e: Emitter, terms, sigma):
