@@ -334,11 +334,12 @@ class VariantKernel:
         return by_groups(self.an, attach_flags(self.an, attach, n), run, n, carry=self._carry)
 
     def solve(self, p):
+        from ..dynamics.payloads import loads_at  # noqa: PLC0415
         # the variant's loads (their wrenches are run-time inputs), a trajectory's columns over them
         given = {ld.name: ld.wrench for ld in self.an.mech.loads} | dict(p.loads or {})
 
         def run(a, rows):
-            part = {k: (np.asarray(v, float)[rows] if np.ndim(v) == 2 else v) for k, v in given.items()}
+            part = loads_at(given, rows)
             return self.kernel.solve_bodies(a, p.q[rows], p.qd[rows], p.qdd[rows], part or None)
         return self._groups(p.attach, len(p.q), run)
 

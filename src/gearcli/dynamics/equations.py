@@ -51,7 +51,7 @@ import numpy as np
 from ..model.belts import belt_arms
 from ..spatial import mv
 from .kinematics import Kinematics
-from ..algebra import ARRAYS, algebra_for, vectors
+from ..algebra import ARRAYS, algebra_for, stack_vectors, vectors
 from . import loss_terms
 from .losses import loss_couples, mesh_friction_moment, power_flow_sides, power_flow_terms, relative_rate
 from .column_terms import group_terms
@@ -140,8 +140,7 @@ class Columns:
             f, P = worm_friction(al, sigma if isinstance(sigma, float) else sg[:, 0], wv["sv"], wv["mu"], R_c, o_c,
                                  wv["h_hat"], wv["point"])
             w = tuple(f) + al.cx(al.vsub(P, o_L), f)
-            return (float(L == c.k) - float(L == c.j)) * np.stack(np.broadcast_arrays(*w, self.kin.o[L][:, 0])[:6],
-                                                                  axis=1)
+            return (float(L == c.k) - float(L == c.j)) * stack_vectors(w, self.kin.n)
         if "flow" in wv:                  # delta coef z on the element's sides (c_r = 1 + delta)
             coef = sum(k for link, k in wv["sides"] if link == L)
             f = wv["flow"]

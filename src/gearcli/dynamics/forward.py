@@ -193,10 +193,10 @@ def forward_dynamics(an, q, qd, motor_torques, loads: dict | None = None, backen
     q, qd, T = sample_arrays({"q": (q, an.dof, joint_names(an)), "qd": (qd, an.dof, joint_names(an)),
                               "motor_torques": (motor_torques, len(motors), motors)})
     if attach:                  # payloads carried at some samples (:mod:`.payloads`)
-        from .payloads import attach_flags, by_groups  # noqa: PLC0415
+        from .payloads import attach_flags, by_groups, loads_at  # noqa: PLC0415
 
         def run(a, rows):
-            part = {k: (np.asarray(v, float)[rows] if np.ndim(v) == 2 else v) for k, v in (loads or {}).items()}
+            part = loads_at(loads, rows)
             return forward_dynamics(a, q[rows], qd[rows], T[rows], part or None, backend, jobs)
         return by_groups(an, attach_flags(an, attach, len(q)), run, len(q))
     target = np.einsum("nm,dm->nd", T, an.A)    # A T per sample; not matmul: BLAS threads would

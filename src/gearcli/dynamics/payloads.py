@@ -63,6 +63,12 @@ def groups(an, flags: np.ndarray) -> list[tuple[tuple[str, ...], np.ndarray]]:
     return out
 
 
+def loads_at(loads: dict | None, rows) -> dict:
+    """The per-sample load values of ``loads`` ({name: (N, 6) or (6,)}) at ``rows`` (a
+    group's samples); a constant wrench as it is."""
+    return {k: (np.asarray(v, float)[rows] if np.ndim(v) == 2 else v) for k, v in (loads or {}).items()}
+
+
 def by_groups(an, flags: np.ndarray, run, n: int, carry=carrying):
     """``run(analysis, rows)`` of every group of samples (:func:`groups`), its array results
     (samples first) scattered back to the n samples.  ``run`` returns a result whose array

@@ -356,13 +356,13 @@ def solve(an, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK, ver
         backend, or backend "llvm" where it is unavailable.
     """
     if attach:
-        from .payloads import attach_flags, by_groups  # noqa: PLC0415
+        from .payloads import attach_flags, by_groups, loads_at  # noqa: PLC0415
         q, qd, qdd = (np.atleast_2d(np.asarray(v, float)) for v in (q, qd, qdd))
         n = q.shape[0]
         flags = attach_flags(an, attach, n)
 
         def run(a, rows):
-            part = {k: (np.asarray(v, float)[rows] if np.ndim(v) == 2 else v) for k, v in (loads or {}).items()}
+            part = loads_at(loads, rows)
             return solver_for(a).solve(q[rows], qd[rows], qdd[rows], method=method, chunk=chunk, verify=verify,
                                        loads=part or None, backend=backend, jobs=jobs, check_finite=check_finite)
         return by_groups(an, flags, run, n)
