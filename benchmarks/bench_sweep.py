@@ -33,6 +33,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--variants", type=int, default=40)
     ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--rounds", type=int, default=3, help="sweeps timed one after another (the median is quoted: "
+                    "this shared machine's rate moves by 1.5x from one second to the next)")
     ap.add_argument("--numpy", action="store_true", help="time the numpy path (no data kernel)")
     ap.add_argument("--dask-workers", type=int, default=0, help="also time a dask LocalCluster of this many "
                     "single-threaded worker processes (0: not)")
@@ -60,12 +62,15 @@ def main() -> None:
     if args.numpy:
         sweep.data_kernel_applies = lambda varies: False
     plan = plan_sweep(load_manifest(tmp / "d.yaml"), varies)
-    t0 = time.perf_counter()
-    rows = run_sweep(plan, jobs=args.jobs)
-    dt = time.perf_counter() - t0
-    n = len(plan.variants)
+    n, times = len(plan.variants), []
+    for _ in range(args.rounds):
+        t0 = time.perf_counter()
+        rows = run_sweep(plan, jobs=args.jobs)
+        times.append(time.perf_counter() - t0)
+    dt = float(np.median(times))
     print(f"gearcli sweep, rated Bendix wrist, 10,000 samples, {len(rows[0])} checks a variant:")
-    print(f"  -j {args.jobs}: {n} variants in {dt:.2f} s: {n / dt:.2f} variants/s ({dt / n * 1e3:.0f} ms a variant); "
+    print(f"  -j {args.jobs}: {n} variants, median of {len(times)} rounds {dt:.2f} s: {n / dt:.2f} variants/s "
+          f"({dt / n * 1e3:.0f} ms a variant; rounds {', '.join(f'{n / x:.1f}' for x in times)} variants/s); "
           f"kernels built here: {len(compiles)} ({'numpy path' if args.numpy else 'data kernel'})")
     if args.dask_workers:
         from dask.distributed import LocalCluster

@@ -265,3 +265,31 @@ def test_payload_load_and_rating_variants_take_the_data_kernel(monkeypatch, desi
         assert [x[:4] + x[5:6] + x[7:] for x in a] == [x[:4] + x[5:6] + x[7:] for x in b]
         for x, y in zip(a, b):
             assert x[4] == pytest.approx(y[4], rel=1e-11, abs=1e-300), x[:3]
+
+
+def test_a_variant_reuses_only_the_parts_its_values_leave_alone():
+    """A variant's mechanism takes the joints, gears and motors built for an earlier variant
+    only when it shares those sections of the file (yaml_reader._build's reuse): a link's
+    mass changes no joint object, a bearing's rating gets its own joints; each equals the
+    mechanism built from scratch with the schema's checks."""
+    from gearcli.batch.manifest import load_manifest
+    from gearcli.batch.sweep import parse_vary, variant_data
+    from gearcli.io.yaml_reader import mechanism_from_data
+
+    manifest = load_manifest(DESIGN)
+    case = manifest.cases[0]
+    mass = (parse_vary("links.2.mass=2,3"),)
+    rating = (parse_vary("joints.J1.bearings.lower.C=1000,2000"),)
+
+    def built(varies, value, schema=False):
+        return mechanism_from_data(variant_data(manifest, varies, (value,))[case.name], str(case.mechanism),
+                                   schema=schema)
+    a, b = built(mass, 2.0), built(mass, 3.0)
+    assert b.joints is a.joints and b.gears is a.gears and b.motors is a.motors
+    assert b.links[2].mass == 3.0 and a.links[2].mass == 2.0
+    c, d = built(rating, 1000.0), built(rating, 2000.0)
+    assert c.joints is not d.joints and c.joints is not a.joints
+    assert (c.joints[0].bearings[0].C, d.joints[0].bearings[0].C) == (1000.0, 2000.0)
+    fresh = built(rating, 2000.0, schema=True)
+    assert [(j.name, [(x.name, x.C, x.C0) for x in j.bearings or ()]) for j in fresh.joints] == \
+        [(j.name, [(x.name, x.C, x.C0) for x in j.bearings or ()]) for j in d.joints]

@@ -121,7 +121,7 @@ def mechanism_from_data(data: dict, file: str = "<string>", lines: dict | None =
     later = Collector(file, lines)       # problems that leave the mechanism buildable (planet assembly)
     data = expand_planets(data, joint_geometry, col, later)
     col.raise_if_any()
-    mech = attach_yaml_ratings(_build(data, col, file, lines), data, col)
+    mech = _build(data, col, file, lines, reuse=not schema)
     if later.issues:
         col.issues[:0] = later.issues
     if col.issues and later.issues and len(col.issues) == len(later.issues):
@@ -178,21 +178,45 @@ class _Names:
             self.col.add(path, f"unknown {what} '{value}'")
 
 
-def _build(data: dict, col: Collector, file: str, lines: dict) -> Mechanism:
+def _build(data: dict, col: Collector, file: str, lines: dict, reuse: bool = False) -> Mechanism:
     """The Mechanism of validated ``data``: links, joints, gears, motors and loads in turn, each
-    checked for names, references and values."""
+    checked for names, references and values, then the ratings attached.  ``reuse``: the
+    joints, gears and motors of ``data`` built before from the very same section objects
+    (and the same link names) are taken again (:data:`_PARTS`: a sweep's variants share
+    the sections no value of theirs changes, :func:`gearcli.batch.sweep.variant_data`)."""
     links, link_list = _links(data, col)
     for key in ("base", "end_effector"):
         links.ref(data[key], key)
     loads = yaml_loads(data, col, set(links.first), data["base"])
-    return Mechanism(
+    sections = tuple(data.get(k) for k in ("joints", "gears", "motors"))
+    key = (*(id(x) for x in sections), tuple(links.first), data["base"])
+    hit = _PARTS.get(key) if reuse else None
+    if hit is not None and all(a is b for a, b in zip(hit[0], sections)):
+        parts = hit[1]
+    else:
+        hit, parts = None, (tuple(_joints(data, col, links)), tuple(_gears(data, col, links)),
+                            tuple(_motors(data, col, links)))
+    mech = Mechanism(
         name=data["name"], base=data["base"], end_effector=data["end_effector"],
-        links=tuple(link_list), joints=tuple(_joints(data, col, links)),
-        gears=tuple(_gears(data, col, links)), motors=tuple(_motors(data, col, links)),
+        links=tuple(link_list), joints=parts[0], gears=parts[1], motors=parts[2],
         gravity=np.asarray(data.get("gravity", [0.0, 0.0, -9.81]), float),
         source=file, lines=dict(lines), loads=loads,
         payloads=yaml_payloads(data, col, set(links.first), data["base"], loads),
     )
+    if hit is None:
+        mech = attach_yaml_ratings(mech, data, col)
+        if reuse and not col.issues:
+            if len(_PARTS) >= 16:
+                _PARTS.clear()
+            _PARTS[key] = (sections, (mech.joints, mech.gears, mech.motors))
+    return mech
+
+
+_PARTS: dict = {}
+"""(ids of the joints, gears and motors sections, link names, base) -> (those sections, their
+rated joints, gears and motors): the parts of the mechanisms built with ``reuse`` (the
+sections are kept, so that their ids stay theirs while they are keys).  The parts are
+frozen dataclasses, shared by the mechanisms built from the same sections."""
 
 
 def _links(data: dict, col: Collector) -> tuple[_Names, list[Link]]:
