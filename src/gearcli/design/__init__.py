@@ -6,3 +6,12 @@ stress; the RMS is :mod:`gearcli.report.rms`), and
 :mod:`checks` (the checks of one mechanism, evaluated on one trajectory at a time).
 May import :mod:`gearcli.model`, ``analysis``, ``dynamics`` and ``report``.
 """
+import numpy as np
+
+
+def magnitudes(x) -> np.ndarray:
+    """abs(x) as a new float array (0-d for a number) that the caller may change in place:
+    the checks' formulas run in place on it, as each (N,) temporary of a sweep's dozens of
+    checks a variant costs a pass over memory."""
+    out = np.array(x, float)
+    return np.abs(out, out=out)

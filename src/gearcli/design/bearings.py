@@ -26,6 +26,7 @@ import math
 import numpy as np
 
 from ..report.rms import trapezoid_weights
+from . import magnitudes
 
 
 def revolutions(rate, t, weights=None) -> np.ndarray:
@@ -33,7 +34,10 @@ def revolutions(rate, t, weights=None) -> np.ndarray:
     :func:`gearcli.report.rms.trapezoid_weights`, or ``weights``, those of ``t`` already
     computed), shape (N,); rate in rad/s, t in s."""
     w = trapezoid_weights(t) if weights is None else weights
-    return np.abs(np.asarray(rate, float)) * w / (2 * math.pi)
+    n = magnitudes(rate)                      # (in place)
+    n *= w
+    n /= 2 * math.pi
+    return n
 
 
 def life_sum(P, revs, p: float, a=1.0) -> float:
@@ -41,8 +45,15 @@ def life_sum(P, revs, p: float, a=1.0) -> float:
     uses up (P_k/C)^p / a_k of a million-revolution life (a_k the life modification factor,
     1 for the basic rating life)."""
     P = np.asarray(P, float)
-    w = np.asarray(revs, float) * (P * P * P if p == 3.0 else P ** p)     # a ball bearing's cube: products, not pow
-    return float(np.sum(w if np.ndim(a) == 0 and a == 1.0 else w / a))    # / 1.0 changes nothing
+    if p == 3.0:              # a ball bearing's cube: products, not pow (in place)
+        w = P * P
+        w *= P
+    else:
+        w = P ** p
+    w *= np.asarray(revs, float)
+    if not (np.ndim(a) == 0 and a == 1.0):      # / 1.0 changes nothing
+        w /= a
+    return float(np.sum(w))
 
 
 def equivalent_load(total: float, revs: float, p: float) -> float:
@@ -79,8 +90,11 @@ def required_equivalent_load(C: float, life_h: float, revolutions_per_hour: floa
 
 def static_equivalent_load(Fr, Fa, X0: float, Y0: float) -> np.ndarray:
     """ISO 76 static equivalent radial load P0 = max(X0 Fr + Y0 Fa, Fr), N, per sample."""
-    Fr, Fa = np.abs(np.asarray(Fr, float)), np.abs(np.asarray(Fa, float))
-    return np.maximum(X0 * Fr + Y0 * Fa, Fr)
+    Fr, Fa = magnitudes(Fr), magnitudes(Fa)
+    P = X0 * Fr
+    Fa *= Y0                  # (in place)
+    P += Fa
+    return np.maximum(P, Fr, out=P)
 
 
 def static_safety(allowable: float, peak: float) -> float:

@@ -50,9 +50,15 @@ def bearing_loads(s: Samples, joint: str, bearings) -> list[tuple[np.ndarray, np
         return [(c[f"joint:{joint}:radial"], axial)]
     R1x, R1y, R2x, R2y = split_components(*(c[f"joint:{joint}:{k}"] for k in ("fx", "fy", "mx", "my")),
                                           bearings[0].position, bearings[1].position)
-    # |(x, y)| as sqrt(x^2 + y^2): np.hypot's care for overflow costs 3x, and a load squared is far from it
-    return [(np.sqrt(x * x + y * y), axial if b.locating else none)
-            for x, y, b in ((R1x, R1y, bearings[0]), (R2x, R2y, bearings[1]))]
+    # |(x, y)| as sqrt(x^2 + y^2): np.hypot's care for overflow costs 3-7x, and a load squared is far from it
+    return [(_norm(x, y), axial if b.locating else none) for x, y, b in ((R1x, R1y, bearings[0]), (R2x, R2y, bearings[1]))]
+
+
+def _norm(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """sqrt(x^2 + y^2) per sample, in one new array."""
+    r = x * x
+    r += y * y
+    return np.sqrt(r, out=r)
 
 
 def signal(check: Check, s: Samples, mech, cache: dict | None = None) -> np.ndarray:
@@ -357,7 +363,7 @@ def combine(check: Check, parts: list[tuple], rates) -> Verdict:
     w = [1.0 if r is None else r for r in rates]         # RMS: equal repetitions when unknown
     per_hour = [r or 0.0 for r in rates]
     scores = [p[5] for p in parts]
-    worst = int(np.argmax(scores))
+    worst = 0 if len(scores) == 1 else int(np.argmax(scores))   # (one trajectory: no numpy call)
     t_worst = parts[worst][1]
     peak = max(p[0] for p in parts)
     if check.kind in ("peak", "energy"):

@@ -36,6 +36,7 @@ import math
 import numpy as np
 
 from ..model.ratings import STEEL_ELASTIC_COEFFICIENT
+from . import magnitudes
 
 # Shigley, Table 14-2: Lewis form factor Y, 20 deg pressure angle, full-depth teeth (the
 # same 25 rows in several public gear-rating codes that cite the table; the rack's 0.485
@@ -78,7 +79,10 @@ def lewis_bending_stress(Ft, module: float, face_width: float, Y: float, K: floa
     K : float
         Product of the load factors (application, load sharing, ...).
     """
-    return K * np.abs(np.asarray(Ft, float)) / (face_width * module * Y)
+    s = magnitudes(Ft)
+    s *= K
+    s /= face_width * module * Y
+    return s
 
 
 def zone_factor(pressure_angle: float, helix_angle: float = 0.0) -> float:
@@ -127,7 +131,13 @@ def hertz_contact_stress(Ft, d1: float, face_width: float, u: float, pressure_an
     """
     ratio = 1.0 - 1.0 / u if internal else 1.0 + 1.0 / u
     Z = zone_factor(pressure_angle, helix_angle) * helix_angle_factor(helix_angle) * ZE
-    return Z * np.sqrt(K * np.abs(np.asarray(Ft, float)) * ratio / (d1 * face_width))
+    s = magnitudes(Ft)                        # Z sqrt(K |Ft| ratio / (d1 b)), in place
+    s *= K
+    s *= ratio
+    s /= d1 * face_width
+    np.sqrt(s, out=s)
+    s *= Z
+    return s
 
 
 def virtual_spur(z: float, d: float, cone_angle: float) -> tuple[float, float]:

@@ -62,6 +62,8 @@ import math
 
 import numpy as np
 
+from . import magnitudes
+
 BALL_F0_FA_C0 = (0.172, 0.345, 0.689, 1.03, 1.38, 2.07, 3.45, 5.17, 6.89)
 BALL_E = (0.19, 0.22, 0.26, 0.28, 0.30, 0.34, 0.38, 0.42, 0.44)
 BALL_Y = (2.30, 1.99, 1.71, 1.55, 1.45, 1.31, 1.15, 1.04, 1.00)
@@ -103,11 +105,12 @@ def ball_factors(Fa, C0: float, f0: float | None = None) -> tuple[np.ndarray, np
     e, Y : ndarray, shape (N,)
         Linear interpolation between the tabulated rows, the end rows held outside them.
     """
-    Fa = np.abs(np.asarray(Fa, float))
+    x = magnitudes(Fa)
     if f0 is None:
-        x = Fa / C0
+        x /= C0
         return np.interp(x, CATALOGUE_FA_C0, CATALOGUE_E), np.interp(x, CATALOGUE_FA_C0, CATALOGUE_Y)
-    x = f0 * Fa / C0
+    x *= f0                   # f0 Fa / C0, in place
+    x /= C0
     return np.interp(x, BALL_F0_FA_C0, BALL_E), np.interp(x, BALL_F0_FA_C0, BALL_Y)
 
 
@@ -117,8 +120,13 @@ def dynamic_equivalent_load(Fr, Fa, X, Y, e) -> np.ndarray:
     P = Fr when Fa <= e Fr, else X Fr + Y Fa (with Fr = 0 and Fa > 0: P = Y Fa).  ``X``,
     ``Y``, ``e`` are floats or arrays of shape (N,) (per-sample table factors).
     """
-    Fr, Fa = np.abs(np.asarray(Fr, float)), np.abs(np.asarray(Fa, float))
-    return np.where(Fa <= e * Fr, Fr, X * Fr + Y * Fa)
+    Fr, Fa = magnitudes(Fr), magnitudes(Fa)
+    low = Fa <= e * Fr
+    P = np.multiply(X, Fr, out=np.empty_like(Fr))
+    Fa *= Y                   # (in place)
+    P += Fa
+    np.copyto(P, Fr, where=low)
+    return P
 
 
 def bearing_equivalent_load(b, Fr, Fa) -> np.ndarray:
