@@ -293,3 +293,41 @@ def test_a_variant_reuses_only_the_parts_its_values_leave_alone():
     fresh = built(rating, 2000.0, schema=True)
     assert [(j.name, [(x.name, x.C, x.C0) for x in j.bearings or ()]) for j in fresh.joints] == \
         [(j.name, [(x.name, x.C, x.C0) for x in j.bearings or ()]) for j in d.joints]
+
+
+def test_a_variant_of_a_loads_wrench_rereads_the_trajectory_and_of_its_mass_does_not(tmp_path, monkeypatch):
+    """The trajectory a variant reads is kept for the next while what the reading depends on
+    is unchanged: the loads' names and wrenches (a load: column replaces one component of the
+    file's wrench).  With a load:payload:fz column, a variant of the payload's force along x
+    (not a column) changes the solve, equal to the numpy path's; a variant of its mass reads
+    the file once for all."""
+    import gearcli.batch.sweep as sweep
+    import gearcli.io.trajectory as trajectory
+    from gearcli.batch.manifest import load_manifest
+    rows = (ROOT / "mechanisms" / "servo_joint_duty.csv").read_text().splitlines()
+    (tmp_path / "duty.csv").write_text("\n".join([rows[0] + ",load:payload:fz"] + [r + ",-25" for r in rows[1:]]) + "\n")
+    mech = (ROOT / "mechanisms" / "servo_joint_rated.yaml").read_text()
+    assert mech.count("force: [0, -10, -19.62]}") == 1
+    (tmp_path / "m.yaml").write_text(mech.replace("force: [0, -10, -19.62]}", "force: [0, -10, -19.62], mass: 1.0}"))
+    (tmp_path / "d.yaml").write_text("cases:\n  - {name: c, mechanism: m.yaml, trajectories: [duty.csv], "
+                                     "min_static_safety: 2.0}\n")
+    path = str(tmp_path / "d.yaml")
+    reads, real = [], trajectory.read_trajectory
+    monkeypatch.setattr(trajectory, "read_trajectory", lambda *a, **k: (reads.append(1), real(*a, **k))[1])
+
+    def run(vary):
+        plan = sweep.plan_sweep(load_manifest(path), [sweep.parse_vary(vary)])
+        reads.clear()
+        sweep._TRAJECTORIES.clear()
+        return [sweep.run_variant(path, plan.varies, values) for values in plan.variants]
+    kernel = run("loads.payload.force[0]=0,40,80")
+    assert len(reads) == 3 and len({tuple(r) for r in kernel}) == 3
+    monkeypatch.setattr(sweep, "data_kernel_applies", lambda varies: False)
+    numpy = run("loads.payload.force[0]=0,40,80")
+    for a, b in zip(kernel, numpy):
+        for x, y in zip(a, b):
+            assert x[4] == pytest.approx(y[4], rel=1e-11, abs=1e-300), x[:3]
+    monkeypatch.undo()
+    monkeypatch.setattr(trajectory, "read_trajectory", lambda *a, **k: (reads.append(1), real(*a, **k))[1])
+    masses = run("loads.payload.mass=0.5,1,2")
+    assert len(reads) == 1 and len({tuple(r) for r in masses}) == 3

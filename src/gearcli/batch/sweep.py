@@ -357,11 +357,21 @@ class VariantKernel:
         return {k: J[:, i] for i, k in enumerate(rated)}
 
 
-@lru_cache(maxsize=64)
 def _trajectory(path: str, names: tuple, degrees: bool, linear: tuple, loads: tuple, payloads: tuple):
+    """The trajectory file read for a variant, kept for the next: the reading depends on the
+    loads only by their names and wrenches (a ``load:`` column replaces a component of the
+    wrench), so a variant of a load's mass or inertia reads nothing again."""
     from ..io.trajectory import read_trajectory  # noqa: PLC0415
-    return read_trajectory(path, list(names), degrees=degrees, linear=np.asarray(linear, bool), loads=loads,
-                           payloads=list(payloads))
+    key = (path, names, degrees, linear, tuple((ld.name, ld.wrench.tobytes()) for ld in loads), payloads)
+    if key not in _TRAJECTORIES:
+        if len(_TRAJECTORIES) >= 64:
+            _TRAJECTORIES.clear()
+        _TRAJECTORIES[key] = read_trajectory(path, list(names), degrees=degrees, linear=np.asarray(linear, bool),
+                                             loads=loads, payloads=list(payloads))
+    return _TRAJECTORIES[key]
+
+
+_TRAJECTORIES: dict = {}
 
 
 def run_variant(manifest_path: str, varies: tuple[Vary, ...], values: tuple[float, ...]) -> list[tuple]:
