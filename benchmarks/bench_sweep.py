@@ -2,7 +2,7 @@
 rated Bendix wrist over a 10,000-sample duty cycle, every check, at >= 50 variants/s with one
 compile in all); prints figures, not a test.
 
-    python benchmarks/bench_sweep.py [--variants 40] [--jobs 1] [--dask-workers 0]
+    python benchmarks/bench_sweep.py [--variants 200] [--rounds 3] [--points 1] [--jobs 1] [--dask-workers 0]
 
 The duty cycle is the bundled Bendix motion resampled to 10,000 samples (a temporary file),
 verified with designs/ci_example.yaml's checks; the variants vary the tool flange's mass, its
@@ -38,6 +38,8 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=3, help="sweeps timed one after another (the median is quoted: "
                     "this shared machine's rate moves by 1.5x from one second to the next)")
     ap.add_argument("--numpy", action="store_true", help="time the numpy path (no data kernel)")
+    ap.add_argument("--points", type=int, default=1, help="also vary the tool's point (a constant of the kernel: "
+                    "one data kernel per point) over this many values, the variants split among them")
     ap.add_argument("--dask-workers", type=int, default=0, help="also time a dask LocalCluster of this many "
                     "single-threaded worker processes (0: not)")
     args = ap.parse_args()
@@ -56,9 +58,11 @@ def main() -> None:
     design = design.replace("../mechanisms/bendix_wrist_rated.yaml", str(tmp / "wrist.yaml"))
     design = design.replace("../mechanisms/bendix_wrist_traj.csv", str(tmp / "traj.csv"))
     (tmp / "d.yaml").write_text(design)
-    n_mass = max(1, args.variants // 10)
+    n_mass = max(1, args.variants // (10 * args.points))
     varies = [parse_vary(f"links.3.mass=0.6:1.2:{n_mass}"), parse_vary("links.3.inertia.izz=0.0011,0.0015"),
               parse_vary("loads.tool.mass=0.2:1.0:5")]
+    if args.points > 1:
+        varies.insert(0, parse_vary(f"loads.tool.point[1]=0.04:0.08:{args.points}"))
     compiles = []
     real = driver.Jit.__init__
 
@@ -67,7 +71,7 @@ def main() -> None:
         real(self, *a, **k)
     driver.Jit.__init__ = counted
     if args.numpy:
-        sweep.data_kernel_applies = lambda varies: False
+        sweep.data_kernel_applies = sweep.structure_kernels_apply = lambda varies: False
     plan = plan_sweep(load_manifest(tmp / "d.yaml"), varies)
     n, times = len(plan.variants), []
     for _ in range(args.rounds):

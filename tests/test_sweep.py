@@ -331,3 +331,32 @@ def test_a_variant_of_a_loads_wrench_rereads_the_trajectory_and_of_its_mass_does
     monkeypatch.setattr(trajectory, "read_trajectory", lambda *a, **k: (reads.append(1), real(*a, **k))[1])
     masses = run("loads.payload.mass=0.5,1,2")
     assert len(reads) == 1 and len({tuple(r) for r in masses}) == 3
+
+
+def test_a_constant_of_the_kernel_gets_a_data_kernel_per_value(monkeypatch):
+    """A load's point is a constant of the kernel; with 8 variants of run-time values for each
+    of its two values (sweep.STRUCTURE_VARIANTS), each point gets one data kernel, which
+    solves its 8 variants: 2 kernels for 16 variants, and every check's value equal to the
+    numpy path's (each variant's mechanism analysed afresh) to 1e-11.  With fewer variants
+    a value, the numpy path."""
+    import gearcli.batch.sweep as sweep
+    from gearcli.batch.manifest import load_manifest
+    from gearcli.dynamics.llvm import driver
+    path = str(ROOT / "designs" / "servo_joint_losses.yaml")
+    varies = [sweep.parse_vary(t) for t in ("loads.payload.point[0]=0.05,0.08", "links.carrier.mass=0.3:0.6:4",
+                                             "loads.payload.force[2]=-19.62,-30")]
+    assert not sweep.data_kernel_applies(varies) and sweep.structure_kernels_apply(varies)
+    assert not sweep.structure_kernels_apply(varies[:2])          # 4 variants a point: numpy
+    plan = sweep.plan_sweep(load_manifest(path), varies)
+    sweep._STRUCTURES.clear()
+    built, real = [], driver.Jit.__init__
+    monkeypatch.setattr(driver.Jit, "__init__", lambda self, *a, **k: (built.append(1), real(self, *a, **k))[1])
+    kernel = [sweep.run_variant(path, plan.varies, values) for values in plan.variants]
+    assert len(plan.variants) == 16 and len(built) == 2
+    monkeypatch.setattr(sweep, "structure_kernels_apply", lambda varies: False)
+    numpy = [sweep.run_variant(path, plan.varies, values) for values in plan.variants]
+    assert len(built) == 2 and len({tuple(r) for r in kernel}) == 16
+    for a, b in zip(kernel, numpy):
+        assert [x[:4] + x[5:6] + x[7:] for x in a] == [x[:4] + x[5:6] + x[7:] for x in b]
+        for x, y in zip(a, b):
+            assert x[4] == pytest.approx(y[4], rel=1e-11, abs=1e-300), x[:3]

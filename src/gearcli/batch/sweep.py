@@ -290,6 +290,43 @@ def data_kernel_applies(varies) -> bool:
     return all(run_time(v.steps) or checks_only(v.steps) for v in varies)
 
 
+STRUCTURE_VARIANTS = 8
+"""Variants per value of the other --vary paths (a ratio, a radius, a point) from which each
+such value gets a data kernel of its own (:func:`structure_kernels_apply`): a compile costs
+what the numpy path takes for 2-10 variants (the Bendix wrist's 0.8 s against 95 ms a
+variant of 10,000 samples; once in the disk cache, nothing)."""
+
+
+def structure_kernels_apply(varies) -> bool:
+    """True when some --vary names a value the data kernel takes as a constant (a ratio, a
+    radius, a load's point: not :func:`data_kernel_applies`) and the others, which it reads
+    at run time or the checks alone read, make at least :data:`STRUCTURE_VARIANTS` variants
+    of each of its values: each such value then gets a data kernel that solves its variants
+    (:func:`_structure_solver`), where the numpy path would solve each."""
+    data = [v for v in varies if run_time(v.steps) or checks_only(v.steps)]
+    return len(data) < len(varies) and math.prod(len(v.values) for v in data) >= STRUCTURE_VARIANTS
+
+
+def _structure_solver(mech_path: str, key: tuple, mech):
+    """The data solver of the mechanism ``mech`` whose constants (not its inertial values, its
+    loads' wrenches or its ratings) are those of the values ``key`` ((path, value) of the
+    --vary paths that are not the data kernel's), built for the first variant of those
+    values and kept for the next (the last 4 kept: a grid's variants come value by value),
+    or None where the llvm backend cannot solve it."""
+    from ..dynamics.determinacy import analyse  # noqa: PLC0415
+    from ..dynamics.solve import Solver  # noqa: PLC0415
+    k = (mech_path, key)
+    if k not in _STRUCTURES:
+        if len(_STRUCTURES) >= 4:
+            _STRUCTURES.pop(next(iter(_STRUCTURES)))
+        solver = Solver(analyse(mech), data_bodies=True)
+        _STRUCTURES[k] = solver if solver.llvm_available() else None
+    return _STRUCTURES[k]
+
+
+_STRUCTURES: dict = {}
+
+
 @lru_cache(maxsize=8)
 def _data_solver(mech_path: str):
     """A solver of the mechanism file as it is whose kernel reads the links' inertial values
@@ -380,7 +417,9 @@ def run_variant(manifest_path: str, varies: tuple[Vary, ...], values: tuple[floa
     out: a local process or a Dask worker runs it the same).  Variants of values the data
     kernel reads at run time or the checks alone read are solved by one data kernel per
     mechanism and process (:func:`data_kernel_applies`), payloads picked and placed included;
-    the others by the numpy path."""
+    the others by the numpy path, or, where a value of theirs has
+    :data:`STRUCTURE_VARIANTS` variants or more (:func:`structure_kernels_apply`), by a data
+    kernel per value."""
     from ..design.checks import build_checks  # noqa: PLC0415
     from ..design.evaluate import combine, partials, profile_rates  # noqa: PLC0415
     from ..dynamics.determinacy import analyse  # noqa: PLC0415
@@ -390,13 +429,18 @@ def run_variant(manifest_path: str, varies: tuple[Vary, ...], values: tuple[floa
 
     manifest = _manifest(manifest_path)
     datas = variant_data(manifest, varies, values)
-    data_kernel = data_kernel_applies(varies)
+    data_kernel, structures = data_kernel_applies(varies), structure_kernels_apply(varies)
     out = []
     for case in manifest.cases:
         # every value passed the schema alone (plan_sweep): the model's checks run here
         mech = mechanism_from_data(datas[case.name], str(case.mechanism), schema=False)
         solver = _data_solver(str(case.mechanism)) if data_kernel else None
-        # the links' inertial values change no part of the analysis (topology, geometry, schedule)
+        if structures:
+            key = tuple((v.path, x) for v, x in zip(varies, values) if (v.case is None or v.case == case.name)
+                        and not (run_time(v.steps) or checks_only(v.steps)))
+            solver = _structure_solver(str(case.mechanism), key, mech) if key else _data_solver(str(case.mechanism))
+        # the links' inertial values change no part of the analysis (topology, geometry, schedule):
+        # the solver's, of the same constants, serves
         an = analyse(mech) if solver is None else dataclasses.replace(solver.an, mech=mech)
         checks = build_checks(an, case.req, Collector(str(case.mechanism)))
         parts = []
