@@ -71,7 +71,7 @@ def main() -> None:
         real(self, *a, **k)
     driver.Jit.__init__ = counted
     if args.numpy:
-        sweep.data_kernel_applies = sweep.structure_kernels_apply = lambda varies: False
+        sweep.data_kernel_applies = sweep.per_value_kernels = lambda varies, variants=None: False
     plan = plan_sweep(load_manifest(tmp / "d.yaml"), varies)
     n, times = len(plan.variants), []
     for _ in range(args.rounds):

@@ -6,6 +6,7 @@ local processes or on a Dask cluster; bad paths and values are located errors be
 anything runs, nothing written."""
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -338,23 +339,25 @@ def test_a_constant_of_the_kernel_gets_a_data_kernel_per_value(monkeypatch):
     of its two values (sweep.STRUCTURE_VARIANTS), each point gets one data kernel, which
     solves its 8 variants: 2 kernels for 16 variants, and every check's value equal to the
     numpy path's (each variant's mechanism analysed afresh) to 1e-11.  With fewer variants
-    a value, the numpy path."""
+    a value (a smaller grid, or random points that rarely repeat one), the numpy path."""
     import gearcli.batch.sweep as sweep
     from gearcli.batch.manifest import load_manifest
     from gearcli.dynamics.llvm import driver
     path = str(ROOT / "designs" / "servo_joint_losses.yaml")
     varies = [sweep.parse_vary(t) for t in ("loads.payload.point[0]=0.05,0.08", "links.carrier.mass=0.3:0.6:4",
                                              "loads.payload.force[2]=-19.62,-30")]
-    assert not sweep.data_kernel_applies(varies) and sweep.structure_kernels_apply(varies)
-    assert not sweep.structure_kernels_apply(varies[:2])          # 4 variants a point: numpy
-    plan = sweep.plan_sweep(load_manifest(path), varies)
+    manifest = load_manifest(path)
+    plan = sweep.plan_sweep(manifest, varies)
+    assert not sweep.data_kernel_applies(varies) and plan.per_value_kernels
+    assert not sweep.plan_sweep(manifest, varies[:2]).per_value_kernels               # 4 variants a point: numpy
+    spread = [sweep.parse_vary("loads.payload.point[0]=0.02:0.09:8")] + varies[1:]
+    assert not sweep.plan_sweep(manifest, spread, samples=16, seed=1).per_value_kernels   # ~2 a point: numpy
     sweep._STRUCTURES.clear()
     built, real = [], driver.Jit.__init__
     monkeypatch.setattr(driver.Jit, "__init__", lambda self, *a, **k: (built.append(1), real(self, *a, **k))[1])
-    kernel = [sweep.run_variant(path, plan.varies, values) for values in plan.variants]
+    kernel = sweep.run_sweep(plan)
     assert len(plan.variants) == 16 and len(built) == 2
-    monkeypatch.setattr(sweep, "structure_kernels_apply", lambda varies: False)
-    numpy = [sweep.run_variant(path, plan.varies, values) for values in plan.variants]
+    numpy = sweep.run_sweep(dataclasses.replace(plan, per_value_kernels=False))
     assert len(built) == 2 and len({tuple(r) for r in kernel}) == 16
     for a, b in zip(kernel, numpy):
         assert [x[:4] + x[5:6] + x[7:] for x in a] == [x[:4] + x[5:6] + x[7:] for x in b]

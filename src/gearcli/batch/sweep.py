@@ -170,6 +170,7 @@ class Plan:
     manifest_path: str
     varies: tuple[Vary, ...]
     variants: tuple[tuple[float, ...], ...]
+    per_value_kernels: bool = False     # a data kernel per value of the kernel's constants (:func:`per_value_kernels`)
 
 
 @lru_cache(maxsize=8)
@@ -242,7 +243,7 @@ def plan_sweep(manifest, varies: list[Vary], samples: int | None = None, seed: i
             raise GearcliError(f"--samples: expected at least 1, got {samples}")
         grid = np.random.default_rng(seed).integers(0, sizes, size=(samples, len(sizes)))
     variants = tuple(tuple(v.values[i] for v, i in zip(varies, row)) for row in grid)
-    return Plan(str(manifest.path), tuple(varies), variants)
+    return Plan(str(manifest.path), tuple(varies), variants, per_value_kernels(varies, variants))
 
 
 @lru_cache(maxsize=4)
@@ -292,19 +293,24 @@ def data_kernel_applies(varies) -> bool:
 
 STRUCTURE_VARIANTS = 8
 """Variants per value of the other --vary paths (a ratio, a radius, a point) from which each
-such value gets a data kernel of its own (:func:`structure_kernels_apply`): a compile costs
+such value gets a data kernel of its own (:func:`per_value_kernels`): a compile costs
 what the numpy path takes for 2-10 variants (the Bendix wrist's 0.8 s against 95 ms a
 variant of 10,000 samples; once in the disk cache, nothing)."""
 
 
-def structure_kernels_apply(varies) -> bool:
+def per_value_kernels(varies, variants) -> bool:
     """True when some --vary names a value the data kernel takes as a constant (a ratio, a
-    radius, a load's point: not :func:`data_kernel_applies`) and the others, which it reads
-    at run time or the checks alone read, make at least :data:`STRUCTURE_VARIANTS` variants
-    of each of its values: each such value then gets a data kernel that solves its variants
-    (:func:`_structure_solver`), where the numpy path would solve each."""
-    data = [v for v in varies if run_time(v.steps) or checks_only(v.steps)]
-    return len(data) < len(varies) and math.prod(len(v.values) for v in data) >= STRUCTURE_VARIANTS
+    radius, a load's point: not :func:`data_kernel_applies`) and the planned ``variants``
+    have on average at least :data:`STRUCTURE_VARIANTS` for each combination of such values
+    (the others vary the values the kernel reads at run time or the checks alone read):
+    each combination then gets a data kernel that solves its variants
+    (:func:`_structure_solver`), where the numpy path would solve each.  (Random points,
+    ``--samples``, rarely repeat a combination: the numpy path.)"""
+    fixed = [i for i, v in enumerate(varies) if not (run_time(v.steps) or checks_only(v.steps))]
+    if not fixed:
+        return False
+    combos = {tuple(x[i] for i in fixed) for x in variants}
+    return len(variants) >= STRUCTURE_VARIANTS * len(combos)
 
 
 def _structure_solver(mech_path: str, key: tuple, mech):
@@ -411,15 +417,16 @@ def _trajectory(path: str, names: tuple, degrees: bool, linear: tuple, loads: tu
 _TRAJECTORIES: dict = {}
 
 
-def run_variant(manifest_path: str, varies: tuple[Vary, ...], values: tuple[float, ...]) -> list[tuple]:
+def run_variant(manifest_path: str, varies: tuple[Vary, ...], values: tuple[float, ...],
+                per_value: bool = False) -> list[tuple]:
     """Every check of the manifest on one variant: [(case, component, quantity, unit, value,
     limit, margin %, passed)] in the manifest's order of cases and checks (picklable in and
     out: a local process or a Dask worker runs it the same).  Variants of values the data
     kernel reads at run time or the checks alone read are solved by one data kernel per
     mechanism and process (:func:`data_kernel_applies`), payloads picked and placed included;
     the others by the numpy path, or, where a value of theirs has
-    :data:`STRUCTURE_VARIANTS` variants or more (:func:`structure_kernels_apply`), by a data
-    kernel per value."""
+    :data:`STRUCTURE_VARIANTS` variants or more (``per_value``: the plan's
+    :func:`per_value_kernels`), by a data kernel per value."""
     from ..design.checks import build_checks  # noqa: PLC0415
     from ..design.evaluate import combine, partials, profile_rates  # noqa: PLC0415
     from ..dynamics.determinacy import analyse  # noqa: PLC0415
@@ -429,7 +436,7 @@ def run_variant(manifest_path: str, varies: tuple[Vary, ...], values: tuple[floa
 
     manifest = _manifest(manifest_path)
     datas = variant_data(manifest, varies, values)
-    data_kernel, structures = data_kernel_applies(varies), structure_kernels_apply(varies)
+    data_kernel, structures = data_kernel_applies(varies), per_value and not data_kernel_applies(varies)
     out = []
     for case in manifest.cases:
         # every value passed the schema alone (plan_sweep): the model's checks run here
@@ -466,7 +473,7 @@ def _chunks(n: int, size: int) -> list[range]:
     return [range(a, min(a + size, n)) for a in range(0, n, size)]
 
 
-def _run_chunk(manifest_path: str, varies, variants) -> list:
+def _run_chunk(manifest_path: str, varies, variants, per_value: bool = False) -> list:
     """:func:`run_variant` of each variant; a variant that cannot be built or solved (values
     that are each valid alone but not together, a belt that goes slack) is the one-line
     reason, a string, in its place."""
@@ -475,7 +482,7 @@ def _run_chunk(manifest_path: str, varies, variants) -> list:
     out = []
     for values in variants:
         try:
-            out.append(run_variant(manifest_path, varies, values))
+            out.append(run_variant(manifest_path, varies, values, per_value))
         except GearcliError as exc:
             out.append(" ".join(exc.lines()[0].split()) if exc.lines() else str(exc))
     return out
@@ -506,7 +513,7 @@ def run_sweep(plan: Plan, jobs: int = 1, dask_address: str | None = None, progre
             progress(len(idx))
 
     def args(idx: list):
-        return plan.manifest_path, plan.varies, [plan.variants[i] for i in idx]
+        return plan.manifest_path, plan.varies, [plan.variants[i] for i in idx], plan.per_value_kernels
 
     if dask_address is not None:
         from dask.distributed import as_completed as dask_completed  # noqa: PLC0415 (optional)
