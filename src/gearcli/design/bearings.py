@@ -34,7 +34,9 @@ def revolutions(rate, t, weights=None) -> np.ndarray:
     :func:`gearcli.report.rms.trapezoid_weights`, or ``weights``, those of ``t`` already
     computed), shape (N,); rate in rad/s, t in s."""
     w = trapezoid_weights(t) if weights is None else weights
-    n = magnitudes(rate)                      # (in place)
+    n = magnitudes(rate)                      # (in place, but for a broadcast)
+    if n.shape != np.shape(w):
+        return n * w / (2 * math.pi)
     n *= w
     n /= 2 * math.pi
     return n
@@ -50,7 +52,8 @@ def life_sum(P, revs, p: float, a=1.0) -> float:
         w *= P
     else:
         w = P ** p
-    w *= np.asarray(revs, float)
+    revs = np.asarray(revs, float)
+    w = w * revs if np.shape(w) != revs.shape else np.multiply(w, revs, out=w)
     if not (np.ndim(a) == 0 and a == 1.0):      # / 1.0 changes nothing
         w /= a
     return float(np.sum(w))
@@ -91,6 +94,8 @@ def required_equivalent_load(C: float, life_h: float, revolutions_per_hour: floa
 def static_equivalent_load(Fr, Fa, X0: float, Y0: float) -> np.ndarray:
     """ISO 76 static equivalent radial load P0 = max(X0 Fr + Y0 Fa, Fr), N, per sample."""
     Fr, Fa = magnitudes(Fr), magnitudes(Fa)
+    if Fr.shape != Fa.shape:  # broadcast: not in place
+        return np.maximum(X0 * Fr + Y0 * Fa, Fr)
     P = X0 * Fr
     Fa *= Y0                  # (in place)
     P += Fa

@@ -122,7 +122,9 @@ def dynamic_equivalent_load(Fr, Fa, X, Y, e) -> np.ndarray:
     """
     Fr, Fa = magnitudes(Fr), magnitudes(Fa)
     low = Fa <= e * Fr
-    P = np.multiply(X, Fr, out=np.empty_like(Fr))
+    if Fa.shape != low.shape or np.shape(Y) not in ((), Fa.shape):      # broadcast: not in place
+        return np.where(low, Fr, X * Fr + Y * Fa)
+    P = np.multiply(X, Fr, out=np.empty(low.shape))
     Fa *= Y                   # (in place)
     P += Fa
     np.copyto(P, Fr, where=low)
