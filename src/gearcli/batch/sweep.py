@@ -165,7 +165,8 @@ def _set(data, v: Vary, value: float) -> None:
 @dataclass(frozen=True)
 class Plan:
     """What a sweep runs: the manifest, its ``varies`` and the variants (per variant one
-    value per vary)."""
+    value per vary), and whether each value of the kernel's constants gets a data kernel
+    (:func:`per_value_kernels`)."""
 
     manifest_path: str
     varies: tuple[Vary, ...]
@@ -436,7 +437,8 @@ def run_variant(manifest_path: str, varies: tuple[Vary, ...], values: tuple[floa
 
     manifest = _manifest(manifest_path)
     datas = variant_data(manifest, varies, values)
-    data_kernel, structures = data_kernel_applies(varies), per_value and not data_kernel_applies(varies)
+    data_kernel = data_kernel_applies(varies)
+    structures = per_value and not data_kernel
     out = []
     for case in manifest.cases:
         # every value passed the schema alone (plan_sweep): the model's checks run here
