@@ -8,7 +8,7 @@ The duty cycle is the bundled Bendix motion resampled to 10,000 samples (a tempo
 verified with designs/ci_example.yaml's checks; the variants vary the tool flange's mass, its
 inertia about its axis and the mass of a tool (a load) on it: values a data kernel reads at
 run time (a gear ratio of the wrist is not one: each pair's ratio is fixed by its mesh
-point, and a variant of one alone is a row that could not run), so one kernel (compiled,
+point, and a variant of one alone is refused before anything runs), so one kernel (compiled,
 or loaded from the disk cache) solves every variant of a process; ``--numpy`` times the numpy
 path instead.  The script prints the variants per second, the kernels built in this process
 (a Dask or -j run's workers build their own), and the load average.

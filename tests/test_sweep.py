@@ -120,6 +120,7 @@ def test_the_plot_of_one_and_two_values(run_cli, tmp_path):
     ("links.2.mass=1:2:0", "expected 1 <= n"),
     ("links.2.mass", "expected PATH=VALUES"),
     ("elsewhere:links.2.mass=1", "no case named 'elsewhere'"),
+    ("gears.5-1.ratio=-3,-2.5", "the value -2.5: gears[0].ratio: ratio -2.5 contradicts the mesh geometry"),
 ])
 def test_bad_paths_and_values_are_located_before_anything_runs(run_cli, tmp_path, vary, said):
     out = tmp_path / "s.csv"

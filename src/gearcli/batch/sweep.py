@@ -202,7 +202,9 @@ def plan_sweep(manifest, varies: list[Vary], samples: int | None = None, seed: i
     """The variants of ``varies`` over ``manifest``'s cases, every path and value checked
     before anything runs: a case name that is not the manifest's, a path a case's mechanism
     lacks, a mechanism that is not YAML, a value the file would not accept (each value tried
-    alone, the others at the file's own values)."""
+    alone, the others at the file's own values; a value of a constant of the kernel (a ratio,
+    a point) analysed too: a ratio that contradicts its pair's mesh point)."""
+    from ..dynamics.determinacy import analyse  # noqa: PLC0415
     from ..io.yaml_reader import mechanism_from_data  # noqa: PLC0415
     if not varies:
         raise GearcliError("sweep: give at least one --vary PATH=VALUES")
@@ -228,7 +230,9 @@ def plan_sweep(manifest, varies: list[Vary], samples: int | None = None, seed: i
             for x in dict.fromkeys(v.values):
                 data = variant_data(manifest, [v], [x])[case.name]
                 try:
-                    mechanism_from_data(data, str(case.mechanism))
+                    mech = mechanism_from_data(data, str(case.mechanism))
+                    if not (run_time(v.steps) or checks_only(v.steps)):     # a ratio against its mesh point, ...
+                        analyse(mech)
                 except MechanismError as exc:
                     i = exc.issues[0]
                     said = f"{i.path}: {i.message}" if i.path else i.message
