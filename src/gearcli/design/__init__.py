@@ -9,9 +9,10 @@ May import :mod:`gearcli.model`, ``analysis``, ``dynamics`` and ``report``.
 import numpy as np
 
 
-def magnitudes(x) -> np.ndarray:
-    """abs(x) as a new float array (0-d for a number) that the caller may change in place:
-    the checks' formulas run in place on it, as each (N,) temporary of a sweep's dozens of
-    checks a variant costs a pass over memory."""
-    out = np.array(x, float)
-    return np.abs(out, out=out)
+def magnitudes(x, *others) -> np.ndarray:
+    """abs(x) as a new float array of the shape x broadcasts to with ``others`` (0-d for
+    numbers), which the caller may change in place with any of them: the checks' formulas
+    run in place on it, as each (N,) temporary of a sweep's dozens of checks a variant
+    costs a pass over memory."""
+    out = np.empty(np.broadcast_shapes(np.shape(x), *(np.shape(v) for v in others)))
+    return np.abs(np.asarray(x, float), out=out)

@@ -34,9 +34,7 @@ def revolutions(rate, t, weights=None) -> np.ndarray:
     :func:`gearcli.report.rms.trapezoid_weights`, or ``weights``, those of ``t`` already
     computed), shape (N,); rate in rad/s, t in s."""
     w = trapezoid_weights(t) if weights is None else weights
-    n = magnitudes(rate)                      # (in place, but for a broadcast)
-    if n.shape != np.shape(w):
-        return n * w / (2 * math.pi)
+    n = magnitudes(rate, w)                   # (in place)
     n *= w
     n /= 2 * math.pi
     return n
@@ -46,14 +44,14 @@ def life_sum(P, revs, p: float, a=1.0) -> float:
     """Palmgren-Miner sum of a duty, sum_k n_k P_k^p / a_k (rev N^p): each revolution at P_k
     uses up (P_k/C)^p / a_k of a million-revolution life (a_k the life modification factor,
     1 for the basic rating life)."""
-    P = np.asarray(P, float)
-    if p == 3.0:              # a ball bearing's cube: products, not pow (in place)
-        w = P * P
+    P, revs = np.asarray(P, float), np.asarray(revs, float)
+    w = np.empty(np.broadcast_shapes(P.shape, revs.shape))      # (in place)
+    if p == 3.0:              # a ball bearing's cube: products, not pow
+        np.multiply(P, P, out=w)
         w *= P
     else:
-        w = P ** p
-    revs = np.asarray(revs, float)
-    w = w * revs if np.shape(w) != revs.shape else np.multiply(w, revs, out=w)
+        np.power(P, p, out=w)
+    w *= revs
     if not (np.ndim(a) == 0 and a == 1.0):      # / 1.0 changes nothing
         w /= a
     return float(np.sum(w))
@@ -93,10 +91,8 @@ def required_equivalent_load(C: float, life_h: float, revolutions_per_hour: floa
 
 def static_equivalent_load(Fr, Fa, X0: float, Y0: float) -> np.ndarray:
     """ISO 76 static equivalent radial load P0 = max(X0 Fr + Y0 Fa, Fr), N, per sample."""
-    Fr, Fa = magnitudes(Fr), magnitudes(Fa)
-    if Fr.shape != Fa.shape:  # broadcast: not in place
-        return np.maximum(X0 * Fr + Y0 * Fa, Fr)
-    P = X0 * Fr
+    Fr, Fa = magnitudes(Fr, Fa), magnitudes(Fa, Fr)
+    P = np.multiply(X0, Fr, out=np.empty_like(Fr))
     Fa *= Y0                  # (in place)
     P += Fa
     return np.maximum(P, Fr, out=P)

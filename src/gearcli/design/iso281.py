@@ -120,11 +120,9 @@ def dynamic_equivalent_load(Fr, Fa, X, Y, e) -> np.ndarray:
     P = Fr when Fa <= e Fr, else X Fr + Y Fa (with Fr = 0 and Fa > 0: P = Y Fa).  ``X``,
     ``Y``, ``e`` are floats or arrays of shape (N,) (per-sample table factors).
     """
-    Fr, Fa = magnitudes(Fr), magnitudes(Fa)
+    Fr, Fa = magnitudes(Fr, Fa, X, Y, e), magnitudes(Fa, Fr, X, Y, e)
     low = Fa <= e * Fr
-    if Fa.shape != low.shape or np.shape(Y) not in ((), Fa.shape):      # broadcast: not in place
-        return np.where(low, Fr, X * Fr + Y * Fa)
-    P = np.multiply(X, Fr, out=np.empty(low.shape))
+    P = np.multiply(X, Fr, out=np.empty_like(Fr))
     Fa *= Y                   # (in place)
     P += Fa
     np.copyto(P, Fr, where=low)
