@@ -144,18 +144,30 @@ class Drive:
         return (u - self.R[k] * current - self.kt[k] * w) / self.L
 
 
+def _limits(ss, mode, q, qd, qdd, T, backend, t):
+    """:meth:`.stick_slip.StickSlip.limits` at one state, its failures those of
+    :func:`_accelerations`."""
+    return _located(lambda: ss.limits(mode, q, qd, qdd, T, backend)[0], qd, t)
+
+
 def _accelerations(ss, mode, q, qd, T, backend, t):
     """(qdd, Q) of :meth:`.stick_slip.StickSlip.accelerations` (the held dynamics of the
-    mode); its failures a :class:`SimulationError` at time(s) t: a value that is not finite,
-    an acceleration with losses that does not settle, a sign search or bearing friction
-    that fails (named by its time), an integration that diverged."""
+    mode) at time(s) t, its failures those of :func:`_located`."""
+    return _located(lambda: ss.accelerations(mode, np.atleast_2d(q), np.atleast_2d(qd), np.atleast_2d(T), backend),
+                    qd, t)
+
+
+def _located(work, qd, t):
+    """``work()``, its failures a :class:`SimulationError` at time(s) t: a value that is not
+    finite, an acceleration with losses that does not settle, a sign search or bearing
+    friction that fails (named by its time), an integration that diverged (rates ``qd``)."""
     from .bearing_friction import BearingFrictionError  # noqa: PLC0415
     from .losses import SlackError  # noqa: PLC0415
     from .signs import SignError                        # noqa: PLC0415
     when = f"t = {t:.9g} s" if np.ndim(t) == 0 else f"t = {t[0]:.9g} to {t[-1]:.9g} s"
     first = float(t) if np.ndim(t) == 0 else float(t[0])
     try:
-        return ss.accelerations(mode, np.atleast_2d(q), np.atleast_2d(qd), np.atleast_2d(T), backend)
+        return work()
     except (SignError, BearingFrictionError, SlackError) as exc:     # its "sample i" counts this call's states
         at = t if np.ndim(t) == 0 else t[min(exc.sample, len(t) - 1)]
         raise SimulationError(f"t = {at:.9g} s: {exc.lines()[0].removeprefix(f'sample {exc.sample}: ')}",
@@ -196,7 +208,7 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
         return variants[attached]
 
     ss = stick_slip(t_eval[0])
-    state = {"mode": Mode(), "memo": (None, None, None), "ss": ss}
+    state = {"mode": Mode(), "memo": (None, None, None), "held": (None, None), "ss": ss}
 
     def dynamics(t, x):
         """(qdd, Q) at (t, x) in the current mode; the last one kept for the events."""
@@ -208,6 +220,17 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
         qdd, Q = _accelerations(state["ss"], state["mode"], q, qd, T, backend, t)
         state["memo"] = (key, qdd[0], Q[0])
         return qdd[0], Q[0]
+
+    def holding(t, x):
+        """(Q, limits) of the held units at (t, x) (:meth:`.stick_slip.StickSlip.limits`),
+        the last one kept: every slip event of a step asks for it."""
+        key = (t, x.tobytes())
+        if state["held"][0] != key:
+            qdd, Q = dynamics(t, x)
+            T, _ = d.torques(t, x[dof:2 * dof], x[2 * dof:])
+            lim = _limits(state["ss"], state["mode"], x[:dof], x[dof:2 * dof], qdd, T, backend, t)
+            state["held"] = (key, (Q, lim))
+        return state["held"][1]
 
     def rhs(t, x):
         qdd = dynamics(t, x)[0]
@@ -225,14 +248,14 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
     try:
         for a, b in row_intervals(drive.t, t_eval[0], t_eval[-1]):
             ss = state["ss"] = stick_slip(a)         # a pick or a place happens at a row
-            state["memo"] = (None, None, None)
+            state["memo"] = state["held"] = (None, None, None)
             while True:
                 # [a, b): a sample at a row takes the row's values (a pick or a place there)
                 last = b >= t_eval[-1]
                 wanted = t_eval[(t_eval >= a) & ((t_eval < b) | (last & (t_eval <= b)))]
                 piece = b if len(wanted) <= PIECE else float(wanted[PIECE])   # at most PIECE samples held
                 wanted = wanted[wanted < piece] if piece < b else wanted
-                switches = ss.events(state["mode"], x[dof:2 * dof], dof, lambda t, y: dynamics(t, y)[1])
+                switches = ss.events(state["mode"], x[dof:2 * dof], dof, holding)
                 events = limits + switches
                 sol = _integrate(solve_ivp, rhs, a, piece, x, wanted, method, rtol, atol, events, segments,
                                  (state["mode"], ss))
@@ -253,7 +276,7 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
                     raise _Stopped()
                 state["mode"], xe[dof:2 * dof] = _after_switch(ss, state["mode"], events[k].switch, xe, d, te,
                                                                dof, backend, dynamics)
-                state["memo"] = (None, None, None)
+                state["memo"] = state["held"] = (None, None, None)
                 x, a = xe, te
                 if a >= b:
                     break
