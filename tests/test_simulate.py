@@ -529,6 +529,30 @@ def test_bearing_friction_holds_an_arm_within_its_moment_by_hand(run_cli, tmp_pa
         assert _held_or_moved(run_cli, tmp_path, mech, "swing", lift * T, "swing")[0] == outcome
 
 
+def test_a_differential_is_held_by_its_mesh_friction(run_cli, mech_dir, tmp_path):
+    """The Bendix wrist with its four bevel pairs at efficiency 0.95: their rates involve
+    J2 and J3 together (rows J2 - J3, -J2 - J3, -J3).  Under its static motor torques plus
+    0.01 N*m on motor5, the meshes' friction holds J2 and J3 exactly at rest while J1 (no
+    friction on its path) turns; before, the gears' rates reversed at 0 at every step and
+    simulate stalled.  With 0.1 N*m more, beyond what they can hold, J2 and J3 move."""
+    from gearcli import analyse, load_mechanism, solve
+    text = re.sub(r"(kind: bevel, teeth: \[\d+, \d+\])", r"\1, efficiency: 0.95",
+                  (mech_dir / "bendix_wrist.yaml").read_text())
+    assert text.count("efficiency: 0.95") == 4
+    mech = write(tmp_path / "wrist.yaml", text)
+    T0 = solve(analyse(load_mechanism(mech)), np.zeros((1, 3)), np.zeros((1, 3)), np.zeros((1, 3))).motor[0]
+    for delta, held in ((0.01, True), (0.1, False)):
+        T = [float(v) for v in T0 + np.array([0.0, delta, 0.0])]
+        inp = write(tmp_path / "in.csv", "t,motor:motor4,motor:motor5,motor:motor7\n"
+                    + "".join(f"{t},{T[0]!r},{T[1]!r},{T[2]!r}\n" for t in (0.0, 0.05)))
+        r = run_cli("simulate", mech, inp, "-o", tmp_path / "traj.csv")
+        assert r.exit_code == 0 and r.stderr == "", r.stderr
+        tr = read_csv(tmp_path / "traj.csv")
+        assert tr["t"][-1] == 0.05 and abs(tr["q:J1"][-1]) > 1e-4
+        rest = max(np.abs(tr[k]).max() for k in ("q:J2", "q:J3", "qd:J2", "qd:J3"))
+        assert (rest <= 1e-15) if held else (rest > 1e-3)
+
+
 def test_a_stiff_motor_under_an_explicit_method_stalls_with_one_line(run_cli, tmp_path):
     """L/R = 5e-10 s under RK45: its stable step is ~1e-9 s, 0.3 s would take ~1e9
     evaluations.  simulate stops after STALL_EVALUATIONS, naming L/R and the way out; Radau

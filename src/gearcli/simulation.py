@@ -33,13 +33,10 @@ class StallWatch:
     """Called with the time of every evaluation of the dynamics: raises StallError when
     :data:`STALL_EVALUATIONS` of them pass without the time reached advancing by
     :data:`STALL_FRACTION` of the span (the integrator's step collapsed: a smooth motion
-    needs a few hundred evaluations a second).  Mesh or bearing friction whose rate
-    involves several coordinates (a differential's) and that would hold a gear at rest does
-    this (it holds nothing at rest: its rate reverses at 0 at every step; a joint's own
-    Coulomb friction, and an element turning with one coordinate alone, stick:
-    :mod:`gearcli.dynamics.stick_slip`), and
-    so does a stiff system (a motor's L/R far below the motion's time scale) under an
-    explicit method; the message says which applies."""
+    needs a few hundred evaluations a second).  A stiff system (a motor's L/R far below the
+    motion's time scale) under an explicit method does this; friction that would hold a
+    joint at rest no longer does (it sticks, :mod:`gearcli.dynamics.stick_slip`).  The
+    message suggests the method."""
 
     def __init__(self, an: Analysis, input_path, t0: float, t1: float, method: str, progress=None):
         self.an, self.input_path, self.method, self.progress = an, input_path, method, progress
@@ -57,15 +54,12 @@ class StallWatch:
             self.progress(t)
 
     def hint(self) -> str:
-        hints = ["a gear's rate reverses at 0 where a mesh or bearing friction turning with several coordinates "
-                 "would hold it (such friction holds nothing at rest: docs/concepts/losses.md)"
-                 ] if self.an.mech.has_losses else []
         tau = [m.model.inductance / m.model.resistance for m in self.an.mech.motors
                if m.model is not None and m.model.inductance]
-        if self.method in ("RK45", "RK23", "DOP853") and (tau or not hints):
-            hints.append(f"a motor's L/R of {min(tau):.3g} s makes the system stiff: give --method Radau or BDF"
-                         if tau else "if the system is stiff, give --method Radau or BDF")
-        return ": " + "; ".join(hints) if hints else ""
+        if self.method not in ("RK45", "RK23", "DOP853"):
+            return ""
+        return (f": a motor's L/R of {min(tau):.3g} s makes the system stiff: give --method Radau or BDF" if tau
+                else ": if the system is stiff, give --method Radau or BDF")
 
 
 @dataclass

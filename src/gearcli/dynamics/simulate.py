@@ -26,7 +26,7 @@ import numpy as np
 
 
 from .payloads import carrying
-from .stick_slip import Mode, StickSlip
+from .stick_slip import Mode, StickSlip, slip_direction
 
 METHODS = ("DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 
@@ -144,12 +144,6 @@ class Drive:
         return (u - self.R[k] * current - self.kt[k] * w) / self.L
 
 
-def _limits(ss, mode, q, qd, qdd, T, backend, t):
-    """:meth:`.stick_slip.StickSlip.limits` at one state, its failures those of
-    :func:`_accelerations`."""
-    return _located(lambda: ss.limits(mode, q, qd, qdd, T, backend)[0], qd, t)
-
-
 def _accelerations(ss, mode, q, qd, T, backend, t):
     """(qdd, Q) of :meth:`.stick_slip.StickSlip.accelerations` (the held dynamics of the
     mode) at time(s) t, its failures those of :func:`_located`."""
@@ -221,15 +215,16 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
         state["memo"] = (key, qdd[0], Q[0])
         return qdd[0], Q[0]
 
-    def holding(t, x):
-        """(Q, limits) of the held units at (t, x) (:meth:`.stick_slip.StickSlip.limits`),
-        the last one kept: every slip event of a step asks for it."""
+    def margins(t, x):
+        """The held units' margins at (t, x) (:meth:`.stick_slip.StickSlip.margins`), the
+        last one kept: every slip event of a step asks for it."""
         key = (t, x.tobytes())
         if state["held"][0] != key:
             qdd, Q = dynamics(t, x)
             T, _ = d.torques(t, x[dof:2 * dof], x[2 * dof:])
-            lim = _limits(state["ss"], state["mode"], x[:dof], x[dof:2 * dof], qdd, T, backend, t)
-            state["held"] = (key, (Q, lim))
+            m = _located(lambda: state["ss"].margins(state["mode"], x[:dof], x[dof:2 * dof], qdd, T, Q, backend)[0],
+                         x[dof:2 * dof], t)
+            state["held"] = (key, m)
         return state["held"][1]
 
     def rhs(t, x):
@@ -255,7 +250,7 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
                 wanted = t_eval[(t_eval >= a) & ((t_eval < b) | (last & (t_eval <= b)))]
                 piece = b if len(wanted) <= PIECE else float(wanted[PIECE])   # at most PIECE samples held
                 wanted = wanted[wanted < piece] if piece < b else wanted
-                switches = ss.events(state["mode"], x[dof:2 * dof], dof, holding)
+                switches = ss.events(state["mode"], x[dof:2 * dof], dof, margins)
                 events = limits + switches
                 sol = _integrate(solve_ivp, rhs, a, piece, x, wanted, method, rtol, atol, events, segments,
                                  (state["mode"], ss))
@@ -275,7 +270,7 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
                     segments.append((np.array([te]), xe[None, :], (state["mode"], ss)))
                     raise _Stopped()
                 state["mode"], xe[dof:2 * dof] = _after_switch(ss, state["mode"], events[k].switch, xe, d, te,
-                                                               dof, backend, dynamics)
+                                                               dof, backend, margins)
                 state["memo"] = state["held"] = (None, None, None)
                 x, a = xe, te
                 if a >= b:
@@ -365,15 +360,15 @@ def _limit_events(an) -> list:
     return out
 
 
-def _after_switch(ss, mode, switch, xe, d, te, dof, backend, dynamics):
+def _after_switch(ss, mode, switch, xe, d, te, dof, backend, margins):
     """(mode, q') after the stick-slip event ``switch`` = (unit, "stick" or "slip") at
-    (te, xe): a unit whose rate reached 0 is held if it can be; a held one whose friction
-    reached F_s slips in the direction -sign Q (the others classified again)."""
+    (te, xe): a unit whose rate reached 0 is held if it can be; a held one whose margin
+    reached 0 slips on that side (the others classified again)."""
     k, kind = switch
     if kind == "stick":
         return _switch(ss, mode, [k], xe, d, te, dof, backend)
-    Q = dynamics(te, xe)[1][mode.stuck.index(k)]
-    released = Mode(tuple(j for j in mode.stuck if j != k), {**mode.start, k: -np.sign(Q) or 1.0})
+    side = slip_direction(margins(te, xe)[mode.stuck.index(k)])
+    released = Mode(tuple(j for j in mode.stuck if j != k), {**mode.start, k: side})
     return _switch(ss, released, [], xe, d, te, dof, backend)
 
 

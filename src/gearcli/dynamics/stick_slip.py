@@ -18,7 +18,8 @@ floating-point resolution of t):
   direction d = -sign Q_J.
 
 Several joints at rest are classified together: all are held, then the one most beyond its
-F_s is released, until every held joint's |Q_J| <= F_s,J.
+F_s (relative to it) is released, until every held joint's |Q_J| <= F_s,J.  With friction
+elements (below) the limits are a unit's two margins, and it slips on the side beyond.
 
 Joints geared to each other (their rows s_J parallel: s_J = a_J u) stick and slip together:
 they are one unit of row u with F_c = sum |a_J| F_c,J and F_s = sum |a_J| F_s,J (how the
@@ -37,26 +38,30 @@ joints (its row s_J of q = S q_ind).  Viscous friction stays in the twin.
 Load-dependent friction at rest
 -------------------------------
 Mesh friction, the losses of the drive elements (reducers, screws, belts, worms) and
-bearing friction stay in the twin too; at a zero relative rate they give no couple.  Where
-one of them turns with one independent coordinate i alone (its rate row r = a e_i, so a
-rate of exactly 0 whenever q'_i is), that coordinate is a unit (with the joints whose rows
-are parallel to e_i) and its elements hold it too, each up to its Coulomb value at the
-current load, in the manner of :func:`gearcli.solve`'s own model.  A held unit's limits
-against a push in its + and - direction are
+bearing friction stay in the twin too; at a zero relative rate they give no couple.  Each
+such element's rate is r . q'_ind (:func:`element_rows`); the row r is a unit (with the
+joints and elements whose rows are parallel to it), and its elements hold it too, each up
+to its Coulomb value at the load it carries, in the manner of :func:`gearcli.solve`'s own
+model.  A held unit k's margins, how far it is from slipping in its + and - direction, are
+the parts along its row u of
 
-    F_s + K_+,   F_s + K_-,    K_d = d (tau_d - tau_0)_i / u_i   (d = +-1),
+    tau_+ - A T   and   A T - tau_-       (the other held rows' parts apart),
 
-tau_d the inverse dynamics of the twin at the held state's q, q'' with q'_i = d sign(u_i)
-TINY: the elements of coordinate i slip in direction d at a vanishing rate (their full
-Coulomb couples, with the tooth and bearing loads those couples give, solved together by
-the solve), tau_0 the same at q'_i = 0 (none).  K_d is so the friction that would hold the
-unit on the verge of slipping in direction d: held while -(F_s + K_+) <= Q <= F_s + K_-,
-the unit slips exactly where the kinetic motion in direction d with zero acceleration
-balances (tests/test_simulate.py, the spur stage and the pendulum by hand).  How the holding
-divides among the elements short of that verge is not determined and not needed: it does
-no work, and the held accelerations do not depend on it.  A held coordinate's rate and
-acceleration are exactly 0, so its elements stay off (sign 0) in the twin.  An element
-whose rate involves several coordinates holds nothing (it slips through 0).
+tau_d the inverse dynamics of the twin at the held state's q, q'' on the verge of slipping
+in direction d: the unit's joints' friction at -d F_s, its elements slipping (rate d TINY
+along one coordinate, d PROBE |q'| along a row of several), with the tooth and bearing
+loads those couples give, solved together by the solve; A T the motors' push.  Held while
+both are >= 0: the unit slips exactly where the kinetic motion in direction d with zero
+acceleration balances (tests/test_simulate.py, the spur stage, the pendulum and the arm on
+a bearing by hand).  How the holding divides among the elements short of a verge is not
+determined and not needed: it does no work, and the held accelerations do not depend on it.
+A unit without elements keeps F_s + Q and F_s - Q.
+
+A held row along one coordinate i has its rate and acceleration set exactly to 0, so its
+elements stay off (sign 0) in the twin.  A held row of several coordinates keeps ~1e-16
+|q'| of rounding in its rate, so its elements' couples may turn on in the twin; they act
+along u and are taken up by the held Q, which the margins do not use, so the accelerations
+and the switches do not depend on them.
 """
 from __future__ import annotations
 
@@ -76,10 +81,16 @@ TINY = 1e-150
 :meth:`StickSlip.limits`: only its sign enters the friction; the velocity terms it adds
 (~TINY times the rates) are far below rounding.  Not subnormal, not squared to one."""
 
+PROBE = 1e-9
+"""The rate along u, relative to the largest |q'| (at least 1), of a held unit whose row
+involves several coordinates in the probe of :meth:`StickSlip.margins`: its held rate
+keeps ~1e-16 |q'| of rounding, so TINY would not decide the sign; the velocity terms move
+by ~1e-9 of theirs."""
+
 SLACK = 1e-12
-"""A held unit's limits are widened by SLACK times the state's torque scale (the largest of
-its limits, |A T| and |tau_0|): a unit at a balance (Q ~1e-17 of rounding against limits
-of 0, e.g. an unloaded gear pair) stays held instead of slipping at once and sticking again."""
+"""A held unit's margins are widened by SLACK times the state's torque scale (the largest of
+|A T|, its F_s and |tau_d|): a unit at a balance (~1e-17 of rounding against a margin of 0,
+e.g. an unloaded gear pair) stays held instead of slipping at once and sticking again."""
 
 
 @dataclass
@@ -106,15 +117,13 @@ class StickSlip:
         self.units = []          # [row u (dof,), F_c, F_s, joints]
         for ji in joints:
             fr, s = an.mech.joints[ji].friction, S[ji]
-            for unit in self.units:
-                a = (unit[0] @ s) / (unit[0] @ unit[0])
-                if np.allclose(a * unit[0], s, rtol=0.0, atol=1e-12 * np.abs(s).max()):
-                    unit[1] += abs(a) * fr.coulomb
-                    unit[2] += abs(a) * fr.holding
-                    unit[3].append(ji)
-                    break
-            else:
+            k, a = self._unit_of(s)
+            if k is None:
                 self.units.append([s, fr.coulomb, fr.holding, [ji]])
+            else:
+                self.units[k][1] += abs(a) * fr.coulomb
+                self.units[k][2] += abs(a) * fr.holding
+                self.units[k][3].append(ji)
         self.analysis = an
         self.couples = []        # (load name, joint, unit, sign of a_J in the unit, child side, axis, prismatic)
         if joints:
@@ -135,25 +144,34 @@ class StickSlip:
                         loads.append(Load(name, link, "link", point))
                         self.couples.append((name, ji, k, a, side, axis, jt.type == "prismatic"))
             self.analysis = analyse(replace(mech, joints=twin, loads=tuple(loads)))
+        self.probe = set()       # units with friction elements (mesh, drive element, bearing) on their row
+        for r in element_rows(self.analysis):
+            k, _ = self._unit_of(r)
+            if k is None:
+                k = len(self.units)
+                self.units.append([r, 0.0, 0.0, []])
+            self.probe.add(k)
         self.coordinate = {}     # unit -> i, for a unit whose row is a e_i (its rate an exact 0 when held)
         for k, unit in enumerate(self.units):
             if np.count_nonzero(unit[0]) == 1:
                 self.coordinate[k] = int(np.flatnonzero(unit[0])[0])
-        self.probe = set()       # units whose coordinate has friction elements (mesh, drive, bearing)
-        for i in element_coordinates(self.analysis):
-            k = next((k for k, c in self.coordinate.items() if c == i), None)
-            if k is None:
-                k = len(self.units)
-                self.units.append([np.eye(an.dof)[i], 0.0, 0.0, []])
-                self.coordinate[k] = i
-            self.probe.add(k)
+
+    def _unit_of(self, s: np.ndarray) -> tuple[int | None, float]:
+        """(k, a) of the unit whose row u is parallel to ``s`` (s = a u), else (None, 0)."""
+        for k, unit in enumerate(self.units):
+            a = (unit[0] @ s) / (unit[0] @ unit[0])
+            if np.allclose(a * unit[0], s, rtol=0.0, atol=1e-12 * np.abs(s).max()):
+                return k, a
+        return None, 0.0
 
     def name(self, u: int) -> str:
         """The unit's joints, e.g. "joint 'Jw'" or "joints 'Jp', 'Jw'" (its coordinate's
         name for a unit held by its friction elements alone)."""
         names = [self.an.mech.joints[ji].name for ji in self.units[u][3]]
         if not names:
-            return f"coordinate '{self.an.independent_names[self.coordinate[u]]}'"
+            u_k = self.units[u][0]
+            return "coordinates " + " ".join(f"{u_k[i]:+.4g} {self.an.independent_names[i]}"
+                                             for i in np.flatnonzero(u_k))
         return ("joint " if len(names) == 1 else "joints ") + ", ".join(f"'{n}'" for n in names)
 
     def rate(self, u: int, qd: np.ndarray):
@@ -202,47 +220,58 @@ class StickSlip:
                 qdd[:, self.coordinate[k]] = 0.0
         return qdd, Q
 
-    def limits(self, mode: Mode, q, qd, qdd, T, backend: str) -> np.ndarray:
-        """(N, len(mode.stuck), 2): the most friction each held unit gives against a push in
-        its + and in its - direction (held while -limit_+ <= Q <= limit_-), widened by
-        :data:`SLACK`: F_s and F_s for a unit without friction elements; for one with them
-        (:attr:`probe`), K_+ and K_- of the module docstring, the verge of slipping."""
-        q, qd, qdd, T = (np.atleast_2d(np.asarray(v, float)) for v in (q, qd, qdd, T))
+    def margins(self, mode: Mode, q, qd, qdd, T, Q, backend: str) -> np.ndarray:
+        """(N, len(mode.stuck), 2): how far each held unit is from slipping in its + and in
+        its - direction (both >= 0: held), in its Q's units and widened by :data:`SLACK`:
+        F_s + Q and F_s - Q for a unit without friction elements; for one with them
+        (:attr:`probe`), the parts along u of tau_+ - A T and A T - tau_- (module docstring;
+        the other held rows' parts apart); +inf for a unit held by the others."""
+        q, qd, qdd, T, Q = (np.atleast_2d(np.asarray(v, float)) for v in (q, qd, qdd, T, Q))
         n = q.shape[0]
         out = np.empty((n, len(mode.stuck), 2))
+        AT = np.einsum("nm,dm->nd", T, self.an.A)
+        scale = np.abs(AT).max(axis=1, initial=0.0)
+        C, kept = self.rows(mode.stuck)
         for j, k in enumerate(mode.stuck):
-            out[:, j, :] = self.units[k][2]
-        scale = np.abs(np.einsum("nm,dm->nd", T, self.an.A)).max(axis=1, initial=0.0)
-        for j, k in enumerate(mode.stuck):
-            if k in self.probe:
-                tau_0, verge = self._verge(mode, k, q, qd, qdd, backend)
-                out[:, j, :] = verge
-                scale = np.maximum(scale, np.abs(tau_0).max(axis=1))
-        return out + SLACK * np.maximum(scale, out.max(axis=(1, 2), initial=0.0))[:, None, None] + 1e-300
+            if k in self.probe and k not in kept:        # held by the others: holds nothing
+                out[:, j, :] = np.inf
+            elif k in self.probe:        # the differences' part along u_k, the other held rows apart
+                tau, along = self._verges(mode, k, q, qd, qdd, backend), np.linalg.pinv(C)[:, kept.index(k)]
+                out[:, j, 0] = (tau[0] - AT) @ along
+                out[:, j, 1] = (AT - tau[1]) @ along
+                scale = np.maximum(scale, np.abs(tau).max(axis=(0, 2)))
+            else:
+                out[:, j, 0] = self.units[k][2] + Q[:, j]
+                out[:, j, 1] = self.units[k][2] - Q[:, j]
+                scale = np.maximum(scale, self.units[k][2])
+        return out + (SLACK * scale + 1e-300)[:, None, None]
 
-    def _verge(self, mode: Mode, k: int, q, qd, qdd, backend: str) -> tuple[np.ndarray, np.ndarray]:
-        """(tau_0 (N, dof), (N, 2) K_+ and K_-) of held unit k (module docstring): one solve
-        of the twin over 3N samples, at rest (no friction at k) and on the verge of slipping
-        in + and in - (its joints' couples -d F_s, its elements' rate d TINY)."""
-        n, i = q.shape[0], self.coordinate[k]
-        u_i = self.units[k][0][i]
-        parts = []
-        for d in (0.0, 1.0, -1.0):
+    def _verges(self, mode: Mode, k: int, q, qd, qdd, backend: str) -> np.ndarray:
+        """(2, N, dof): tau_+ and tau_- of held unit k (module docstring), one solve of the
+        twin over 2N samples on the verge of slipping in + and in -: its joints' couples
+        -d F_s, its elements' rate d TINY (a row along one coordinate; else d PROBE |q'|
+        along u, above the rounding the held rate keeps)."""
+        n, u = q.shape[0], self.units[k][0]
+        parts, rates = [], []
+        for d in (1.0, -1.0):
             loads = self.loads(mode, qd)
             for name, ji, unit, a, side, axis, prismatic in self.couples:
                 if unit == k:
-                    w = loads[name]
-                    w[:, (0 if prismatic else 3):(3 if prismatic else 6)] = (
+                    loads[name][:, (0 if prismatic else 3):(3 if prismatic else 6)] = (
                         -side * d * a * self.an.mech.joints[ji].friction.holding * axis)
             parts.append(load_values(self.analysis.mech, n, loads))
-        rates = np.concatenate([qd] * 3)
-        rates[n:2 * n, i], rates[2 * n:, i] = np.sign(u_i) * TINY, -np.sign(u_i) * TINY
+            if k in self.coordinate:
+                i = self.coordinate[k]
+                rate = qd.copy()
+                rate[:, i] = d * np.sign(u[i]) * TINY
+            else:
+                size = PROBE * np.maximum(np.abs(qd).max(axis=1), 1.0)
+                rate = qd + d * size[:, None] * u / (u @ u)
+            rates.append(rate)
         tau = solver_for(self.analysis).solve(
-            np.concatenate([q] * 3), rates, np.concatenate([qdd] * 3), backend=backend, check_finite=False,
-            loads={key: np.concatenate([p[key] for p in parts]) for key in parts[0]}).tau
-        tau_0 = tau[:n]
-        K = np.stack([(tau[n:2 * n, i] - tau_0[:, i]) / u_i, -(tau[2 * n:, i] - tau_0[:, i]) / u_i], axis=1)
-        return tau_0, np.maximum(K, 0.0)
+            np.concatenate([q] * 2), np.concatenate(rates), np.concatenate([qdd] * 2), backend=backend,
+            check_finite=False, loads={key: np.concatenate([p[key] for p in parts]) for key in parts[0]}).tau
+        return tau.reshape(2, n, -1)
 
     def classify(self, mode: Mode, at_rest: list, q, qd, T, backend: str) -> tuple[Mode, np.ndarray]:
         """The mode after the units ``at_rest`` (rate 0 now; the others keep theirs) are
@@ -263,23 +292,25 @@ class StickSlip:
             if not held:
                 return trial, qd
             qdd, Q = self.accelerations(trial, q[None, :], qd[None, :], T[None, :], backend)
-            over = beyond(Q[0], self.limits(trial, q, qd, qdd[0], T, backend)[0])
+            m = self.margins(trial, q, qd, qdd[0], T, Q[0], backend)[0]
+            least = m.min(axis=1)
+            over = np.where(np.isfinite(least), -least / np.maximum(m.sum(axis=1), 1e-300), -1.0)
             i = int(np.argmax(over))
             if over[i] <= 0.0:
                 return trial, qd
             k = held.pop(i)
-            start[k] = -np.sign(Q[0, i]) or 1.0
+            start[k] = slip_direction(m[i])
 
-    def events(self, mode: Mode, qd: np.ndarray, dof: int, holding) -> list:
+    def events(self, mode: Mode, qd: np.ndarray, dof: int, margins) -> list:
         """The switch events of ``mode`` from state rates ``qd``: a slipping unit's rate
-        crossing 0 against its direction, a stuck unit's Q reaching one of its limits
-        (``holding(t, x)``: the held units' Q and :meth:`limits` at that state).  Each has
-        ``switch`` = (unit, "stick" or "slip")."""
+        crossing 0 against its direction, a stuck unit's margin reaching 0 (``margins(t,
+        x)``: :meth:`margins` at that state).  Each has ``switch`` = (unit, "stick" or
+        "slip")."""
         out = []
         for k, (s, _, _, _) in enumerate(self.units):
             if k in mode.stuck:
                 i = mode.stuck.index(k)
-                ev = (lambda t, x, i=i: _margin(*holding(t, x), i))
+                ev = (lambda t, x, i=i: float(margins(t, x)[i].min()))
                 ev.direction, ev.switch = -1.0, (k, "slip")
             else:
                 d = np.sign(qd @ s) or mode.start.get(k, 0.0)
@@ -292,27 +323,20 @@ class StickSlip:
         return out
 
 
-def _margin(Q: np.ndarray, limits: np.ndarray, i: int) -> float:
-    """How far held unit i's Q is inside its limits (< 0: beyond one)."""
-    return min(limits[i, 0] + Q[i], limits[i, 1] - Q[i])
+def slip_direction(margin: np.ndarray) -> float:
+    """The direction a held unit with margins (+, -) slips in: the side most beyond."""
+    return 1.0 if margin[0] < margin[1] else -1.0
 
 
-def beyond(Q: np.ndarray, limits: np.ndarray) -> np.ndarray:
-    """Each held unit's |Q| beyond its limit in Q's direction, relative to that limit
-    (<= 0: within it)."""
-    cap = np.where(Q < 0.0, limits[:, 0], limits[:, 1])
-    return (np.abs(Q) - cap) / cap
-
-
-def element_coordinates(an) -> list[int]:
-    """The independent coordinates i that a load-dependent friction element turns with alone
-    (its rate row a e_i): a lossy gear pair's or drive element's relative rate
-    (:attr:`~gearcli.analysis.types.Analysis.mesh_rate_rows`) or a joint with bearing
+def element_rows(an) -> list[np.ndarray]:
+    """The rate rows r (dof,) of the load-dependent friction elements, r . q'_ind their
+    rate: a lossy gear pair's or drive element's relative rate
+    (:attr:`~gearcli.analysis.types.Analysis.mesh_rate_rows`) and a joint with bearing
     friction (its row of S)."""
     mech = an.mech
     rows = [an.mesh_rate_rows[ci] for ci, c in enumerate(an.circuits) if _lossy(mech.gears[c.gear])]
     rows += [np.asarray(an.S[ji], float) for ji in friction_joints(mech)]
-    return sorted({int(np.flatnonzero(r)[0]) for r in rows if np.count_nonzero(r) == 1})
+    return [r for r in rows if r.any()]
 
 
 def _lossy(g) -> bool:
