@@ -108,7 +108,7 @@ class ReducerLosses:
     housing; a screw: -h screw, +h nut); ``carriers`` (R,) the link whose axes ``axis`` (R, 3)
     is given in (the housing, the carrier); ``tables``: (eta_f, eta_b, T0 or None) each as
     (speeds, values) over |a|; ``signed``: 1 when its efficiency is below 1; ``reducer``: 1 for a
-    reducer (its input torque is an output).  The kernel adds delta = A |s_w| + B sigma s_w to
+    reducer (its input torque is an output).  The kernel adds delta = A s_w^2 + B sigma s_w to
     c_r = 1 + delta, A = (1/eta_f + eta_b)/2 - 1, B = (eta_b - 1/eta_f)/2: 1/eta_f where sigma
     s_w = -1, eta_b where +1, 1 at rest; a reducer's no-load torque -T0 s_w coef z on its sides is
     a known load."""

@@ -31,6 +31,7 @@ from .inverse_cache import InverseCache
 from .links import Sample, floats
 from .signs import SignedBlock, signs_of
 from .world import lu_solve
+from ..loss_terms import power_flow_delta
 from ..signs import sign_patterns
 from ..wrenches import worm_friction
 
@@ -321,10 +322,11 @@ def _worm_friction(e: Emitter, s: Sample, worms, k: int, sigma):
 
 
 def _reducer_delta(e: Emitter, terms, sigma):
-    """(delta, z): a power-flow element's change of its torque's factor, delta = A |s_w| + B
-    sigma s_w (:class:`.loss_program.ReducerLosses`), and its axis in world axes."""
-    sa, A, B, z = terms[:4]
-    return e.add(e.mul(A, e.mul(sa, sa)), e.mul(B, e.mul(sigma, sa))), z
+    """(delta, z): a power-flow element's change of its torque's factor, delta = A s_w^2 + B
+    sigma s_w (:func:`..loss_terms.power_flow_delta`, :class:`.loss_program.ReducerLosses`),
+    and its axis in world axes."""
+    s_w, A, B, z = terms[:4]
+    return power_flow_delta(e, A, B, sigma, s_w), z
 
 
 def _carrier(lp, k: int) -> int:
