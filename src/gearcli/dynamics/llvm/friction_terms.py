@@ -20,8 +20,7 @@ where the generator applies them.
 """
 from __future__ import annotations
 
-from ..loss_terms import (element_loss, input_torque, joint_friction as joint_friction_law, mesh_loss,
-                          no_load_torque, power_flow_coefficients, power_flow_delta)
+from .. import loss_terms as laws  # by attribute when emitting: a monkeypatched law (tests/) reaches both paths
 from ..wrenches import unit_joint_wrench
 from .build import FLAGS, Emitter
 from .links import Sample, floats
@@ -52,12 +51,12 @@ def reducer_terms(e: Emitter, s: Sample, red) -> list:
         z = e.mv(s.R[int(red.carriers[k])], floats(red.axis[k]))
         fwd, bwd, t0 = red.tables[k]
         mode = red.mode[k] if red.mode else 0
-        A, B = (e.const(v) for v in power_flow_coefficients(e, speed, fwd, bwd, mode))
+        A, B = (e.const(v) for v in laws.power_flow_coefficients(e, speed, fwd, bwd, mode))
         T0 = 0.0 if t0 is None else e.const(e.interp(speed, t0))
         out.append((sw, A, B, z, w, T0, speed))
         if t0 is None:
             continue
-        tq = e.const(no_load_torque(e, T0, sw))
+        tq = e.const(laws.no_load_torque(e, T0, sw))
         for L, coef in red.sides[k]:
             if L >= 0:
                 s.rhs[L] = s.rhs[L][:3] + tuple(e.sub(s.rhs[L][3 + h], e.mul(e.mul(coef, tq), z[h])) for h in range(3))
@@ -75,7 +74,7 @@ def joint_friction(e: Emitter, s: Sample, lp, rows: dict) -> dict:
         f = floats(lp.joint_flt[k])
         if not (f[6] or f[7]):         # bearing friction only (.bearings)
             continue
-        Q = own[ji] = e.const(joint_friction_law(e, f[6], f[7], e.const(s.qd[ji])))
+        Q = own[ji] = e.const(laws.joint_friction(e, f[6], f[7], e.const(s.qd[ji])))
         if ji not in late:
             _write_joint(e, s, ji, Q, rows)
         Rc, oc = s.R[child], s.o[child]
@@ -100,7 +99,7 @@ def write_losses(e: Emitter, s: Sample, lp, gear_col, rates: list, own: dict, ro
     for k, ci in enumerate(lp.rate_meshes):
         c, rj = floats(lp.loss_flt[k])
         t = s.sol[int(gear_col[ci])]
-        e.store(mesh_loss(e, c, rj, t, rates[k]), rows["gear_loss"], ci)
+        e.store(laws.mesh_loss(e, c, rj, t, rates[k]), rows["gear_loss"], ci)
     inputs = _reducer_outputs(e, s, lp.reducers, gear_col, rows) if lp.reducers is not None else {}
     done = set(lp.reducers.circuits) if lp.reducers is not None else set()
     for ci in set(range(len(gear_col))) - set(lp.rate_meshes) - done:
@@ -124,10 +123,10 @@ def _reducer_outputs(e: Emitter, s: Sample, red, gear_col, rows: dict) -> dict:
             continue
         sw, A, B, _, w, T0, speed = s.red[k]
         u = s.sol[int(gear_col[ci])]
-        delta = power_flow_delta(e, A, B, e.sign(u), sw)
-        e.store(element_loss(e, delta, u, w, T0, speed), rows["gear_loss"], ci)
+        delta = laws.power_flow_delta(e, A, B, e.sign(u), sw)
+        e.store(laws.element_loss(e, delta, u, w, T0, speed), rows["gear_loss"], ci)
         if red.reducer[k]:
-            out[ci] = e.const(input_torque(e, delta, u, T0, sw))
+            out[ci] = e.const(laws.input_torque(e, delta, u, T0, sw))
     return out
 
 

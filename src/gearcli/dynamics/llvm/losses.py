@@ -31,7 +31,7 @@ from .inverse_cache import InverseCache
 from .links import Sample, floats
 from .signs import SignedBlock, signs_of
 from .world import lu_solve
-from ..loss_terms import power_flow_delta
+from .. import loss_terms
 from ..signs import sign_patterns
 from ..wrenches import worm_friction
 
@@ -326,7 +326,7 @@ def _reducer_delta(e: Emitter, terms, sigma):
     sigma s_w (:func:`..loss_terms.power_flow_delta`, :class:`.loss_program.ReducerLosses`),
     and its axis in world axes."""
     s_w, A, B, z = terms[:4]
-    return power_flow_delta(e, A, B, sigma, s_w), z
+    return loss_terms.power_flow_delta(e, A, B, sigma, s_w), z
 
 
 def _carrier(lp, k: int) -> int:
