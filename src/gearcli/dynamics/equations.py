@@ -55,7 +55,8 @@ from ..algebra import ARRAYS, algebra_for, stack_vectors, vectors
 from . import loss_terms
 from .losses import loss_couples, mesh_friction_moment, power_flow_sides, power_flow_terms, relative_rate
 from .column_terms import group_terms
-from .wrenches import term_direction, term_point, term_wrench, worm_friction
+from .wrenches import (mesh_friction_column, power_flow_column, term_direction, term_point, term_wrench,
+                       worm_friction, worm_friction_column)
 
 
 def _moment(d: np.ndarray) -> np.ndarray:
@@ -130,22 +131,22 @@ class Columns:
         return col
 
     def _loss(self, c, wv: dict, L: int, sigma) -> np.ndarray | float:
-        """(N, 6) the loss addition of lossy circuit c on link L per unit of its unknown."""
-        sg = np.asarray(sigma, float).reshape(-1, 1)
+        """(N, 6) the loss addition of lossy circuit c on link L per unit of its unknown
+        (:mod:`.wrenches`' columns, the kernel's too)."""
+        al, n = self.al, self.kin.n
+        sg = sigma if isinstance(sigma, float) else np.asarray(sigma, float).reshape(-1)
         if "fr" in wv:                    # the friction couple sigma s_v fr on j, minus on k
-            sign = float(L == c.j) - float(L == c.k)
-            return _moment(sign * sg * wv["sv"][:, None] * wv["fr"])
+            side = float(L == c.j) - float(L == c.k)
+            return stack_vectors(mesh_friction_column(al, side, sg, wv["sv"], vectors(wv["fr"])), n)
         if "mu" in wv:                    # sigma s_v mu h at P on the wheel, minus on the worm
-            al, (R_c, o_c), o_L = self.al, self.kin.link_terms(c.carrier)[:2], self.kin.link_terms(L)[1]
-            f, P = worm_friction(al, sigma if isinstance(sigma, float) else sg[:, 0], wv["sv"], wv["mu"], R_c, o_c,
-                                 wv["h_hat"], wv["point"])
-            w = tuple(f) + al.cx(al.vsub(P, o_L), f)
-            return (float(L == c.k) - float(L == c.j)) * stack_vectors(w, self.kin.n)
+            (R_c, o_c), o_L = self.kin.link_terms(c.carrier)[:2], self.kin.link_terms(L)[1]
+            f, P = worm_friction(al, sg, wv["sv"], wv["mu"], R_c, o_c, wv["h_hat"], wv["point"])
+            return stack_vectors(worm_friction_column(al, float(L == c.k) - float(L == c.j), f, P, o_L), n)
         if "flow" in wv:                  # delta coef z on the element's sides (c_r = 1 + delta)
-            coef = sum(k for link, k in wv["sides"] if link == L)
+            coef = float(sum(k for link, k in wv["sides"] if link == L))
             f = wv["flow"]
-            delta = np.broadcast_to(loss_terms.power_flow_delta(ARRAYS, f.A, f.B, sigma, f.s_w), f.s_w.shape)
-            return _moment((coef * delta)[:, None] * wv["z"])
+            delta = loss_terms.power_flow_delta(ARRAYS, f.A, f.B, sg, f.s_w)
+            return stack_vectors(power_flow_column(al, coef, delta, vectors(wv["z"])), n)
         on_j, on_k = loss_couples(wv["belt"], wv["tj"], wv["tk"], wv["rate"],
                                   np.broadcast_to(np.asarray(sigma, float), wv["rate"].shape))
         cp = (float(L == c.j) - float(L == c.carrier)) * on_j + (float(L == c.k) - float(L == c.carrier)) * on_k

@@ -51,6 +51,29 @@ def worm_friction(al, sigma, s_v, mu, R_c, o_c, h_hat, point) -> tuple:
     return al.scale(term_direction(al, h_hat, R_c), coef), term_point(al, point, R_c, o_c)
 
 
+def mesh_friction_column(al, side, sigma, s_v, fr) -> tuple:
+    """The column addition on a link of a geared mesh's friction couple per unit of its
+    tooth force t (:mod:`.losses`): a moment side sigma s_v fr, ``fr`` R_c times the couple
+    per unit of :func:`.losses.mesh_friction_moment` (base axes), ``side`` +1 on gear j, -1
+    on gear k, ``sigma`` = sign(t) and ``s_v`` the sign of j's rate relative to the carrier."""
+    return (0.0, 0.0, 0.0) + al.scale(fr, al.mul(al.mul(sigma, s_v), side))
+
+
+def worm_friction_column(al, side, f, P, o_L) -> tuple:
+    """The column addition on a link of a worm pair's sliding friction per unit of its flank
+    load (:func:`worm_friction`'s f at P): side [f ; (P - o_L) x f], ``side`` +1 on the
+    wheel, -1 on the worm."""
+    return al.scale(f, side) + al.scale(al.cx(al.vsub(P, o_L), f), side)
+
+
+def power_flow_column(al, coef, delta, z) -> tuple:
+    """The column addition on a link of a power-flow element's change of its torque's factor
+    per unit of its interaction u (:mod:`.loss_terms`): a moment (coef delta) z about the
+    element's axis z (base axes), ``coef`` the link's side (+1 the input, -1 the housing, or
+    the pulley's arm of a belt side)."""
+    return (0.0, 0.0, 0.0) + al.scale(z, al.mul(coef, delta))
+
+
 def load_wrench(al, f, m, arm) -> tuple:
     """The wrench about o_L of a force f and moment m applied at the point o_L + arm (base
     axes): [f ; m + arm x f]."""

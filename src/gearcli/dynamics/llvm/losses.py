@@ -33,7 +33,7 @@ from .signs import SignedBlock, signs_of
 from .world import lu_solve
 from .. import loss_terms
 from ..signs import sign_patterns
-from ..wrenches import worm_friction
+from ..wrenches import mesh_friction_column, power_flow_column, worm_friction, worm_friction_column
 
 
 def _product_table(e: Emitter, tables: dict, name: str, products: list, index, key):
@@ -292,24 +292,23 @@ def world_columns(lp, bl, s: Sample):
     sv = s.sv
 
     def add(e: Emitter, A: list, tcols: list, sig: list) -> None:
+        def column(row, col, w):
+            for h in range(6):
+                if not (isinstance(w[h], float) and w[h] == 0.0):
+                    A[6 * row + h][col] = e.add(A[6 * row + h][col], w[h])
+
         for n, k, ci, rows in zip(bl.positions, bl.rates, bl.circuits, bl.rows):
             fr = e.mv(s.R[_carrier(lp, k)], floats(lp.couple[ci]))
-            coef = e.mul(sig[n], sv[k])
             for row, sign in rows:
-                for h in range(3):
-                    A[6 * row + 3 + h][tcols[n]] = e.add(A[6 * row + 3 + h][tcols[n]], e.mul(coef, e.mul(float(sign), fr[h])))
+                column(row, tcols[n], mesh_friction_column(e, float(sign), sig[n], sv[k], fr))
         for n, k, rows, _ in bl.worms:               # friction sigma s_v mu h_hat, a force at P
             f, P = _worm_friction(e, s, lp.worms, k, sig[n])
             for row, L, sign in rows:
-                m = e.cx(e.vsub(P, s.o[L]), f)
-                for h in range(3):
-                    A[6 * row + h][tcols[n]] = e.add(A[6 * row + h][tcols[n]], e.mul(sign, f[h]))
-                    A[6 * row + 3 + h][tcols[n]] = e.add(A[6 * row + 3 + h][tcols[n]], e.mul(sign, m[h]))
+                column(row, tcols[n], worm_friction_column(e, float(sign), f, P, s.o[L]))
         for n, k, rows, _ in bl.reducers:
             delta, z = _reducer_delta(e, s.red[k], sig[n])
             for row, coef in rows:
-                for h in range(3):
-                    A[6 * row + 3 + h][tcols[n]] = e.add(A[6 * row + 3 + h][tcols[n]], e.mul(e.mul(float(coef), delta), z[h]))
+                column(row, tcols[n], power_flow_column(e, float(coef), delta, z))
     return add
 
 
