@@ -77,6 +77,10 @@ MAX_STEPS = 60
 SECANT_STEPS = 8
 """With losses: the correction steps taken with the lossless M; a sample still not settled
 then takes Newton steps with the lossy Jacobian (:func:`_lossy_jacobian`, dof + 1 solves)."""
+FEW_SAMPLES, FEW_SECANT_STEPS = 4, 1
+"""A call of at most FEW_SAMPLES samples (a simulate step, a stick-slip switch) takes
+FEW_SECANT_STEPS steps with M before Newton's: each step is then a solve call's overhead
+(~0.5 ms), and the SCARA's settling took 12.6 calls with 8 (docs/performance.md)."""
 
 
 def _stacked_chunks(sol, q, qd, loads, backend, jobs):
@@ -270,6 +274,9 @@ def _settle(sol, q, qd, target, M, h, qdd, Q, C, loads, backend, jobs) -> tuple[
     todo = np.arange(len(q))
     last = np.full(len(q), np.inf)
     dof, k = an.dof, C.shape[0]
+    # a few samples (a simulate step): a solve call costs its overhead, not its samples, and
+    # Newton (2 calls a step, exact where the signs hold) settles in 2-3 steps, M in ~10
+    secant = SECANT_STEPS if len(q) > FEW_SAMPLES else FEW_SECANT_STEPS
 
     def tau(rows, acc):
         return sol.solve(q[rows], qd[rows], acc, loads={key: v[rows] for key, v in values.items()},
@@ -283,7 +290,7 @@ def _settle(sol, q, qd, target, M, h, qdd, Q, C, loads, backend, jobs) -> tuple[
         todo, r = todo[~done], r[~done]
         if todo.size == 0:
             return qdd, Q
-        J = M[todo] if step < SECANT_STEPS else _lossy_jacobian(tau, todo, qdd[todo], r + target[todo] + Q[todo] @ C)
+        J = M[todo] if step < secant else _lossy_jacobian(tau, todo, qdd[todo], r + target[todo] + Q[todo] @ C)
         if k == 0:
             qdd[todo] -= np.linalg.solve(J, r[:, :, None])[:, :, 0]
         else:

@@ -10,6 +10,8 @@ work arrays (the sign of every t used, the failing block of every sample) are ke
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..errors import counted
@@ -77,7 +79,7 @@ def result_arrays(an, n: int, out=None) -> dict:
 def one_allocation(shapes: dict) -> dict:
     """{name: new uninitialised float64 array of shapes[name]}, C-ordered views of one
     allocation apart from each other."""
-    sizes = {k: int(np.prod(shape)) for k, shape in shapes.items()}
+    sizes = {k: math.prod(shape) for k, shape in shapes.items()}      # (not np.prod: 5 us a shape)
     buf, arrays, at = np.empty(sum(sizes.values())), {}, 0
     for k, shape in shapes.items():
         arrays[k] = buf[at:at + sizes[k]].reshape(shape)

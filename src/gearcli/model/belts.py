@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -87,6 +88,16 @@ class BeltGeometry:
     alpha: float
     ratio: float         # e = theta_j / theta_k about each pulley's own axis
 
+    @cached_property
+    def arms(self) -> dict:
+        """:func:`belt_arms`' values."""
+        z = self.z
+        tj = float(z @ (np.cross(self.X[0, 0] - self.C_j, 0.5 * self.e[0])
+                        + np.cross(self.X[1, 0] - self.C_j, -0.5 * self.e[1])))
+        tk = float(z @ (np.cross(self.X[0, 1] - self.C_k, -0.5 * self.e[0])
+                        + np.cross(self.X[1, 1] - self.C_k, 0.5 * self.e[1])))
+        return {"tj": tj, "tk": tk, "rk": -tj / tk}
+
 
 def belt_geometry(belt: Belt, oj, zj, ok, zk, names=("j", "k")) -> tuple[BeltGeometry | None, list]:
     """The spans of a belt from its pulleys' axis lines (points, directions; carrier frame);
@@ -124,8 +135,6 @@ def slack_problem(belt: Belt, E) -> int | None:
 
 def belt_arms(geo: BeltGeometry) -> dict:
     """{"tj", "tk": the torque about z of the effective pull's forces on pulley j and on k per
-    unit E (m), "rk": the ratio of k's rate about z to j's, r_j / r_k}."""
-    z = geo.z
-    tj = float(z @ (np.cross(geo.X[0, 0] - geo.C_j, 0.5 * geo.e[0]) + np.cross(geo.X[1, 0] - geo.C_j, -0.5 * geo.e[1])))
-    tk = float(z @ (np.cross(geo.X[0, 1] - geo.C_k, -0.5 * geo.e[0]) + np.cross(geo.X[1, 1] - geo.C_k, 0.5 * geo.e[1])))
-    return {"tj": tj, "tk": tk, "rk": -tj / tk}
+    unit E (m), "rk": the ratio of k's rate about z to j's, r_j / r_k} (a new dict; computed
+    once per geometry: every solve's loss outputs ask for it, a simulate step a dozen times)."""
+    return dict(geo.arms)
