@@ -553,6 +553,30 @@ def test_a_differential_is_held_by_its_mesh_friction(run_cli, mech_dir, tmp_path
         assert (rest <= 1e-15) if held else (rest > 1e-3)
 
 
+def test_the_scara_starts_from_rest_under_its_duty_torques(run_cli, mech_dir, tmp_path):
+    """The bundled SCARA (belt, strain-wave gear, ball screw, all lossy) from rest under the
+    motor torques `solve` gives for the first 10 ms of its duty cycle: its friction holds the
+    joints that rest and lets go of the one that moves.  Before, its gears' rates reversed
+    at 0 at every step (their friction held nothing) and simulate stalled at t = 8e-5 s."""
+    rows = (mech_dir / "scara_traj.csv").read_text().splitlines()[:12]
+    traj = write(tmp_path / "traj.csv", "\n".join(rows) + "\n")
+    r = run_cli("solve", mech_dir / "scara.yaml", traj, "-o", tmp_path / "loads.csv")
+    assert r.exit_code == 0, r.stderr
+    loads = read_csv(tmp_path / "loads.csv")
+    motors = [k for k in loads if k.startswith("motor:") and k.count(":") == 1]
+    assert len(motors) == 3
+    inp = write(tmp_path / "in.csv", ",".join(["t"] + motors) + "\n" + "".join(
+        ",".join(repr(float(loads[k][i])) for k in ["t"] + motors) + "\n" for i in range(len(loads["t"]))))
+    start = read_csv(traj)
+    q0 = ",".join(repr(float(start[f"q:{j}"][0])) for j in ("J1", "J2", "Jz"))
+    r = run_cli("simulate", mech_dir / "scara.yaml", inp, "-o", tmp_path / "sim.csv", f"--q0={q0}")
+    assert r.exit_code == 0 and r.stderr == "", r.stderr
+    sim = read_csv(tmp_path / "sim.csv")
+    assert sim["t"][-1] == pytest.approx(0.01) and len(sim["t"]) == 11
+    moving = start["qd:Jz"][1:11]
+    assert np.all(np.sign(sim["qd:Jz"][1:]) == np.sign(moving)) and np.abs(moving).min() > 0
+
+
 def test_a_stiff_motor_under_an_explicit_method_stalls_with_one_line(run_cli, tmp_path):
     """L/R = 5e-10 s under RK45: its stable step is ~1e-9 s, 0.3 s would take ~1e9
     evaluations.  simulate stops after STALL_EVALUATIONS, naming L/R and the way out; Radau
