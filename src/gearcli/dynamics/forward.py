@@ -280,7 +280,7 @@ def _settle(sol, q, qd, target, M, h, qdd, Q, C, loads, backend, jobs) -> tuple[
 
     def tau(rows, acc):
         return sol.solve(q[rows], qd[rows], acc, loads={key: v[rows] for key, v in values.items()},
-                         backend=backend, jobs=jobs, check_finite=False).tau
+                         backend=backend, jobs=jobs, check_finite=False, element_outputs=False).tau
 
     for step in range(MAX_STEPS):
         r = tau(todo, qdd[todo]) - target[todo] - Q[todo] @ C

@@ -183,8 +183,11 @@ class Solver:
 
     def solve(self, q, qd, qdd, method: str = "block", chunk: int = DEFAULT_CHUNK,
               verify: bool = False, loads: dict | None = None, backend: str | None = None,
-              jobs: int | None = None, out: Result | None = None, check_finite: bool = True) -> Result:
-        """See :func:`solve` (``backend``, ``jobs`` None: the solver's)."""
+              jobs: int | None = None, out: Result | None = None, check_finite: bool = True,
+              element_outputs: bool = True) -> Result:
+        """See :func:`solve` (``backend``, ``jobs`` None: the solver's).  ``element_outputs``
+        False leaves the worm pairs' and belts' numpy-computed outputs unfilled (a caller
+        that reads ``tau`` alone: forward dynamics' settling, a stick-slip verge)."""
         backend = self.backend if backend is None else backend
         jobs = self.jobs if jobs is None else jobs
         q, qd, qdd = motion_arrays(self.an, q, qd, qdd, check_finite)
@@ -200,16 +203,17 @@ class Solver:
         if method == "block":
             self.samples_solved += max(q.shape[0], CALL_SAMPLES)
         if how.path != "numpy" and not verify:     # no BLAS call: the limit would cost ~30 us a call
-            return self._by_kernel(how, q, qd, qdd, values, jobs, chunk, verify, out)
+            return self._by_kernel(how, q, qd, qdd, values, jobs, chunk, verify, out, element_outputs)
         # the operands are 3x3 to 48x48 matrices: BLAS threads only contend (2-3x slower
         # with a busy second core), so one BLAS thread, whatever the environment says
         with one_blas_thread():
             if how.path != "numpy":
-                return self._by_kernel(how, q, qd, qdd, values, jobs, chunk, verify, out)
+                return self._by_kernel(how, q, qd, qdd, values, jobs, chunk, verify, out, element_outputs)
             res = self._by_numpy(q, qd, qdd, method, chunk, verify, values)
         fill_reducers(self.an, qd, res)
-        fill_worms(self.an, qd, res)
-        fill_belts(self.an, qd, res)
+        if element_outputs:
+            fill_worms(self.an, qd, res)
+            fill_belts(self.an, qd, res)
         res.motor_speed = qd @ self.an.A
         if out is not None:
             copy_into(out, res)
@@ -217,15 +221,16 @@ class Solver:
         res.backend, res.backend_note = how.path, how.note
         return res
 
-    def _by_kernel(self, how, q, qd, qdd, values, jobs, chunk, verify, out=None) -> Result:
+    def _by_kernel(self, how, q, qd, qdd, values, jobs, chunk, verify, out=None, element_outputs=True) -> Result:
         arrays = result_arrays(self.an, q.shape[0], out)
         work, losses = work_arrays(q.shape[0], len(self.kernel_program().signed), out), {}
         sig = self.llvm_kernel().solve(self.an, q, qd, qdd, values, jobs, chunk, arrays, work, losses)
         res = Result(**arrays) if out is None else out
         res.residual, res.backend, res.backend_note = None, how.path, how.note
         fill_kernel_losses(res, arrays, losses)      # (a reducer's input torque and loss: the kernel's)
-        fill_worms(self.an, qd, res)                  # a worm pair's outputs from N (numpy, both paths)
-        fill_belts(self.an, qd, res)                  # a belt's slack check and loss (numpy, both paths)
+        if element_outputs:
+            fill_worms(self.an, qd, res)              # a worm pair's outputs from N (numpy, both paths)
+            fill_belts(self.an, qd, res)              # a belt's loss (numpy, both paths)
         if verify:
             x_all = _unknowns(self.an, res)
             worst = 0.0

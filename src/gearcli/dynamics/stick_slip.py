@@ -270,7 +270,8 @@ class StickSlip:
             rates.append(rate)
         tau = solver_for(self.analysis).solve(
             np.concatenate([q] * 2), np.concatenate(rates), np.concatenate([qdd] * 2), backend=backend,
-            check_finite=False, loads={key: np.concatenate([p[key] for p in parts]) for key in parts[0]}).tau
+            check_finite=False, element_outputs=False,
+            loads={key: np.concatenate([p[key] for p in parts]) for key in parts[0]}).tau
         return tau.reshape(2, n, -1)
 
     def classify(self, mode: Mode, at_rest: list, q, qd, T, backend: str) -> tuple[Mode, np.ndarray]:
