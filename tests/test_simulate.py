@@ -691,7 +691,12 @@ def test_dc_motor_model_survives_the_urdf_round_trip(run_cli, tmp_path):
         r = run_cli("simulate", tmp_path / name, inp, "-o", tmp_path / f"{name}.csv", "--method", "Radau")
         assert r.exit_code == 0, r.stderr
     assert read_csv(tmp_path / "stage.urdf.csv")["qd:Jd"][-1] != 0.0
-    assert (tmp_path / "stage.yaml.csv").read_text() == (tmp_path / "stage.urdf.csv").read_text()
+    # the same trajectory to rounding: the second run may find on disk the kernel the first
+    # compiled (the first-call rule), and numpy and the kernel round differently
+    a, b = read_csv(tmp_path / "stage.yaml.csv"), read_csv(tmp_path / "stage.urdf.csv")
+    assert a.keys() == b.keys() and np.array_equal(a["t"], b["t"])
+    for key in a:
+        assert np.abs(a[key] - b[key]).max() <= 1e-11 * np.abs(a[key]).max(), key
 
 
 @pytest.mark.parametrize("element,message", [
