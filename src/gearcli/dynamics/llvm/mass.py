@@ -35,7 +35,7 @@ import numpy as np
 
 from .blocks import block
 from .build import D, DP, I64, I64P, Emitter
-from .driver import LlvmKernel, _program_ids
+from .driver import LlvmKernel, _program_ids, address
 from .jobs import job_ranges, run_parts, threads_for
 from .kernel import sample_loop, signature
 from .links import Sample, at_rest, external, floats, inertia, joint, joint_space, load_groups
@@ -120,6 +120,6 @@ class MassKernel(LlvmKernel):
         n, dof = q.shape
         out = M, h, qdd = np.empty((n, dof, dof)), np.empty((n, dof)), np.empty((n, dof))
         keep = [np.ascontiguousarray(v, float) for v in (q, qd, rhs)] + self.load_args(an, values, n) + list(out)
-        ptrs = [v.ctypes.data for v in keep]
+        ptrs = [address(v) for v in keep]
         bad = run_parts(lambda s, e: self._run(*ptrs, s, e), job_ranges(n, jobs), threads_for(n, jobs))
         return None if bad else out
