@@ -293,7 +293,8 @@ def simulate(
 ) -> None:
     """Integrate the exact geared dynamics under motor torques or voltages, losses included (its energy falls by them;
     --loads has gear:<pair>:loss, joint:<joint>:loss in W, joint:<joint>:friction).  Joints with Coulomb friction stick
-    and slip (joints[].friction.static); attach:<payload> columns (0/1, held from row to row) carry payloads.  A joint
+    and slip (joints[].friction.static), held at rest by mesh, drive-element and bearing friction too, each up to its
+    Coulomb value at the load; attach:<payload> columns (0/1, held from row to row) carry payloads.  A joint
     limit, a stall or a failure after the first sample stops it: the trajectory up to there is written (exit 1)."""
     from .simulation import simulate_with_progress  # noqa: PLC0415
     report = simulate_with_progress(mech, drive, output, stderr_console(), load_analysis(mech), t_end, q0, qd0, dt, rtol, atol, method, loads)
