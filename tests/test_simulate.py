@@ -577,6 +577,23 @@ def test_the_scara_starts_from_rest_under_its_duty_torques(run_cli, mech_dir, tm
     assert np.all(np.sign(sim["qd:Jz"][1:]) == np.sign(moving)) and np.abs(moving).min() > 0
 
 
+def test_a_self_locking_worm_holds_its_load_between_its_verges(run_cli, mech_dir, tmp_path):
+    """The bundled worm lift (self-locking): with the motor off the load hangs exactly still
+    (before, the worm's friction held nothing at rest and simulate stalled at once).  It
+    holds for any motor torque between the two quasi-static ones `solve` gives at a creeping
+    1e-12 rad/s, lifting (0.3245 N*m) and lowering (-0.0281 N*m: it must be driven down),
+    and moves, the way the motor pushes, 1e-6 beyond either."""
+    from gearcli import analyse, load_mechanism, solve
+    mech = mech_dir / "worm_lift.yaml"
+    an = analyse(load_mechanism(mech))
+    lift, lower = (float(solve(an, [[0.0]], [[v]], [[0.0]]).motor[0, 0]) for v in (1e-12, -1e-12))
+    assert lower < 0.0 < lift
+    assert _held_or_moved(run_cli, tmp_path, mech, "motor", 0.0, "Jd") == ("held", 0.0)
+    for verge, way in ((lift, 1.0), (lower, -1.0)):
+        assert _held_or_moved(run_cli, tmp_path, mech, "motor", verge * (1 - 1e-6), "Jd") == ("held", 0.0)
+        assert _held_or_moved(run_cli, tmp_path, mech, "motor", verge * (1 + 1e-6), "Jd") == ("moved", way)
+
+
 def test_a_stiff_motor_under_an_explicit_method_stalls_with_one_line(run_cli, tmp_path):
     """L/R = 5e-10 s under RK45: its stable step is ~1e-9 s, 0.3 s would take ~1e9
     evaluations.  simulate stops after STALL_EVALUATIONS, naming L/R and the way out; Radau
