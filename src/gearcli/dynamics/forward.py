@@ -78,6 +78,12 @@ SECANT_STEPS = 8
 """With losses: the correction steps taken with the lossless M; a sample still not settled
 then takes Newton steps with the lossy Jacobian (:func:`_lossy_jacobian`, dof + 1 solves)."""
 FEW_SAMPLES, FEW_SECANT_STEPS = 4, 1
+STEP = 1e-4
+"""The lossy Jacobian's difference step, relative to a sample's largest |qdd| (at least 1):
+small enough that the friction's sign pattern and the bearing friction's curvature seldom
+change across it (a step of 1 did, and Newton then converged linearly, at ~0.04 a step, on
+a quarter of the SCARA's states), large enough that the differences' rounding (~1e-12 of
+the torques) leaves Newton quadratic to TOLERANCE."""
 """A call of at most FEW_SAMPLES samples (a simulate step, a stick-slip switch) takes
 FEW_SECANT_STEPS steps with M before Newton's: each step is then a solve call's overhead
 (~0.5 ms), and the SCARA's settling took 12.6 calls with 8 (docs/performance.md)."""
@@ -303,13 +309,14 @@ def _settle(sol, q, qd, target, M, h, qdd, Q, C, loads, backend, jobs) -> tuple[
 
 def _lossy_jacobian(tau, rows, qdd: np.ndarray, tau0: np.ndarray) -> np.ndarray:
     """d tau / d qdd (n, dof, dof) of the samples ``rows`` at ``qdd`` (their torques
-    ``tau0``), by differences over a step of max(1, 1e-3 |qdd|) per sample: exact where the
-    friction's sign pattern holds across it (tau is piecewise linear in qdd), and the slope
+    ``tau0``), by differences over a step of :data:`STEP` max(1, |qdd|) per sample: exact,
+    to rounding, where the friction's sign pattern holds across it (tau is piecewise linear
+    in qdd), and the slope
     of the losses that the lossless M leaves out (bearing friction of large mu d / lever
     converges at ~Lambda a step with M: it stopped at MAX_STEPS, both backends at their own
     sample)."""
     n, dof = qdd.shape
-    delta = np.maximum(1.0, 1e-3 * np.abs(qdd).max(axis=1))
+    delta = STEP * np.maximum(1.0, np.abs(qdd).max(axis=1))
     shifted = np.repeat(qdd, dof, axis=0) + (np.tile(np.eye(dof), (n, 1)) * np.repeat(delta, dof)[:, None])
     cols = tau(np.repeat(rows, dof), shifted).reshape(n, dof, dof)      # [sample, column i, tau]
     return np.transpose(cols - tau0[:, None, :], (0, 2, 1)) / delta[:, None, None]
