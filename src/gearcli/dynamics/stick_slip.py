@@ -164,16 +164,6 @@ class StickSlip:
                 return k, a
         return None, 0.0
 
-    def name(self, u: int) -> str:
-        """The unit's joints, e.g. "joint 'Jw'" or "joints 'Jp', 'Jw'" (its coordinate's
-        name for a unit held by its friction elements alone)."""
-        names = [self.an.mech.joints[ji].name for ji in self.units[u][3]]
-        if not names:
-            u_k = self.units[u][0]
-            return "coordinates " + " ".join(f"{u_k[i]:+.4g} {self.an.independent_names[i]}"
-                                             for i in np.flatnonzero(u_k))
-        return ("joint " if len(names) == 1 else "joints ") + ", ".join(f"'{n}'" for n in names)
-
     def rate(self, u: int, qd: np.ndarray):
         """Unit u's rate u . q'."""
         return qd @ self.units[u][0]
