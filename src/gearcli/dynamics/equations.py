@@ -118,8 +118,8 @@ class Columns:
         wv = self.world.get(ci, {})
         if "fr" not in wv:
             return None
-        sign = 1.0 if L == self.an.circuits[ci].j else -1.0
-        return sign * _moment(wv["fr"])[:, :, None]
+        side = 1.0 if L == self.an.circuits[ci].j else -1.0
+        return stack_vectors(mesh_friction_column(self.al, side, 1.0, 1.0, vectors(wv["fr"])), self.kin.n)[:, :, None]
 
     def group(self, g, L: int, sigma=1.0) -> np.ndarray:
         """(N, 6, g.size) columns of unknown group ``g`` on link L (sigma: sign of t), the

@@ -346,11 +346,10 @@ def propagate(e: Emitter, s: Sample, lp, bl, x: list, tcols: list, sig: list) ->
     for a, (n, k, ci) in enumerate(zip(bl.positions, bl.rates, bl.circuits)):
         if not bl.later[a]:
             continue
-        m = e.mv(s.R[_carrier(lp, k)], floats(lp.couple[ci]))
-        amount = e.mul(e.mul(sig[n], s.sv[k]), x[tcols[n]])
-        for L, sign in bl.later[a]:
-            s.rhs[L] = s.rhs[L][:3] + tuple(e.sub(s.rhs[L][3 + h], e.mul(float(sign), e.mul(amount, m[h])))
-                                            for h in range(3))
+        fr = e.mv(s.R[_carrier(lp, k)], floats(lp.couple[ci]))
+        for L, sign in bl.later[a]:            # its column (the shared term) times the solved t
+            col = mesh_friction_column(e, float(sign), sig[n], s.sv[k], fr)
+            s.rhs[L] = s.rhs[L][:3] + tuple(e.sub(s.rhs[L][3 + h], e.mul(col[3 + h], x[tcols[n]])) for h in range(3))
     for n, k, _, later in bl.worms:             # the worm's friction force on the later links
         f, P = _worm_friction(e, s, lp.worms, k, sig[n])
         f = e.scale(f, x[tcols[n]])
