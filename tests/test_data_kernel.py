@@ -74,3 +74,66 @@ def test_threads_sharing_a_data_kernel_keep_their_own_values():
         got = list(pool.map(run, range(4)))
     for k in range(4):
         assert all(np.allclose(g, want[k], rtol=0, atol=1e-12 * np.abs(want[k]).max()) for g in got[k])
+
+
+VARIANTS = {   # (mechanism, the text a variant changes, its values): constants of the kernel, not run-time arrays
+    "reducer ratio": ("cobot_6axis", "teeth: [200, 202]", ("teeth: [160, 162]", "teeth: [100, 102]")),
+    "reducer efficiency": ("cobot_6axis", "efficiency: {forward: 0.78, backward: 0.65}",
+                           ("efficiency: {forward: 0.7, backward: 0.5}", "efficiency: {forward: 0.9, backward: 0.8}")),
+    "link mass": ("bendix_wrist_rated", "mass: 0.8", ("mass: 0.95", "mass: 1.3")),
+}
+
+
+@pytest.mark.parametrize("case", sorted(VARIANTS))
+def test_variants_of_a_constant_share_one_compile(case, tmp_path, monkeypatch):
+    """The kernel's constants are data (its constant pool, dynamics/llvm/build.py): mechanisms
+    differing in a ratio, an efficiency or a mass generate the same IR, and the second and
+    third are linked from the first one's object code (no compile), each solving with its
+    own values as the numpy path solves its own mechanism (to 1e-12 of each sample's largest
+    reaction), with and without the disk cache."""
+    from gearcli import parse_mechanism
+    from gearcli.dynamics.llvm import driver
+    name, old, news = VARIANTS[case]
+    text = (ROOT / "mechanisms" / f"{name}.yaml").read_text()
+    assert text.count(old) >= 1
+    rng = np.random.default_rng(5)
+    for cache in ("on", "off"):
+        monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path / "cache") if cache == "on" else "/dev/null/none")
+        monkeypatch.setattr(driver, "_RECENT", {})
+        keys, base_an = [], None
+        for k, variant in enumerate((text,) + tuple(text.replace(old, new, 1) for new in news)):
+            an = analyse(parse_mechanism(variant, file=f"{name}-{k}.yaml"))
+            n = 400
+            q, qd, qdd = (rng.uniform(-1, 1, (n, an.dof)) for _ in range(3))
+            s = Solver(an, backend="llvm", jobs=1)
+            got, ref = s.solve(q, qd, qdd), solve(an, q, qd, qdd, backend="numpy")
+            assert got.backend == "llvm" and _worst(got, ref, n) < 1e-12
+            jit = s.llvm_kernel().jit
+            keys.append(jit.key)
+            assert jit.from_cache == (k > 0), (cache, k)
+            base_an = base_an if k else an
+            if k:                      # the variant's own values, not the first one's
+                assert np.abs(got.motor - solve(base_an, q, qd, qdd, backend="numpy").motor).max() > 1e-9
+        assert len(set(keys)) == 1
+
+
+def test_a_note_with_damaged_constants_is_not_used(tmp_path, monkeypatch):
+    """A program note holds the kernel's constant pool (the object code holds zeros): one whose
+    values are damaged is deleted and the kernel's code regenerated, with the right results."""
+    from gearcli.dynamics.llvm import driver
+    monkeypatch.setenv("GEARCLI_CACHE_DIR", str(tmp_path))
+    an = analyse(load_mechanism(ROOT / "mechanisms" / "paper_2dof.yaml"))
+    q, qd, qdd = (np.random.default_rng(2).uniform(-1, 1, (50, an.dof)) for _ in range(3))
+    ref = solve(an, q, qd, qdd, backend="numpy")
+    Solver(an, backend="llvm").solve(q, qd, qdd)
+    (note,) = (tmp_path / "llvm").glob("*.prog")
+    data = bytearray(note.read_bytes())
+    data[-3] ^= 0x10                           # a bit of the last constant
+    note.write_bytes(bytes(data))
+    monkeypatch.setattr(driver, "_RECENT", {})
+    s = Solver(an, backend="llvm")
+    got = s.solve(q, qd, qdd)
+    assert not s.llvm_kernel().jit.by_program and s.llvm_kernel().jit.from_cache
+    assert _worst(got, ref, 50) < 1e-12
+    again = Solver(an, backend="llvm")         # the note written again, whole: found by program
+    assert _worst(again.solve(q, qd, qdd), ref, 50) < 1e-12 and again.llvm_kernel().jit.by_program

@@ -202,7 +202,7 @@ def newton(e: Emitter, fn, tag: str, start: tuple, lv: list, moving: list, faile
     e.b.cbranch(e.b.and_(finite, e.b.icmp_signed("<=", it1, ir.Constant(I64, MAX_ITERATIONS))), body, failb)
     for phis, first, again in ((Mb, start[0], new), ([it], [start[1]], [it1])):
         for ph, v0, v1 in zip(phis, first, again):
-            ph.add_incoming(e.const(v0), pre)
+            ph.add_incoming(e.imm(v0), pre)
             ph.add_incoming(v1, more)
     e.b.position_at_end(failb)
     failed(g, change)
@@ -210,5 +210,5 @@ def newton(e: Emitter, fn, tag: str, start: tuple, lv: list, moving: list, faile
     kept = [e.b.phi(D_) for _ in Mb]
     for ph, m, v in zip(kept, Mb, new):
         ph.add_incoming(m, here)
-        ph.add_incoming(e.const(v), there)
+        ph.add_incoming(e.imm(v), there)
     return kept, it, failb, Mb

@@ -188,7 +188,7 @@ def _restart(e: Emitter, start: tuple, refit, failb) -> tuple:
     (``start``, from ``refit``) or p's affine model did not converge (zero moments, iteration
     1, from ``failb``: as the numpy path, whose sign search follows the moments)."""
     Mb, it = [e.b.phi(D) for _ in start[0]], e.b.phi(I64)
-    _incoming(Mb + [it], [e.const(v) for v in start[0]] + [start[1]], refit)
+    _incoming(Mb + [it], [e.imm(v) for v in start[0]] + [start[1]], refit)
     _incoming(Mb + [it], [ir.Constant(D, 0.0)] * len(Mb) + [ir.Constant(I64, 1)], failb)
     return Mb, it
 
@@ -231,7 +231,7 @@ def _cold(e: Emitter, fn, tag: str, lv: list, jt: _Joints, start: tuple) -> tupl
     e.b.branch(join)
     e.b.position_at_end(join)
     Mb, it = [e.b.phi(D) for _ in Mc], e.b.phi(I64)
-    _incoming(Mb + [it], [e.const(w) for w in start[0]] + [start[1]], pre)
+    _incoming(Mb + [it], [e.imm(w) for w in start[0]] + [start[1]], pre)
     _incoming(Mb + [it], Mc + [itc], cold_bb)
     return Mb, it
 
@@ -281,7 +281,7 @@ def _phis(e: Emitter, ends: list, k: int):
     vals = [en[k] if isinstance(en[k], list) else [en[k]] for en in ends]
     phis = [e.b.phi(getattr(v, "type", D)) for v in vals[0]]
     for en, vs in zip(ends, vals):
-        _incoming(phis, [e.const(v) for v in vs], en[0])
+        _incoming(phis, [e.imm(v) for v in vs], en[0])
     return phis
 
 

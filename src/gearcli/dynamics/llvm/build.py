@@ -18,6 +18,7 @@ import math
 import struct
 
 import llvmlite.ir as ir
+import numpy as np
 
 from ...algebra import Algebra
 from . import trig
@@ -25,35 +26,72 @@ from .types import D, DP, FLAGS, I1, I64, I64P  # noqa: F401 (the types, for the
 
 
 class ConstantPool:
-    """The constants of one function's arithmetic in one internal constant array, each read
-    at its use as base + offset from one register, the base loaded once in the function's
-    entry (``finish`` writes the array).  As immediates of the JIT's large code model each
-    use cost a 10-byte ``movabs`` of its address besides the instruction: the code of a
-    many-mesh lossy kernel then overflowed the instruction cache (planetary_5p with mesh
-    friction: ~350 L1i misses a sample, valgrind)."""
+    """The constants of one function's arithmetic in one constant array, each read at its
+    use as base + offset.  As immediates of the JIT's large code model each use cost a
+    10-byte ``movabs`` of its address besides the instruction: the code of a many-mesh lossy
+    kernel then overflowed the instruction cache (planetary_5p with mesh friction: ~350 L1i
+    misses a sample, valgrind).
 
-    def __init__(self, fn: ir.Function):
-        self.fn, self.index = fn, {}
+    The base comes from an empty volatile asm at the top of each sample (``at``: the loop
+    body's builder; the function's entry without): a register LLVM can neither fold into
+    each read's offset nor see the pool through, and reads that depend on the sample, which
+    LLVM folds into their arithmetic instead of hoisting them out of the loop and spilling
+    them (servo_joint: 906 -> 872 spills, 1-2% faster).
+
+    The array's values are data, not IR: :meth:`finish` declares it as zeros and leaves the
+    values in ``values``, which :class:`.driver.Jit` writes into the loaded code.  So the IR
+    text, the compile and the disk cache's object code depend on where constants are used,
+    not on their values: mechanisms that differ only in masses, a ratio, an efficiency, a
+    friction coefficient, a point (a sweep's variants) share one compiled kernel, each with
+    its own pool, as long as they fold the same products (a ratio of exactly -1 or 1, a zero
+    coordinate folds).  Up to :data:`POOL_SLOTS` reads each has its own slot, so which values
+    happen to be equal does not matter either; above, the reads of one value share a slot
+    (per-read slots cost servo_joint's 2,170 reads 8% of its speed, the Bendix wrist's 535
+    under 2%, same run)."""
+
+    def __init__(self, fn: ir.Function, at: ir.IRBuilder | None = None):
+        self.fn, self.reads = fn, []
         self.ptr = ir.GlobalVariable(fn.module, DP, f"{fn.name}_pool_at")
         self.ptr.global_constant, self.ptr.linkage = True, "internal"
-        ib = ir.IRBuilder(fn.entry_basic_block)
-        ib.position_at_start(fn.entry_basic_block)
-        # the base through an empty asm: a register LLVM cannot fold into each load's offset
-        self.base = ib.asm(ir.FunctionType(DP, [DP]), "", "=r,0", [ib.load(self.ptr)], False)
+        if at is None:
+            at = ir.IRBuilder(fn.entry_basic_block)
+            at.position_at_start(fn.entry_basic_block)
+        self.base = at.asm(ir.FunctionType(DP, [DP]), "", "=r,0", [at.load(self.ptr)], True)
         self.invariant = fn.module.add_metadata([])
 
     def load(self, b: ir.IRBuilder, a: float) -> ir.Value:
-        """The constant ``a`` (a double), read from the pool at the builder's position."""
-        i = self.index.setdefault(struct.pack("<d", a), len(self.index))
-        v = b.load(b.gep(self.base, [ir.Constant(I64, i)]))
+        """The constant ``a`` (a double), read from the pool at the builder's position (its
+        slot numbered by :meth:`finish`)."""
+        slot = ir.Constant(I64, 0)
+        self.reads.append((struct.pack("<d", a), slot))
+        v = b.load(b.gep(self.base, [slot]))
         v.set_metadata("invariant.load", self.invariant)
         return v
 
     def finish(self) -> None:
-        values = [struct.unpack("<d", k)[0] for k in self.index] or [0.0]
-        g = ir.GlobalVariable(self.fn.module, ir.ArrayType(D, len(values)), f"{self.fn.name}_pool")
-        g.global_constant, g.linkage, g.initializer = True, "internal", ir.Constant(g.value_type, values)
+        """Number the slots, declare the pool (zeros, internal and read-only: the code
+        LLVM makes of a constant array) and record its ``values`` in the module's
+        ``pool_values`` ({symbol: values})."""
+        index: dict = {}
+        for k, (key, slot) in enumerate(self.reads):
+            slot.constant = k if len(self.reads) <= POOL_SLOTS else index.setdefault(key, len(index))
+        keys = [key for key, _ in self.reads] if len(self.reads) <= POOL_SLOTS else list(index)
+        self.values = np.array([struct.unpack("<d", k)[0] for k in keys] or [0.0])
+        g = ir.GlobalVariable(self.fn.module, ir.ArrayType(D, len(self.values)), pool_name(self.fn.name))
+        g.global_constant, g.initializer = True, ir.Constant(g.value_type, None)
         self.ptr.initializer = g.bitcast(DP)
+        pools = getattr(self.fn.module, "pool_values", {})
+        pools[pool_name(self.fn.name)] = self.values
+        self.fn.module.pool_values = pools
+
+
+POOL_SLOTS = 1024
+"""Reads of the pool of one function up to which each has its own slot (:class:`ConstantPool`)."""
+
+
+def pool_name(fn_name: str) -> str:
+    """The symbol of function ``fn_name``'s constant pool (:class:`ConstantPool`)."""
+    return f"{fn_name}_pool"
 
 
 class Emitter(Algebra):
@@ -67,15 +105,21 @@ class Emitter(Algebra):
         self.module = module
         self.pool = pool
 
-    def _operand(self, a) -> ir.Value:
-        """``a`` as an operand of an arithmetic instruction (a pool read for a constant)."""
+    def const(self, a) -> ir.Value:
+        """``a`` as an LLVM value at the builder's position: a float is read from the pool
+        (an immediate without one), so that the IR text holds no value of the mechanism's
+        (:class:`ConstantPool`).  Not for a phi's incoming value (:meth:`imm`)."""
         if isinstance(a, float) and self.pool is not None:
             return self.pool.load(self.b, a)
-        return self.const(a)
+        return self.imm(a)
+
+    _operand = const
 
     @staticmethod
-    def const(a) -> ir.Value:
-        """``a`` as an LLVM value (a float becomes a double constant)."""
+    def imm(a) -> ir.Value:
+        """``a`` as an LLVM value, a float as an immediate double (a phi's incoming value,
+        which a read at the builder's position could not be; a value that is the mechanism's
+        then makes the IR text differ with it: another kernel, not a wrong one)."""
         return ir.Constant(D, a) if isinstance(a, float) else a
 
     def intrinsic(self, name: str, nargs: int = 1) -> ir.Function:
@@ -145,8 +189,8 @@ class Emitter(Algebra):
         if isinstance(v, float):
             return pos if v > 0.0 else neg if v < 0.0 else 0.0
         zero = ir.Constant(D, 0.0)
-        return self.b.select(self.b.fcmp_ordered(">", v, zero), ir.Constant(D, pos),
-                             self.b.select(self.b.fcmp_ordered("<", v, zero), ir.Constant(D, neg), zero))
+        return self.b.select(self.b.fcmp_ordered(">", v, zero), self.imm(pos),
+                             self.b.select(self.b.fcmp_ordered("<", v, zero), self.imm(neg), zero))
 
     def sincos(self, q):
         """(cos q, sin q) of an angle, inline (:mod:`.trig`; a constant folds)."""
@@ -162,8 +206,8 @@ class Emitter(Algebra):
         for i in range(len(xs) - 1):
             slope = (ys[i + 1] - ys[i]) / (xs[i + 1] - xs[i])
             seg = self.add(ys[i], self.mul(slope, self.sub(x, xs[i])))
-            y = self.b.select(self.b.fcmp_ordered(">", x, ir.Constant(D, xs[i])), self.const(seg), self.const(y))
-        return self.b.select(self.b.fcmp_ordered(">=", x, ir.Constant(D, xs[-1])), ir.Constant(D, ys[-1]), y)
+            y = self.b.select(self.b.fcmp_ordered(">", x, self.const(xs[i])), self.const(seg), self.const(y))
+        return self.b.select(self.b.fcmp_ordered(">=", x, self.const(xs[-1])), self.const(ys[-1]), y)
 
     # --- memory -------------------------------------------------------------------------
     def load(self, ptr, index):
@@ -172,9 +216,10 @@ class Emitter(Algebra):
         return self.b.load(self.b.gep(ptr, [idx]))
 
     def store(self, value, ptr, index):
-        """ptr[index] = value."""
+        """ptr[index] = value (a constant as an immediate: read from the pool, LLVM hoists the
+        invariant reads out of the sample loop, and servo_joint's spills went from 906 to 2,150)."""
         idx = ir.Constant(I64, index) if isinstance(index, int) else index
-        self.b.store(self.const(value), self.b.gep(ptr, [idx]))
+        self.b.store(self.imm(value), self.b.gep(ptr, [idx]))
 
     def row(self, ptr, n, width: int):
         """A pointer to row n of a (N, width) C-ordered array at ``ptr``."""
@@ -195,7 +240,7 @@ class Emitter(Algebra):
         for i in range(len(values[0])):
             phi = self.b.phi(D)
             for end, vals in zip(ends, values):
-                phi.add_incoming(self.const(vals[i]), end)
+                phi.add_incoming(self.imm(vals[i]), end)
             out.append(phi)
         return out
 

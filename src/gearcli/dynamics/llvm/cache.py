@@ -27,9 +27,14 @@ optimising and generating it again.  The cache dir is :func:`gearcli.io.cache_ro
 * Bounded: after a write the oldest entries (by modification time, which a hit renews)
   go beyond :data:`MAX_ENTRIES` or :data:`MAX_BYTES`.
 
-``<program key>.prog`` notes hold their own program key and the object key of that kernel
-program (its arrays and loads, hashed without building the IR, see :func:`program_key`); a
-note that does not name itself (moved from another program's name, damaged) is deleted.
+The IR, hence the object code, holds no value of the mechanism: its constants are read
+from a pool declared as zeros (:class:`.build.ConstantPool`), whose values :class:`.driver.Jit`
+writes where it loads the code.  So mechanisms that differ only in values (a sweep's
+variants of a ratio, a mass, an efficiency) share one entry.
+``<program key>.prog`` notes hold their own program key, the object key of that kernel
+program (its arrays and loads, hashed without building the IR, see :func:`program_key`),
+the SHA-256 of the rest and the values of its constant pools; a note that does not name
+itself (moved from another program's name) or whose digest does not match is deleted.
 :func:`..backends.llvm_on_disk` (the first-call rule) asks :func:`has_program` whether a compile would be a load, and
 :class:`.driver.Jit` loads the object code through :func:`load_program` without
 generating the IR at all (~0.05 s for the Bendix wrist) when the program key also hashes
@@ -46,8 +51,9 @@ import numpy as np
 
 from ...io.cache_root import BadEntry, cache_root, read_entry, remove_entry, write_entry
 
-FORMAT = 3                          # ours: change when the entry layout, the key or what an IR compiles to
-# changes (3: the middle-end passes skipped for a large IR, driver.pass_level)
+FORMAT = 4                          # ours: change when the entry layout, the key or what an IR compiles to
+# changes (3: the middle-end passes skipped for a large IR, driver.pass_level; 4: the constant pools
+# are data, kept in the program notes)
 MAGIC = b"gearcli-llvm-obj\x00"
 _HEAD = len(MAGIC) + 8 + 8 + 32     # magic, header and payload lengths (little endian), SHA-256
 MAX_ENTRIES = 500
@@ -167,40 +173,68 @@ def store(key: str, payload: bytes, fingerprint: str = "") -> bool:
     return ok
 
 
-def _note(pkey: str) -> str | None:
-    """The object key program key ``pkey``'s note names (None: no note; one that is not
-    ``pkey``'s own, or damaged, is deleted)."""
+def _note(pkey: str) -> tuple[str, dict] | None:
+    """(object key, constant pools) of program key ``pkey``'s note (None: no note; one that
+    is not ``pkey``'s own, or damaged, is deleted).  The pools are the values of the
+    kernel's constant pools (:class:`.build.ConstantPool`: {symbol: float64 array}), data
+    that the object code does not hold."""
     path = cache_dir() / f"{pkey}.prog"
-    data = _read(path, 256)
+    data = _read(path, MAX_NOTE_BYTES)
     if data is None:
         return None
-    parts = data.split(b" ")
-    if len(parts) != 2 or parts[0] != pkey.encode() or len(parts[1]) != 64 or not parts[1].isalnum():
+    head, _, body = data.partition(b"\n")
+    parts = head.split(b" ")
+    pools = _pools(body) if len(parts) == 3 and parts[2] == hashlib.sha256(body).hexdigest().encode() else None
+    if pools is None or parts[0] != pkey.encode() or len(parts[1]) != 64 or not parts[1].isalnum():
         remove_entry(path)
         return None
-    return parts[1].decode()
+    return parts[1].decode(), pools
 
 
-def note_program(pkey: str, key: str) -> None:
-    """Remember that program key ``pkey`` compiles to object key ``key`` (for the estimate)."""
-    if _note(pkey) != key:
-        write_entry(cache_dir() / f"{pkey}.prog", f"{pkey} {key}".encode())
+MAX_NOTE_BYTES = 8 * 2**20          # a note's pools: 8 bytes a constant, some thousands
 
 
-def load_program(pkey: str, fingerprint: str | None = None) -> tuple[str, bytes] | None:
-    """(object key, object code) noted for program key ``pkey`` (and kernel program
-    ``fingerprint``), or None (no note, or its entry absent, not whole or another program's)."""
-    key = _note(pkey)
-    payload = None if key is None else load(key, fingerprint)
-    return None if payload is None else (key, payload)
+def _pools(body: bytes) -> dict | None:
+    """The {symbol: values} a note's body holds (a line "symbol count ..." then the doubles), or None."""
+    line, _, raw = body.partition(b"\n")
+    try:
+        words = line.decode("ascii").split()
+        names, counts = words[0::2], [int(c) for c in words[1::2]]
+    except (UnicodeDecodeError, ValueError):
+        return None
+    if len(names) != len(counts) or 8 * sum(counts) != len(raw):
+        return None
+    values = np.frombuffer(raw, "<f8")
+    cuts = np.cumsum([0] + counts)
+    return {n: values[a:b].copy() for n, a, b in zip(names, cuts, cuts[1:])}
+
+
+def note_program(pkey: str, key: str, pools: dict) -> None:
+    """Remember that program key ``pkey`` compiles to object key ``key`` with these constant
+    pools ({symbol: values}, the data of its code)."""
+    names = sorted(pools)
+    body = (" ".join(f"{n} {len(pools[n])}" for n in names) + "\n").encode() + b"".join(
+        np.ascontiguousarray(pools[n], "<f8").tobytes() for n in names)
+    note = _note(pkey)
+    if note is None or note[0] != key or _pools(body) is None or \
+            any(not np.array_equal(note[1].get(n), pools[n]) for n in names) or set(note[1]) != set(names):
+        write_entry(cache_dir() / f"{pkey}.prog", f"{pkey} {key} {hashlib.sha256(body).hexdigest()}\n".encode() + body)
+
+
+def load_program(pkey: str, fingerprint: str | None = None) -> tuple[str, bytes, dict] | None:
+    """(object key, object code, constant pools) noted for program key ``pkey`` (and kernel
+    program ``fingerprint``), or None (no note, or its entry absent, not whole or another program's)."""
+    note = _note(pkey)
+    payload = None if note is None else load(note[0], fingerprint)
+    return None if payload is None else (note[0], payload, note[1])
 
 
 def has_program(pkey: str) -> bool:
     """True when program key ``pkey``'s object code is in the cache (a compile would be a
     load; a guess: the entry is not read)."""
-    key = _note(pkey)
+    note = _note(pkey)
     try:
-        return key is not None and (cache_dir() / f"{key}.obj").is_file()
+        return note is not None and (cache_dir() / f"{note[0]}.obj").is_file()
     except OSError:
         return False
 

@@ -12,6 +12,8 @@ independent of the split (bitwise identical results for any number of jobs).
 from __future__ import annotations
 
 import ctypes
+import mmap
+import sys
 import threading
 import hashlib
 import time
@@ -126,6 +128,43 @@ def address(a: np.ndarray) -> int:
         return a.ctypes.data
 
 
+def writable_copy(dest: int, values: np.ndarray) -> None:
+    """Copy ``values`` to address ``dest`` in read-only memory (a loaded kernel's constant
+    pool): its pages made writable for the copy, then read-only again."""
+    page = mmap.PAGESIZE
+    lo, hi = dest // page * page, -(-(dest + values.nbytes) // page) * page
+    if sys.platform == "win32":
+        old = ctypes.c_ulong()
+        protect = ctypes.windll.kernel32.VirtualProtect
+        ok = protect(ctypes.c_void_p(lo), ctypes.c_size_t(hi - lo), 0x04, ctypes.byref(old))   # PAGE_READWRITE
+        ctypes.memmove(dest, address(values), values.nbytes)
+        ok = ok and protect(ctypes.c_void_p(lo), ctypes.c_size_t(hi - lo), old.value, ctypes.byref(old))
+    else:
+        protect = _libc().mprotect
+        ok = protect(ctypes.c_void_p(lo), ctypes.c_size_t(hi - lo), mmap.PROT_READ | mmap.PROT_WRITE) == 0
+        ctypes.memmove(dest, address(values), values.nbytes)
+        ok = ok and protect(ctypes.c_void_p(lo), ctypes.c_size_t(hi - lo), mmap.PROT_READ) == 0
+    if not ok:
+        raise OSError(ctypes.get_errno(), "cannot write a kernel's constant pool")
+
+
+@lru_cache(maxsize=1)
+def _libc():
+    lib = ctypes.CDLL(None, use_errno=True)
+    lib.mprotect.argtypes = [ctypes.c_void_p, ctypes.c_size_t, ctypes.c_int]
+    return lib
+
+
+RECENT_OBJECTS = 8
+"""Object codes this process made that it keeps in memory (:data:`_RECENT`)."""
+
+_RECENT: dict = {}
+"""{object key: object code} of the last :data:`RECENT_OBJECTS` kernels this process compiled:
+another program whose IR is the same (a sweep's variant of a ratio, an efficiency: only
+the constant pools' values differ, :class:`.build.ConstantPool`) links it without a
+compile, whether or not the disk cache is writable."""
+
+
 class Jit:
     """An IR module compiled for the host CPU (:func:`pass_level`); ``address(name)`` of its functions.
 
@@ -142,15 +181,16 @@ class Jit:
 
     def __init__(self, module, cache: bool = True, program_key: str | None = None, fingerprint: str = ""):
         llvm, tm = _target_machine()
-        self._tm, self._ir, self.build_seconds = tm, None, 0.0
+        self._tm, self._ir, self.build_seconds, self.pools = tm, None, 0.0, {}
         self._make = module if callable(module) else (lambda: module)
         hit = llvm_cache.load_program(program_key, fingerprint) if program_key and cache else None
         self.by_program = hit is not None
         if hit is not None:
-            self.key, cached = hit
+            self.key, cached, self.pools = hit
         else:
             self.key = llvm_cache.object_key(self.ir, host_identity())
             cached = llvm_cache.load(self.key, adopt=fingerprint) if cache else None
+            cached = _RECENT.get(self.key) if cached is None else cached
         self.from_cache = cached is not None
         self._module = None if cached else self._optimised(llvm, tm)
         mod = self._module
@@ -161,7 +201,19 @@ class Jit:
         self._engine = llvm.create_mcjit_compiler(mod, tm)
         self._engine.set_object_cache(lambda _m, buf: made.append(bytes(buf)), lambda _m: cached)
         self._engine.finalize_object()
+        self._fill_pools()
+        if made:
+            _RECENT[self.key] = made[0]
+            while len(_RECENT) > RECENT_OBJECTS:
+                _RECENT.pop(next(iter(_RECENT)))
         self.stored = bool(cache and made) and llvm_cache.store(self.key, made[0], fingerprint)
+
+    def _fill_pools(self) -> None:
+        """Write the constant pools' values (:class:`.build.ConstantPool`: data, not part of
+        the IR or the object code) into the loaded code's read-only pool arrays."""
+        for name, values in self.pools.items():
+            v = np.ascontiguousarray(values, float)
+            writable_copy(self._engine.get_global_value_address(name), v)
 
     @property
     def ir(self) -> str:
@@ -171,7 +223,7 @@ class Jit:
             module = self._make()
             self.build_seconds += time.perf_counter() - t0
             module.triple, module.data_layout = self._tm.triple, str(self._tm.target_data)
-            self._ir = str(module)
+            self._ir, self.pools = str(module), dict(getattr(module, "pool_values", {}))
         return self._ir
 
     def _optimised(self, llvm, tm):
@@ -214,7 +266,7 @@ class LlvmKernel:
         self.jit = Jit(lambda: self.build(prog, loads), program_key=pkey if generator_digest() else None,
                        fingerprint=fingerprint)
         if self.jit.stored or (self.jit.from_cache and not self.jit.by_program):
-            llvm_cache.note_program(pkey, self.jit.key)
+            llvm_cache.note_program(pkey, self.jit.key, self.jit.pools)
         proto = ctypes.CFUNCTYPE(ctypes.c_int64, *([ctypes.c_void_p] * self.POINTERS + [ctypes.c_int64] * self.INTS))
         self._run = proto(self.jit.address(self.ENTRY))
         self.build_seconds = self.jit.build_seconds

@@ -153,7 +153,7 @@ def sample_loop(fn: ir.Function, body, carry: int | None = None) -> None:
     n.add_incoming(start, entry)
     bad.add_incoming(ir.Constant(I64, 0), entry)
     before = [b.phi(I64) for _ in range(carry or 0)]
-    pool = ConstantPool(fn)
+    pool = ConstantPool(fn, b)
     e = Emitter(b, fn.module, pool)
     failed, after = body(e, n, before) if carry is not None else (body(e, n), ())
     pool.finish()
