@@ -6,16 +6,19 @@ compile in all); prints figures, not a test.
 
 The duty cycle is the bundled Bendix motion resampled to 10,000 samples (a temporary file),
 verified with designs/ci_example.yaml's checks; the variants vary the tool flange's mass, its
-inertia about its axis and the mass of a tool (a load) on it: values a data kernel reads at
-run time (a gear ratio of the wrist is not one: each pair's ratio is fixed by its mesh
-point, and a variant of one alone is refused before anything runs), so one kernel (compiled,
-or loaded from the disk cache) solves every variant of a process; ``--numpy`` times the numpy
-path instead.  The script prints the variants per second, the kernels built in this process
-(a Dask or -j run's workers build their own), and the load average.
+inertia about its axis, the mass of a tool (a load) on it and the ratio of the pinion pair
+4-1 (``--ratios`` values from -2.5 to -3.5; each moves the pair's mesh point along the line
+of centres).  The masses and inertias are values the data kernel reads at run time; each
+ratio gets a data kernel of its own, which is the first one's code with its own constant
+pool (no compile: the IR holds no value of the mechanism).  The script prints the
+variants per second, the kernels built in this process and how many of them were compiled
+(the others linked from the first's object code; a Dask or -j run's workers build their
+own), and the load average.  ``--numpy`` times the numpy path instead.
 """
 from __future__ import annotations
 
 import argparse
+import os
 import tempfile
 import time
 from pathlib import Path
@@ -40,6 +43,7 @@ def main() -> None:
     ap.add_argument("--numpy", action="store_true", help="time the numpy path (no data kernel)")
     ap.add_argument("--points", type=int, default=1, help="also vary the tool's point (a constant of the kernel: "
                     "one data kernel per point) over this many values, the variants split among them")
+    ap.add_argument("--ratios", type=int, default=4, help="values of the pinion pair's ratio (1: not varied)")
     ap.add_argument("--dask-workers", type=int, default=0, help="also time a dask LocalCluster of this many "
                     "single-threaded worker processes (0: not)")
     args = ap.parse_args()
@@ -49,6 +53,7 @@ def main() -> None:
     t = np.linspace(d[0, 0], d[-1, 0], 10_000)
     q = np.column_stack([np.interp(t, d[:, 0], d[:, k]) for k in range(1, d.shape[1])])
     tmp = Path(tempfile.mkdtemp())
+    os.environ["GEARCLI_CACHE_DIR"] = str(tmp / "cache")       # a cold disk cache: the compiles counted are real
     np.savetxt(tmp / "traj.csv", np.column_stack([t, q]), delimiter=",", header=head, comments="", fmt="%.17g")
     # the wrist with a tool on its flange: a load whose mass (kg) a variant sets
     mech = (ROOT / "mechanisms" / "bendix_wrist_rated.yaml").read_text()
@@ -58,17 +63,19 @@ def main() -> None:
     design = design.replace("../mechanisms/bendix_wrist_rated.yaml", str(tmp / "wrist.yaml"))
     design = design.replace("../mechanisms/bendix_wrist_traj.csv", str(tmp / "traj.csv"))
     (tmp / "d.yaml").write_text(design)
-    n_mass = max(1, args.variants // (10 * args.points))
+    n_mass = max(1, args.variants // (10 * args.points * args.ratios))
     varies = [parse_vary(f"links.3.mass=0.6:1.2:{n_mass}"), parse_vary("links.3.inertia.izz=0.0011,0.0015"),
               parse_vary("loads.tool.mass=0.2:1.0:5")]
+    if args.ratios > 1:
+        varies.insert(0, parse_vary(f"gears.4-1.ratio=-2.5:-3.5:{args.ratios}"))
     if args.points > 1:
         varies.insert(0, parse_vary(f"loads.tool.point[1]=0.04:0.08:{args.points}"))
     compiles = []
     real = driver.Jit.__init__
 
-    def counted(self, *a, **k):                # every kernel the run builds (compiled or from the disk cache)
-        compiles.append(1)
+    def counted(self, *a, **k):                # every kernel the run builds: compiled, or linked from object code
         real(self, *a, **k)
+        compiles.append(not self.from_cache)
     driver.Jit.__init__ = counted
     if args.numpy:
         sweep.data_kernel_applies = sweep.per_value_kernels = lambda varies, variants=None: False
@@ -82,7 +89,8 @@ def main() -> None:
     print(f"gearcli sweep, rated Bendix wrist, 10,000 samples, {len(rows[0])} checks a variant:")
     print(f"  -j {args.jobs}: {n} variants, median of {len(times)} rounds {dt:.2f} s: {n / dt:.2f} variants/s "
           f"({dt / n * 1e3:.0f} ms a variant; rounds {', '.join(f'{n / x:.1f}' for x in times)} variants/s); "
-          f"kernels built here: {len(compiles)} ({'numpy path' if args.numpy else 'data kernel'})")
+          f"kernels built here: {len(compiles)}, compiled: {sum(compiles)} "
+          f"({'numpy path' if args.numpy else 'data kernels'})")
     if args.dask_workers:
         from dask.distributed import LocalCluster
         with LocalCluster(n_workers=args.dask_workers, threads_per_worker=1, dashboard_address=None) as cluster:

@@ -120,7 +120,9 @@ def test_the_plot_of_one_and_two_values(run_cli, tmp_path):
     ("links.2.mass=1:2:0", "expected 1 <= n"),
     ("links.2.mass", "expected PATH=VALUES"),
     ("elsewhere:links.2.mass=1", "no case named 'elsewhere'"),
-    ("gears.5-1.ratio=-3,-2.5", "the value -2.5: gears[0].ratio: ratio -2.5 contradicts the mesh geometry"),
+    ("gears.5-1.ratio=-3,2", "the value 2: gears[0].ratio: ratio 2 contradicts the mesh geometry"),
+    ("gears.5-1.ratio=-3,-2.5", "the value -2.5: gears[0].teeth: tooth counts 30:90 give |ratio| 3"),
+    ("gears.5-1.ratio=-3,0", "gear pair '5-1': a gear ratio must be finite and nonzero, got 0"),
 ])
 def test_bad_paths_and_values_are_located_before_anything_runs(run_cli, tmp_path, vary, said):
     out = tmp_path / "s.csv"
@@ -337,10 +339,11 @@ def test_a_variant_of_a_loads_wrench_rereads_the_trajectory_and_of_its_mass_does
 
 def test_a_constant_of_the_kernel_gets_a_data_kernel_per_value(monkeypatch):
     """A load's point is a constant of the kernel; with 8 variants of run-time values for each
-    of its two values (sweep.STRUCTURE_VARIANTS), each point gets one data kernel, which
-    solves its 8 variants: 2 kernels for 16 variants, and every check's value equal to the
-    numpy path's (each variant's mechanism analysed afresh) to 1e-11.  With fewer variants
-    a value (a smaller grid, or random points that rarely repeat one), the numpy path."""
+    of its two values (at least sweep.STRUCTURE_VARIANTS), each point gets one data kernel,
+    which solves its 8 variants: 2 kernels for 16 variants, one compile (the second point's
+    kernel is the first's code with its own constant pool), and every check's value equal
+    to the numpy path's (each variant's mechanism analysed afresh) to 1e-11.  With fewer
+    variants a value (one each, or random points that rarely repeat one), the numpy path."""
     import gearcli.batch.sweep as sweep
     from gearcli.batch.manifest import load_manifest
     from gearcli.dynamics.llvm import driver
@@ -350,16 +353,58 @@ def test_a_constant_of_the_kernel_gets_a_data_kernel_per_value(monkeypatch):
     manifest = load_manifest(path)
     plan = sweep.plan_sweep(manifest, varies)
     assert not sweep.data_kernel_applies(varies) and plan.per_value_kernels
-    assert not sweep.plan_sweep(manifest, varies[:2]).per_value_kernels               # 4 variants a point: numpy
+    assert not sweep.plan_sweep(manifest, varies[:1]).per_value_kernels               # 1 variant a point: numpy
     spread = [sweep.parse_vary("loads.payload.point[0]=0.02:0.09:8")] + varies[1:]
-    assert not sweep.plan_sweep(manifest, spread, samples=16, seed=1).per_value_kernels   # ~2 a point: numpy
+    assert not sweep.plan_sweep(manifest, spread, samples=8, seed=1).per_value_kernels    # ~1 a point: numpy
     sweep._STRUCTURES.clear()
+    monkeypatch.setattr(driver, "_RECENT", {})
+    monkeypatch.setenv("GEARCLI_CACHE_DIR", "/dev/null/none")      # no disk cache: sharing in memory
     built, real = [], driver.Jit.__init__
-    monkeypatch.setattr(driver.Jit, "__init__", lambda self, *a, **k: (built.append(1), real(self, *a, **k))[1])
+    monkeypatch.setattr(driver.Jit, "__init__", lambda self, *a, **k: (real(self, *a, **k), built.append(self))[0])
     kernel = sweep.run_sweep(plan)
-    assert len(plan.variants) == 16 and len(built) == 2
+    assert len(plan.variants) == 16 and len(built) == 2 and [j.from_cache for j in built] == [False, True]
     numpy = sweep.run_sweep(dataclasses.replace(plan, per_value_kernels=False))
     assert len(built) == 2 and len({tuple(r) for r in kernel}) == 16
+    for a, b in zip(kernel, numpy):
+        assert [x[:4] + x[5:6] + x[7:] for x in a] == [x[:4] + x[5:6] + x[7:] for x in b]
+        for x, y in zip(a, b):
+            assert x[4] == pytest.approx(y[4], rel=1e-11, abs=1e-300), x[:3]
+
+
+def test_a_ratio_variant_moves_the_mesh_point_and_shares_the_compile(monkeypatch):
+    """A gear pair's ratio varied moves its mesh point along the line of centres (the centre
+    distance kept: the Bendix wrist's pinion 4 and link 1, 0.08 m apart, at e = -2.5 have
+    pitch radii 0.08/3.5 and 0.08 - 0.08/3.5, by hand), and its tooth counts varied move a
+    bevel pair's along the pitch cone; each ratio gets a data kernel, all of them one
+    compile, and every check's value equals the numpy path's to 1e-11."""
+    import gearcli.batch.sweep as sweep
+    from gearcli.batch.manifest import load_manifest
+    from gearcli.dynamics.llvm import driver
+    from gearcli import analyse
+    from gearcli.io.yaml_reader import mechanism_from_data
+    path = str(ROOT / "designs" / "ci_example.yaml")
+    manifest = load_manifest(path)
+    varies = [sweep.parse_vary(t) for t in ("gears.4-1.ratio=-2.5,-3.5", "gears.5-6.teeth[1]=25,30",
+                                             "links.3.mass=0.7,0.9")]
+    data = sweep.variant_data(manifest, varies, (-2.5, 30, 0.7))["wrist_motion"]
+    pairs = {g["name"]: g for g in data["gears"]}
+    r_4 = 0.08 / 3.5
+    assert np.allclose(pairs["4-1"]["mesh_point"], [0.08 - r_4, 0.0, 0.3], rtol=0, atol=1e-15)
+    an = analyse(mechanism_from_data(data, path))        # the geometry of the moved points, from the mechanism
+    ratio = {an.mech.gears[c.gear].name: c.geometry.ratio for c in an.circuits if c.geometry is not None}
+    assert abs(ratio["4-1"] + 2.5) < 1e-12 and abs(abs(ratio["5-6"]) - 30 / 25) < 1e-12
+    plan = sweep.plan_sweep(manifest, varies)
+    assert plan.per_value_kernels and len(plan.variants) == 8
+    sweep._STRUCTURES.clear()
+    monkeypatch.setattr(driver, "_RECENT", {})
+    monkeypatch.setenv("GEARCLI_CACHE_DIR", "/dev/null/none")
+    built, real = [], driver.Jit.__init__
+    monkeypatch.setattr(driver.Jit, "__init__", lambda self, *a, **k: (real(self, *a, **k), built.append(self))[0])
+    kernel = sweep.run_sweep(plan)
+    compiles = sum(not j.from_cache for j in built)
+    assert len(built) == 4 and compiles <= 2     # the 25:25 bevel folds its ratio of 1: another IR
+    numpy = sweep.run_sweep(dataclasses.replace(plan, per_value_kernels=False))
+    assert len({tuple(map(tuple, r)) for r in kernel}) == 8
     for a, b in zip(kernel, numpy):
         assert [x[:4] + x[5:6] + x[7:] for x in a] == [x[:4] + x[5:6] + x[7:] for x in b]
         for x, y in zip(a, b):

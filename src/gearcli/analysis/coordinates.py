@@ -77,6 +77,10 @@ def independent_coordinates(h: Home, cparent: list, canon: np.ndarray, primary: 
         col.raise_if_any()
     S = np.linalg.solve(Mfull, np.vstack([np.zeros((cr.rank, dof)), np.eye(dof)]))
     S[np.abs(S) < 1e-15] = 0.0
+    # a coefficient one ulp or two from +-1 (the LU solve's rounding of a direct drive) is
+    # +-1: exact, and the same IR for every ratio of a sweep (the kernel folds a unit product)
+    unit = np.abs(np.abs(S) - 1.0) <= 4 * np.finfo(float).eps
+    S[unit] = np.sign(S[unit])
     independent = []
     for c in chain:
         jt = h.jin[c]

@@ -194,8 +194,43 @@ def variant_data(manifest, varies, values) -> dict[str, dict]:
             data[key] = copy.deepcopy(data[key])
         for v, x in mine:
             _set(data, v, x)
+        for v in {v.steps[1]: v for v, _ in mine if moves_mesh_point(v.steps)}.values():
+            _follow_mesh_point(str(case.mechanism), data, v)
         out[case.name] = data
     return out
+
+
+def moves_mesh_point(steps: tuple) -> bool:
+    """True when a path names a gear pair's ``ratio`` or ``teeth``: a variant of it moves the
+    pair's mesh point, if it has one (:func:`_follow_mesh_point`)."""
+    return len(steps) >= 3 and steps[0] == "gears" and steps[2] in ("ratio", "teeth")
+
+
+def _follow_mesh_point(mech_path: str, data: dict, v: Vary) -> None:
+    """Move the mesh point of the pair ``v`` names (its ratio or tooth counts varied) to where
+    its axes, as the file places them, give it the variant's ratio
+    (:func:`gearcli.model.gears.mesh_point_for_ratio`: the centre distance or the cone
+    distance kept); a pair without a mesh point (a reducer, a coupling) is left as it is."""
+    from ..model.gears import mesh_point_for_ratio  # noqa: PLC0415
+    pairs = data["gears"]
+    i = next(i for i, g in enumerate(pairs) if isinstance(g, dict) and g.get("name") == v.steps[1])
+    pair = pairs[i] = dict(pairs[i])
+    geometry = _file_geometry(mech_path).get(v.steps[1])
+    if "mesh_point" not in pair or geometry is None or pair.get("kind") == "rack":
+        return
+    ratio = pair["teeth"][1] / pair["teeth"][0] if v.steps[2] == "teeth" else pair["ratio"]
+    try:
+        pair["mesh_point"] = [float(x) for x in mesh_point_for_ratio(geometry, ratio)]
+    except ValueError as exc:
+        raise GearcliError(f"--vary '{v.text}': gear pair '{v.steps[1]}': {exc}") from None
+
+
+@lru_cache(maxsize=8)
+def _file_geometry(mech_path: str) -> dict:
+    """{gear pair name: its mesh geometry (carrier frame)} of the mechanism file as written."""
+    from ..dynamics.determinacy import load_analysed  # noqa: PLC0415
+    an = load_analysed(mech_path)
+    return {an.mech.gears[c.gear].name: c.geometry for c in an.circuits if c.geometry is not None}
 
 
 def plan_sweep(manifest, varies: list[Vary], samples: int | None = None, seed: int = 0) -> Plan:
@@ -296,11 +331,13 @@ def data_kernel_applies(varies) -> bool:
     return all(run_time(v.steps) or checks_only(v.steps) for v in varies)
 
 
-STRUCTURE_VARIANTS = 8
+STRUCTURE_VARIANTS = 2
 """Variants per value of the other --vary paths (a ratio, a radius, a point) from which each
-such value gets a data kernel of its own (:func:`per_value_kernels`): a compile costs
-what the numpy path takes for 2-10 variants (the Bendix wrist's 0.8 s against 95 ms a
-variant of 10,000 samples; once in the disk cache, nothing)."""
+such value gets a data kernel of its own (:func:`per_value_kernels`).  The kernels of the
+values share one compile (the IR holds no value of the mechanism:
+:class:`gearcli.dynamics.llvm.build.ConstantPool`): a value's kernel costs its analysis, its
+IR and a link, 0.13 s for the Bendix wrist (2026-12-08), what the numpy path takes for
+one or two variants of 10,000 samples (95 ms each)."""
 
 
 def per_value_kernels(varies, variants) -> bool:

@@ -82,6 +82,43 @@ def gear_geometry(kind: str, P, oj, zj, ok, zk, teeth=None, ratio=None, cones=No
     return GearGeometry(P, zj, zk, rad_j, rad_k, ut, us, r_j, r_k, e, cone_j, cone_k, ring), problems
 
 
+def mesh_point_for_ratio(g: GearGeometry, ratio: float) -> np.ndarray:
+    """The mesh point (carrier frame, m) that gives the pair of geometry ``g`` the ratio
+    ``ratio`` (its magnitude |e_kj| = r_k / r_j; the sign is the geometry's), the axes kept:
+    a design sweep's variant of a ratio or of tooth counts (issue 37: "ratios and radii,
+    which move the mesh points").
+
+    * Parallel axes: the centre distance d is kept, the point stays on the line of centres:
+      external r_j + r_k = d, so r_j' = d / (1 + |e|); internal |r_k - r_j| = d, so
+      r_j' = d / (|e| - 1) (k the ring, |e| > 1) or d / (1 - |e|) (j the ring, |e| < 1).
+      P' = F_j + r_j' rad_j, F_j = P - r_j rad_j the foot of P on gear j's axis.
+    * Intersecting axes (bevel): the cone distance L = r_j / sin(cone_j) and the shaft
+      angle S = cone_j + cone_k are kept: r_k / r_j = sin(cone_k) / sin(cone_j), so
+      tan(cone_j') = sin S / (|e| + cos S); P' = A + L (cos(cone_j') a_j + sin(cone_j') rad_j),
+      A the apex (where the axes through the feet F_j, F_k of P meet), a_j the direction
+      of gear j's axis from A towards F_j.
+    A ratio the geometry cannot take (an internal pair through |e| = 1, a zero) is a ValueError.
+    """
+    e = abs(float(ratio))
+    if not np.isfinite(e) or e <= 0.0:
+        raise ValueError(f"a gear ratio must be finite and nonzero, got {ratio:g}")
+    foot = g.P - g.r_j * g.rad_j
+    if g.cone_j == 0.0 and g.cone_k == 0.0:            # parallel axes
+        if g.ring is None:
+            return foot + (g.r_j + g.r_k) / (1.0 + e) * g.rad_j
+        if (g.ring == 1) != (e > 1.0):
+            raise ValueError(f"an internal pair's |ratio| must stay {'above' if g.ring == 1 else 'below'} 1 "
+                             f"(its ring is gear {'k' if g.ring == 1 else 'j'}), got {e:g}")
+        return foot + abs(g.r_k - g.r_j) / abs(e - 1.0) * g.rad_j
+    S = g.cone_j + g.cone_k
+    s, _ = np.linalg.lstsq(np.stack([g.zj, -g.zk], axis=1), g.P - g.r_k * g.rad_k - foot, rcond=None)[0]
+    apex = foot + s * g.zj
+    a_j = (foot - apex) / np.linalg.norm(foot - apex)
+    L = float(np.linalg.norm(g.P - apex))
+    cone = np.arctan2(np.sin(S), e + np.cos(S))
+    return apex + L * (np.cos(cone) * a_j + np.sin(cone) * g.rad_j)
+
+
 def rack_geometry(P, zj, zk, rad_j, r_j, ratio, names):
     """Rack and pinion: pinion j turning about (oj, zj), rack k sliding along zk.
 
