@@ -409,3 +409,31 @@ def test_a_ratio_variant_moves_the_mesh_point_and_shares_the_compile(monkeypatch
         assert [x[:4] + x[5:6] + x[7:] for x in a] == [x[:4] + x[5:6] + x[7:] for x in b]
         for x, y in zip(a, b):
             assert x[4] == pytest.approx(y[4], rel=1e-11, abs=1e-300), x[:3]
+
+
+@pytest.mark.parametrize("kind, P, axis_k, ratio", [
+    ("external", [0.02, 0, 0.1], ([0.08, 0, 0], [0, 0, 1]), -2.0),
+    ("internal", [0.03, 0, 0], ([-0.02, 0, 0], [0, 0, 1]), 2.5),
+    ("bevel", [0.025, 0, 0.075], ([0, 0, 0.1], [1, 0, 0]), -1.6),
+    ("bevel", [0.02, 0, 0.05], ([0, 0, 0], [np.sin(1.2), 0, np.cos(1.2)]), 0.5),
+])
+def test_the_mesh_point_of_a_ratio_gives_that_ratio(kind, P, axis_k, ratio):
+    """mesh_point_for_ratio moves a pair's mesh point so that the geometry (gear_geometry, its
+    own code) gives |ratio|, the centre distance (parallel axes) or the cone distance
+    (intersecting) kept; an internal pair's ratio cannot cross 1."""
+    from gearcli.model.gears import gear_geometry, mesh_point_for_ratio
+    axes = ([0, 0, 0], [0, 0, 1]) + axis_k
+    g, problems = gear_geometry(kind, np.array(P, float), *axes)
+    assert not problems
+    P2 = mesh_point_for_ratio(g, ratio)
+    g2, problems = gear_geometry(kind, P2, *axes)
+    assert not problems and abs(abs(g2.ratio) - abs(ratio)) < 1e-12 * abs(ratio)
+    if kind == "bevel":
+        apex = np.array([0.0, 0.0, 0.1 if axis_k[0][2] else 0.0])
+        assert abs(np.linalg.norm(P2 - apex) - np.linalg.norm(np.array(P) - apex)) < 1e-15
+    else:
+        d = (lambda G: G.r_j + G.r_k if kind == "external" else abs(G.r_k - G.r_j))
+        assert abs(d(g2) - d(g)) < 1e-15
+    if kind == "internal":
+        with pytest.raises(ValueError, match="must stay above 1"):
+            mesh_point_for_ratio(g, 0.8)

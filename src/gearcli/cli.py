@@ -398,7 +398,8 @@ def sweep(
     vary: list[str] = typer.Option(..., "--vary", metavar="PATH=VALUES", help="A number of the cases' YAML "
                                    "mechanism files and its values: links.payload.mass=0.5,1,2 (a list), "
                                    "gears.g1.ratio=50:120:8 (a:b:n, n values), log:a:b:n (evenly in log); "
-                                   "CASE:PATH for one case's mechanism.  Repeat for a grid."),
+                                   "CASE:PATH for one case's mechanism.  Repeat for a grid.  A gear pair's ratio "
+                                   "or teeth moves its mesh point (the axes kept)."),
     output: str = typer.Option(None, "-o", "--output", metavar="TABLE.csv|parquet|feather",
                                help="Write one row per variant: the varied values, every check's value, limit and "
                                     "margin %, the worst margin and its check."),

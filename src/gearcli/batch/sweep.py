@@ -206,17 +206,23 @@ def moves_mesh_point(steps: tuple) -> bool:
     return len(steps) >= 3 and steps[0] == "gears" and steps[2] in ("ratio", "teeth")
 
 
+TOOTHED = ("external", "internal", "bevel")
+"""The kinds of gear pair whose mesh point a ratio variant moves (spur, helical, ring, bevel;
+not a rack, whose ratio is its pinion's radius, nor a worm, a belt or a reducer)."""
+
+
 def _follow_mesh_point(mech_path: str, data: dict, v: Vary) -> None:
     """Move the mesh point of the pair ``v`` names (its ratio or tooth counts varied) to where
     its axes, as the file places them, give it the variant's ratio
     (:func:`gearcli.model.gears.mesh_point_for_ratio`: the centre distance or the cone
-    distance kept); a pair without a mesh point (a reducer, a coupling) is left as it is."""
+    distance kept); a pair without a mesh point (a reducer, a coupling) or not :data:`TOOTHED`
+    is left as it is."""
     from ..model.gears import mesh_point_for_ratio  # noqa: PLC0415
     pairs = data["gears"]
     i = next(i for i, g in enumerate(pairs) if isinstance(g, dict) and g.get("name") == v.steps[1])
     pair = pairs[i] = dict(pairs[i])
     geometry = _file_geometry(mech_path).get(v.steps[1])
-    if "mesh_point" not in pair or geometry is None or pair.get("kind") == "rack":
+    if "mesh_point" not in pair or geometry is None or pair.get("kind", "external") not in TOOTHED:
         return
     ratio = pair["teeth"][1] / pair["teeth"][0] if v.steps[2] == "teeth" else pair["ratio"]
     try:
