@@ -1,6 +1,6 @@
 """verify's per-trajectory reduction (design.evaluate.partials) against the plain definition
 written out here: every check of the rated Bendix wrist and the rated paper arm, bit for bit
-(the fast paths: the peak searched once per signal and without |x| for signals that are
+but a bearing life's sums, to the last bit (the fast paths: the peak searched once per signal and without |x| for signals that are
 never negative, life sums without dividing by a_ISO = 1, rainflow on turning points)."""
 import math
 from pathlib import Path
@@ -75,7 +75,10 @@ def test_partials_equal_the_plain_definition(tmp_path, mech):
     s = solve_samples(an, tmp_path / "m.csv", False)
     got, ref = partials(checks, s, an.mech), reference(checks, s, an.mech)
     for ch, g, r in zip(checks, got, ref):
-        assert np.array(g[:7]).tobytes() == np.array(r).tobytes(), ch.name
+        if ch.kind == "life":      # the product cubes by two products (bearings.life_sum), the reference by pow:
+            assert np.allclose(g[:7], r, rtol=1e-15, atol=0), ch.name      # the last bits may differ
+        else:
+            assert np.array(g[:7]).tobytes() == np.array(r).tobytes(), ch.name
         if ch.kind == "fatigue":     # the counts the damage came from: the counted cycles, by stress
             levels = [s for s, n in g[7][0] for _ in range(n)]
             assert levels == sorted(F.rainflow_peaks(signal(ch, s, an.mech)).tolist())
