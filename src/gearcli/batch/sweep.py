@@ -206,6 +206,16 @@ def moves_mesh_point(steps: tuple) -> bool:
     return len(steps) >= 3 and steps[0] == "gears" and steps[2] in ("ratio", "teeth")
 
 
+def _both_given(data: dict, steps: tuple) -> str:
+    """A hint for a varied ratio or tooth count of a pair that gives both (the other one then
+    contradicts the variant: vary the tooth counts alone, the file's ratio removed), or ""."""
+    if not moves_mesh_point(steps):
+        return ""
+    pair = next((g for g in data.get("gears", ()) if isinstance(g, dict) and g.get("name") == steps[1]), {})
+    return (f" (gear pair '{steps[1]}' gives both ratio and teeth: remove its ratio and vary its teeth)"
+            if "ratio" in pair and "teeth" in pair else "")
+
+
 TOOTHED = ("external", "internal", "bevel")
 """The kinds of gear pair whose mesh point a ratio variant moves (spur, helical, ring, bevel;
 not a rack, whose ratio is its pinion's radius, nor a worm, a belt or a reducer)."""
@@ -277,7 +287,8 @@ def plan_sweep(manifest, varies: list[Vary], samples: int | None = None, seed: i
                 except MechanismError as exc:
                     i = exc.issues[0]
                     said = f"{i.path}: {i.message}" if i.path else i.message
-                    raise GearcliError(f"{where}: case '{case.name}': the value {x:g}: {said}") from None
+                    raise GearcliError(f"{where}: case '{case.name}': the value {x:g}: {said}"
+                                       f"{_both_given(data, v.steps)}") from None
     sizes = [len(v.values) for v in varies]
     total = math.prod(sizes)
     if samples is None:
