@@ -190,14 +190,34 @@ def variant_data(manifest, varies, values) -> dict[str, dict]:
         # built from its data without changing it): a deep copy of the whole file was a
         # tenth of a variant's time
         data = dict(file_data(str(case.mechanism)))
-        for key in {v.steps[0] for v, _ in mine}:
-            data[key] = copy.deepcopy(data[key])
-        for v, x in mine:
-            _set(data, v, x)
-        for v in {v.steps[1]: v for v, _ in mine if moves_mesh_point(v.steps)}.values():
-            _follow_mesh_point(str(case.mechanism), data, v)
+        for key in dict.fromkeys(v.steps[0] for v, _ in mine):
+            data[key] = _section_copy(str(case.mechanism), key, tuple((v, x) for v, x in mine if v.steps[0] == key))
         out[case.name] = data
     return out
+
+
+def _section_copy(mech_path: str, key: str, values: tuple):
+    """Section ``key`` of the mechanism file with the variant's ``values`` ((vary, value) of
+    the paths into it) set, a gear pair's mesh point following its ratio; the same object
+    for the same values, kept for the next variants (the last :data:`SECTION_COPIES`): the
+    reader then reuses the parts it built from it (:func:`gearcli.io.yaml_reader._section`),
+    e.g. the gear pairs of one ratio while the masses vary."""
+    k = (mech_path, key, tuple((v.path, v.case, v.mode, x) for v, x in values))
+    if k not in _SECTIONS:
+        if len(_SECTIONS) >= SECTION_COPIES:
+            _SECTIONS.pop(next(iter(_SECTIONS)))
+        data = dict(file_data(mech_path))
+        data[key] = copy.deepcopy(data[key])
+        for v, x in values:
+            _set(data, v, x)
+        for v in {v.steps[1]: v for v, _ in values if moves_mesh_point(v.steps)}.values():
+            _follow_mesh_point(mech_path, data, v)
+        _SECTIONS[k] = data[key]
+    return _SECTIONS[k]
+
+
+SECTION_COPIES = 64
+_SECTIONS: dict = {}
 
 
 def moves_mesh_point(steps: tuple) -> bool:

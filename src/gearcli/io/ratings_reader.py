@@ -171,27 +171,37 @@ PRISMATIC_BEARINGS = ("rolling-bearing ratings and friction (ISO 281 life in rev
                       "joints[].friction (coulomb N, viscous N*s/m)")
 
 
-def attach_yaml_ratings(mech: Mechanism, data: dict, col: Collector) -> Mechanism:
-    """``mech`` with the ratings of the (schema-valid) YAML ``data`` attached; issues to ``col``."""
+def rated_motors(motors: tuple, data: dict, col: Collector) -> tuple:
+    """The motors with their ``rating`` and ``model`` of the YAML ``data`` attached."""
     motors = tuple(replace(m, rating=motor_rating(s["rating"], f"motors[{i}].rating", col.add))
-                   if "rating" in s else m for i, (m, s) in enumerate(zip(mech.motors, data.get("motors", []))))
-    motors = tuple(replace(m, model=motor_model(s["model"], f"motors[{i}].model", col.add))
-                   if "model" in s else m for i, (m, s) in enumerate(zip(motors, data.get("motors", []))))
+                   if "rating" in s else m for i, (m, s) in enumerate(zip(motors, data.get("motors", []))))
+    return tuple(replace(m, model=motor_model(s["model"], f"motors[{i}].model", col.add))
+                 if "model" in s else m for i, (m, s) in enumerate(zip(motors, data.get("motors", []))))
+
+
+def rated_joints(joints: tuple, data: dict, col: Collector) -> tuple:
+    """The joints with their ``bearings`` of the YAML ``data`` attached."""
     joints = tuple(replace(j, bearings=bearing_ratings(s["bearings"], f"{item_path(data, 'joints', i)}.bearings",
                                                        col.add))
-                   if "bearings" in s else j for i, (j, s) in enumerate(zip(mech.joints, data["joints"])))
+                   if "bearings" in s else j for i, (j, s) in enumerate(zip(joints, data["joints"])))
     for i, j in enumerate(joints):
         if j.bearings and j.type == "prismatic":
             col.add(f"joints[{i}].bearings", PRISMATIC_BEARINGS)
-    gears = []
-    for i, (g, s) in enumerate(zip(mech.gears, data.get("gears", []))):
+    return joints
+
+
+def rated_gears(gears: tuple, data: dict, col: Collector) -> tuple:
+    """The gear pairs with their ``rating`` of the YAML ``data`` attached (a reducer's, a
+    screw's, a worm's and a belt's are their readers')."""
+    out = []
+    for i, (g, s) in enumerate(zip(gears, data.get("gears", []))):
         if "rating" in s and g.reducer is None and g.screw is None and g.worm is None and g.belt is None:   # theirs: io.reducer_specs, io.element_specs
             path = f"{item_path(data, 'gears', i)}.rating"   # a planet copy: its original's path
             if g.mesh_point is None:
                 col.add(path, "a gear rating needs the mesh geometry (mesh_point)")
             g = replace(g, rating=gear_rating(s["rating"], path, col.add))
-        gears.append(g)
-    return replace(mech, motors=motors, joints=joints, gears=tuple(gears))
+        out.append(g)
+    return tuple(out)
 
 
 # -- URDF ---------------------------------------------------------------------------------

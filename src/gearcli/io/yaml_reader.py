@@ -21,7 +21,7 @@ from ..model.friction import JointFriction
 from ..model.mechanism import GearPair, Joint, Link, Mechanism, Motor
 from .loads_reader import yaml_loads, yaml_payloads
 from .planets import expand_planets, item_path
-from .ratings_reader import attach_yaml_ratings
+from .ratings_reader import rated_gears, rated_joints, rated_motors
 from ..model.geometry import dh_transform, origin_axis_transform
 from ..model.reducers import REDUCER_KINDS
 from ..model.validate import check_inertia, gear_pair_problems, inertia_matrix, number_problem
@@ -180,43 +180,53 @@ class _Names:
 
 def _build(data: dict, col: Collector, file: str, lines: dict, reuse: bool = False) -> Mechanism:
     """The Mechanism of validated ``data``: links, joints, gears, motors and loads in turn, each
-    checked for names, references and values, then the ratings attached.  ``reuse``: the
-    joints, gears and motors of ``data`` built before from the very same section objects
-    (and the same link names) are taken again (:data:`_PARTS`: a sweep's variants share
-    the sections no value of theirs changes, :func:`gearcli.batch.sweep.variant_data`)."""
+    checked for names, references and values, and rated.  ``reuse``: each of the joints,
+    gears and motors sections built before from the very same section object (and the same
+    link names) is taken again (:data:`_PARTS`: a sweep's variants share the sections no
+    value of theirs changes, :func:`gearcli.batch.sweep.variant_data`)."""
     links, link_list = _links(data, col)
     for key in ("base", "end_effector"):
         links.ref(data[key], key)
     loads = yaml_loads(data, col, set(links.first), data["base"])
-    sections = tuple(data.get(k) for k in ("joints", "gears", "motors"))
-    key = (*(id(x) for x in sections), tuple(links.first), data["base"])
-    hit = _PARTS.get(key) if reuse else None
-    if hit is not None and all(a is b for a, b in zip(hit[0], sections)):
-        parts = hit[1]
-    else:
-        hit, parts = None, (tuple(_joints(data, col, links)), tuple(_gears(data, col, links)),
-                            tuple(_motors(data, col, links)))
-    mech = Mechanism(
+    parts = tuple(_section(kind, data, col, links, reuse) for kind in ("joints", "gears", "motors"))
+    return Mechanism(
         name=data["name"], base=data["base"], end_effector=data["end_effector"],
         links=tuple(link_list), joints=parts[0], gears=parts[1], motors=parts[2],
         gravity=np.asarray(data.get("gravity", [0.0, 0.0, -9.81]), float),
         source=file, lines=dict(lines), loads=loads,
         payloads=yaml_payloads(data, col, set(links.first), data["base"], loads),
     )
-    if hit is None:
-        mech = attach_yaml_ratings(mech, data, col)
-        if reuse and not col.issues:
-            if len(_PARTS) >= 16:
-                _PARTS.clear()
-            _PARTS[key] = (sections, (mech.joints, mech.gears, mech.motors))
-    return mech
+
+
+_BUILD = {"joints": (lambda data, col, links: _joints(data, col, links), rated_joints),
+          "gears": (lambda data, col, links: _gears(data, col, links), rated_gears),
+          "motors": (lambda data, col, links: _motors(data, col, links), rated_motors)}
+
+
+def _section(kind: str, data: dict, col: Collector, links: _Names, reuse: bool) -> tuple:
+    """The rated parts of section ``kind`` (joints, gears or motors) of ``data``; with
+    ``reuse``, those built before from the very same section object and link names
+    (:data:`_PARTS`), else built, rated and (without a new issue) kept."""
+    section = data.get(kind)
+    key = (kind, id(section), tuple(links.first), data["base"])
+    hit = _PARTS.get(key) if reuse else None
+    if hit is not None and hit[0] is section:
+        return hit[1]
+    build, rate = _BUILD[kind]
+    before = len(col.issues)
+    parts = rate(tuple(build(data, col, links)), data, col)
+    if reuse and len(col.issues) == before:
+        if len(_PARTS) >= 48:
+            _PARTS.clear()
+        _PARTS[key] = (section, parts)
+    return parts
 
 
 _PARTS: dict = {}
-"""(ids of the joints, gears and motors sections, link names, base) -> (those sections, their
-rated joints, gears and motors): the parts of the mechanisms built with ``reuse`` (the
-sections are kept, so that their ids stay theirs while they are keys).  The parts are
-frozen dataclasses, shared by the mechanisms built from the same sections."""
+"""(section kind, its id, link names, base) -> (the section, its rated joints, gears or
+motors): the parts of the mechanisms built with ``reuse`` (the sections are kept, so that
+their ids stay theirs while they are keys).  The parts are frozen dataclasses, shared by
+the mechanisms built from the same sections."""
 
 
 def _links(data: dict, col: Collector) -> tuple[_Names, list[Link]]:
