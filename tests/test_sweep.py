@@ -124,6 +124,7 @@ def test_the_plot_of_one_and_two_values(run_cli, tmp_path):
     ("gears.5-1.ratio=-3,-2.5", "the value -2.5: gears[0].teeth: tooth counts 30:90 give |ratio| 3, but the mesh "
      "geometry gives 2.5 (gear pair '5-1' gives both ratio and teeth: remove its ratio and vary its teeth)"),
     ("gears.5-1.ratio=-3,0", "gear pair '5-1': a gear ratio must be finite and nonzero, got 0"),
+    ("gears.5-1.teeth[0]=30,0", "the value 0: gears[0].teeth[0]: expected at least 1, got 0"),
 ])
 def test_bad_paths_and_values_are_located_before_anything_runs(run_cli, tmp_path, vary, said):
     out = tmp_path / "s.csv"

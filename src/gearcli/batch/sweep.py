@@ -254,6 +254,8 @@ def _follow_mesh_point(mech_path: str, data: dict, v: Vary) -> None:
     geometry = _file_geometry(mech_path).get(v.steps[1])
     if "mesh_point" not in pair or geometry is None or pair.get("kind", "external") not in TOOTHED:
         return
+    if v.steps[2] == "teeth" and not all(isinstance(z, (int, float)) and z > 0 for z in pair["teeth"]):
+        return                          # the reader says what is wrong with the tooth counts
     ratio = pair["teeth"][1] / pair["teeth"][0] if v.steps[2] == "teeth" else pair["ratio"]
     try:
         pair["mesh_point"] = [float(x) for x in mesh_point_for_ratio(geometry, ratio)]

@@ -36,7 +36,7 @@ class ConstantPool:
     body's builder; the function's entry without): a register LLVM can neither fold into
     each read's offset nor see the pool through, and reads that depend on the sample, which
     LLVM folds into their arithmetic instead of hoisting them out of the loop and spilling
-    them (servo_joint: 906 -> 872 spills, 1-2% faster).
+    them (servo_joint: 906 -> 872 stack spills; speed the same within the noise).
 
     The array's values are data, not IR: :meth:`finish` declares it as zeros and leaves the
     values in ``values``, which :class:`.driver.Jit` writes into the loaded code.  So the IR
@@ -45,9 +45,10 @@ class ConstantPool:
     friction coefficient, a point (a sweep's variants) share one compiled kernel, each with
     its own pool, as long as they fold the same products (a ratio of exactly -1 or 1, a zero
     coordinate folds).  Up to :data:`POOL_SLOTS` reads each has its own slot, so which values
-    happen to be equal does not matter either; above, the reads of one value share a slot
-    (per-read slots cost servo_joint's 2,170 reads 8% of its speed, the Bendix wrist's 535
-    under 2%, same run)."""
+    happen to be equal does not matter either; above, the reads of one value share a slot,
+    which keeps a large kernel's pool small (planetary_3p_rated: 6,312 reads of 1,872
+    values).  Per-read and shared slots ran at the same speed within the noise on the
+    bundled kernels (2026-12-08, same process)."""
 
     def __init__(self, fn: ir.Function, at: ir.IRBuilder | None = None):
         self.fn, self.reads = fn, []

@@ -215,10 +215,10 @@ def note_program(pkey: str, key: str, pools: dict) -> None:
     names = sorted(pools)
     body = (" ".join(f"{n} {len(pools[n])}" for n in names) + "\n").encode() + b"".join(
         np.ascontiguousarray(pools[n], "<f8").tobytes() for n in names)
-    note = _note(pkey)
-    if note is None or note[0] != key or _pools(body) is None or \
-            any(not np.array_equal(note[1].get(n), pools[n]) for n in names) or set(note[1]) != set(names):
-        write_entry(cache_dir() / f"{pkey}.prog", f"{pkey} {key} {hashlib.sha256(body).hexdigest()}\n".encode() + body)
+    path = cache_dir() / f"{pkey}.prog"
+    content = f"{pkey} {key} {hashlib.sha256(body).hexdigest()}\n".encode() + body
+    if _read(path, MAX_NOTE_BYTES) != content:
+        write_entry(path, content)
 
 
 def load_program(pkey: str, fingerprint: str | None = None) -> tuple[str, bytes, dict] | None:

@@ -174,10 +174,12 @@ class Jit:
     (``from_cache``: then no LLVM pass runs, MCJIT only links the stored object code;
     ``by_program``: found by ``program_key`` without generating the IR, the entry found
     then that of kernel program ``fingerprint``, :func:`.cache.program_fingerprint`, kept in
-    the entries it stores), else MCJIT makes it in memory and it is stored.  ``cache``
-    False: compile in memory, neither read nor write the cache.  ``ir`` is the IR text
-    (generated on first use when the code came by program key).  Keeps the execution
-    engine alive (freeing it frees the code)."""
+    the entries it stores) or when this process compiled it (:data:`_RECENT`), else MCJIT
+    makes it in memory and it is stored.  ``cache`` False: compile in memory, neither read
+    nor write the caches.  ``ir`` is the IR text (generated on first use when the code came
+    by program key); ``pools`` the values of its constant pools ({symbol: values}, from the
+    generator or the program's note), written into the loaded code (:meth:`_fill_pools`).
+    Keeps the execution engine alive (freeing it frees the code)."""
 
     def __init__(self, module, cache: bool = True, program_key: str | None = None, fingerprint: str = ""):
         llvm, tm = _target_machine()
@@ -190,7 +192,7 @@ class Jit:
         else:
             self.key = llvm_cache.object_key(self.ir, host_identity())
             cached = llvm_cache.load(self.key, adopt=fingerprint) if cache else None
-            cached = _RECENT.get(self.key) if cached is None else cached
+            cached = _RECENT.get(self.key) if cached is None and cache else cached
         self.from_cache = cached is not None
         self._module = None if cached else self._optimised(llvm, tm)
         mod = self._module
@@ -202,7 +204,7 @@ class Jit:
         self._engine.set_object_cache(lambda _m, buf: made.append(bytes(buf)), lambda _m: cached)
         self._engine.finalize_object()
         self._fill_pools()
-        if made:
+        if made and cache:
             _RECENT[self.key] = made[0]
             while len(_RECENT) > RECENT_OBJECTS:
                 _RECENT.pop(next(iter(_RECENT)))
