@@ -28,6 +28,7 @@ import dataclasses
 import json
 import math
 import re
+import threading
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -203,21 +204,23 @@ def _section_copy(mech_path: str, key: str, values: tuple):
     reader then reuses the parts it built from it (:func:`gearcli.io.yaml_reader._section`),
     e.g. the gear pairs of one ratio while the masses vary."""
     k = (mech_path, key, tuple((v.path, v.case, v.mode, x) for v, x in values))
-    if k not in _SECTIONS:
-        if len(_SECTIONS) >= SECTION_COPIES:
-            _SECTIONS.pop(next(iter(_SECTIONS)))
-        data = dict(file_data(mech_path))
-        data[key] = copy.deepcopy(data[key])
-        for v, x in values:
-            _set(data, v, x)
-        for v in {v.steps[1]: v for v, _ in values if moves_mesh_point(v.steps)}.values():
-            _follow_mesh_point(mech_path, data, v)
-        _SECTIONS[k] = data[key]
-    return _SECTIONS[k]
+    with _SECTIONS_LOCK:                # a Dask worker's threads share it
+        if k not in _SECTIONS:
+            if len(_SECTIONS) >= SECTION_COPIES:
+                _SECTIONS.pop(next(iter(_SECTIONS)))
+            data = dict(file_data(mech_path))
+            data[key] = copy.deepcopy(data[key])
+            for v, x in values:
+                _set(data, v, x)
+            for v in {v.steps[1]: v for v, _ in values if moves_mesh_point(v.steps)}.values():
+                _follow_mesh_point(mech_path, data, v)
+            _SECTIONS[k] = data[key]
+        return _SECTIONS[k]
 
 
 SECTION_COPIES = 64
 _SECTIONS: dict = {}
+_SECTIONS_LOCK = threading.RLock()
 
 
 def moves_mesh_point(steps: tuple) -> bool:

@@ -158,6 +158,7 @@ def _libc():
 RECENT_OBJECTS = 8
 """Object codes this process made that it keeps in memory (:data:`_RECENT`)."""
 
+_RECENT_LOCK = threading.Lock()
 _RECENT: dict = {}
 """{object key: object code} of the last :data:`RECENT_OBJECTS` kernels this process compiled:
 another program whose IR is the same (a sweep's variant of a ratio, an efficiency: only
@@ -205,9 +206,10 @@ class Jit:
         self._engine.finalize_object()
         self._fill_pools()
         if made and cache:
-            _RECENT[self.key] = made[0]
-            while len(_RECENT) > RECENT_OBJECTS:
-                _RECENT.pop(next(iter(_RECENT)))
+            with _RECENT_LOCK:           # kernels made on several threads (a Dask worker's)
+                _RECENT[self.key] = made[0]
+                while len(_RECENT) > RECENT_OBJECTS:
+                    _RECENT.pop(next(iter(_RECENT)))
         self.stored = bool(cache and made) and llvm_cache.store(self.key, made[0], fingerprint)
 
     def _fill_pools(self) -> None:
