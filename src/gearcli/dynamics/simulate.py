@@ -243,7 +243,7 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
     try:
         for a, b in row_intervals(drive.t, t_eval[0], t_eval[-1]):
             ss = state["ss"] = stick_slip(a)         # a pick or a place happens at a row
-            state["memo"] = state["held"] = (None, None, None)
+            state["memo"], state["held"] = (None, None, None), (None, None)
             while True:
                 # [a, b): a sample at a row takes the row's values (a pick or a place there)
                 last = b >= t_eval[-1]
@@ -271,7 +271,7 @@ def simulate(an, drive, t_eval, q0, qd0, rtol: float = 1e-8, atol: float = 1e-10
                     raise _Stopped()
                 state["mode"], xe[dof:2 * dof] = _after_switch(ss, state["mode"], events[k].switch, xe, d, te,
                                                                dof, backend, margins)
-                state["memo"] = state["held"] = (None, None, None)
+                state["memo"], state["held"] = (None, None, None), (None, None)
                 x, a = xe, te
                 if a >= b:
                     break

@@ -222,13 +222,14 @@ class StickSlip:
         AT = np.einsum("nm,dm->nd", T, self.an.A)
         scale = np.abs(AT).max(axis=1, initial=0.0)
         C, kept = self.rows(mode.stuck)
+        along = np.linalg.pinv(C) if any(k in self.probe for k in kept) else None   # (dof, held rows)
         for j, k in enumerate(mode.stuck):
             if k in self.probe and k not in kept:        # held by the others: holds nothing
                 out[:, j, :] = np.inf
             elif k in self.probe:        # the differences' part along u_k, the other held rows apart
-                tau, along = self._verges(mode, k, q, qd, qdd, backend), np.linalg.pinv(C)[:, kept.index(k)]
-                out[:, j, 0] = (tau[0] - AT) @ along
-                out[:, j, 1] = (AT - tau[1]) @ along
+                tau, u = self._verges(mode, k, q, qd, qdd, backend), along[:, kept.index(k)]
+                out[:, j, 0] = (tau[0] - AT) @ u
+                out[:, j, 1] = (AT - tau[1]) @ u
                 scale = np.maximum(scale, np.abs(tau).max(axis=(0, 2)))
             else:
                 out[:, j, 0] = self.units[k][2] + Q[:, j]
@@ -325,10 +326,7 @@ def element_rows(an) -> list[np.ndarray]:
     (:attr:`~gearcli.analysis.types.Analysis.mesh_rate_rows`) and a joint with bearing
     friction (its row of S)."""
     mech = an.mech
-    rows = [an.mesh_rate_rows[ci] for ci, c in enumerate(an.circuits) if _lossy(mech.gears[c.gear])]
+    rows = [an.mesh_rate_rows[ci] for ci, c in enumerate(an.circuits) if mech.gears[c.gear].lossy]
     rows += [np.asarray(an.S[ji], float) for ji in friction_joints(mech)]
     return [r for r in rows if r.any()]
 
-
-def _lossy(g) -> bool:
-    return bool(g.loss_factor) or any(e is not None and e.lossy for e in (g.reducer, g.screw, g.worm, g.belt))

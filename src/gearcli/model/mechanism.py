@@ -122,6 +122,13 @@ class GearPair:
     # A timing belt (kind belt, model.belts): j the input pulley, k the output; ratio from the geometry.
     belt: Belt | None = None
 
+    @property
+    def lossy(self) -> bool:
+        """True when the pair dissipates power: a mesh loss factor, or a drive element
+        (reducer, screw, worm, belt) with losses."""
+        return bool(self.loss_factor) or any(e is not None and e.lossy
+                                             for e in (self.reducer, self.screw, self.worm, self.belt))
+
 
 @dataclass(frozen=True, eq=False)
 class Motor:
@@ -169,9 +176,7 @@ class Mechanism:
     def has_losses(self) -> bool:
         """True when any gear pair has a loss factor, any reducer an efficiency below 1 or a
         no-load torque, or any joint has friction of its own or in its bearings."""
-        return any(g.loss_factor or (g.reducer is not None and g.reducer.lossy) or (g.screw is not None and g.screw.lossy)
-                   or (g.worm is not None and g.worm.lossy) or (g.belt is not None and g.belt.lossy)
-                   for g in self.gears) or any(
+        return any(g.lossy for g in self.gears) or any(
             (j.friction is not None and j.friction.active) or any(b.friction_arm for b in j.bearings or ())
             for j in self.joints)
 
